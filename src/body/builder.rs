@@ -1,0 +1,144 @@
+//! [`SoftBodyBuilder`]: the rapier-style way to describe a soft body before creating it.
+
+use super::{SoftBody, lumped_masses};
+use crate::Error;
+use crate::damping::RayleighDamping;
+use crate::fvm::FvmMesh;
+use crate::material::Material;
+use crate::mesh::TetMesh;
+use rapier3d::glamx::{DQuat, DVec3};
+
+/// Describes a soft body: its mesh and material, placement, initial velocity, damping and pinned
+/// nodes.
+///
+/// # Example
+/// ```
+/// use rapier_fvm::prelude::*;
+///
+/// let mesh = mesh::cuboid(DVec3::new(0.5, 0.05, 0.05), [10, 1, 1])?;
+/// let clamped = mesh.nodes_where(|p| p.x <= -0.5 + 1e-9);
+/// let steel = Material::new(MaterialModel::Corotated, 200e9, 0.3, 7850.0)?;
+/// let beam = SoftBodyBuilder::new(mesh, steel)
+///     .translation(DVec3::new(0.5, 1.0, 0.0))
+///     .pinned_nodes(clamped)
+///     .build()?;
+/// assert!((beam.total_mass() - 7850.0 * 0.01).abs() < 1e-9);
+/// # Ok::<(), rapier_fvm::Error>(())
+/// ```
+#[derive(Debug, Clone)]
+#[must_use = "a builder does nothing until `build` is called"]
+pub struct SoftBodyBuilder {
+    mesh: TetMesh,
+    material: Material,
+    damping: Option<RayleighDamping>,
+    rotation: DQuat,
+    translation: DVec3,
+    linvel: DVec3,
+    pinned: Vec<u32>,
+    user_data: u128,
+}
+
+impl SoftBodyBuilder {
+    /// A body of `mesh` (rest positions in m) made of `material`, at rest where the mesh lies,
+    /// undamped, with no pinned node.
+    pub fn new(mesh: TetMesh, material: Material) -> Self {
+        Self {
+            mesh,
+            material,
+            damping: None,
+            rotation: DQuat::IDENTITY,
+            translation: DVec3::ZERO,
+            linvel: DVec3::ZERO,
+            pinned: Vec::new(),
+            user_data: 0,
+        }
+    }
+
+    /// Rayleigh damping on the strain rate.
+    pub fn damping(mut self, damping: RayleighDamping) -> Self {
+        self.damping = Some(damping);
+        self
+    }
+
+    /// Translation (m) applied to the rest mesh to place the body in the world.
+    pub fn translation(mut self, translation: DVec3) -> Self {
+        self.translation = translation;
+        self
+    }
+
+    /// Rotation applied to the rest mesh (about the mesh origin, before the translation).
+    pub fn rotation(mut self, rotation: DQuat) -> Self {
+        self.rotation = rotation;
+        self
+    }
+
+    /// Initial velocity (m/s) of every node.
+    pub fn linvel(mut self, linvel: DVec3) -> Self {
+        self.linvel = linvel;
+        self
+    }
+
+    /// Nodes held fixed at their initial world position (added to any pinned before).
+    pub fn pinned_nodes(mut self, nodes: impl IntoIterator<Item = u32>) -> Self {
+        self.pinned.extend(nodes);
+        self
+    }
+
+    /// User data stored on the body.
+    pub fn user_data(mut self, user_data: u128) -> Self {
+        self.user_data = user_data;
+        self
+    }
+
+    /// Creates the body.
+    ///
+    /// # Errors
+    /// [`Error::NodeOutOfRange`] for a pinned node that does not exist;
+    /// [`Error::NonFiniteInput`] for a non-finite velocity or translation or a zero rotation.
+    pub fn build(self) -> Result<SoftBody, Error> {
+        let node_count = self.mesh.node_count();
+        let mut pinned = vec![false; node_count];
+        for &node in &self.pinned {
+            let flag = pinned
+                .get_mut(node as usize)
+                .ok_or(Error::NodeOutOfRange {
+                    node: node as usize,
+                    node_count,
+                })?;
+            *flag = true;
+        }
+        for (parameter, finite) in [
+            ("translation", self.translation.is_finite()),
+            ("rotation", self.rotation.is_finite() && self.rotation.length() > 0.0),
+            ("linvel", self.linvel.is_finite()),
+        ] {
+            if !finite {
+                return Err(Error::NonFiniteInput { parameter });
+            }
+        }
+        let rotation = self.rotation.normalize();
+        let positions = self
+            .mesh
+            .positions()
+            .iter()
+            .map(|p| rotation * *p + self.translation)
+            .collect();
+        let velocities = (0..node_count)
+            .map(|n| if pinned[n] { DVec3::ZERO } else { self.linvel })
+            .collect();
+        Ok(SoftBody {
+            fvm: FvmMesh::new(&self.mesh),
+            masses: lumped_masses(&self.mesh, self.material.density()),
+            min_altitude: self.mesh.min_altitude(),
+            forces: vec![DVec3::ZERO; node_count],
+            saved_state: (Vec::with_capacity(node_count), Vec::with_capacity(node_count)),
+            mesh: self.mesh,
+            material: self.material,
+            damping: self.damping,
+            positions,
+            velocities,
+            pinned,
+            user_data: self.user_data,
+        })
+    }
+}

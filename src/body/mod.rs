@@ -1,0 +1,198 @@
+//! Soft bodies: a mesh, a material, and the state that moves: nodal positions (m), velocities
+//! (m/s) and lumped masses (kg), plus pinned (Dirichlet) nodes.
+
+mod builder;
+
+pub use builder::SoftBodyBuilder;
+
+use crate::damping::RayleighDamping;
+use crate::fvm::FvmMesh;
+use crate::material::{Material, with_hyperelastic_model};
+use crate::mesh::TetMesh;
+use rapier3d::glamx::DVec3;
+
+/// A deformable body discretized by linear tetrahedra and simulated by finite volumes.
+///
+/// Built with [`SoftBodyBuilder`]. Mass is lumped on the nodes from their control volumes (a
+/// quarter of each incident tetrahedron's rest volume times the density), so the nodal masses sum
+/// to density times rest volume.
+#[derive(Debug, Clone)]
+pub struct SoftBody {
+    pub(crate) mesh: TetMesh,
+    pub(crate) fvm: FvmMesh,
+    pub(crate) material: Material,
+    pub(crate) damping: Option<RayleighDamping>,
+    pub(crate) positions: Vec<DVec3>,
+    pub(crate) velocities: Vec<DVec3>,
+    pub(crate) masses: Vec<f64>,
+    pub(crate) pinned: Vec<bool>,
+    pub(crate) min_altitude: f64,
+    /// Scratch: the last internal forces computed (N per node).
+    pub(crate) forces: Vec<DVec3>,
+    /// Positions and velocities saved before a step, restored if the step fails.
+    pub(crate) saved_state: (Vec<DVec3>, Vec<DVec3>),
+    /// Arbitrary user data, as on rapier's bodies.
+    pub user_data: u128,
+}
+
+impl SoftBody {
+    /// The rest mesh (rest positions in the body's own frame, m).
+    pub fn mesh(&self) -> &TetMesh {
+        &self.mesh
+    }
+
+    /// The material.
+    pub fn material(&self) -> &Material {
+        &self.material
+    }
+
+    /// The Rayleigh damping, if any.
+    pub fn damping(&self) -> Option<&RayleighDamping> {
+        self.damping.as_ref()
+    }
+
+    /// Number of nodes.
+    pub fn node_count(&self) -> usize {
+        self.positions.len()
+    }
+
+    /// World positions of the nodes (m).
+    pub fn positions(&self) -> &[DVec3] {
+        &self.positions
+    }
+
+    /// Mutable world positions of the nodes (m).
+    pub fn positions_mut(&mut self) -> &mut [DVec3] {
+        &mut self.positions
+    }
+
+    /// Node velocities (m/s).
+    pub fn velocities(&self) -> &[DVec3] {
+        &self.velocities
+    }
+
+    /// Mutable node velocities (m/s).
+    pub fn velocities_mut(&mut self) -> &mut [DVec3] {
+        &mut self.velocities
+    }
+
+    /// Lumped nodal masses (kg).
+    pub fn masses(&self) -> &[f64] {
+        &self.masses
+    }
+
+    /// Total mass (kg).
+    pub fn total_mass(&self) -> f64 {
+        self.masses.iter().sum()
+    }
+
+    /// Whether node `node` is pinned (held at its position with zero velocity).
+    ///
+    /// # Panics
+    /// If `node >= self.node_count()`.
+    pub fn is_pinned(&self, node: usize) -> bool {
+        self.pinned[node]
+    }
+
+    /// Smallest tetrahedron altitude of the rest mesh (m).
+    pub fn min_altitude(&self) -> f64 {
+        self.min_altitude
+    }
+
+    /// Internal forces (N per node): elastic plus damping, at the current positions and velocities.
+    pub fn internal_forces(&mut self) -> &[DVec3] {
+        self.compute_internal_forces();
+        &self.forces
+    }
+
+    /// Copies positions and velocities aside (no allocation after the first call).
+    pub(crate) fn save_state(&mut self) {
+        self.saved_state.0.clone_from(&self.positions);
+        self.saved_state.1.clone_from(&self.velocities);
+    }
+
+    /// Puts back the state saved by [`SoftBody::save_state`].
+    pub(crate) fn restore_state(&mut self) {
+        self.positions.clone_from(&self.saved_state.0);
+        self.velocities.clone_from(&self.saved_state.1);
+    }
+
+    /// Recomputes `self.forces`.
+    pub(crate) fn compute_internal_forces(&mut self) {
+        let Self {
+            fvm,
+            material,
+            damping,
+            positions,
+            velocities,
+            forces,
+            ..
+        } = self;
+        with_hyperelastic_model!(material, |model| fvm.internal_forces(
+            &model,
+            damping.as_ref(),
+            positions,
+            velocities,
+            forces
+        ));
+    }
+
+    /// Elastic strain energy (J) at the current positions.
+    pub fn elastic_energy(&self) -> f64 {
+        with_hyperelastic_model!(self.material, |model| self
+            .fvm
+            .elastic_energy(&model, &self.positions))
+    }
+
+    /// Kinetic energy `Σ m v²/2` (J).
+    pub fn kinetic_energy(&self) -> f64 {
+        self.masses
+            .iter()
+            .zip(&self.velocities)
+            .map(|(m, v)| 0.5 * m * v.length_squared())
+            .sum()
+    }
+
+    /// Potential energy `-Σ m g·x` (J) in the uniform gravity `gravity` (m/s²).
+    pub fn gravity_potential_energy(&self, gravity: DVec3) -> f64 {
+        -self
+            .masses
+            .iter()
+            .zip(&self.positions)
+            .map(|(m, x)| m * gravity.dot(*x))
+            .sum::<f64>()
+    }
+
+    /// Total linear momentum `Σ m v` (kg·m/s).
+    pub fn linear_momentum(&self) -> DVec3 {
+        self.masses
+            .iter()
+            .zip(&self.velocities)
+            .map(|(m, v)| *v * *m)
+            .sum()
+    }
+
+    /// Centre of mass (m).
+    pub fn center_of_mass(&self) -> DVec3 {
+        let weighted: DVec3 = self
+            .masses
+            .iter()
+            .zip(&self.positions)
+            .map(|(m, x)| *x * *m)
+            .sum();
+        weighted / self.total_mass()
+    }
+}
+
+/// Lumped nodal masses (kg): each node receives a quarter of the mass of every tetrahedron it
+/// belongs to (its median-dual control volume times `density`, kg/m³).
+pub(crate) fn lumped_masses(mesh: &TetMesh, density: f64) -> Vec<f64> {
+    let mut masses = vec![0.0; mesh.node_count()];
+    for (t, tet) in mesh.tets().iter().enumerate() {
+        let quarter = 0.25 * density * mesh.tet_volume(t);
+        for &n in tet {
+            masses[n as usize] += quarter;
+        }
+    }
+    masses
+}

@@ -1,0 +1,86 @@
+//! Rayleigh damping on the strain rate: `σ_damp = φ tr(ε̇) I + 2ψ ε̇`.
+//!
+//! The strain rate is the rate of the Green strain, `ε̇ = Ġ = sym(Fᵀ Ḟ)`, which equals the small
+//! strain rate `sym(Ḟ)` to first order and is exactly zero for any rigid motion (translation or
+//! spin), so rigid motion is never damped. The stress enters as a second Piola–Kirchhoff stress,
+//! `P_damp = F σ_damp`. Its power on the body, `-V σ_damp : ε̇`, is never positive when `ψ >= 0`
+//! and `φ + 2ψ/3 >= 0`.
+
+use crate::Error;
+use crate::material::{LameParameters, symmetric_part, trace};
+use rapier3d::glamx::DMat3;
+
+/// Rayleigh damping coefficients, the viscous counterparts of the Lamé parameters.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RayleighDamping {
+    /// Volumetric damping coefficient `φ` (Pa·s), multiplying `tr(ε̇)`.
+    phi: f64,
+    /// Shear damping coefficient `ψ` (Pa·s), multiplying `2 ε̇`.
+    psi: f64,
+}
+
+impl RayleighDamping {
+    /// Damping with coefficients `φ` and `ψ` (Pa·s).
+    ///
+    /// # Errors
+    /// [`Error::InvalidMaterial`] if either is not finite, `ψ < 0`, or `φ + 2ψ/3 < 0` (the bulk
+    /// viscosity would be negative and the damping would inject energy).
+    pub fn new(phi: f64, psi: f64) -> Result<Self, Error> {
+        if !(psi.is_finite() && psi >= 0.0) {
+            return Err(Error::InvalidMaterial {
+                parameter: "psi",
+                value: psi,
+                reason: "shear damping must be finite and non-negative (Pa s)",
+            });
+        }
+        if !(phi.is_finite() && phi + 2.0 * psi / 3.0 >= 0.0) {
+            return Err(Error::InvalidMaterial {
+                parameter: "phi",
+                value: phi,
+                reason: "volumetric damping must be finite with phi + 2 psi / 3 >= 0 (Pa s)",
+            });
+        }
+        Ok(Self { phi, psi })
+    }
+
+    /// Stiffness-proportional damping `φ = β λ`, `ψ = β μ`: the damping matrix is `β K` at rest, so
+    /// a mode of angular frequency `ω` (rad/s) gets the damping ratio `β ω / 2`. `beta` is in
+    /// seconds.
+    ///
+    /// # Errors
+    /// [`Error::InvalidMaterial`] if `beta` is negative or not finite.
+    pub fn stiffness_proportional(beta: f64, lame: LameParameters) -> Result<Self, Error> {
+        if !(beta.is_finite() && beta >= 0.0) {
+            return Err(Error::InvalidMaterial {
+                parameter: "beta",
+                value: beta,
+                reason: "stiffness-proportional damping time must be finite and non-negative (s)",
+            });
+        }
+        Self::new(beta * lame.lambda, beta * lame.mu)
+    }
+
+    /// Volumetric coefficient `φ` (Pa·s).
+    pub fn phi(&self) -> f64 {
+        self.phi
+    }
+
+    /// Shear coefficient `ψ` (Pa·s).
+    pub fn psi(&self) -> f64 {
+        self.psi
+    }
+
+    /// The P-wave viscosity `φ + 2ψ` (Pa·s), the damping counterpart of `λ + 2μ`.
+    pub fn p_wave_viscosity(&self) -> f64 {
+        self.phi + 2.0 * self.psi
+    }
+
+    /// Damping stress as a first Piola–Kirchhoff stress (Pa), for deformation gradient `f` and its
+    /// rate `f_dot` (1/s).
+    #[inline(always)]
+    pub fn first_piola(&self, f: &DMat3, f_dot: &DMat3) -> DMat3 {
+        let strain_rate = symmetric_part(&(f.transpose() * *f_dot));
+        let stress = DMat3::IDENTITY * (self.phi * trace(&strain_rate)) + strain_rate * (2.0 * self.psi);
+        *f * stress
+    }
+}

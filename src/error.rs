@@ -1,0 +1,126 @@
+//! The crate's typed errors: every invalid input is reported with the element, node or parameter
+//! at fault, never as a panic.
+
+use thiserror::Error;
+
+/// Everything that can go wrong when building or stepping a soft body.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// The mesh has no nodes or no tetrahedra.
+    #[error("the mesh is empty ({nodes} nodes, {tets} tetrahedra)")]
+    EmptyMesh {
+        /// Number of nodes given.
+        nodes: usize,
+        /// Number of tetrahedra given.
+        tets: usize,
+    },
+    /// A node coordinate is NaN or infinite.
+    #[error("node {node} has a non-finite coordinate {position:?}")]
+    NonFiniteCoordinate {
+        /// Index of the offending node.
+        node: usize,
+        /// Its coordinates (m).
+        position: [f64; 3],
+    },
+    /// A tetrahedron refers to a node that does not exist.
+    #[error("tetrahedron {tet} refers to node {node}, but the mesh has {node_count} nodes")]
+    NodeIndexOutOfRange {
+        /// Index of the offending tetrahedron.
+        tet: usize,
+        /// The out-of-range node index.
+        node: u32,
+        /// Number of nodes in the mesh.
+        node_count: usize,
+    },
+    /// A tetrahedron uses the same node twice.
+    #[error("tetrahedron {tet} uses node {node} more than once")]
+    RepeatedNode {
+        /// Index of the offending tetrahedron.
+        tet: usize,
+        /// The repeated node.
+        node: u32,
+    },
+    /// A tetrahedron has (numerically) zero rest volume.
+    #[error("tetrahedron {tet} is degenerate: rest volume {volume:e} m^3 is zero at the mesh's scale")]
+    DegenerateTet {
+        /// Index of the offending tetrahedron.
+        tet: usize,
+        /// Its signed rest volume (m^3).
+        volume: f64,
+    },
+    /// A tetrahedron has negative rest volume (its nodes are ordered clockwise).
+    /// [`TetMesh::new_reoriented`](crate::mesh::TetMesh::new_reoriented) fixes the ordering.
+    #[error(
+        "tetrahedron {tet} is inverted: rest volume {volume:e} m^3 < 0 (use TetMesh::new_reoriented to fix the node order)"
+    )]
+    InvertedTet {
+        /// Index of the offending tetrahedron.
+        tet: usize,
+        /// Its signed rest volume (m^3).
+        volume: f64,
+    },
+    /// A node index given to a body (pin, selection) does not exist.
+    #[error("node {node} does not exist: the body has {node_count} nodes")]
+    NodeOutOfRange {
+        /// The offending node index.
+        node: usize,
+        /// Number of nodes in the body.
+        node_count: usize,
+    },
+    /// A generator was asked for a shape it cannot mesh (zero cells, non-positive size).
+    #[error("invalid mesh generator parameter `{parameter}` = {value}: {reason}")]
+    InvalidGeneratorParameter {
+        /// Name of the parameter.
+        parameter: &'static str,
+        /// The value given.
+        value: f64,
+        /// What it must satisfy.
+        reason: &'static str,
+    },
+    /// A material or damping constant is outside its physical range.
+    #[error("invalid material parameter `{parameter}` = {value}: {reason}")]
+    InvalidMaterial {
+        /// Name of the parameter.
+        parameter: &'static str,
+        /// The value given.
+        value: f64,
+        /// What it must satisfy.
+        reason: &'static str,
+    },
+    /// A placement, velocity or load given to a body is NaN or infinite.
+    #[error("`{parameter}` must be finite")]
+    NonFiniteInput {
+        /// Name of the input.
+        parameter: &'static str,
+    },
+    /// A time step or substep count is not usable.
+    #[error("invalid time step {dt} s: {reason}")]
+    InvalidTimeStep {
+        /// The step given (s).
+        dt: f64,
+        /// What it must satisfy.
+        reason: &'static str,
+    },
+    /// Stepping produced a NaN or infinite state; the step was rejected and the state before it kept.
+    #[error("stepping produced a non-finite state at node {node}; the step was rejected and the previous state kept")]
+    NonFiniteState {
+        /// First node found with a non-finite position or velocity.
+        node: usize,
+    },
+    /// The static solver met a stiffness matrix it cannot factor (not positive definite), e.g. an
+    /// unconstrained body with no pinned node, or a material state that lost stability.
+    #[error("the tangent stiffness is not positive definite at Newton iteration {iteration}")]
+    IndefiniteStiffness {
+        /// Newton iteration (0-based) at which factorization failed.
+        iteration: usize,
+    },
+    /// The static solver did not reach its tolerance.
+    #[error("static solve did not converge in {iterations} Newton iterations (relative residual {residual:e})")]
+    StaticSolveDidNotConverge {
+        /// Iterations performed.
+        iterations: usize,
+        /// Final residual norm over the load norm.
+        residual: f64,
+    },
+}

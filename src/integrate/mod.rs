@@ -1,0 +1,5 @@
+//! Time integration of soft bodies: `M v̇ = f_int(x, v) + M g`, `ẋ = v`, with pinned nodes held.
+
+mod explicit;
+
+pub use explicit::{StepReport, Substeps, SymplecticEuler};

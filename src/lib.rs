@@ -1,0 +1,64 @@
+//! # rapier_fvm
+//!
+//! Physically based soft bodies for the [rapier](https://rapier.rs) physics engine, simulated with
+//! the finite-volume method on tetrahedral meshes, in SI units throughout: lengths in m, time in
+//! s, Young's modulus and stresses in Pa, densities in kg/m³, damping coefficients in Pa·s.
+//!
+//! ## The method
+//! 1. Each material point has a rest position `p` and a world position `x = X(p)`; the motion is
+//!    piecewise linear, so the deformation gradient `F = dX/dp` is constant per tetrahedron
+//!    ([`fvm::TetRest::gradient`]).
+//! 2. A [`material::HyperelasticModel`] turns `F` into the first Piola–Kirchhoff stress `P`;
+//!    [`damping::RayleighDamping`] adds a viscous stress on the strain rate that ignores rigid
+//!    motion.
+//! 3. The force on a node is the traction integrated over the boundary of its control volume:
+//!    `f_i = P b_i` per tetrahedron ([`fvm::tet_forces`]).
+//! 4. Mass is lumped on the nodes from the same control volumes.
+//! 5. [`integrate::SymplecticEuler`] advances velocities then positions, splitting each frame
+//!    into as many substeps as stability requires; [`statics`] finds equilibria and natural
+//!    frequencies directly.
+//!
+//! ## Example
+//! ```
+//! use rapier_fvm::prelude::*;
+//!
+//! // A 1 m rubber beam clamped at x = 0, sagging under gravity.
+//! let mesh = mesh::cuboid(DVec3::new(0.5, 0.05, 0.05), [10, 1, 1])?;
+//! let clamped = mesh.nodes_where(|p| p.x <= -0.5 + 1e-9);
+//! let rubber = Material::new(MaterialModel::StableNeoHookean, 1e6, 0.45, 1100.0)?;
+//! let mut beam = SoftBodyBuilder::new(mesh, rubber)
+//!     .damping(RayleighDamping::stiffness_proportional(0.01, rubber.lame())?)
+//!     .pinned_nodes(clamped)
+//!     .build()?;
+//! let integrator = SymplecticEuler::default();
+//! for _frame in 0..6 {
+//!     let report = integrator.step(&mut beam, 1.0 / 60.0, DVec3::new(0.0, -9.81, 0.0))?;
+//!     assert!(report.substeps >= 1);
+//! }
+//! assert!(beam.positions().iter().all(|x| x.is_finite()));
+//! # Ok::<(), rapier_fvm::Error>(())
+//! ```
+
+pub mod body;
+pub mod damping;
+mod error;
+pub mod fvm;
+pub mod integrate;
+pub mod material;
+pub mod mesh;
+pub mod statics;
+
+pub use error::Error;
+/// glam math types (f64 `DVec3`, `DMat3`, `DQuat` for this crate's API), re-exported from rapier.
+pub use rapier3d::glamx;
+
+/// The types most programs need.
+pub mod prelude {
+    pub use crate::Error;
+    pub use crate::body::{SoftBody, SoftBodyBuilder};
+    pub use crate::damping::RayleighDamping;
+    pub use crate::integrate::{StepReport, Substeps, SymplecticEuler};
+    pub use crate::material::{LameParameters, Material, MaterialModel, YoungPoisson};
+    pub use crate::mesh::{self, TetMesh};
+    pub use rapier3d::glamx::{DMat3, DQuat, DVec3};
+}

@@ -1,0 +1,80 @@
+//! Corotated linear elasticity: with the polar decomposition `F = R S` (`R` a proper rotation),
+//! `Ψ = μ ‖F - R‖² + λ/2 (tr(S) - 3)²` and `P = 2μ (F - R) + λ (tr(S) - 3) R`.
+//!
+//! The rotation comes from the singular value decomposition with the sign fix of Irving, Teran and
+//! Fedkiw (2004): when `det F < 0` the smallest singular value is negated so that `R` stays a
+//! rotation and the energy pushes an inverted element back to positive volume.
+
+use super::{HyperelasticModel, LameParameters, trace};
+use rapier3d::glamx::{DMat3, DVec3};
+use rapier3d::na;
+
+/// Corotated linear elastic material with the given Lamé parameters.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Corotated(pub LameParameters);
+
+/// The rotation `R` of the polar decomposition `F = R S`, with `det R = +1` even for inverted `F`.
+pub(crate) fn polar_rotation(f: &DMat3) -> DMat3 {
+    let m = na::Matrix3::from_column_slice(&f.to_cols_array());
+    let svd = m.svd(true, true);
+    // Both are present because they were requested above.
+    let (Some(mut u), Some(mut v_t)) = (svd.u, svd.v_t) else {
+        return DMat3::IDENTITY;
+    };
+    let smallest = svd.singular_values.imin();
+    if u.determinant() < 0.0 {
+        u.column_mut(smallest).neg_mut();
+    }
+    if v_t.determinant() < 0.0 {
+        v_t.row_mut(smallest).neg_mut();
+    }
+    DMat3::from_cols_slice((u * v_t).as_slice())
+}
+
+/// Axial vector `a` of a skew matrix `[a]x`.
+fn axial(skew: &DMat3) -> DVec3 {
+    DVec3::new(skew.y_axis.z, skew.z_axis.x, skew.x_axis.y)
+}
+
+/// Cross-product matrix `[w]x`, so that `[w]x v = w x v`.
+fn cross_matrix(w: DVec3) -> DMat3 {
+    DMat3::from_cols(
+        DVec3::new(0.0, w.z, -w.y),
+        DVec3::new(-w.z, 0.0, w.x),
+        DVec3::new(w.y, -w.x, 0.0),
+    )
+}
+
+impl HyperelasticModel for Corotated {
+    fn energy_density(&self, f: &DMat3) -> f64 {
+        let r = polar_rotation(f);
+        let LameParameters { lambda, mu } = self.0;
+        let diff = *f - r;
+        let stretch_trace = trace(&(r.transpose() * *f));
+        mu * super::double_dot(&diff, &diff) + 0.5 * lambda * (stretch_trace - 3.0).powi(2)
+    }
+
+    fn first_piola(&self, f: &DMat3) -> DMat3 {
+        let r = polar_rotation(f);
+        let LameParameters { lambda, mu } = self.0;
+        let stretch_trace = trace(&(r.transpose() * *f));
+        (*f - r) * (2.0 * mu) + r * (lambda * (stretch_trace - 3.0))
+    }
+
+    /// Uses `dR = R [w]x` with `w = (tr(S) I - S)⁻¹ axial(Rᵀ dF - dFᵀ R)` (McAdams et al. 2011).
+    fn first_piola_differential(&self, f: &DMat3, df: &DMat3) -> DMat3 {
+        let r = polar_rotation(f);
+        let LameParameters { lambda, mu } = self.0;
+        let s = r.transpose() * *f;
+        let stretch_trace = trace(&s);
+        let rt_df = r.transpose() * *df;
+        let system = DMat3::IDENTITY * stretch_trace - s;
+        let w = if system.determinant().abs() > f64::EPSILON {
+            system.inverse() * axial(&(rt_df - rt_df.transpose()))
+        } else {
+            DVec3::ZERO
+        };
+        let dr = r * cross_matrix(w);
+        (*df - dr) * (2.0 * mu) + r * (lambda * trace(&rt_df)) + dr * (lambda * (stretch_trace - 3.0))
+    }
+}

@@ -1,0 +1,68 @@
+//! Stable Neo-Hookean (Smith, de Goes and Kim, "Stable Neo-Hookean Flesh Simulation", 2018), in
+//! the log-free form of Kim and Eberle's "Dynamic Deformables" notes:
+//! `Ψ = μ/2 (I_C - 3) - μ (J - 1) + λ'/2 (J - 1)²`, with `I_C = tr(FᵀF)`, `J = det F` and
+//! `λ' = λ + μ` so that the small-strain limit is exactly linear elasticity with `(λ, μ)`.
+//! `P = μ F + (λ' (J - 1) - μ) cof(F)`, defined for inverted elements (`J <= 0`) too.
+
+use super::{HyperelasticModel, LameParameters, double_dot};
+use rapier3d::glamx::DMat3;
+
+/// Stable Neo-Hookean material.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StableNeoHookean {
+    mu: f64,
+    /// `λ' = λ + μ` (Pa), the volumetric coefficient of this energy.
+    lambda_prime: f64,
+}
+
+impl StableNeoHookean {
+    /// The model whose small-strain limit has Lamé parameters `lame`.
+    pub fn new(lame: LameParameters) -> Self {
+        Self {
+            mu: lame.mu,
+            lambda_prime: lame.lambda + lame.mu,
+        }
+    }
+}
+
+/// Cofactor matrix `cof(F) = det(F) F⁻ᵀ = ∂ det F / ∂F`, column `i` being `f_(i+1) x f_(i+2)`.
+#[inline(always)]
+pub(crate) fn cofactor(f: &DMat3) -> DMat3 {
+    DMat3::from_cols(
+        f.y_axis.cross(f.z_axis),
+        f.z_axis.cross(f.x_axis),
+        f.x_axis.cross(f.y_axis),
+    )
+}
+
+/// Differential of the cofactor matrix for a change `df` of `f`.
+fn cofactor_differential(f: &DMat3, df: &DMat3) -> DMat3 {
+    DMat3::from_cols(
+        df.y_axis.cross(f.z_axis) + f.y_axis.cross(df.z_axis),
+        df.z_axis.cross(f.x_axis) + f.z_axis.cross(df.x_axis),
+        df.x_axis.cross(f.y_axis) + f.x_axis.cross(df.y_axis),
+    )
+}
+
+impl HyperelasticModel for StableNeoHookean {
+    fn energy_density(&self, f: &DMat3) -> f64 {
+        let i_c = double_dot(f, f);
+        let j = f.determinant();
+        0.5 * self.mu * (i_c - 3.0) - self.mu * (j - 1.0)
+            + 0.5 * self.lambda_prime * (j - 1.0).powi(2)
+    }
+
+    #[inline(always)]
+    fn first_piola(&self, f: &DMat3) -> DMat3 {
+        let j = f.determinant();
+        *f * self.mu + cofactor(f) * (self.lambda_prime * (j - 1.0) - self.mu)
+    }
+
+    fn first_piola_differential(&self, f: &DMat3, df: &DMat3) -> DMat3 {
+        let cof = cofactor(f);
+        let j = f.determinant();
+        *df * self.mu
+            + cof * (self.lambda_prime * double_dot(&cof, df))
+            + cofactor_differential(f, df) * (self.lambda_prime * (j - 1.0) - self.mu)
+    }
+}

@@ -1,0 +1,224 @@
+//! Tetrahedral meshes: a validated [`TetMesh`] of rest positions (m) and positively oriented
+//! tetrahedra, its boundary surface, and generators for boxes, cylinders and spheres.
+//!
+//! A tetrahedron `[a, b, c, d]` is positively oriented when `((b - a) x (c - a)) . (d - a) > 0`,
+//! i.e. its signed volume is positive.
+
+mod generators;
+mod hex_mesher;
+mod surface;
+
+pub use generators::{cuboid, cylinder, sphere};
+
+use crate::Error;
+use rapier3d::glamx::DVec3;
+
+/// Relative volume below which a tetrahedron counts as degenerate: `|V| <= 1e-12 * l^3`, with `l`
+/// the tetrahedron's longest edge.
+const DEGENERATE_RELATIVE_VOLUME: f64 = 1e-12;
+
+/// A validated tetrahedral mesh in its rest configuration.
+///
+/// Every tetrahedron refers to existing, distinct nodes, has finite coordinates and a positive
+/// rest volume. Construction never panics: each defect is an [`Error`] naming the offending node or
+/// tetrahedron.
+///
+/// # Example
+/// ```
+/// use rapier_fvm::mesh::TetMesh;
+/// use rapier_fvm::glamx::DVec3;
+///
+/// let mesh = TetMesh::new(
+///     vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z],
+///     vec![[0, 1, 2, 3]],
+/// )?;
+/// assert!((mesh.volume() - 1.0 / 6.0).abs() < 1e-15);
+/// # Ok::<(), rapier_fvm::Error>(())
+/// ```
+#[derive(Debug, Clone, PartialEq)]
+pub struct TetMesh {
+    positions: Vec<DVec3>,
+    tets: Vec<[u32; 4]>,
+}
+
+impl TetMesh {
+    /// Builds a mesh from rest positions (m) and tetrahedra (node indices), rejecting any defect.
+    ///
+    /// # Errors
+    /// [`Error::EmptyMesh`], [`Error::NonFiniteCoordinate`], [`Error::NodeIndexOutOfRange`],
+    /// [`Error::RepeatedNode`], [`Error::DegenerateTet`] or [`Error::InvertedTet`], naming the
+    /// first offending node or tetrahedron.
+    pub fn new(positions: Vec<DVec3>, tets: Vec<[u32; 4]>) -> Result<Self, Error> {
+        validate_topology(&positions, &tets)?;
+        for (tet, nodes) in tets.iter().enumerate() {
+            let volume = signed_volume(&positions, nodes);
+            check_not_degenerate(&positions, nodes, tet, volume)?;
+            if volume < 0.0 {
+                return Err(Error::InvertedTet { tet, volume });
+            }
+        }
+        Ok(Self { positions, tets })
+    }
+
+    /// Like [`TetMesh::new`], but tetrahedra with negative volume are fixed by swapping two of
+    /// their nodes instead of being rejected. Returns the mesh and how many tetrahedra were flipped.
+    ///
+    /// # Errors
+    /// The errors of [`TetMesh::new`] except [`Error::InvertedTet`].
+    pub fn new_reoriented(
+        positions: Vec<DVec3>,
+        mut tets: Vec<[u32; 4]>,
+    ) -> Result<(Self, usize), Error> {
+        validate_topology(&positions, &tets)?;
+        let mut flipped = 0;
+        for (tet, nodes) in tets.iter_mut().enumerate() {
+            let volume = signed_volume(&positions, nodes);
+            check_not_degenerate(&positions, nodes, tet, volume)?;
+            if volume < 0.0 {
+                nodes.swap(2, 3);
+                flipped += 1;
+            }
+        }
+        Ok((Self { positions, tets }, flipped))
+    }
+
+    /// Rest positions of the nodes (m).
+    pub fn positions(&self) -> &[DVec3] {
+        &self.positions
+    }
+
+    /// The tetrahedra, as four node indices each, positively oriented.
+    pub fn tets(&self) -> &[[u32; 4]] {
+        &self.tets
+    }
+
+    /// Number of nodes.
+    pub fn node_count(&self) -> usize {
+        self.positions.len()
+    }
+
+    /// Number of tetrahedra.
+    pub fn tet_count(&self) -> usize {
+        self.tets.len()
+    }
+
+    /// Rest volume of tetrahedron `tet` (m^3).
+    ///
+    /// # Panics
+    /// If `tet >= self.tet_count()`.
+    pub fn tet_volume(&self, tet: usize) -> f64 {
+        signed_volume(&self.positions, &self.tets[tet])
+    }
+
+    /// Total rest volume (m^3).
+    pub fn volume(&self) -> f64 {
+        (0..self.tet_count()).map(|t| self.tet_volume(t)).sum()
+    }
+
+    /// The smallest altitude (vertex to opposite face distance) over all tetrahedra (m): the
+    /// length scale of the explicit stability limit.
+    pub fn min_altitude(&self) -> f64 {
+        self.tets
+            .iter()
+            .map(|t| min_tet_altitude(&self.positions, t))
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// Indices of the nodes whose rest position satisfies `predicate`, ascending; e.g. the nodes of
+    /// a clamped face: `mesh.nodes_where(|p| p.x <= 1e-9)`.
+    pub fn nodes_where(&self, predicate: impl Fn(DVec3) -> bool) -> Vec<u32> {
+        (0..self.positions.len() as u32)
+            .filter(|&i| predicate(self.positions[i as usize]))
+            .collect()
+    }
+
+    /// The index of the node whose rest position is nearest to `point` (m).
+    pub fn nearest_node(&self, point: DVec3) -> u32 {
+        let mut best = (0, f64::INFINITY);
+        for (i, p) in self.positions.iter().enumerate() {
+            let d = p.distance_squared(point);
+            if d < best.1 {
+                best = (i, d);
+            }
+        }
+        best.0 as u32
+    }
+
+    /// Boundary triangles (faces belonging to exactly one tetrahedron), ordered so that their
+    /// normals `(b - a) x (c - a)` point out of the body.
+    pub fn surface_triangles(&self) -> Vec<[u32; 3]> {
+        surface::boundary_faces(&self.tets)
+    }
+}
+
+/// Signed volume of a tetrahedron (m^3): positive when positively oriented.
+pub(crate) fn signed_volume(positions: &[DVec3], tet: &[u32; 4]) -> f64 {
+    let [a, b, c, d] = tet.map(|i| positions[i as usize]);
+    (b - a).cross(c - a).dot(d - a) / 6.0
+}
+
+fn min_tet_altitude(positions: &[DVec3], tet: &[u32; 4]) -> f64 {
+    let p = tet.map(|i| positions[i as usize]);
+    let volume = signed_volume(positions, tet).abs();
+    // Altitude from vertex i = 3 V / area of the opposite face.
+    (0..4)
+        .map(|i| {
+            let [a, b, c] = [p[(i + 1) % 4], p[(i + 2) % 4], p[(i + 3) % 4]];
+            let area = 0.5 * (b - a).cross(c - a).length();
+            3.0 * volume / area
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+fn validate_topology(positions: &[DVec3], tets: &[[u32; 4]]) -> Result<(), Error> {
+    if positions.is_empty() || tets.is_empty() {
+        return Err(Error::EmptyMesh {
+            nodes: positions.len(),
+            tets: tets.len(),
+        });
+    }
+    if let Some(node) = positions.iter().position(|p| !p.is_finite()) {
+        return Err(Error::NonFiniteCoordinate {
+            node,
+            position: positions[node].to_array(),
+        });
+    }
+    for (tet, nodes) in tets.iter().enumerate() {
+        if let Some(&node) = nodes.iter().find(|&&n| n as usize >= positions.len()) {
+            return Err(Error::NodeIndexOutOfRange {
+                tet,
+                node,
+                node_count: positions.len(),
+            });
+        }
+        for i in 0..4 {
+            if nodes[i + 1..].contains(&nodes[i]) {
+                return Err(Error::RepeatedNode {
+                    tet,
+                    node: nodes[i],
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+fn check_not_degenerate(
+    positions: &[DVec3],
+    nodes: &[u32; 4],
+    tet: usize,
+    volume: f64,
+) -> Result<(), Error> {
+    let p = nodes.map(|i| positions[i as usize]);
+    let mut longest_edge_sq: f64 = 0.0;
+    for i in 0..4 {
+        for j in i + 1..4 {
+            longest_edge_sq = longest_edge_sq.max(p[i].distance_squared(p[j]));
+        }
+    }
+    let scale = longest_edge_sq * longest_edge_sq.sqrt();
+    if volume.abs() <= DEGENERATE_RELATIVE_VOLUME * scale {
+        return Err(Error::DegenerateTet { tet, volume });
+    }
+    Ok(())
+}

@@ -1,0 +1,203 @@
+//! Static analysis: the equilibrium `f_int(x) + M g = 0` of a body under gravity with its pinned
+//! nodes held, found by Newton's method on the total potential energy, and the natural
+//! frequencies of small vibrations about the current configuration.
+//!
+//! Both use the sparse tangent stiffness `K = -∂f_int/∂x` and faer's sparse Cholesky
+//! factorization, so they need `K` positive definite on the free nodes: pin enough nodes to stop
+//! rigid motion.
+
+mod stiffness;
+
+use crate::Error;
+use crate::body::SoftBody;
+use crate::material::with_hyperelastic_model;
+use faer::linalg::solvers::Solve;
+use faer::sparse::linalg::solvers::Llt;
+use faer::{Col, Side};
+use rapier3d::glamx::DVec3;
+use stiffness::Stiffness;
+
+/// Convergence settings of [`solve_equilibrium`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StaticSettings {
+    /// Stop when the norm of the out-of-balance force is below this fraction of the load's norm
+    /// (dimensionless).
+    pub tolerance: f64,
+    /// Give up after this many Newton iterations.
+    pub max_iterations: usize,
+}
+
+impl Default for StaticSettings {
+    fn default() -> Self {
+        Self {
+            tolerance: 1e-8,
+            max_iterations: 50,
+        }
+    }
+}
+
+/// What [`solve_equilibrium`] did.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StaticReport {
+    /// Newton iterations performed.
+    pub iterations: usize,
+    /// Final out-of-balance force norm over the load norm.
+    pub relative_residual: f64,
+}
+
+/// Moves `body` to static equilibrium under `gravity` (m/s²), starting from its current positions,
+/// with pinned nodes held where they are and all velocities set to zero.
+///
+/// # Errors
+/// [`Error::IndefiniteStiffness`] if the tangent stiffness cannot be factored (too few pinned
+/// nodes, or a buckled state), [`Error::StaticSolveDidNotConverge`] if the tolerance is not met.
+pub fn solve_equilibrium(
+    body: &mut SoftBody,
+    gravity: DVec3,
+    settings: &StaticSettings,
+) -> Result<StaticReport, Error> {
+    body.velocities.fill(DVec3::ZERO);
+    let mut stiffness = Stiffness::new(body);
+    let load: Vec<DVec3> = (0..body.node_count())
+        .map(|n| if body.pinned[n] { DVec3::ZERO } else { gravity * body.masses[n] })
+        .collect();
+    let mut residual = out_of_balance(body, &load);
+    let reference = norm(&load).max(norm(&residual));
+    if reference == 0.0 {
+        return Ok(StaticReport {
+            iterations: 0,
+            relative_residual: 0.0,
+        });
+    }
+    for iteration in 0..settings.max_iterations {
+        let relative = norm(&residual) / reference;
+        if relative <= settings.tolerance {
+            return Ok(StaticReport {
+                iterations: iteration,
+                relative_residual: relative,
+            });
+        }
+        stiffness.assemble(body);
+        let factor = factorize(&stiffness, iteration)?;
+        let step = solve(&factor, &residual);
+        line_search(body, &load, &residual, &step);
+        residual = out_of_balance(body, &load);
+    }
+    let relative = norm(&residual) / reference;
+    if relative <= settings.tolerance {
+        Ok(StaticReport {
+            iterations: settings.max_iterations,
+            relative_residual: relative,
+        })
+    } else {
+        Err(Error::StaticSolveDidNotConverge {
+            iterations: settings.max_iterations,
+            residual: relative,
+        })
+    }
+}
+
+/// The lowest natural frequency (Hz) of small undamped vibrations about the current positions,
+/// with pinned nodes held: `K φ = ω² M φ` solved by inverse iteration with the lumped mass.
+///
+/// # Errors
+/// [`Error::IndefiniteStiffness`] if the tangent stiffness cannot be factored (e.g. no pinned
+/// node, so rigid modes have zero frequency).
+pub fn fundamental_frequency(body: &SoftBody) -> Result<f64, Error> {
+    const MAX_ITERATIONS: usize = 500;
+    const TOLERANCE: f64 = 1e-13;
+    let mut stiffness = Stiffness::new(body);
+    stiffness.assemble(body);
+    let factor = factorize(&stiffness, 0)?;
+    let masses = &body.masses;
+    let free = |n: usize| !body.pinned[n];
+    // Start from a uniform motion along (1, 1, 1) of the free nodes, which has a component on
+    // every bending mode of a body not aligned with an axis.
+    let mut mode: Vec<DVec3> = (0..body.node_count())
+        .map(|n| if free(n) { DVec3::ONE } else { DVec3::ZERO })
+        .collect();
+    let mut eigenvalue = f64::INFINITY;
+    for _ in 0..MAX_ITERATIONS {
+        let mass_times_mode: Vec<DVec3> = mode.iter().zip(masses).map(|(x, m)| *x * *m).collect();
+        let next = solve(&factor, &mass_times_mode);
+        // Rayleigh quotient of the previous iterate: xᵀ M x / xᵀ M K⁻¹ M x.
+        let x_m_x: f64 = mode.iter().zip(&mass_times_mode).map(|(a, b)| a.dot(*b)).sum();
+        let x_m_y: f64 = next.iter().zip(&mass_times_mode).map(|(a, b)| a.dot(*b)).sum();
+        let estimate = x_m_x / x_m_y;
+        let y_m_y: f64 = next.iter().zip(masses).map(|(y, m)| m * y.length_squared()).sum();
+        mode = next.iter().map(|y| *y / y_m_y.sqrt()).collect();
+        let converged = (estimate - eigenvalue).abs() <= TOLERANCE * estimate;
+        eigenvalue = estimate;
+        if converged {
+            break;
+        }
+    }
+    Ok(eigenvalue.sqrt() / (2.0 * std::f64::consts::PI))
+}
+
+/// `f_int(x) + load`, zero on pinned nodes (N).
+fn out_of_balance(body: &mut SoftBody, load: &[DVec3]) -> Vec<DVec3> {
+    let SoftBody {
+        fvm,
+        material,
+        positions,
+        velocities,
+        forces,
+        ..
+    } = body;
+    with_hyperelastic_model!(material, |model| fvm.internal_forces(
+        &model, None, positions, velocities, forces
+    ));
+    (0..load.len())
+        .map(|n| if body.pinned[n] { DVec3::ZERO } else { body.forces[n] + load[n] })
+        .collect()
+}
+
+/// Total potential energy (J): elastic energy minus the work of the constant load.
+fn potential_energy(body: &SoftBody, load: &[DVec3]) -> f64 {
+    let load_work: f64 = load.iter().zip(&body.positions).map(|(f, x)| f.dot(*x)).sum();
+    body.elastic_energy() - load_work
+}
+
+/// Backtracking line search along `step` that guarantees the potential energy decreases
+/// (Armijo condition), leaving the accepted positions in `body`.
+fn line_search(body: &mut SoftBody, load: &[DVec3], residual: &[DVec3], step: &[DVec3]) {
+    const ARMIJO: f64 = 1e-4;
+    const MIN_STEP: f64 = 1.0 / 1024.0;
+    let start = body.positions.clone();
+    let energy = potential_energy(body, load);
+    // The energy gradient is -residual, so its slope along the step is -residual·step.
+    let slope: f64 = -residual.iter().zip(step).map(|(r, s)| r.dot(*s)).sum::<f64>();
+    let round_off = 1e-12 * energy.abs();
+    let mut alpha = 1.0;
+    loop {
+        for ((x, x0), s) in body.positions.iter_mut().zip(&start).zip(step) {
+            *x = *x0 + *s * alpha;
+        }
+        let trial = potential_energy(body, load);
+        if trial <= energy + ARMIJO * alpha * slope + round_off || alpha <= MIN_STEP {
+            return;
+        }
+        alpha *= 0.5;
+    }
+}
+
+fn factorize(stiffness: &Stiffness, iteration: usize) -> Result<Llt<usize, f64>, Error> {
+    stiffness
+        .as_faer()
+        .sp_cholesky(Side::Lower)
+        .map_err(|_| Error::IndefiniteStiffness { iteration })
+}
+
+/// Solves `K u = rhs` for per-node vectors.
+fn solve(factor: &Llt<usize, f64>, rhs: &[DVec3]) -> Vec<DVec3> {
+    let mut x = Col::<f64>::from_fn(3 * rhs.len(), |i| rhs[i / 3][i % 3]);
+    factor.solve_in_place(x.as_mat_mut());
+    (0..rhs.len())
+        .map(|n| DVec3::new(x[3 * n], x[3 * n + 1], x[3 * n + 2]))
+        .collect()
+}
+
+fn norm(v: &[DVec3]) -> f64 {
+    v.iter().map(|x| x.length_squared()).sum::<f64>().sqrt()
+}

@@ -1,0 +1,86 @@
+//! Shared fixtures for the integration tests: the reference cantilever and its closed-form values.
+#![allow(dead_code)]
+
+use rapier_fvm::prelude::*;
+
+/// Beam length (m), cross-section side (m), density (kg/m³) and gravity (m/s²) of the reference
+/// cantilever.
+pub const LENGTH: f64 = 1.0;
+pub const SIDE: f64 = 0.1;
+pub const DENSITY: f64 = 1000.0;
+pub const GRAVITY: f64 = 9.81;
+
+/// The reference cantilever along +x from x = 0 (clamped) to x = L, centred on the x axis, with
+/// `cells` cubes along x, y, z; returns the body and the node at the centre of the free end.
+pub fn cantilever(cells: [usize; 3], material: Material) -> (SoftBody, usize) {
+    let half = DVec3::new(LENGTH / 2.0, SIDE / 2.0, SIDE / 2.0);
+    let mesh = mesh::cuboid(half, cells).unwrap();
+    let clamped = mesh.nodes_where(|p| p.x <= -half.x + 1e-9);
+    let tip = mesh.nearest_node(DVec3::new(half.x, 0.0, 0.0)) as usize;
+    let body = SoftBodyBuilder::new(mesh, material)
+        .translation(DVec3::new(half.x, 0.0, 0.0))
+        .pinned_nodes(clamped)
+        .build()
+        .unwrap();
+    (body, tip)
+}
+
+/// Second moment of area of the square section (m⁴).
+pub fn second_moment() -> f64 {
+    SIDE.powi(4) / 12.0
+}
+
+/// Static tip deflection (m) of the cantilever under its own weight, Timoshenko beam theory:
+/// `q L⁴ / (8 E I) + q L² / (2 κ G A)` with Cowper's shear coefficient for a rectangle,
+/// `κ = 10 (1 + ν) / (12 + 11 ν)`.
+pub fn timoshenko_tip_deflection(young_modulus: f64, poisson_ratio: f64) -> f64 {
+    let area = SIDE * SIDE;
+    let q = DENSITY * area * GRAVITY;
+    let shear_modulus = young_modulus / (2.0 * (1.0 + poisson_ratio));
+    let kappa = 10.0 * (1.0 + poisson_ratio) / (12.0 + 11.0 * poisson_ratio);
+    q * LENGTH.powi(4) / (8.0 * young_modulus * second_moment())
+        + q * LENGTH.powi(2) / (2.0 * kappa * shear_modulus * area)
+}
+
+/// First bending frequency (Hz) of the cantilever, Euler–Bernoulli:
+/// `0.5596 / L² sqrt(E I / (ρ A))`.
+pub fn euler_bernoulli_first_frequency(young_modulus: f64) -> f64 {
+    0.5596 / LENGTH.powi(2) * (young_modulus * second_moment() / (DENSITY * SIDE * SIDE)).sqrt()
+}
+
+/// Gravity along -y (m/s²).
+pub fn gravity() -> DVec3 {
+    DVec3::new(0.0, -GRAVITY, 0.0)
+}
+
+/// A deterministic pseudo-random number in [-1, 1) (a 64-bit linear congruential generator).
+pub struct Lcg(pub u64);
+
+impl Lcg {
+    pub fn next(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((self.0 >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+    }
+
+    pub fn vector(&mut self) -> DVec3 {
+        DVec3::new(self.next(), self.next(), self.next())
+    }
+}
+
+/// All four constitutive models.
+pub const MODELS: [MaterialModel; 4] = [
+    MaterialModel::Linear,
+    MaterialModel::StVenantKirchhoff,
+    MaterialModel::Corotated,
+    MaterialModel::StableNeoHookean,
+];
+
+/// The rotation-invariant (objective) models.
+pub const OBJECTIVE_MODELS: [MaterialModel; 3] = [
+    MaterialModel::StVenantKirchhoff,
+    MaterialModel::Corotated,
+    MaterialModel::StableNeoHookean,
+];
