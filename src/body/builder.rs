@@ -129,7 +129,6 @@ impl SoftBodyBuilder {
         Ok(SoftBody {
             fvm: FvmMesh::new(&self.mesh),
             masses: lumped_masses(&self.mesh, self.material.density()),
-            min_altitude: self.mesh.min_altitude(),
             forces: vec![DVec3::ZERO; node_count],
             saved_state: (Vec::with_capacity(node_count), Vec::with_capacity(node_count)),
             mesh: self.mesh,

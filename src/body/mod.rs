@@ -26,7 +26,6 @@ pub struct SoftBody {
     pub(crate) velocities: Vec<DVec3>,
     pub(crate) masses: Vec<f64>,
     pub(crate) pinned: Vec<bool>,
-    pub(crate) min_altitude: f64,
     /// Scratch: the last internal forces computed (N per node).
     pub(crate) forces: Vec<DVec3>,
     /// Positions and velocities saved before a step, restored if the step fails.
@@ -94,9 +93,11 @@ impl SoftBody {
         self.pinned[node]
     }
 
-    /// Smallest tetrahedron altitude of the rest mesh (m).
-    pub fn min_altitude(&self) -> f64 {
-        self.min_altitude
+    /// The mesh's wave length scale (m), see [`FvmMesh::wave_length_scale`]: the explicit
+    /// critical step is about [`COURANT_NUMBER`](crate::integrate::COURANT_NUMBER) times this over
+    /// the pressure wave speed.
+    pub fn wave_length_scale(&self) -> f64 {
+        self.fvm.wave_length_scale()
     }
 
     /// Internal forces (N per node): elastic plus damping, at the current positions and velocities.

@@ -48,6 +48,7 @@ pub struct FvmMesh {
     tets: Vec<[u32; 4]>,
     rest: Vec<TetRest>,
     node_count: usize,
+    wave_length_scale: f64,
     /// For node `n`, `incidence[offsets[n]..offsets[n + 1]]` lists `4 * tet + corner` of every
     /// tetrahedron corner at `n`, in ascending tetrahedron order.
     #[cfg(feature = "parallel")]
@@ -65,6 +66,7 @@ impl FvmMesh {
         let tets = mesh.tets().to_vec();
         let rest = TetRest::of_mesh(mesh);
         let node_count = mesh.node_count();
+        let wave_length_scale = wave_length_scale(&tets, &rest, node_count);
         #[cfg(feature = "parallel")]
         {
             let (offsets, incidence) = node_incidence(&tets, node_count);
@@ -77,6 +79,7 @@ impl FvmMesh {
                 tets,
                 rest,
                 node_count,
+                wave_length_scale,
                 offsets,
                 incidence,
                 per_tet,
@@ -87,6 +90,7 @@ impl FvmMesh {
             tets,
             rest,
             node_count,
+            wave_length_scale,
         }
     }
 
@@ -103,6 +107,16 @@ impl FvmMesh {
     /// Number of nodes.
     pub fn node_count(&self) -> usize {
         self.node_count
+    }
+
+    /// The length `ℓ` (m) such that a wave of speed `c` through the mesh has its highest angular
+    /// frequency below `2c/ℓ`: the smallest over the nodes of
+    /// `ℓ_i = 2 sqrt(V_i / Σ_e V_e |∇N_i| Σ_j |∇N_j|)`, with `V_i` the node's control volume and
+    /// the sums over the tetrahedra `e` at node `i` (Gershgorin's bound on the lumped-mass wave
+    /// operator). Unlike the smallest element altitude it accounts for how many elements share a
+    /// node, so it tracks the true limit on every kind of mesh.
+    pub fn wave_length_scale(&self) -> f64 {
+        self.wave_length_scale
     }
 
     /// Writes into `out` the internal force (N) on every node, for positions `x` (m) and
@@ -164,6 +178,26 @@ impl FvmMesh {
             .map(|(tet, rest)| rest.volume * model.energy_density(&rest.gradient(&gather(tet, x))))
             .sum()
     }
+}
+
+fn wave_length_scale(tets: &[[u32; 4]], rest: &[TetRest], node_count: usize) -> f64 {
+    let mut control_volume = vec![0.0; node_count];
+    let mut row_sum = vec![0.0; node_count];
+    for (tet, rest) in tets.iter().zip(rest) {
+        let g = rest.inverse_rest_edges.transpose();
+        let gradients = [-(g.x_axis + g.y_axis + g.z_axis), g.x_axis, g.y_axis, g.z_axis];
+        let total: f64 = gradients.iter().map(|g| g.length()).sum();
+        for (corner, &n) in tet.iter().enumerate() {
+            control_volume[n as usize] += 0.25 * rest.volume;
+            row_sum[n as usize] += rest.volume * gradients[corner].length() * total;
+        }
+    }
+    control_volume
+        .iter()
+        .zip(&row_sum)
+        .filter(|(_, row)| **row > 0.0)
+        .map(|(volume, row)| 2.0 * (volume / row).sqrt())
+        .fold(f64::INFINITY, f64::min)
 }
 
 /// The four entries of `values` at the nodes of `tet`.

@@ -2,4 +2,4 @@
 
 mod explicit;
 
-pub use explicit::{StepReport, Substeps, SymplecticEuler};
+pub use explicit::{COURANT_NUMBER, StepReport, Substeps, SymplecticEuler};
