@@ -80,7 +80,8 @@ impl RayleighDamping {
     #[inline(always)]
     pub fn first_piola(&self, f: &DMat3, f_dot: &DMat3) -> DMat3 {
         let strain_rate = symmetric_part(&(f.transpose() * *f_dot));
-        let stress = DMat3::IDENTITY * (self.phi * trace(&strain_rate)) + strain_rate * (2.0 * self.psi);
+        let stress =
+            DMat3::IDENTITY * (self.phi * trace(&strain_rate)) + strain_rate * (2.0 * self.psi);
         *f * stress
     }
 }

@@ -42,7 +42,9 @@ pub enum Error {
         node: u32,
     },
     /// A tetrahedron has (numerically) zero rest volume.
-    #[error("tetrahedron {tet} is degenerate: rest volume {volume:e} m^3 is zero at the mesh's scale")]
+    #[error(
+        "tetrahedron {tet} is degenerate: rest volume {volume:e} m^3 is zero at the mesh's scale"
+    )]
     DegenerateTet {
         /// Index of the offending tetrahedron.
         tet: usize,
@@ -103,7 +105,9 @@ pub enum Error {
         reason: &'static str,
     },
     /// Stepping produced a NaN or infinite state; the step was rejected and the state before it kept.
-    #[error("stepping produced a non-finite state at node {node}; the step was rejected and the previous state kept")]
+    #[error(
+        "stepping produced a non-finite state at node {node}; the step was rejected and the previous state kept"
+    )]
     NonFiniteState {
         /// First node found with a non-finite position or velocity.
         node: usize,
@@ -116,7 +120,9 @@ pub enum Error {
         iteration: usize,
     },
     /// The static solver did not reach its tolerance.
-    #[error("static solve did not converge in {iterations} Newton iterations (relative residual {residual:e})")]
+    #[error(
+        "static solve did not converge in {iterations} Newton iterations (relative residual {residual:e})"
+    )]
     StaticSolveDidNotConverge {
         /// Iterations performed.
         iterations: usize,

@@ -26,7 +26,11 @@ fn highest_angular_frequency(body: &mut SoftBody) -> f64 {
         let forces = body.internal_forces().to_vec();
         let next: Vec<DVec3> = (0..rest.len())
             .map(|n| {
-                if body.is_pinned(n) { DVec3::ZERO } else { -forces[n] / masses[n] / scale }
+                if body.is_pinned(n) {
+                    DVec3::ZERO
+                } else {
+                    -forces[n] / masses[n] / scale
+                }
             })
             .collect();
         eigenvalue = next.iter().zip(&u).map(|(a, b)| a.dot(*b)).sum::<f64>() / norm.powi(2);
@@ -39,9 +43,18 @@ fn highest_angular_frequency(body: &mut SoftBody) -> f64 {
 
 fn meshes() -> Vec<(&'static str, TetMesh)> {
     vec![
-        ("cube 4^3", mesh::cuboid(DVec3::splat(0.1), [4, 4, 4]).unwrap()),
-        ("beam 20x2x2", mesh::cuboid(DVec3::new(0.5, 0.05, 0.05), [20, 2, 2]).unwrap()),
-        ("plate 8x8x1", mesh::cuboid(DVec3::new(0.1, 0.1, 0.01), [8, 8, 1]).unwrap()),
+        (
+            "cube 4^3",
+            mesh::cuboid(DVec3::splat(0.1), [4, 4, 4]).unwrap(),
+        ),
+        (
+            "beam 20x2x2",
+            mesh::cuboid(DVec3::new(0.5, 0.05, 0.05), [20, 2, 2]).unwrap(),
+        ),
+        (
+            "plate 8x8x1",
+            mesh::cuboid(DVec3::new(0.1, 0.1, 0.01), [8, 8, 1]).unwrap(),
+        ),
         ("cylinder", mesh::cylinder(0.1, 0.2, 6, 6).unwrap()),
         ("sphere", mesh::sphere(0.1, 8).unwrap()),
     ]
@@ -64,8 +77,15 @@ fn computed_critical_step_is_below_and_close_to_the_true_limit() {
                 true_limit / altitude,
                 computed / true_limit
             );
-            assert!(computed <= true_limit, "{name}, nu = {nu}: computed step above the true limit ({})", computed / true_limit);
-            assert!(computed >= 0.75 * true_limit, "{name}, nu = {nu}: estimate too pessimistic");
+            assert!(
+                computed <= true_limit,
+                "{name}, nu = {nu}: computed step above the true limit ({})",
+                computed / true_limit
+            );
+            assert!(
+                computed >= 0.75 * true_limit,
+                "{name}, nu = {nu}: estimate too pessimistic"
+            );
         }
     }
     assert!(COURANT_NUMBER > 0.0);
@@ -121,10 +141,16 @@ fn steps_above_the_limit_explode_and_automatic_substeps_do_not() {
             "damping time {damping_time:e} s: critical step {critical:.3e} s; energy x{above:.3e} \
              after 400 steps at 1.5x; x{short:.3} after 400 and x{long:.3} after 4000 at the automatic step"
         );
-        assert!(above > 1e3, "1.5x the limit must be unstable (growth {above})");
+        assert!(
+            above > 1e3,
+            "1.5x the limit must be unstable (growth {above})"
+        );
         // Symplectic Euler's measured energy oscillates by O(h ω) around a conserved value, it does
         // not grow: bounded by 1.5 after 400 and after 4000 steps.
-        assert!(short < 1.5 && long < 1.5, "the automatic step must not gain energy");
+        assert!(
+            short < 1.5 && long < 1.5,
+            "the automatic step must not gain energy"
+        );
     }
 }
 
@@ -136,7 +162,10 @@ fn automatic_substeps_keep_every_case_bounded() {
     let frame = 1.0 / 60.0;
     for young in [1e4, 1e6, 1e8] {
         for nu in [-0.5, 0.0, 0.3, 0.45, 0.49] {
-            for model in [MaterialModel::StVenantKirchhoff, MaterialModel::StableNeoHookean] {
+            for model in [
+                MaterialModel::StVenantKirchhoff,
+                MaterialModel::StableNeoHookean,
+            ] {
                 for damping_time in [0.0, 1e-3] {
                     let material = Material::new(model, young, nu, 1000.0).unwrap();
                     let (mut body, _) = common::cantilever([6, 1, 1], material);
@@ -147,7 +176,10 @@ fn automatic_substeps_keep_every_case_bounded() {
                             let pinned: Vec<u32> = mesh.nodes_where(|p| p.x <= -0.5 + 1e-9);
                             SoftBodyBuilder::new(mesh, material)
                                 .translation(DVec3::new(0.5, 0.0, 0.0))
-                                .damping(RayleighDamping::stiffness_proportional(damping_time, lame).unwrap())
+                                .damping(
+                                    RayleighDamping::stiffness_proportional(damping_time, lame)
+                                        .unwrap(),
+                                )
                                 .pinned_nodes(pinned)
                                 .build()
                                 .unwrap()
@@ -160,8 +192,10 @@ fn automatic_substeps_keep_every_case_bounded() {
                     for _ in 0..20 {
                         integrator.step(&mut body, frame, gravity).unwrap();
                     }
-                    let total = body.kinetic_energy() + body.elastic_energy()
-                        + body.gravity_potential_energy(gravity) - start;
+                    let total = body.kinetic_energy()
+                        + body.elastic_energy()
+                        + body.gravity_potential_energy(gravity)
+                        - start;
                     assert!(
                         total.is_finite() && total <= 0.01 * weight_scale,
                         "E = {young}, nu = {nu}, {model:?}, damping {damping_time}: energy {total}"

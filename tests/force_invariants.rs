@@ -34,7 +34,11 @@ fn sums(body: &mut SoftBody) -> (DVec3, DVec3, f64, f64) {
     let positions = body.positions().to_vec();
     let forces = body.internal_forces().to_vec();
     let net: DVec3 = forces.iter().sum();
-    let torque: DVec3 = positions.iter().zip(&forces).map(|(x, f)| x.cross(*f)).sum();
+    let torque: DVec3 = positions
+        .iter()
+        .zip(&forces)
+        .map(|(x, f)| x.cross(*f))
+        .sum();
     let force_scale: f64 = forces.iter().map(|f| f.length()).sum();
     let torque_scale: f64 = positions
         .iter()
@@ -125,13 +129,16 @@ fn forces_are_the_negative_gradient_of_the_elastic_energy() {
 fn check_differential(model: &impl HyperelasticModel, name: &str, rng: &mut Lcg) {
     let mut worst: f64 = 0.0;
     for _ in 0..20 {
-        let f = DMat3::IDENTITY
-            + DMat3::from_cols(rng.vector(), rng.vector(), rng.vector()) * 0.3;
+        let f = DMat3::IDENTITY + DMat3::from_cols(rng.vector(), rng.vector(), rng.vector()) * 0.3;
         let df = DMat3::from_cols(rng.vector(), rng.vector(), rng.vector());
         let h = 1e-6;
-        let numeric = (model.first_piola(&(f + df * h)) - model.first_piola(&(f - df * h))) / (2.0 * h);
+        let numeric =
+            (model.first_piola(&(f + df * h)) - model.first_piola(&(f - df * h))) / (2.0 * h);
         let analytic = model.first_piola_differential(&f, &df);
-        let scale = numeric.to_cols_array().iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let scale = numeric
+            .to_cols_array()
+            .iter()
+            .fold(0.0f64, |m, x| m.max(x.abs()));
         let error = (numeric - analytic)
             .to_cols_array()
             .iter()
@@ -144,7 +151,9 @@ fn check_differential(model: &impl HyperelasticModel, name: &str, rng: &mut Lcg)
 
 #[test]
 fn stress_differentials_match_finite_differences() {
-    let lame = Material::new(MaterialModel::Linear, 1e6, 0.3, 1.0).unwrap().lame();
+    let lame = Material::new(MaterialModel::Linear, 1e6, 0.3, 1.0)
+        .unwrap()
+        .lame();
     let mut rng = Lcg(5);
     check_differential(&LinearElastic(lame), "linear", &mut rng);
     check_differential(&StVenantKirchhoff(lame), "StVK", &mut rng);
@@ -154,12 +163,29 @@ fn stress_differentials_match_finite_differences() {
 
 #[test]
 fn stress_is_the_derivative_of_the_energy_density() {
-    let lame = Material::new(MaterialModel::Linear, 1e6, 0.3, 1.0).unwrap().lame();
+    let lame = Material::new(MaterialModel::Linear, 1e6, 0.3, 1.0)
+        .unwrap()
+        .lame();
     let mut rng = Lcg(9);
     let models: [(&str, &dyn Fn(&DMat3) -> (f64, DMat3)); 4] = [
-        ("linear", &|f| (LinearElastic(lame).energy_density(f), LinearElastic(lame).first_piola(f))),
-        ("StVK", &|f| (StVenantKirchhoff(lame).energy_density(f), StVenantKirchhoff(lame).first_piola(f))),
-        ("corotated", &|f| (Corotated(lame).energy_density(f), Corotated(lame).first_piola(f))),
+        ("linear", &|f| {
+            (
+                LinearElastic(lame).energy_density(f),
+                LinearElastic(lame).first_piola(f),
+            )
+        }),
+        ("StVK", &|f| {
+            (
+                StVenantKirchhoff(lame).energy_density(f),
+                StVenantKirchhoff(lame).first_piola(f),
+            )
+        }),
+        ("corotated", &|f| {
+            (
+                Corotated(lame).energy_density(f),
+                Corotated(lame).first_piola(f),
+            )
+        }),
         ("stable Neo-Hookean", &|f| {
             let m = StableNeoHookean::new(lame);
             (m.energy_density(f), m.first_piola(f))
@@ -169,7 +195,8 @@ fn stress_is_the_derivative_of_the_energy_density() {
         // Include an inverted gradient (negative determinant): the robust models must stay smooth.
         for flip in [1.0, -1.0] {
             let f = DMat3::from_diagonal(DVec3::new(1.0, 1.0, flip))
-                * (DMat3::IDENTITY + DMat3::from_cols(rng.vector(), rng.vector(), rng.vector()) * 0.2);
+                * (DMat3::IDENTITY
+                    + DMat3::from_cols(rng.vector(), rng.vector(), rng.vector()) * 0.2);
             let (_, stress) = model(&f);
             let h = 1e-6;
             let mut worst: f64 = 0.0;
@@ -183,8 +210,14 @@ fn stress_is_the_derivative_of_the_energy_density() {
                     worst = worst.max((derivative - stress.col(c)[r]).abs());
                 }
             }
-            let scale = stress.to_cols_array().iter().fold(0.0f64, |m, x| m.max(x.abs()));
-            println!("{name} (det F sign {flip}): worst |dΨ/dF - P| / max|P| = {:.2e}", worst / scale);
+            let scale = stress
+                .to_cols_array()
+                .iter()
+                .fold(0.0f64, |m, x| m.max(x.abs()));
+            println!(
+                "{name} (det F sign {flip}): worst |dΨ/dF - P| / max|P| = {:.2e}",
+                worst / scale
+            );
             assert!(worst < 1e-6 * scale, "{name}");
         }
     }

@@ -29,7 +29,9 @@ fn unphysical_constants_are_typed_errors() {
     for (e, nu, rho, name) in bad {
         match Material::new(MaterialModel::StableNeoHookean, e, nu, rho) {
             Err(Error::InvalidMaterial { parameter, .. }) => assert_eq!(parameter, name),
-            other => panic!("E={e}, nu={nu}, rho={rho}: expected an error on {name}, got {other:?}"),
+            other => {
+                panic!("E={e}, nu={nu}, rho={rho}: expected an error on {name}, got {other:?}")
+            }
         }
     }
     assert!(Material::new(MaterialModel::Linear, 1e6, 0.4999, 1000.0).is_ok());
@@ -40,18 +42,30 @@ fn unphysical_constants_are_typed_errors() {
 fn damping_that_would_inject_energy_is_rejected() {
     assert!(matches!(
         RayleighDamping::new(0.0, -1.0),
-        Err(Error::InvalidMaterial { parameter: "psi", .. })
+        Err(Error::InvalidMaterial {
+            parameter: "psi",
+            ..
+        })
     ));
     assert!(matches!(
         RayleighDamping::new(-1.0, 1.0),
-        Err(Error::InvalidMaterial { parameter: "phi", .. })
+        Err(Error::InvalidMaterial {
+            parameter: "phi",
+            ..
+        })
     ));
     // A negative φ is allowed while the bulk viscosity φ + 2ψ/3 stays non-negative (as λ < 0 is
     // allowed for auxetic materials).
     assert!(RayleighDamping::new(-0.5, 1.0).is_ok());
-    let lame = LameParameters { lambda: 1.0, mu: 2.0 };
+    let lame = LameParameters {
+        lambda: 1.0,
+        mu: 2.0,
+    };
     assert!(matches!(
         RayleighDamping::stiffness_proportional(-1e-3, lame),
-        Err(Error::InvalidMaterial { parameter: "beta", .. })
+        Err(Error::InvalidMaterial {
+            parameter: "beta",
+            ..
+        })
     ));
 }

@@ -162,7 +162,9 @@ fn cylinder_volume_converges_and_elements_are_well_shaped() {
         let mesh = mesh::cylinder(radius, half_height, cells, cells * 5 / 2).unwrap();
         let error = (mesh.volume() - exact).abs() / exact;
         let shape = worst_shape_ratio(&mesh);
-        println!("cylinder {cells} cells across: volume error {error:.2e}, worst altitude/edge {shape:.3}");
+        println!(
+            "cylinder {cells} cells across: volume error {error:.2e}, worst altitude/edge {shape:.3}"
+        );
         // The inscribed boundary polygon's deficit falls as (cells)^-2: at least 3x per doubling.
         assert!(error < previous_error / 3.0);
         assert!(shape > 0.1, "elements must stay well shaped");
@@ -180,7 +182,9 @@ fn sphere_volume_converges_and_elements_are_well_shaped() {
         let mesh = mesh::sphere(radius, cells).unwrap();
         let error = (mesh.volume() - exact).abs() / exact;
         let shape = worst_shape_ratio(&mesh);
-        println!("sphere {cells} cells across: volume error {error:.2e}, worst altitude/edge {shape:.3}");
+        println!(
+            "sphere {cells} cells across: volume error {error:.2e}, worst altitude/edge {shape:.3}"
+        );
         // The inscribed faceted boundary's deficit falls as (cells)^-2: at least 3x per doubling.
         assert!(error < previous_error / 3.0);
         assert!(shape > 0.1, "elements must stay well shaped");
@@ -193,19 +197,31 @@ fn sphere_volume_converges_and_elements_are_well_shaped() {
 fn generators_reject_bad_parameters() {
     assert!(matches!(
         mesh::cuboid(DVec3::ONE, [2, 0, 2]),
-        Err(Error::InvalidGeneratorParameter { parameter: "cells", .. })
+        Err(Error::InvalidGeneratorParameter {
+            parameter: "cells",
+            ..
+        })
     ));
     assert!(matches!(
         mesh::cuboid(DVec3::new(1.0, -1.0, 1.0), [2, 2, 2]),
-        Err(Error::InvalidGeneratorParameter { parameter: "half_extents.y", .. })
+        Err(Error::InvalidGeneratorParameter {
+            parameter: "half_extents.y",
+            ..
+        })
     ));
     assert!(matches!(
         mesh::cylinder(f64::NAN, 1.0, 4, 4),
-        Err(Error::InvalidGeneratorParameter { parameter: "radius", .. })
+        Err(Error::InvalidGeneratorParameter {
+            parameter: "radius",
+            ..
+        })
     ));
     assert!(matches!(
         mesh::sphere(1.0, 1),
-        Err(Error::InvalidGeneratorParameter { parameter: "cells_across", .. })
+        Err(Error::InvalidGeneratorParameter {
+            parameter: "cells_across",
+            ..
+        })
     ));
 }
 

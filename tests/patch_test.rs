@@ -19,7 +19,11 @@ fn distorted_box() -> TetMesh {
         .iter()
         .map(|p| {
             let interior = p.abs().max_element() < half - 1e-9;
-            if interior { *p + rng.vector() * (0.3 * cell) } else { *p }
+            if interior {
+                *p + rng.vector() * (0.3 * cell)
+            } else {
+                *p
+            }
         })
         .collect();
     TetMesh::new(positions, regular.tets().to_vec()).expect("the distortion keeps every tet valid")
@@ -56,7 +60,10 @@ fn interior_force_ratio(
             boundary = boundary.max(f.length());
         }
     }
-    assert!(boundary > 0.0, "the imposed deformation must load the boundary");
+    assert!(
+        boundary > 0.0,
+        "the imposed deformation must load the boundary"
+    );
     interior / boundary
 }
 
@@ -69,7 +76,12 @@ fn linear_patch_test_small_affine_displacement() {
         DVec3::new(0.6e-3, 0.1e-3, 0.8e-3),
     );
     let b = DVec3::new(0.01, -0.02, 0.03);
-    let ratio = interior_force_ratio(MaterialModel::Linear, None, |p| p + a * p + b, |_| DVec3::ZERO);
+    let ratio = interior_force_ratio(
+        MaterialModel::Linear,
+        None,
+        |p| p + a * p + b,
+        |_| DVec3::ZERO,
+    );
     println!("linear patch test: interior/boundary force = {ratio:.2e}");
     assert!(ratio < 1e-9);
 }
@@ -82,7 +94,8 @@ fn every_model_passes_the_patch_test_under_a_finite_homogeneous_deformation() {
         DVec3::new(0.1, 0.9, 0.0),
         DVec3::new(0.0, 0.05, 1.1),
     );
-    let rotation = DMat3::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 40f64.to_radians());
+    let rotation =
+        DMat3::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 40f64.to_radians());
     let f = rotation * stretch_shear;
     for model in MODELS {
         let ratio = interior_force_ratio(model, None, |p| f * p + DVec3::X, |_| DVec3::ZERO);

@@ -66,7 +66,12 @@ fn damping_ignores_rigid_spin_even_for_the_linear_model() {
     // spin gives no damping force. The linear model's elastic force vanishes at zero rotation.
     let mut body = body(MaterialModel::Linear);
     let scale = force_scale(&body);
-    move_rigidly(&mut body, DQuat::IDENTITY, DVec3::new(3.0, -7.0, 2.0), DVec3::ONE);
+    move_rigidly(
+        &mut body,
+        DQuat::IDENTITY,
+        DVec3::new(3.0, -7.0, 2.0),
+        DVec3::ONE,
+    );
     let largest = body
         .internal_forces()
         .iter()
@@ -83,11 +88,18 @@ fn linear_model_spurious_energy_under_rotation_matches_its_closed_form() {
     let mut body = body(MaterialModel::Linear);
     let lame = body.material().lame();
     let volume = body.mesh().volume();
-    println!("rotation  spurious energy (J)  closed form (J)  largest spurious force / 1% strain force");
+    println!(
+        "rotation  spurious energy (J)  closed form (J)  largest spurious force / 1% strain force"
+    );
     for degrees in [1.0, 10.0, 30.0, 90.0, 180.0] {
         let theta = f64::to_radians(degrees);
         let axis = DVec3::new(1.0, 1.0, 0.0).normalize();
-        move_rigidly(&mut body, DQuat::from_axis_angle(axis, theta), DVec3::ZERO, DVec3::ZERO);
+        move_rigidly(
+            &mut body,
+            DQuat::from_axis_angle(axis, theta),
+            DVec3::ZERO,
+            DVec3::ZERO,
+        );
         let energy = body.elastic_energy();
         let expected = volume * (1.0 - theta.cos()).powi(2) * 2.0 * (lame.mu + lame.lambda);
         let scale = force_scale(&body);
@@ -96,7 +108,10 @@ fn linear_model_spurious_energy_under_rotation_matches_its_closed_form() {
             .iter()
             .map(|f| f.length())
             .fold(0.0, f64::max);
-        println!("{degrees:7.1}  {energy:18.6e}  {expected:15.6e}  {:.3e}", largest / scale);
+        println!(
+            "{degrees:7.1}  {energy:18.6e}  {expected:15.6e}  {:.3e}",
+            largest / scale
+        );
         assert!((energy - expected).abs() <= 1e-9 * expected);
     }
 }

@@ -76,6 +76,9 @@ fn uniaxial_tension_gives_e_epsilon_and_minus_nu_epsilon() {
             -nu * STRAIN
         );
         assert!(stress_error < 1e-6, "axial stress error {stress_error:e}");
-        assert!(lateral_error < 1e-6, "lateral strain error {lateral_error:e}");
+        assert!(
+            lateral_error < 1e-6,
+            "lateral strain error {lateral_error:e}"
+        );
     }
 }

@@ -99,17 +99,18 @@ impl SoftBodyBuilder {
         let node_count = self.mesh.node_count();
         let mut pinned = vec![false; node_count];
         for &node in &self.pinned {
-            let flag = pinned
-                .get_mut(node as usize)
-                .ok_or(Error::NodeOutOfRange {
-                    node: node as usize,
-                    node_count,
-                })?;
+            let flag = pinned.get_mut(node as usize).ok_or(Error::NodeOutOfRange {
+                node: node as usize,
+                node_count,
+            })?;
             *flag = true;
         }
         for (parameter, finite) in [
             ("translation", self.translation.is_finite()),
-            ("rotation", self.rotation.is_finite() && self.rotation.length() > 0.0),
+            (
+                "rotation",
+                self.rotation.is_finite() && self.rotation.length() > 0.0,
+            ),
             ("linvel", self.linvel.is_finite()),
         ] {
             if !finite {
@@ -130,7 +131,10 @@ impl SoftBodyBuilder {
             fvm: FvmMesh::new(&self.mesh),
             masses: lumped_masses(&self.mesh, self.material.density()),
             forces: vec![DVec3::ZERO; node_count],
-            saved_state: (Vec::with_capacity(node_count), Vec::with_capacity(node_count)),
+            saved_state: (
+                Vec::with_capacity(node_count),
+                Vec::with_capacity(node_count),
+            ),
             mesh: self.mesh,
             material: self.material,
             damping: self.damping,

@@ -166,7 +166,9 @@ impl FvmMesh {
         out.par_iter_mut().enumerate().for_each(|(n, force)| {
             *force = incidence[offsets[n]..offsets[n + 1]]
                 .iter()
-                .fold(DVec3::ZERO, |sum, &e| sum + per_tet[e as usize / 4][e as usize % 4]);
+                .fold(DVec3::ZERO, |sum, &e| {
+                    sum + per_tet[e as usize / 4][e as usize % 4]
+                });
         });
     }
 
@@ -185,7 +187,12 @@ fn wave_length_scale(tets: &[[u32; 4]], rest: &[TetRest], node_count: usize) -> 
     let mut row_sum = vec![0.0; node_count];
     for (tet, rest) in tets.iter().zip(rest) {
         let g = rest.inverse_rest_edges.transpose();
-        let gradients = [-(g.x_axis + g.y_axis + g.z_axis), g.x_axis, g.y_axis, g.z_axis];
+        let gradients = [
+            -(g.x_axis + g.y_axis + g.z_axis),
+            g.x_axis,
+            g.y_axis,
+            g.z_axis,
+        ];
         let total: f64 = gradients.iter().map(|g| g.length()).sum();
         for (corner, &n) in tet.iter().enumerate() {
             control_volume[n as usize] += 0.25 * rest.volume;

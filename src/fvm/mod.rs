@@ -9,6 +9,6 @@
 mod kernel;
 mod rest;
 
-pub use kernel::{FvmMesh, tet_forces};
 pub(crate) use kernel::gather;
+pub use kernel::{FvmMesh, tet_forces};
 pub use rest::TetRest;

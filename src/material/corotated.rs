@@ -1,9 +1,11 @@
 //! Corotated linear elasticity: with the polar decomposition `F = R S` (`R` a proper rotation),
 //! `Ψ = μ ‖F - R‖² + λ/2 (tr(S) - 3)²` and `P = 2μ (F - R) + λ (tr(S) - 3) R`.
 //!
-//! The rotation comes from the singular value decomposition with the sign fix of Irving, Teran and
-//! Fedkiw (2004): when `det F < 0` the smallest singular value is negated so that `R` stays a
-//! rotation and the energy pushes an inverted element back to positive volume.
+//! The rotation comes from Higham's scaled Newton iteration `X ← (γX + X⁻ᵀ/γ)/2`, which converges
+//! quadratically to the polar factor of a well-conditioned `F` in a handful of 3x3 inverses. Nearly
+//! flat or inverted elements fall back to the singular value decomposition with the sign fix of
+//! Irving, Teran and Fedkiw (2004): when `det F < 0` the smallest singular value is negated so that
+//! `R` stays a rotation and the energy pushes the element back to positive volume.
 
 use super::{HyperelasticModel, LameParameters, trace};
 use rapier3d::glamx::{DMat3, DVec3};
@@ -13,8 +15,45 @@ use rapier3d::na;
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Corotated(pub LameParameters);
 
+/// Below this `det F / (‖F‖²/3)^(3/2)` (1 for a rotation, 0 for a flat element) the polar
+/// rotation is taken from the SVD rather than Newton's iteration.
+const NEWTON_MIN_CONDITION: f64 = 0.05;
+/// Newton's iteration stops when an update changes `X` by less than this (Frobenius norm).
+const NEWTON_TOLERANCE: f64 = 1e-14;
+const NEWTON_MAX_ITERATIONS: usize = 20;
+
 /// The rotation `R` of the polar decomposition `F = R S`, with `det R = +1` even for inverted `F`.
 pub(crate) fn polar_rotation(f: &DMat3) -> DMat3 {
+    let size = super::double_dot(f, f) / 3.0;
+    if f.determinant() > NEWTON_MIN_CONDITION * size * size.sqrt() {
+        if let Some(rotation) = polar_rotation_newton(f) {
+            return rotation;
+        }
+    }
+    polar_rotation_svd(f)
+}
+
+/// Higham's scaled Newton iteration for the polar factor; `None` if it has not converged.
+fn polar_rotation_newton(f: &DMat3) -> Option<DMat3> {
+    let mut x = *f;
+    for _ in 0..NEWTON_MAX_ITERATIONS {
+        let inverse_transpose = x.inverse().transpose();
+        let gamma = (super::double_dot(&inverse_transpose, &inverse_transpose)
+            / super::double_dot(&x, &x))
+        .sqrt()
+        .sqrt();
+        let next = (x * gamma + inverse_transpose * (1.0 / gamma)) * 0.5;
+        let change = next - x;
+        x = next;
+        if super::double_dot(&change, &change) <= NEWTON_TOLERANCE * NEWTON_TOLERANCE {
+            return Some(x);
+        }
+    }
+    None
+}
+
+/// The polar rotation from the SVD with the inversion sign fix.
+fn polar_rotation_svd(f: &DMat3) -> DMat3 {
     let m = na::Matrix3::from_column_slice(&f.to_cols_array());
     let svd = m.svd(true, true);
     // Both are present because they were requested above.
@@ -75,6 +114,8 @@ impl HyperelasticModel for Corotated {
             DVec3::ZERO
         };
         let dr = r * cross_matrix(w);
-        (*df - dr) * (2.0 * mu) + r * (lambda * trace(&rt_df)) + dr * (lambda * (stretch_trace - 3.0))
+        (*df - dr) * (2.0 * mu)
+            + r * (lambda * trace(&rt_df))
+            + dr * (lambda * (stretch_trace - 3.0))
     }
 }

@@ -10,8 +10,8 @@
 //! different cell orientations, so each hexahedral cell is split around a node at its centre,
 //! every face along the diagonal through its lowest-numbered node: neighbours then always agree.
 
-use super::hex_mesher::HexMesher;
 use super::TetMesh;
+use super::hex_mesher::HexMesher;
 use crate::Error;
 use rapier3d::glamx::{DVec2, DVec3};
 
@@ -73,7 +73,11 @@ pub fn cylinder(
     // The core: a straight box of half-size r/2 in x and z.
     hexes.add_block([core, cells_along, core], |u| {
         let half = CYLINDER_CORE * radius;
-        DVec3::new((2.0 * u.x - 1.0) * half, height(u.y), (2.0 * u.z - 1.0) * half)
+        DVec3::new(
+            (2.0 * u.x - 1.0) * half,
+            height(u.y),
+            (2.0 * u.z - 1.0) * half,
+        )
     });
     // Four blocks from the core's sides (direction d on the unit square's boundary) to the circle.
     for side in 0..4 {
@@ -110,7 +114,9 @@ pub fn sphere(radius: f64, cells_across: usize) -> Result<TetMesh, Error> {
     let core = ((cells_across as f64 * 0.4).round() as usize).max(1);
     let layers = ((core as f64 * 0.6).round() as usize).max(1);
     let mut hexes = HexMesher::new(radius);
-    hexes.add_block([core; 3], |u| (u * 2.0 - DVec3::ONE) * (SPHERE_CORE * radius));
+    hexes.add_block([core; 3], |u| {
+        (u * 2.0 - DVec3::ONE) * (SPHERE_CORE * radius)
+    });
     for axis in 0..3 {
         for sign in [1.0, -1.0] {
             hexes.add_block([core, core, layers], |u| {

@@ -59,8 +59,9 @@ impl HexMesher {
         for k in 0..nz {
             for j in 0..ny {
                 for i in 0..nx {
-                    let corners =
-                        std::array::from_fn(|c| index(i + (c & 1), j + ((c >> 1) & 1), k + (c >> 2)));
+                    let corners = std::array::from_fn(|c| {
+                        index(i + (c & 1), j + ((c >> 1) & 1), k + (c >> 2))
+                    });
                     self.add_hex(corners);
                 }
             }

@@ -84,3 +84,46 @@ pub const OBJECTIVE_MODELS: [MaterialModel; 3] = [
     MaterialModel::Corotated,
     MaterialModel::StableNeoHookean,
 ];
+
+/// Vertical tip deflection (m) of an inextensible, shear-rigid cantilever under its own weight at
+/// any rotation (the elastica): `EI θ'' = -q (L - s) cos θ`, `θ(0) = 0`, `θ'(L) = 0`, solved by
+/// shooting on `θ'(0)` with fourth-order Runge–Kutta (2000 steps) and bisection.
+pub fn elastica_tip_deflection(young_modulus: f64) -> f64 {
+    let load = DENSITY * SIDE * SIDE * GRAVITY / (young_modulus * second_moment());
+    let steps = 2000;
+    let ds = LENGTH / steps as f64;
+    // Integrates from the clamp with curvature `k0`; returns (θ'(L), tip deflection).
+    let shoot = |k0: f64| {
+        let rhs = |s: f64, theta: f64| -load * (LENGTH - s) * theta.cos();
+        let (mut theta, mut kappa, mut deflection) = (0.0f64, k0, 0.0);
+        for i in 0..steps {
+            let s = i as f64 * ds;
+            let (t1, k1) = (kappa, rhs(s, theta));
+            let (t2, k2) = (
+                kappa + 0.5 * ds * k1,
+                rhs(s + 0.5 * ds, theta + 0.5 * ds * t1),
+            );
+            let (t3, k3) = (
+                kappa + 0.5 * ds * k2,
+                rhs(s + 0.5 * ds, theta + 0.5 * ds * t2),
+            );
+            let (t4, k4) = (kappa + ds * k3, rhs(s + ds, theta + ds * t3));
+            let next_theta = theta + ds / 6.0 * (t1 + 2.0 * t2 + 2.0 * t3 + t4);
+            deflection += 0.5 * ds * (theta.sin() + next_theta.sin());
+            theta = next_theta;
+            kappa += ds / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+        }
+        (kappa, deflection)
+    };
+    // θ'(L) grows with θ'(0) = k0 from negative (k0 = 0) to positive (k0 = q L² / 2 + margin).
+    let (mut low, mut high) = (0.0, load * LENGTH * LENGTH);
+    for _ in 0..100 {
+        let mid = 0.5 * (low + high);
+        if shoot(mid).0 < 0.0 {
+            low = mid
+        } else {
+            high = mid
+        }
+    }
+    shoot(0.5 * (low + high)).1
+}
