@@ -7,6 +7,7 @@
 //! and `φ + 2ψ/3 >= 0`.
 
 use crate::Error;
+use crate::lanes::{Mat3x4, f64x4};
 use crate::material::{LameParameters, symmetric_part, trace};
 use rapier3d::glamx::DMat3;
 
@@ -83,5 +84,14 @@ impl RayleighDamping {
         let stress =
             DMat3::IDENTITY * (self.phi * trace(&strain_rate)) + strain_rate * (2.0 * self.psi);
         *f * stress
+    }
+
+    /// The damping stress as a second Piola–Kirchhoff stress `φ tr(ε̇) I + 2ψ ε̇` (Pa) in four
+    /// lanes, for deformation gradients `f` and their rates `f_dot` (1/s).
+    #[inline(always)]
+    pub fn second_piola_lanes(&self, f: &Mat3x4, f_dot: &Mat3x4) -> Mat3x4 {
+        let strain_rate = f.transpose_mul(f_dot).symmetric_part();
+        (strain_rate * f64x4::splat(2.0 * self.psi))
+            .add_diagonal(strain_rate.trace() * f64x4::splat(self.phi))
     }
 }

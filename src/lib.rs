@@ -44,6 +44,7 @@ pub mod damping;
 mod error;
 pub mod fvm;
 pub mod integrate;
+pub mod lanes;
 pub mod material;
 pub mod mesh;
 pub mod statics;

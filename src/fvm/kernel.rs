@@ -1,21 +1,25 @@
-//! The force kernel: `f_i = P b_i` per tetrahedron (a pure function), and the loop that sums it
-//! over a mesh into nodal forces without allocating.
+//! The force kernel: `f_i = P b_i` per tetrahedron, and the loop that sums it over a mesh into
+//! nodal forces without allocating.
 //!
-//! The loop runs serially or, with the `parallel` feature on large meshes and more than one rayon
-//! thread, in two parallel passes (per-tetrahedron forces, then a per-node gather over a
-//! precomputed incidence list). Both add a node's contributions in ascending tetrahedron order, so
-//! the results are bit-identical whatever the thread count.
+//! [`tet_forces`] is the scalar reference. The mesh loop evaluates four tetrahedra at once, one
+//! per SIMD lane ([`crate::lanes`]), with the same formulas, and adds each tetrahedron's forces to
+//! its nodes in ascending tetrahedron order.
+//!
+//! Large meshes are cut into fixed chunks of consecutive tetrahedra. Each chunk adds its forces
+//! into a window of its own covering the nodes it touches (small for meshes numbered in spatial
+//! order, as the generators' are), so chunks run in parallel without sharing writes; the windows
+//! are then added into the result in chunk order. The chunking depends only on the mesh, so the
+//! forces are bit-identical whatever the number of threads.
 
 use super::TetRest;
 use crate::damping::RayleighDamping;
+use crate::lanes::{LANES, Mat3x4, Vec3x4, f64x4};
 use crate::material::HyperelasticModel;
 use crate::mesh::TetMesh;
 use rapier3d::glamx::DVec3;
 
-/// Meshes with fewer tetrahedra than this are summed serially even with `parallel` on: below it,
-/// thread hand-off costs more than it saves.
-#[cfg(feature = "parallel")]
-const PARALLEL_MIN_TETS: usize = 4096;
+/// Tetrahedra per chunk (a multiple of [`LANES`]); meshes of one chunk are summed directly.
+const CHUNK_TETS: usize = 8192;
 
 /// Internal (elastic plus damping) forces (N) on the four nodes of one tetrahedron, for node
 /// positions `x` (m) and velocities `v` (m/s). They sum to zero and have zero net torque.
@@ -41,67 +45,87 @@ pub fn tet_forces<M: HyperelasticModel>(
     ]
 }
 
+/// Rest data of [`LANES`] consecutive tetrahedra, one per lane.
+#[derive(Debug, Clone, Copy)]
+struct RestBlock {
+    inverse_rest_edges: Mat3x4,
+    volume: f64x4,
+}
+
 /// The mesh as the finite-volume method sees it: tetrahedra, their rest data, and reusable storage
-/// for summing [`tet_forces`] into nodal forces.
+/// for summing the forces into nodal forces.
 #[derive(Debug, Clone)]
 pub struct FvmMesh {
+    /// The tetrahedra, padded with copies of the last one to a multiple of [`LANES`].
     tets: Vec<[u32; 4]>,
-    rest: Vec<TetRest>,
+    tet_count: usize,
+    blocks: Vec<RestBlock>,
     node_count: usize,
     wave_length_scale: f64,
-    /// For node `n`, `incidence[offsets[n]..offsets[n + 1]]` lists `4 * tet + corner` of every
-    /// tetrahedron corner at `n`, in ascending tetrahedron order.
-    #[cfg(feature = "parallel")]
-    offsets: Vec<usize>,
-    #[cfg(feature = "parallel")]
-    incidence: Vec<u32>,
-    /// Per-tetrahedron forces of the parallel pass; empty when the mesh is summed serially.
-    #[cfg(feature = "parallel")]
-    per_tet: Vec<[DVec3; 4]>,
+    /// Per chunk of [`CHUNK_TETS`] tetrahedra: the first node it touches and its force window;
+    /// empty for meshes of a single chunk.
+    windows: Vec<(usize, Vec<DVec3>)>,
 }
 
 impl FvmMesh {
     /// Precomputes the rest data of every tetrahedron of `mesh`.
     pub fn new(mesh: &TetMesh) -> Self {
-        let tets = mesh.tets().to_vec();
+        let tet_count = mesh.tet_count();
         let rest = TetRest::of_mesh(mesh);
         let node_count = mesh.node_count();
-        let wave_length_scale = wave_length_scale(&tets, &rest, node_count);
-        #[cfg(feature = "parallel")]
-        {
-            let (offsets, incidence) = node_incidence(&tets, node_count);
-            let per_tet = if tets.len() >= PARALLEL_MIN_TETS {
-                vec![[DVec3::ZERO; 4]; tets.len()]
-            } else {
-                Vec::new()
-            };
-            Self {
-                tets,
-                rest,
-                node_count,
-                wave_length_scale,
-                offsets,
-                incidence,
-                per_tet,
-            }
-        }
-        #[cfg(not(feature = "parallel"))]
+        let wave_length_scale = wave_length_scale(mesh.tets(), &rest, node_count);
+        let padded = tet_count.div_ceil(LANES) * LANES;
+        let mut tets = mesh.tets().to_vec();
+        tets.resize(padded, tets[tet_count - 1]);
+        let blocks = (0..padded / LANES)
+            .map(|b| {
+                let lane = |l: usize| rest[(LANES * b + l).min(tet_count - 1)];
+                let lanes: [TetRest; LANES] = std::array::from_fn(lane);
+                RestBlock {
+                    inverse_rest_edges: Mat3x4::from_lanes(lanes.map(|r| r.inverse_rest_edges)),
+                    volume: f64x4::new(lanes.map(|r| r.volume)),
+                }
+            })
+            .collect();
+        let windows = if tet_count > CHUNK_TETS {
+            tets[..tet_count]
+                .chunks(CHUNK_TETS)
+                .map(|chunk| {
+                    let nodes = chunk.iter().flatten();
+                    let first = *nodes.clone().min().unwrap_or(&0) as usize;
+                    let last = *nodes.max().unwrap_or(&0) as usize;
+                    (first, vec![DVec3::ZERO; last + 1 - first])
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
         Self {
             tets,
-            rest,
+            tet_count,
+            blocks,
             node_count,
             wave_length_scale,
+            windows,
         }
     }
 
     /// The tetrahedra (node indices).
     pub fn tets(&self) -> &[[u32; 4]] {
-        &self.tets
+        &self.tets[..self.tet_count]
     }
 
-    /// Rest data per tetrahedron, in the order of [`FvmMesh::tets`].
-    pub fn rest(&self) -> &[TetRest] {
-        &self.rest
+    /// Rest data of tetrahedron `tet`.
+    ///
+    /// # Panics
+    /// If `tet` is not below the number of tetrahedra.
+    pub fn tet_rest(&self, tet: usize) -> TetRest {
+        assert!(tet < self.tet_count, "tetrahedron {tet} does not exist");
+        let block = &self.blocks[tet / LANES];
+        TetRest {
+            inverse_rest_edges: block.inverse_rest_edges.to_lanes()[tet % LANES],
+            volume: block.volume.to_array()[tet % LANES],
+        }
     }
 
     /// Number of nodes.
@@ -131,55 +155,102 @@ impl FvmMesh {
     ) {
         debug_assert!(x.len() == self.node_count && v.len() == self.node_count);
         debug_assert!(out.len() == self.node_count);
-        #[cfg(feature = "parallel")]
-        if !self.per_tet.is_empty() && rayon::current_num_threads() > 1 {
-            self.internal_forces_parallel(model, damping, x, v, out);
+        out.fill(DVec3::ZERO);
+        if self.windows.is_empty() {
+            add_chunk_forces(model, damping, &self.tets, &self.blocks, self.tet_count, x, v, out, 0);
             return;
         }
-        out.fill(DVec3::ZERO);
-        for (tet, rest) in self.tets.iter().zip(&self.rest) {
-            let forces = tet_forces(model, damping, rest, &gather(tet, x), &gather(tet, v));
-            for (corner, &n) in tet.iter().enumerate() {
-                out[n as usize] += forces[corner];
+        let (tets, blocks, tet_count) = (&self.tets, &self.blocks, self.tet_count);
+        let chunk_forces = |(c, (first, window)): (usize, &mut (usize, Vec<DVec3>))| {
+            window.fill(DVec3::ZERO);
+            let start = c * CHUNK_TETS;
+            let end = (start + CHUNK_TETS).min(tets.len());
+            let blocks = &blocks[start / LANES..end / LANES];
+            let valid = tet_count - start;
+            add_chunk_forces(model, damping, &tets[start..end], blocks, valid, x, v, window, *first);
+        };
+        #[cfg(feature = "parallel")]
+        {
+            use rayon::prelude::*;
+            self.windows.par_iter_mut().enumerate().for_each(chunk_forces);
+        }
+        #[cfg(not(feature = "parallel"))]
+        self.windows.iter_mut().enumerate().for_each(chunk_forces);
+        for (first, window) in &self.windows {
+            for (total, force) in out[*first..].iter_mut().zip(window) {
+                *total += *force;
             }
         }
     }
 
-    #[cfg(feature = "parallel")]
-    fn internal_forces_parallel<M: HyperelasticModel>(
-        &mut self,
-        model: &M,
-        damping: Option<&RayleighDamping>,
-        x: &[DVec3],
-        v: &[DVec3],
-        out: &mut [DVec3],
-    ) {
-        use rayon::prelude::*;
-        let (tets, rest) = (&self.tets, &self.rest);
-        self.per_tet
-            .par_iter_mut()
-            .zip(tets.par_iter().zip(rest.par_iter()))
-            .for_each(|(forces, (tet, rest))| {
-                *forces = tet_forces(model, damping, rest, &gather(tet, x), &gather(tet, v));
-            });
-        let (offsets, incidence, per_tet) = (&self.offsets, &self.incidence, &self.per_tet);
-        out.par_iter_mut().enumerate().for_each(|(n, force)| {
-            *force = incidence[offsets[n]..offsets[n + 1]]
-                .iter()
-                .fold(DVec3::ZERO, |sum, &e| {
-                    sum + per_tet[e as usize / 4][e as usize % 4]
-                });
-        });
-    }
-
     /// Total elastic energy `Σ V Ψ(F)` (J) at positions `x` (m).
     pub fn elastic_energy<M: HyperelasticModel>(&self, model: &M, x: &[DVec3]) -> f64 {
-        self.tets
-            .iter()
-            .zip(&self.rest)
-            .map(|(tet, rest)| rest.volume * model.energy_density(&rest.gradient(&gather(tet, x))))
+        (0..self.tet_count)
+            .map(|t| {
+                let rest = self.tet_rest(t);
+                rest.volume * model.energy_density(&rest.gradient(&gather(&self.tets[t], x)))
+            })
             .sum()
     }
+}
+
+/// Adds the forces of the first `valid` of `tets` (padded to whole blocks) into `out`, whose
+/// entry 0 is node `first`.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn add_chunk_forces<M: HyperelasticModel>(
+    model: &M,
+    damping: Option<&RayleighDamping>,
+    tets: &[[u32; 4]],
+    blocks: &[RestBlock],
+    valid: usize,
+    x: &[DVec3],
+    v: &[DVec3],
+    out: &mut [DVec3],
+    first: usize,
+) {
+    for (b, (block_tets, rest)) in tets.chunks_exact(LANES).zip(blocks).enumerate() {
+        let forces = block_forces(model, damping, rest, block_tets, x, v);
+        let block_valid = valid.saturating_sub(b * LANES).min(LANES);
+        for (tet, tet_forces) in block_tets.iter().zip(&forces).take(block_valid) {
+            for (&n, f) in tet.iter().zip(tet_forces) {
+                out[n as usize - first] += *f;
+            }
+        }
+    }
+}
+
+/// [`tet_forces`] for the [`LANES`] tetrahedra of one block.
+#[inline(always)]
+fn block_forces<M: HyperelasticModel>(
+    model: &M,
+    damping: Option<&RayleighDamping>,
+    rest: &RestBlock,
+    tets: &[[u32; 4]],
+    x: &[DVec3],
+    v: &[DVec3],
+) -> [[DVec3; 4]; LANES] {
+    let f = lane_edges(tets, x) * rest.inverse_rest_edges;
+    let extra = match damping {
+        Some(damping) => {
+            damping.second_piola_lanes(&f, &(lane_edges(tets, v) * rest.inverse_rest_edges))
+        }
+        None => Mat3x4::splat(rapier3d::glamx::DMat3::ZERO),
+    };
+    let stress = model.first_piola_plus_lanes(&f, &extra);
+    // Forces on nodes 1..3 are the columns of P b = -V P Dm⁻ᵀ.
+    let forces = stress * rest.inverse_rest_edges.transpose() * -rest.volume;
+    let [f1, f2, f3] = forces.cols.map(Vec3x4::to_lanes);
+    let f0 = (-(forces.cols[0] + forces.cols[1] + forces.cols[2])).to_lanes();
+    std::array::from_fn(|l| [f0[l], f1[l], f2[l], f3[l]])
+}
+
+/// The edge matrices `[x1 - x0, x2 - x0, x3 - x0]` of the block's tetrahedra, one per lane.
+#[inline(always)]
+fn lane_edges(tets: &[[u32; 4]], values: &[DVec3]) -> Mat3x4 {
+    let corner = |c: usize| Vec3x4::from_lanes(std::array::from_fn(|l| values[tets[l][c] as usize]));
+    let origin = corner(0);
+    Mat3x4::from_cols(corner(1) - origin, corner(2) - origin, corner(3) - origin)
 }
 
 fn wave_length_scale(tets: &[[u32; 4]], rest: &[TetRest], node_count: usize) -> f64 {
@@ -187,12 +258,7 @@ fn wave_length_scale(tets: &[[u32; 4]], rest: &[TetRest], node_count: usize) -> 
     let mut row_sum = vec![0.0; node_count];
     for (tet, rest) in tets.iter().zip(rest) {
         let g = rest.inverse_rest_edges.transpose();
-        let gradients = [
-            -(g.x_axis + g.y_axis + g.z_axis),
-            g.x_axis,
-            g.y_axis,
-            g.z_axis,
-        ];
+        let gradients = [-(g.x_axis + g.y_axis + g.z_axis), g.x_axis, g.y_axis, g.z_axis];
         let total: f64 = gradients.iter().map(|g| g.length()).sum();
         for (corner, &n) in tet.iter().enumerate() {
             control_volume[n as usize] += 0.25 * rest.volume;
@@ -211,27 +277,4 @@ fn wave_length_scale(tets: &[[u32; 4]], rest: &[TetRest], node_count: usize) -> 
 #[inline]
 pub(crate) fn gather(tet: &[u32; 4], values: &[DVec3]) -> [DVec3; 4] {
     tet.map(|n| values[n as usize])
-}
-
-/// Node-to-corner incidence lists in CSR form, each in ascending tetrahedron order.
-#[cfg(feature = "parallel")]
-fn node_incidence(tets: &[[u32; 4]], node_count: usize) -> (Vec<usize>, Vec<u32>) {
-    let mut offsets = vec![0usize; node_count + 1];
-    for tet in tets {
-        for &n in tet {
-            offsets[n as usize + 1] += 1;
-        }
-    }
-    for n in 0..node_count {
-        offsets[n + 1] += offsets[n];
-    }
-    let mut fill = offsets.clone();
-    let mut incidence = vec![0u32; 4 * tets.len()];
-    for (t, tet) in tets.iter().enumerate() {
-        for (corner, &n) in tet.iter().enumerate() {
-            incidence[fill[n as usize]] = (4 * t + corner) as u32;
-            fill[n as usize] += 1;
-        }
-    }
-    (offsets, incidence)
 }

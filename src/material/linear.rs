@@ -1,7 +1,8 @@
 //! Linear elasticity: `ε = sym(F) - I`, `P = σ = λ tr(ε) I + 2 μ ε`,
 //! `Ψ = μ ε:ε + λ/2 tr(ε)²`.
 
-use super::{HyperelasticModel, LameParameters, double_dot, symmetric_part, trace};
+use super::{HyperelasticModel, LameParameters, double_dot, linear_law_lanes, symmetric_part, trace};
+use crate::lanes::{Mat3x4, f64x4};
 use rapier3d::glamx::DMat3;
 
 /// Linear (small-strain) elasticity with the given Lamé parameters. Not invariant under rotation.
@@ -30,5 +31,11 @@ impl HyperelasticModel for LinearElastic {
 
     fn first_piola_differential(&self, _f: &DMat3, df: &DMat3) -> DMat3 {
         self.stress_of_strain(&symmetric_part(df))
+    }
+
+    #[inline(always)]
+    fn first_piola_plus_lanes(&self, f: &Mat3x4, s_extra: &Mat3x4) -> Mat3x4 {
+        let strain = f.symmetric_part().add_diagonal(f64x4::splat(-1.0));
+        linear_law_lanes(self.0, &strain) + *f * *s_extra
     }
 }

@@ -17,6 +17,7 @@ pub use neo_hookean::StableNeoHookean;
 pub use stvk::StVenantKirchhoff;
 
 use crate::Error;
+use crate::lanes::{Mat3x4, f64x4};
 use rapier3d::glamx::DMat3;
 
 /// A hyperelastic constitutive model: energy density, stress and stress differential of the
@@ -28,6 +29,22 @@ pub trait HyperelasticModel: Copy + Send + Sync {
     fn first_piola(&self, f: &DMat3) -> DMat3;
     /// Differential of the stress, `dP = (∂P/∂F) : dF` (Pa), for a change `df` of `F`.
     fn first_piola_differential(&self, f: &DMat3, df: &DMat3) -> DMat3;
+
+    /// `P(F) + F S_extra` (Pa) in four lanes at once: the stress plus the first Piola–Kirchhoff
+    /// form of an extra second Piola–Kirchhoff stress (the damping stress). The default evaluates
+    /// the lanes one by one with the scalar methods; models with short branch-free formulas
+    /// override it with SIMD arithmetic.
+    #[inline(always)]
+    fn first_piola_plus_lanes(&self, f: &Mat3x4, s_extra: &Mat3x4) -> Mat3x4 {
+        let stress = Mat3x4::from_lanes(f.to_lanes().map(|f| self.first_piola(&f)));
+        stress + *f * *s_extra
+    }
+}
+
+/// `λ tr(E) I + 2μ E` in four lanes: the linear law on a symmetric strain `E`.
+#[inline(always)]
+pub(crate) fn linear_law_lanes(lame: LameParameters, strain: &Mat3x4) -> Mat3x4 {
+    (*strain * f64x4::splat(2.0 * lame.mu)).add_diagonal(strain.trace() * f64x4::splat(lame.lambda))
 }
 
 /// Which constitutive law a body uses. All four share the Lamé parameters of the material.

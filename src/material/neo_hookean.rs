@@ -5,6 +5,7 @@
 //! `P = μ F + (λ' (J - 1) - μ) cof(F)`, defined for inverted elements (`J <= 0`) too.
 
 use super::{HyperelasticModel, LameParameters, double_dot};
+use crate::lanes::{Mat3x4, f64x4};
 use rapier3d::glamx::DMat3;
 
 /// Stable Neo-Hookean material.
@@ -64,5 +65,14 @@ impl HyperelasticModel for StableNeoHookean {
         *df * self.mu
             + cof * (self.lambda_prime * double_dot(&cof, df))
             + cofactor_differential(f, df) * (self.lambda_prime * (j - 1.0) - self.mu)
+    }
+
+    /// `F (μ I + S_extra) + (λ' (J - 1) - μ) cof(F)`.
+    #[inline(always)]
+    fn first_piola_plus_lanes(&self, f: &Mat3x4, s_extra: &Mat3x4) -> Mat3x4 {
+        let cofactor = f.cofactor();
+        let j = f.cols[0].dot(cofactor.cols[0]);
+        let volumetric = (j - f64x4::ONE) * f64x4::splat(self.lambda_prime) - f64x4::splat(self.mu);
+        *f * s_extra.add_diagonal(f64x4::splat(self.mu)) + cofactor * volumetric
     }
 }

@@ -1,7 +1,8 @@
 //! St. Venant–Kirchhoff: the linear law on the Green strain `G = (FᵀF - I)/2`,
 //! `S = λ tr(G) I + 2 μ G`, `P = F S`, `Ψ = μ G:G + λ/2 tr(G)²`.
 
-use super::{HyperelasticModel, LameParameters, double_dot, symmetric_part, trace};
+use super::{HyperelasticModel, LameParameters, double_dot, linear_law_lanes, symmetric_part, trace};
+use crate::lanes::{Mat3x4, f64x4};
 use rapier3d::glamx::DMat3;
 
 /// St. Venant–Kirchhoff material with the given Lamé parameters.
@@ -39,5 +40,12 @@ impl HyperelasticModel for StVenantKirchhoff {
         let s = self.second_piola(&green_strain(f));
         let ds = self.second_piola(&symmetric_part(&(f.transpose() * *df)));
         *df * s + *f * ds
+    }
+
+    /// `F (S + S_extra)`: one product for the elastic and the extra stress.
+    #[inline(always)]
+    fn first_piola_plus_lanes(&self, f: &Mat3x4, s_extra: &Mat3x4) -> Mat3x4 {
+        let green = (f.transpose_mul(f).add_diagonal(f64x4::splat(-1.0))) * f64x4::splat(0.5);
+        *f * (linear_law_lanes(self.0, &green) + *s_extra)
     }
 }

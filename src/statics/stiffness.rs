@@ -75,8 +75,8 @@ impl Stiffness {
         self.values.fill(0.0);
         let fvm = &body.fvm;
         with_hyperelastic_model!(body.material, |model| {
-            for (tet, rest) in fvm.tets().iter().zip(fvm.rest()) {
-                let k = element_stiffness(&model, rest, &gather(tet, body.positions()));
+            for (t, tet) in fvm.tets().iter().enumerate() {
+                let k = element_stiffness(&model, &fvm.tet_rest(t), &gather(tet, body.positions()));
                 self.add_element(tet, &k, &body.pinned);
             }
         });
