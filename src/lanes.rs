@@ -164,9 +164,21 @@ impl Mat3x4 {
     pub fn transpose(&self) -> Self {
         let [a, b, c] = self.cols;
         Self::from_cols(
-            Vec3x4 { x: a.x, y: b.x, z: c.x },
-            Vec3x4 { x: a.y, y: b.y, z: c.y },
-            Vec3x4 { x: a.z, y: b.z, z: c.z },
+            Vec3x4 {
+                x: a.x,
+                y: b.x,
+                z: c.x,
+            },
+            Vec3x4 {
+                x: a.y,
+                y: b.y,
+                z: c.y,
+            },
+            Vec3x4 {
+                x: a.z,
+                y: b.z,
+                z: c.z,
+            },
         )
     }
 

@@ -1,4 +1,4 @@
-//! # rapier_fvm
+//! # `rapier_fvm`
 //!
 //! Physically based soft bodies for the [rapier](https://rapier.rs) physics engine, simulated with
 //! the finite-volume method on tetrahedral meshes, in SI units throughout: lengths in m, time in
@@ -50,6 +50,11 @@ pub mod mesh;
 pub mod statics;
 
 pub use error::Error;
+
+/// The README's examples, compiled and run as doctests.
+#[doc = include_str!("../README.md")]
+#[cfg(doctest)]
+pub struct ReadmeDoctests;
 /// glam math types (f64 `DVec3`, `DMat3`, `DQuat` for this crate's API), re-exported from rapier.
 pub use rapier3d::glamx;
 

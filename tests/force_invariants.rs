@@ -167,7 +167,8 @@ fn stress_is_the_derivative_of_the_energy_density() {
         .unwrap()
         .lame();
     let mut rng = Lcg(9);
-    let models: [(&str, &dyn Fn(&DMat3) -> (f64, DMat3)); 4] = [
+    type EnergyAndStress<'a> = &'a dyn Fn(&DMat3) -> (f64, DMat3);
+    let models: [(&str, EnergyAndStress); 4] = [
         ("linear", &|f| {
             (
                 LinearElastic(lame).energy_density(f),
@@ -230,18 +231,26 @@ fn simd_mesh_loop_matches_the_scalar_kernel() {
     use rapier_fvm::fvm::{FvmMesh, tet_forces};
     // 80 tetrahedra (one chunk), and 20 250 (three chunks of the parallel loop, the last block
     // padded).
-    let bodies = MODELS.map(|model| random_body(model, 21, 0.01)).into_iter().chain([{
-        let material = Material::new(MaterialModel::StVenantKirchhoff, 1e6, 0.35, 1000.0).unwrap();
-        let mesh = mesh::cuboid(DVec3::new(0.3, 0.3, 0.05), [27, 30, 5]).unwrap();
-        let mut body = SoftBodyBuilder::new(mesh, material)
-            .damping(RayleighDamping::new(300.0, 200.0).unwrap())
-            .build()
-            .unwrap();
-        let mut rng = Lcg(8);
-        body.positions_mut().iter_mut().for_each(|x| *x += rng.vector() * 1e-3);
-        body.velocities_mut().iter_mut().for_each(|v| *v = rng.vector());
-        body
-    }]);
+    let bodies = MODELS
+        .map(|model| random_body(model, 21, 0.01))
+        .into_iter()
+        .chain([{
+            let material =
+                Material::new(MaterialModel::StVenantKirchhoff, 1e6, 0.35, 1000.0).unwrap();
+            let mesh = mesh::cuboid(DVec3::new(0.3, 0.3, 0.05), [27, 30, 5]).unwrap();
+            let mut body = SoftBodyBuilder::new(mesh, material)
+                .damping(RayleighDamping::new(300.0, 200.0).unwrap())
+                .build()
+                .unwrap();
+            let mut rng = Lcg(8);
+            body.positions_mut()
+                .iter_mut()
+                .for_each(|x| *x += rng.vector() * 1e-3);
+            body.velocities_mut()
+                .iter_mut()
+                .for_each(|v| *v = rng.vector());
+            body
+        }]);
     for body in bodies {
         let model = body.material().model();
         let fvm = FvmMesh::new(body.mesh());
@@ -255,10 +264,22 @@ fn simd_mesh_loop_matches_the_scalar_kernel() {
             let vs = tet.map(|n| v[n as usize]);
             let rest = fvm.tet_rest(t);
             let forces = match model {
-                MaterialModel::Linear => tet_forces(&LinearElastic(lame), damping.as_ref(), &rest, &xs, &vs),
-                MaterialModel::StVenantKirchhoff => tet_forces(&StVenantKirchhoff(lame), damping.as_ref(), &rest, &xs, &vs),
-                MaterialModel::Corotated => tet_forces(&Corotated(lame), damping.as_ref(), &rest, &xs, &vs),
-                _ => tet_forces(&StableNeoHookean::new(lame), damping.as_ref(), &rest, &xs, &vs),
+                MaterialModel::Linear => {
+                    tet_forces(&LinearElastic(lame), damping.as_ref(), &rest, &xs, &vs)
+                }
+                MaterialModel::StVenantKirchhoff => {
+                    tet_forces(&StVenantKirchhoff(lame), damping.as_ref(), &rest, &xs, &vs)
+                }
+                MaterialModel::Corotated => {
+                    tet_forces(&Corotated(lame), damping.as_ref(), &rest, &xs, &vs)
+                }
+                _ => tet_forces(
+                    &StableNeoHookean::new(lame),
+                    damping.as_ref(),
+                    &rest,
+                    &xs,
+                    &vs,
+                ),
             };
             for (c, &n) in tet.iter().enumerate() {
                 expected[n as usize] += forces[c];
@@ -267,8 +288,15 @@ fn simd_mesh_loop_matches_the_scalar_kernel() {
         let mut body = body;
         let actual = body.internal_forces().to_vec();
         let largest = expected.iter().map(|f| f.length()).fold(0.0, f64::max);
-        let worst = expected.iter().zip(&actual).map(|(a, b)| (*a - *b).length()).fold(0.0, f64::max);
-        assert!(worst <= 1e-13 * largest, "{model:?}: {worst:e} of {largest:e}");
+        let worst = expected
+            .iter()
+            .zip(&actual)
+            .map(|(a, b)| (*a - *b).length())
+            .fold(0.0, f64::max);
+        assert!(
+            worst <= 1e-13 * largest,
+            "{model:?}: {worst:e} of {largest:e}"
+        );
     }
 }
 
@@ -281,8 +309,12 @@ fn forces_are_bit_identical_whatever_the_thread_count() {
         .build()
         .unwrap();
     let mut rng = Lcg(12);
-    body.positions_mut().iter_mut().for_each(|x| *x += rng.vector() * 1e-3);
-    body.velocities_mut().iter_mut().for_each(|v| *v = rng.vector());
+    body.positions_mut()
+        .iter_mut()
+        .for_each(|x| *x += rng.vector() * 1e-3);
+    body.velocities_mut()
+        .iter_mut()
+        .for_each(|v| *v = rng.vector());
     let forces_with = |threads: usize, body: &mut SoftBody| {
         rayon::ThreadPoolBuilder::new()
             .num_threads(threads)

@@ -157,7 +157,17 @@ impl FvmMesh {
         debug_assert!(out.len() == self.node_count);
         out.fill(DVec3::ZERO);
         if self.windows.is_empty() {
-            add_chunk_forces(model, damping, &self.tets, &self.blocks, self.tet_count, x, v, out, 0);
+            add_chunk_forces(
+                model,
+                damping,
+                &self.tets,
+                &self.blocks,
+                self.tet_count,
+                x,
+                v,
+                out,
+                0,
+            );
             return;
         }
         let (tets, blocks, tet_count) = (&self.tets, &self.blocks, self.tet_count);
@@ -167,12 +177,25 @@ impl FvmMesh {
             let end = (start + CHUNK_TETS).min(tets.len());
             let blocks = &blocks[start / LANES..end / LANES];
             let valid = tet_count - start;
-            add_chunk_forces(model, damping, &tets[start..end], blocks, valid, x, v, window, *first);
+            add_chunk_forces(
+                model,
+                damping,
+                &tets[start..end],
+                blocks,
+                valid,
+                x,
+                v,
+                window,
+                *first,
+            );
         };
         #[cfg(feature = "parallel")]
         {
             use rayon::prelude::*;
-            self.windows.par_iter_mut().enumerate().for_each(chunk_forces);
+            self.windows
+                .par_iter_mut()
+                .enumerate()
+                .for_each(chunk_forces);
         }
         #[cfg(not(feature = "parallel"))]
         self.windows.iter_mut().enumerate().for_each(chunk_forces);
@@ -248,7 +271,8 @@ fn block_forces<M: HyperelasticModel>(
 /// The edge matrices `[x1 - x0, x2 - x0, x3 - x0]` of the block's tetrahedra, one per lane.
 #[inline(always)]
 fn lane_edges(tets: &[[u32; 4]], values: &[DVec3]) -> Mat3x4 {
-    let corner = |c: usize| Vec3x4::from_lanes(std::array::from_fn(|l| values[tets[l][c] as usize]));
+    let corner =
+        |c: usize| Vec3x4::from_lanes(std::array::from_fn(|l| values[tets[l][c] as usize]));
     let origin = corner(0);
     Mat3x4::from_cols(corner(1) - origin, corner(2) - origin, corner(3) - origin)
 }
@@ -258,7 +282,12 @@ fn wave_length_scale(tets: &[[u32; 4]], rest: &[TetRest], node_count: usize) -> 
     let mut row_sum = vec![0.0; node_count];
     for (tet, rest) in tets.iter().zip(rest) {
         let g = rest.inverse_rest_edges.transpose();
-        let gradients = [-(g.x_axis + g.y_axis + g.z_axis), g.x_axis, g.y_axis, g.z_axis];
+        let gradients = [
+            -(g.x_axis + g.y_axis + g.z_axis),
+            g.x_axis,
+            g.y_axis,
+            g.z_axis,
+        ];
         let total: f64 = gradients.iter().map(|g| g.length()).sum();
         for (corner, &n) in tet.iter().enumerate() {
             control_volume[n as usize] += 0.25 * rest.volume;

@@ -100,7 +100,7 @@ impl HyperelasticModel for Corotated {
         (*f - r) * (2.0 * mu) + r * (lambda * (stretch_trace - 3.0))
     }
 
-    /// Uses `dR = R [w]x` with `w = (tr(S) I - S)⁻¹ axial(Rᵀ dF - dFᵀ R)` (McAdams et al. 2011).
+    /// Uses `dR = R [w]x` with `w = (tr(S) I - S)⁻¹ axial(Rᵀ dF - dFᵀ R)` (`McAdams` et al. 2011).
     fn first_piola_differential(&self, f: &DMat3, df: &DMat3) -> DMat3 {
         let r = polar_rotation(f);
         let LameParameters { lambda, mu } = self.0;

@@ -1,7 +1,9 @@
 //! Linear elasticity: `ε = sym(F) - I`, `P = σ = λ tr(ε) I + 2 μ ε`,
 //! `Ψ = μ ε:ε + λ/2 tr(ε)²`.
 
-use super::{HyperelasticModel, LameParameters, double_dot, linear_law_lanes, symmetric_part, trace};
+use super::{
+    HyperelasticModel, LameParameters, double_dot, linear_law_lanes, symmetric_part, trace,
+};
 use crate::lanes::{Mat3x4, f64x4};
 use rapier3d::glamx::DMat3;
 

@@ -1,7 +1,9 @@
 //! St. Venant–Kirchhoff: the linear law on the Green strain `G = (FᵀF - I)/2`,
 //! `S = λ tr(G) I + 2 μ G`, `P = F S`, `Ψ = μ G:G + λ/2 tr(G)²`.
 
-use super::{HyperelasticModel, LameParameters, double_dot, linear_law_lanes, symmetric_part, trace};
+use super::{
+    HyperelasticModel, LameParameters, double_dot, linear_law_lanes, symmetric_part, trace,
+};
 use crate::lanes::{Mat3x4, f64x4};
 use rapier3d::glamx::DMat3;
 
