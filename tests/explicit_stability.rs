@@ -166,23 +166,11 @@ fn automatic_substeps_keep_every_case_bounded() {
             ] {
                 for damping_time in [0.0, 1e-3] {
                     let material = Material::new(model, young, nu, 1000.0).unwrap();
-                    let (mut body, _) = common::cantilever([6, 1, 1], material);
-                    if damping_time > 0.0 {
-                        body = {
-                            let lame = material.lame();
-                            let mesh = body.mesh().clone();
-                            let pinned: Vec<u32> = mesh.nodes_where(|p| p.x <= -0.5 + 1e-9);
-                            SoftBodyBuilder::new(mesh, material)
-                                .translation(DVec3::new(0.5, 0.0, 0.0))
-                                .damping(
-                                    RayleighDamping::stiffness_proportional(damping_time, lame)
-                                        .unwrap(),
-                                )
-                                .pinned_nodes(pinned)
-                                .build()
-                                .unwrap()
-                        };
-                    }
+                    let damping = (damping_time > 0.0).then(|| {
+                        RayleighDamping::stiffness_proportional(damping_time, material.lame())
+                            .unwrap()
+                    });
+                    let (mut body, _) = common::damped_cantilever([6, 1, 1], material, damping);
                     let gravity = common::gravity();
                     let start = body.gravity_potential_energy(gravity);
                     let weight_scale = body.total_mass() * common::GRAVITY * common::LENGTH;

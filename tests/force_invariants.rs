@@ -12,10 +12,11 @@ use rapier_fvm::material::{
 };
 use rapier_fvm::prelude::*;
 
-fn random_body(model: MaterialModel, seed: u64, amplitude: f64) -> SoftBody {
+/// A body of `mesh` (E = 1 MPa, ν = 0.35, damped) with its nodes moved randomly by up to
+/// `amplitude` (m) and random velocities up to 1 m/s per component.
+fn randomized(mesh: TetMesh, model: MaterialModel, seed: u64, amplitude: f64) -> SoftBody {
     let material = Material::new(model, 1e6, 0.35, 1000.0).unwrap();
     let damping = RayleighDamping::new(300.0, 200.0).unwrap();
-    let mesh = mesh::cuboid(DVec3::new(0.2, 0.1, 0.1), [4, 2, 2]).unwrap();
     let mut body = SoftBodyBuilder::new(mesh, material)
         .damping(damping)
         .build()
@@ -28,6 +29,12 @@ fn random_body(model: MaterialModel, seed: u64, amplitude: f64) -> SoftBody {
         *v = rng.vector();
     }
     body
+}
+
+/// A 4 x 2 x 2-cell (80-tetrahedron) bar, randomized.
+fn random_body(model: MaterialModel, seed: u64, amplitude: f64) -> SoftBody {
+    let mesh = mesh::cuboid(DVec3::new(0.2, 0.1, 0.1), [4, 2, 2]).unwrap();
+    randomized(mesh, model, seed, amplitude)
 }
 
 fn sums(body: &mut SoftBody) -> (DVec3, DVec3, f64, f64) {
@@ -234,23 +241,12 @@ fn simd_mesh_loop_matches_the_scalar_kernel() {
     let bodies = MODELS
         .map(|model| random_body(model, 21, 0.01))
         .into_iter()
-        .chain([{
-            let material =
-                Material::new(MaterialModel::StVenantKirchhoff, 1e6, 0.35, 1000.0).unwrap();
-            let mesh = mesh::cuboid(DVec3::new(0.3, 0.3, 0.05), [27, 30, 5]).unwrap();
-            let mut body = SoftBodyBuilder::new(mesh, material)
-                .damping(RayleighDamping::new(300.0, 200.0).unwrap())
-                .build()
-                .unwrap();
-            let mut rng = Lcg(8);
-            body.positions_mut()
-                .iter_mut()
-                .for_each(|x| *x += rng.vector() * 1e-3);
-            body.velocities_mut()
-                .iter_mut()
-                .for_each(|v| *v = rng.vector());
-            body
-        }]);
+        .chain([randomized(
+            mesh::cuboid(DVec3::new(0.3, 0.3, 0.05), [27, 30, 5]).unwrap(),
+            MaterialModel::StVenantKirchhoff,
+            8,
+            1e-3,
+        )]);
     for body in bodies {
         let model = body.material().model();
         let fvm = FvmMesh::new(body.mesh());
@@ -302,19 +298,8 @@ fn simd_mesh_loop_matches_the_scalar_kernel() {
 
 #[test]
 fn forces_are_bit_identical_whatever_the_thread_count() {
-    let material = Material::new(MaterialModel::StableNeoHookean, 1e6, 0.35, 1000.0).unwrap();
     let mesh = mesh::cuboid(DVec3::splat(0.2), [16, 16, 16]).unwrap();
-    let mut body = SoftBodyBuilder::new(mesh, material)
-        .damping(RayleighDamping::new(300.0, 200.0).unwrap())
-        .build()
-        .unwrap();
-    let mut rng = Lcg(12);
-    body.positions_mut()
-        .iter_mut()
-        .for_each(|x| *x += rng.vector() * 1e-3);
-    body.velocities_mut()
-        .iter_mut()
-        .for_each(|v| *v = rng.vector());
+    let mut body = randomized(mesh, MaterialModel::StableNeoHookean, 12, 1e-3);
     let forces_with = |threads: usize, body: &mut SoftBody| {
         rayon::ThreadPoolBuilder::new()
             .num_threads(threads)

@@ -47,18 +47,8 @@ fn released_from_static_deflection(
 ) -> (SoftBody, usize) {
     let (mut body, tip) = cantilever(cells, material(model));
     statics::solve_equilibrium(&mut body, common::gravity(), &StaticSettings::default()).unwrap();
-    let deflected = body.positions().to_vec();
-    let clamped = body
-        .mesh()
-        .nodes_where(|p| p.x <= -common::LENGTH / 2.0 + 1e-9);
-    let mut builder = SoftBodyBuilder::new(body.mesh().clone(), material(model))
-        .translation(DVec3::new(common::LENGTH / 2.0, 0.0, 0.0))
-        .pinned_nodes(clamped);
-    if let Some(damping) = damping {
-        builder = builder.damping(damping);
-    }
-    let mut released = builder.build().unwrap();
-    released.positions_mut().copy_from_slice(&deflected);
+    let (mut released, _) = common::damped_cantilever(cells, material(model), damping);
+    released.positions_mut().copy_from_slice(body.positions());
     (released, tip)
 }
 

@@ -13,16 +13,26 @@ pub const GRAVITY: f64 = 9.81;
 /// The reference cantilever along +x from x = 0 (clamped) to x = L, centred on the x axis, with
 /// `cells` cubes along x, y, z; returns the body and the node at the centre of the free end.
 pub fn cantilever(cells: [usize; 3], material: Material) -> (SoftBody, usize) {
+    damped_cantilever(cells, material, None)
+}
+
+/// [`cantilever`] with optional Rayleigh damping.
+pub fn damped_cantilever(
+    cells: [usize; 3],
+    material: Material,
+    damping: Option<RayleighDamping>,
+) -> (SoftBody, usize) {
     let half = DVec3::new(LENGTH / 2.0, SIDE / 2.0, SIDE / 2.0);
     let mesh = mesh::cuboid(half, cells).unwrap();
     let clamped = mesh.nodes_where(|p| p.x <= -half.x + 1e-9);
     let tip = mesh.nearest_node(DVec3::new(half.x, 0.0, 0.0)) as usize;
-    let body = SoftBodyBuilder::new(mesh, material)
+    let mut builder = SoftBodyBuilder::new(mesh, material)
         .translation(DVec3::new(half.x, 0.0, 0.0))
-        .pinned_nodes(clamped)
-        .build()
-        .unwrap();
-    (body, tip)
+        .pinned_nodes(clamped);
+    if let Some(damping) = damping {
+        builder = builder.damping(damping);
+    }
+    (builder.build().unwrap(), tip)
 }
 
 /// Second moment of area of the square section (m⁴).
