@@ -39,6 +39,7 @@
 //! # Ok::<(), rapier_fvm::Error>(())
 //! ```
 
+mod assembly;
 pub mod body;
 pub mod damping;
 mod error;

@@ -6,16 +6,11 @@
 //! factorization, so they need `K` positive definite on the free nodes: pin enough nodes to stop
 //! rigid motion.
 
-mod stiffness;
-
 use crate::Error;
+use crate::assembly::{Stiffness, factorize, solve, stress_tangent};
 use crate::body::SoftBody;
-use crate::material::with_hyperelastic_model;
-use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::Llt;
-use faer::{Col, Side};
+use crate::material::{HyperelasticModel, with_hyperelastic_model};
 use rapier3d::glamx::DVec3;
-use stiffness::Stiffness;
 
 /// The largest relative residual accepted as round-off when Newton stops reducing it.
 const ROUND_OFF_CEILING: f64 = 1e-6;
@@ -91,8 +86,16 @@ pub fn solve_equilibrium(
             });
         }
         previous = relative;
-        stiffness.assemble(body);
-        let factor = factorize(&stiffness, iteration)?;
+        // The exact tangent converges quadratically; where the body is in an unstable (buckling)
+        // state it is indefinite, and the projected tangent still gives a descent direction.
+        assemble_elastic(&mut stiffness, body, false);
+        let factor = match factorize(&stiffness, iteration) {
+            Ok(factor) => factor,
+            Err(_) => {
+                assemble_elastic(&mut stiffness, body, true);
+                factorize(&stiffness, iteration)?
+            }
+        };
         let step = solve(&factor, &residual);
         line_search(body, &load, &residual, &step);
         residual = out_of_balance(body, &load);
@@ -121,7 +124,7 @@ pub fn fundamental_frequency(body: &SoftBody) -> Result<f64, Error> {
     const MAX_ITERATIONS: usize = 500;
     const TOLERANCE: f64 = 1e-13;
     let mut stiffness = Stiffness::new(body);
-    stiffness.assemble(body);
+    assemble_elastic(&mut stiffness, body, false);
     let factor = factorize(&stiffness, 0)?;
     let masses = &body.masses;
     let free = |n: usize| !body.pinned[n];
@@ -159,6 +162,17 @@ pub fn fundamental_frequency(body: &SoftBody) -> Result<f64, Error> {
         }
     }
     Ok(eigenvalue.sqrt() / (2.0 * std::f64::consts::PI))
+}
+
+/// The elastic tangent stiffness at the body's current positions, projected per element to be
+/// positive semi-definite if `project`.
+fn assemble_elastic(stiffness: &mut Stiffness, body: &SoftBody, project: bool) {
+    with_hyperelastic_model!(body.material, |model| stiffness.assemble(
+        body,
+        None,
+        project,
+        |_, f| stress_tangent(|df| model.first_piola_differential(f, df))
+    ));
 }
 
 /// `f_int(x) + load`, zero on pinned nodes (N).
@@ -219,22 +233,6 @@ fn line_search(body: &mut SoftBody, load: &[DVec3], residual: &[DVec3], step: &[
         }
         alpha *= 0.5;
     }
-}
-
-fn factorize(stiffness: &Stiffness, iteration: usize) -> Result<Llt<usize, f64>, Error> {
-    stiffness
-        .as_faer()
-        .sp_cholesky(Side::Lower)
-        .map_err(|_| Error::IndefiniteStiffness { iteration })
-}
-
-/// Solves `K u = rhs` for per-node vectors.
-fn solve(factor: &Llt<usize, f64>, rhs: &[DVec3]) -> Vec<DVec3> {
-    let mut x = Col::<f64>::from_fn(3 * rhs.len(), |i| rhs[i / 3][i % 3]);
-    factor.solve_in_place(x.as_mat_mut());
-    (0..rhs.len())
-        .map(|n| DVec3::new(x[3 * n], x[3 * n + 1], x[3 * n + 2]))
-        .collect()
 }
 
 fn norm(v: &[DVec3]) -> f64 {

@@ -1,0 +1,217 @@
+//! Assembly of sparse symmetric tangent matrices (N/m) over a body's mesh: the lower triangle in
+//! compressed columns, pinned nodes' rows and columns replaced by the identity.
+//!
+//! An element contributes `K_e = V Gᵀ A G`, where `A = ∂P/∂F` is the 9 x 9 tangent of the stress
+//! with respect to the deformation gradient and `G` maps the four node displacements to `dF`.
+//! On request `A` is first projected onto its positive semi-definite part, so that `K_e` has no
+//! negative eigenvalue and Newton steps always descend (the stress tangents of St.
+//! Venant–Kirchhoff and Neo-Hookean are indefinite under compression); the projection stiffens
+//! the rotational directions of a stressed element, so exact tangents are used where they exist.
+
+use crate::Error;
+use crate::body::SoftBody;
+use crate::fvm::{TetRest, gather};
+use faer::linalg::solvers::Solve;
+use faer::sparse::linalg::solvers::Llt;
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::{Col, Side};
+use rapier3d::glamx::{DMat3, DVec3};
+use rapier3d::na;
+
+/// A 9 x 9 stress tangent `A[(r, c), (s, d)] = ∂P_rc / ∂F_sd` (Pa), indices column-major
+/// (`3 c + r`).
+pub(crate) type StressTangent = na::SMatrix<f64, 9, 9>;
+
+/// The sparsity pattern of the lower triangle of the 3n x 3n tangent of a mesh, and its values.
+pub(crate) struct Stiffness {
+    dofs: usize,
+    col_ptr: Vec<usize>,
+    row_idx: Vec<usize>,
+    /// For node `b`: its neighbours `a >= b` (itself first), ascending.
+    lower_neighbours: Vec<Vec<u32>>,
+    /// Matrix entries in compressed-column order (N/m).
+    pub(crate) values: Vec<f64>,
+}
+
+impl Stiffness {
+    /// The pattern of `body`'s mesh, values zero.
+    pub(crate) fn new(body: &SoftBody) -> Self {
+        let n = body.node_count();
+        let mut lower_neighbours: Vec<Vec<u32>> = (0..n as u32).map(|b| vec![b]).collect();
+        for tet in body.mesh().tets() {
+            for &a in tet {
+                for &b in tet {
+                    if a > b {
+                        lower_neighbours[b as usize].push(a);
+                    }
+                }
+            }
+        }
+        for list in &mut lower_neighbours {
+            list.sort_unstable();
+            list.dedup();
+        }
+        let mut col_ptr = Vec::with_capacity(3 * n + 1);
+        let mut row_idx = Vec::new();
+        col_ptr.push(0);
+        for (b, list) in lower_neighbours.iter().enumerate() {
+            for j in 0..3 {
+                row_idx.extend((j..3).map(|i| 3 * b + i));
+                for &a in &list[1..] {
+                    row_idx.extend((0..3).map(|i| 3 * a as usize + i));
+                }
+                col_ptr.push(row_idx.len());
+            }
+        }
+        Self {
+            dofs: 3 * n,
+            values: vec![0.0; row_idx.len()],
+            col_ptr,
+            row_idx,
+            lower_neighbours,
+        }
+    }
+
+    /// Index into `values` of the entry (row `3a + i`, column `3b + j`), for `a > b`, or `a == b`
+    /// and `i >= j`.
+    fn entry(&self, a: usize, i: usize, b: usize, j: usize) -> usize {
+        let start = self.col_ptr[3 * b + j];
+        if a == b {
+            return start + i - j;
+        }
+        let k = self.lower_neighbours[b]
+            .binary_search(&(a as u32))
+            .expect("the pattern contains every pair of nodes sharing a tetrahedron");
+        start + (3 - j) + 3 * (k - 1) + i
+    }
+
+    /// Fills the values with `diagonal[n] I` on each free node plus, for every tetrahedron,
+    /// `V Gᵀ A G` with `A = tangent(t, F)`, projected to be positive semi-definite if `project`;
+    /// `F` is taken at the body's current positions.
+    pub(crate) fn assemble(
+        &mut self,
+        body: &SoftBody,
+        diagonal: Option<&[f64]>,
+        project: bool,
+        tangent: impl Fn(usize, &DMat3) -> StressTangent,
+    ) {
+        self.values.fill(0.0);
+        let fvm = &body.fvm;
+        for (t, tet) in fvm.tets().iter().enumerate() {
+            let rest = fvm.tet_rest(t);
+            let f = rest.gradient(&gather(tet, body.positions()));
+            let a = tangent(t, &f);
+            let k = element_matrix(&rest, &if project { project_positive(a) } else { a });
+            self.add_element(tet, &k, &body.pinned);
+        }
+        for (node, &pinned) in body.pinned.iter().enumerate() {
+            for i in 0..3 {
+                let e = self.entry(node, i, node, i);
+                if pinned {
+                    self.values[e] = 1.0;
+                } else if let Some(diagonal) = diagonal {
+                    self.values[e] += diagonal[node];
+                }
+            }
+        }
+    }
+
+    fn add_element(&mut self, tet: &[u32; 4], k: &[[f64; 12]; 12], pinned: &[bool]) {
+        for (cb, &b) in tet.iter().enumerate() {
+            for (ca, &a) in tet.iter().enumerate() {
+                let (a, b) = (a as usize, b as usize);
+                if a < b || pinned[a] || pinned[b] {
+                    continue;
+                }
+                for j in 0..3 {
+                    for i in 0..3 {
+                        if a == b && i < j {
+                            continue;
+                        }
+                        let e = self.entry(a, i, b, j);
+                        self.values[e] += k[3 * ca + i][3 * cb + j];
+                    }
+                }
+            }
+        }
+    }
+
+    /// A view of the assembled matrix for faer.
+    pub(crate) fn as_faer(&self) -> SparseColMatRef<'_, usize, f64> {
+        let symbolic = SymbolicSparseColMatRef::new_checked(
+            self.dofs,
+            self.dofs,
+            &self.col_ptr,
+            None,
+            &self.row_idx,
+        );
+        SparseColMatRef::new(symbolic, &self.values)
+    }
+}
+
+/// The Cholesky factor of an assembled matrix.
+pub(crate) fn factorize(stiffness: &Stiffness, iteration: usize) -> Result<Llt<usize, f64>, Error> {
+    stiffness
+        .as_faer()
+        .sp_cholesky(Side::Lower)
+        .map_err(|_| Error::IndefiniteStiffness { iteration })
+}
+
+/// Solves `K u = rhs` for per-node vectors.
+pub(crate) fn solve(factor: &Llt<usize, f64>, rhs: &[DVec3]) -> Vec<DVec3> {
+    let mut x = Col::<f64>::from_fn(3 * rhs.len(), |i| rhs[i / 3][i % 3]);
+    factor.solve_in_place(x.as_mat_mut());
+    (0..rhs.len())
+        .map(|n| DVec3::new(x[3 * n], x[3 * n + 1], x[3 * n + 2]))
+        .collect()
+}
+
+/// The stress tangent `∂P/∂F` of `differential` (a stress differential `dF -> dP`) at one `F`,
+/// built column by column from the nine unit changes of `F`.
+pub(crate) fn stress_tangent(differential: impl Fn(&DMat3) -> DMat3) -> StressTangent {
+    let mut tangent = StressTangent::zeros();
+    for column in 0..9 {
+        let mut df = [0.0; 9];
+        df[column] = 1.0;
+        let dp = differential(&DMat3::from_cols_array(&df)).to_cols_array();
+        for (row, value) in dp.iter().enumerate() {
+            tangent[(row, column)] = *value;
+        }
+    }
+    tangent
+}
+
+/// The nearest positive semi-definite matrix to the symmetric part of `a` (negative eigenvalues
+/// set to zero).
+pub(crate) fn project_positive(a: StressTangent) -> StressTangent {
+    let symmetric = (a + a.transpose()) * 0.5;
+    let eigen = na::SymmetricEigen::new(symmetric);
+    if eigen.eigenvalues.iter().all(|&l| l >= 0.0) {
+        return symmetric;
+    }
+    let clamped = eigen.eigenvalues.map(|l| l.max(0.0));
+    eigen.eigenvectors * StressTangent::from_diagonal(&clamped) * eigen.eigenvectors.transpose()
+}
+
+/// `K_e[3a+i][3b+j] = V Σ A[(i,c),(j,d)] g_a,c g_b,d` (N/m): the element matrix of a stress
+/// tangent, `g_a` the gradient of node `a`'s shape function.
+fn element_matrix(rest: &TetRest, tangent: &StressTangent) -> [[f64; 12]; 12] {
+    let g = rest.inverse_rest_edges.transpose();
+    let gradients = [
+        -(g.x_axis + g.y_axis + g.z_axis),
+        g.x_axis,
+        g.y_axis,
+        g.z_axis,
+    ];
+    // G: 9 x 12, vec(dF) = G dx with dF_rc = Σ_b dx_b,r g_b,c at row 3c + r.
+    let mut map = na::SMatrix::<f64, 9, 12>::zeros();
+    for (b, gradient) in gradients.iter().enumerate() {
+        for r in 0..3 {
+            for c in 0..3 {
+                map[(3 * c + r, 3 * b + r)] = gradient[c];
+            }
+        }
+    }
+    let k = map.transpose() * tangent * map * rest.volume;
+    std::array::from_fn(|row| std::array::from_fn(|col| k[(row, col)]))
+}
