@@ -8,7 +8,7 @@
 
 use crate::Error;
 use crate::lanes::{Mat3x4, f64x4};
-use crate::material::{LameParameters, symmetric_part, trace};
+use crate::material::{LameParameters, double_dot, green_strain, symmetric_part, trace};
 use rapier3d::glamx::DMat3;
 
 /// Rayleigh damping coefficients, the viscous counterparts of the Lamé parameters.
@@ -93,5 +93,38 @@ impl RayleighDamping {
         let strain_rate = f.transpose_mul(f_dot).symmetric_part();
         (strain_rate * f64x4::splat(2.0 * self.psi))
             .add_diagonal(strain_rate.trace() * f64x4::splat(self.phi))
+    }
+
+    /// `φ tr(E) I + 2ψ E` (Pa) for a symmetric strain rate `E` (1/s).
+    #[inline(always)]
+    fn stress_of_rate(&self, rate: &DMat3) -> DMat3 {
+        DMat3::IDENTITY * (self.phi * trace(rate)) + *rate * (2.0 * self.psi)
+    }
+
+    /// The dissipation potential of one step of length `h` (s) per unit rest volume (J/m³),
+    /// `h (φ/2 tr(Ġ)² + ψ Ġ:Ġ)` with the rate taken over the step, `Ġ = (G(F) - G_prev)/h`: its
+    /// derivative in `F` is the damping stress, so implicit integrators can minimize it.
+    pub(crate) fn step_potential(&self, f: &DMat3, green_previous: &DMat3, h: f64) -> f64 {
+        let rate = (green_strain(f) - *green_previous) * (1.0 / h);
+        h * (0.5 * self.phi * trace(&rate).powi(2) + self.psi * double_dot(&rate, &rate))
+    }
+
+    /// `∂/∂F` of [`RayleighDamping::step_potential`]: `F σ_damp(Ġ)` (Pa).
+    pub(crate) fn step_first_piola(&self, f: &DMat3, green_previous: &DMat3, h: f64) -> DMat3 {
+        let rate = (green_strain(f) - *green_previous) * (1.0 / h);
+        *f * self.stress_of_rate(&rate)
+    }
+
+    /// Differential of [`RayleighDamping::step_first_piola`] for a change `df` of `F` (Pa).
+    pub(crate) fn step_first_piola_differential(
+        &self,
+        f: &DMat3,
+        green_previous: &DMat3,
+        h: f64,
+        df: &DMat3,
+    ) -> DMat3 {
+        let rate = (green_strain(f) - *green_previous) * (1.0 / h);
+        let d_rate = symmetric_part(&(f.transpose() * *df)) * (1.0 / h);
+        *df * self.stress_of_rate(&rate) + *f * self.stress_of_rate(&d_rate)
     }
 }

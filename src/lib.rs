@@ -48,6 +48,7 @@ pub mod integrate;
 pub mod lanes;
 pub mod material;
 pub mod mesh;
+mod newton;
 pub mod statics;
 
 pub use error::Error;
@@ -64,7 +65,9 @@ pub mod prelude {
     pub use crate::Error;
     pub use crate::body::{SoftBody, SoftBodyBuilder};
     pub use crate::damping::RayleighDamping;
-    pub use crate::integrate::{StepReport, Substeps, SymplecticEuler};
+    pub use crate::integrate::{
+        BackwardEuler, ImplicitReport, StepReport, Substeps, SymplecticEuler,
+    };
     pub use crate::material::{LameParameters, Material, MaterialModel, YoungPoisson};
     pub use crate::mesh::{self, TetMesh};
     pub use rapier3d::glamx::{DMat3, DQuat, DVec3};

@@ -12,7 +12,7 @@ use rapier_fvm::material::{
 };
 use rapier_fvm::prelude::*;
 
-/// A body of `mesh` (E = 1 MPa, ν = 0.35, damped) with its nodes moved randomly by up to
+/// A body of `mesh` (E = 1e6 Pa, ν = 0.35, damped) with its nodes moved randomly by up to
 /// `amplitude` (m) and random velocities up to 1 m/s per component.
 fn randomized(mesh: TetMesh, model: MaterialModel, seed: u64, amplitude: f64) -> SoftBody {
     let material = Material::new(model, 1e6, 0.35, 1000.0).unwrap();

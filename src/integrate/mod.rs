@@ -1,5 +1,7 @@
 //! Time integration of soft bodies: `M v̇ = f_int(x, v) + M g`, `ẋ = v`, with pinned nodes held.
 
 mod explicit;
+mod implicit;
 
 pub use explicit::{COURANT_NUMBER, StepReport, Substeps, SymplecticEuler};
+pub use implicit::{BackwardEuler, ImplicitReport};

@@ -15,6 +15,7 @@ pub use corotated::Corotated;
 pub use linear::LinearElastic;
 pub use neo_hookean::StableNeoHookean;
 pub use stvk::StVenantKirchhoff;
+pub(crate) use stvk::green_strain;
 
 use crate::Error;
 use crate::lanes::{Mat3x4, f64x4};

@@ -10,6 +10,7 @@ use crate::Error;
 use crate::assembly::{Stiffness, factorize, solve, stress_tangent};
 use crate::body::SoftBody;
 use crate::material::{HyperelasticModel, with_hyperelastic_model};
+use crate::newton::{line_search, norm};
 use rapier3d::glamx::DVec3;
 
 /// The largest relative residual accepted as round-off when Newton stops reducing it.
@@ -97,7 +98,7 @@ pub fn solve_equilibrium(
             }
         };
         let step = solve(&factor, &residual);
-        line_search(body, &load, &residual, &step);
+        line_search(body, &residual, &step, |body| potential_energy(body, &load));
         residual = out_of_balance(body, &load);
     }
     let relative = norm(&residual) / reference;
@@ -206,35 +207,4 @@ fn potential_energy(body: &SoftBody, load: &[DVec3]) -> f64 {
         .map(|(f, x)| f.dot(*x))
         .sum();
     body.elastic_energy() - load_work
-}
-
-/// Backtracking line search along `step` that guarantees the potential energy decreases
-/// (Armijo condition), leaving the accepted positions in `body`.
-fn line_search(body: &mut SoftBody, load: &[DVec3], residual: &[DVec3], step: &[DVec3]) {
-    const ARMIJO: f64 = 1e-4;
-    const MIN_STEP: f64 = 1.0 / 1024.0;
-    let start = body.positions.clone();
-    let energy = potential_energy(body, load);
-    // The energy gradient is -residual, so its slope along the step is -residual·step.
-    let slope: f64 = -residual
-        .iter()
-        .zip(step)
-        .map(|(r, s)| r.dot(*s))
-        .sum::<f64>();
-    let round_off = 1e-12 * energy.abs();
-    let mut alpha = 1.0;
-    loop {
-        for ((x, x0), s) in body.positions.iter_mut().zip(&start).zip(step) {
-            *x = *x0 + *s * alpha;
-        }
-        let trial = potential_energy(body, load);
-        if trial <= energy + ARMIJO * alpha * slope + round_off || alpha <= MIN_STEP {
-            return;
-        }
-        alpha *= 0.5;
-    }
-}
-
-fn norm(v: &[DVec3]) -> f64 {
-    v.iter().map(|x| x.length_squared()).sum::<f64>().sqrt()
 }
