@@ -41,6 +41,12 @@ pub enum Error {
         /// The repeated node.
         node: u32,
     },
+    /// A node belongs to no tetrahedron: it would have no mass and no stiffness.
+    #[error("node {node} belongs to no tetrahedron")]
+    UnreferencedNode {
+        /// Index of the offending node.
+        node: usize,
+    },
     /// A tetrahedron has (numerically) zero rest volume.
     #[error(
         "tetrahedron {tet} is degenerate: rest volume {volume:e} m^3 is zero at the mesh's scale"
@@ -96,6 +102,32 @@ pub enum Error {
         /// Name of the input.
         parameter: &'static str,
     },
+    /// A solver setting is outside its valid range.
+    #[error("invalid setting `{parameter}` = {value}: {reason}")]
+    InvalidSetting {
+        /// Name of the setting.
+        parameter: &'static str,
+        /// The value given.
+        value: f64,
+        /// What it must satisfy.
+        reason: &'static str,
+    },
+    /// The stability limit asks for more substeps than allowed: the material is too stiff, the
+    /// damping too strong or an element too thin for explicit integration at this frame step.
+    #[error(
+        "a frame step of {frame_dt} s needs {needed} explicit substeps, more than the {max} allowed; use the implicit integrator or a coarser mesh"
+    )]
+    TooManySubsteps {
+        /// The frame step (s).
+        frame_dt: f64,
+        /// Substeps the stability limit asks for.
+        needed: f64,
+        /// The configured maximum.
+        max: u32,
+    },
+    /// Every node is pinned: there is nothing to solve for.
+    #[error("every node is pinned")]
+    NoFreeNode,
     /// A time step or substep count is not usable.
     #[error("invalid time step {dt} s: {reason}")]
     InvalidTimeStep {

@@ -22,7 +22,7 @@
 //! ```
 //! use rapier_fvm::prelude::*;
 //!
-//! // A 1 m rubber beam clamped at x = 0, sagging under gravity.
+//! // A 1 m rubber beam clamped at x = -0.5 m, sagging under gravity.
 //! let mesh = mesh::cuboid(DVec3::new(0.5, 0.05, 0.05), [10, 1, 1])?;
 //! let clamped = mesh.nodes_where(|p| p.x <= -0.5 + 1e-9);
 //! let rubber = Material::new(MaterialModel::StableNeoHookean, 1e6, 0.45, 1100.0)?;

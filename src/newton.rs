@@ -11,7 +11,8 @@ pub(crate) fn norm(v: &[DVec3]) -> f64 {
 
 /// Moves `body` along `direction` from its current positions by the largest step `α` in
 /// `1, 1/2, 1/4, …, 1/1024` that satisfies the Armijo condition on `energy` (J), whose gradient
-/// is `-residual` (N).
+/// is `-residual` (N), so that the energy decreases; if none does, the smallest step is taken
+/// and the caller's convergence test decides.
 pub(crate) fn line_search(
     body: &mut SoftBody,
     residual: &[DVec3],

@@ -159,3 +159,46 @@ fn large_deflection_corotated_stays_finite_and_settles() {
 fn large_deflection_stable_neo_hookean_stays_finite_and_settles() {
     large_deflection_settles(MaterialModel::StableNeoHookean);
 }
+
+#[test]
+fn static_solver_errors_leave_the_body_untouched() {
+    let material = Material::new(MaterialModel::Linear, 1e8, 0.3, common::DENSITY).unwrap();
+    let (mut body, _) = cantilever([4, 1, 1], material);
+    let before = body.positions().to_vec();
+    assert!(matches!(
+        statics::solve_equilibrium(
+            &mut body,
+            DVec3::new(f64::NAN, 0.0, 0.0),
+            &StaticSettings::default()
+        ),
+        Err(Error::NonFiniteInput {
+            parameter: "gravity"
+        })
+    ));
+    let mesh = body.mesh().clone();
+    let all = 0..mesh.node_count() as u32;
+    let mut frozen = SoftBodyBuilder::new(mesh, material)
+        .pinned_nodes(all)
+        .build()
+        .unwrap();
+    assert_eq!(
+        statics::solve_equilibrium(&mut frozen, gravity(), &StaticSettings::default()),
+        Err(Error::NoFreeNode)
+    );
+    assert_eq!(
+        statics::fundamental_frequency(&frozen),
+        Err(Error::NoFreeNode)
+    );
+    // A body with no pinned node has rigid motions: its stiffness is singular.
+    let free = SoftBodyBuilder::new(body.mesh().clone(), material)
+        .build()
+        .unwrap();
+    let mut free_body = free.clone();
+    let outcome = statics::solve_equilibrium(&mut free_body, gravity(), &StaticSettings::default());
+    assert!(
+        outcome.is_err(),
+        "an unsupported body has no static equilibrium: {outcome:?}"
+    );
+    assert_eq!(free_body.positions(), free.positions());
+    assert_eq!(body.positions(), &before[..]);
+}

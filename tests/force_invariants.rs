@@ -236,8 +236,8 @@ fn simd_mesh_loop_matches_the_scalar_kernel() {
     // The mesh loop evaluates four tetrahedra per SIMD lane group; it must agree with the scalar
     // reference `tet_forces` summed tetrahedron by tetrahedron (1e-13 of the largest force).
     use rapier_fvm::fvm::{FvmMesh, tet_forces};
-    // 80 tetrahedra (one chunk), and 20 250 (three chunks of the parallel loop, the last block
-    // padded).
+    // 80 tetrahedra (one chunk), 20 250 (three chunks of the parallel loop, the last block
+    // padded) and a 29 184-tetrahedron ball (block-structured, renumbered in spatial order).
     let bodies = MODELS
         .map(|model| random_body(model, 21, 0.01))
         .into_iter()
@@ -246,6 +246,12 @@ fn simd_mesh_loop_matches_the_scalar_kernel() {
             MaterialModel::StVenantKirchhoff,
             8,
             1e-3,
+        )])
+        .chain([randomized(
+            mesh::sphere(0.1, 20).unwrap(),
+            MaterialModel::StableNeoHookean,
+            9,
+            1e-4,
         )]);
     for body in bodies {
         let model = body.material().model();
@@ -311,4 +317,43 @@ fn forces_are_bit_identical_whatever_the_thread_count() {
     let two = forces_with(2, &mut body);
     let three = forces_with(3, &mut body);
     assert!(one == two && two == three);
+}
+
+#[test]
+fn every_model_has_the_linear_elastic_tangent_at_rest() {
+    // dP at F = I must be λ tr(dF) I + μ (dF + dFᵀ) for every model (this checks, among others,
+    // the stable Neo-Hookean's λ' = λ + μ), to round-off.
+    let lame = Material::new(MaterialModel::Linear, 1e6, 0.3, 1.0)
+        .unwrap()
+        .lame();
+    let mut rng = Lcg(17);
+    for _ in 0..10 {
+        let df = DMat3::from_cols(rng.vector(), rng.vector(), rng.vector());
+        let expected = LinearElastic(lame).first_piola_differential(&DMat3::IDENTITY, &df);
+        let scale = expected
+            .to_cols_array()
+            .iter()
+            .fold(0.0f64, |m, x| m.max(x.abs()));
+        let models: [(&str, DMat3); 3] = [
+            (
+                "StVK",
+                StVenantKirchhoff(lame).first_piola_differential(&DMat3::IDENTITY, &df),
+            ),
+            (
+                "corotated",
+                Corotated(lame).first_piola_differential(&DMat3::IDENTITY, &df),
+            ),
+            (
+                "stable Neo-Hookean",
+                StableNeoHookean::new(lame).first_piola_differential(&DMat3::IDENTITY, &df),
+            ),
+        ];
+        for (name, actual) in models {
+            let error = (actual - expected)
+                .to_cols_array()
+                .iter()
+                .fold(0.0f64, |m, x| m.max(x.abs()));
+            assert!(error < 1e-12 * scale, "{name}: {error:e}");
+        }
+    }
 }

@@ -282,3 +282,55 @@ fn builder_rejects_missing_pinned_node_and_non_finite_placement() {
         }
     );
 }
+
+#[test]
+fn unreferenced_node_is_rejected() {
+    let mut positions = unit_tet();
+    positions.push(DVec3::ONE);
+    assert_eq!(
+        TetMesh::new(positions, vec![[0, 1, 2, 3]]),
+        Err(Error::UnreferencedNode { node: 4 })
+    );
+}
+
+/// Checks that the boundary of `mesh` is closed (every edge shared by exactly two boundary
+/// triangles, in opposite directions) and encloses the mesh volume (divergence theorem, 1e-12).
+fn assert_closed_outward_surface(mesh: &TetMesh) {
+    let surface = mesh.surface_triangles();
+    let mut directed_edges = std::collections::HashMap::new();
+    for tri in &surface {
+        for k in 0..3 {
+            *directed_edges
+                .entry((tri[k], tri[(k + 1) % 3]))
+                .or_insert(0) += 1;
+        }
+    }
+    for (&(a, b), &count) in &directed_edges {
+        assert_eq!(count, 1, "edge {a}-{b} used twice in the same direction");
+        assert_eq!(
+            directed_edges.get(&(b, a)),
+            Some(&1),
+            "edge {a}-{b} is on a crack"
+        );
+    }
+    let p = mesh.positions();
+    let enclosed: f64 = surface
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| p[i as usize]);
+            (b - a).cross(c - a).dot(a) / 6.0
+        })
+        .sum();
+    assert!((enclosed - mesh.volume()).abs() < 1e-12 * mesh.volume());
+}
+
+#[test]
+fn round_shapes_have_closed_outward_surfaces() {
+    // A missed merge of the blocks' shared nodes would open a crack inside the body, which the
+    // volume checks cannot see.
+    for cells in [2, 3, 8] {
+        assert_closed_outward_surface(&mesh::cylinder(0.1, 0.2, cells, 3).unwrap());
+        assert_closed_outward_surface(&mesh::sphere(0.1, cells).unwrap());
+    }
+    assert_closed_outward_surface(&mesh::cuboid(DVec3::new(0.3, 0.2, 0.1), [3, 4, 2]).unwrap());
+}

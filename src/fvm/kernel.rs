@@ -9,7 +9,8 @@
 //! into a window of its own covering the nodes it touches (small for meshes numbered in spatial
 //! order, as the generators' are), so chunks run in parallel without sharing writes; the windows
 //! are then added into the result in chunk order. The chunking depends only on the mesh, so the
-//! forces are bit-identical whatever the number of threads.
+//! forces are bit-identical whatever the number of threads. A mesh numbered without spatial order
+//! would need windows as large as the whole mesh for every chunk; it is summed serially instead.
 
 use super::TetRest;
 use crate::damping::RayleighDamping;
@@ -20,6 +21,8 @@ use rapier3d::glamx::DVec3;
 
 /// Tetrahedra per chunk (a multiple of [`LANES`]); meshes of one chunk are summed directly.
 const CHUNK_TETS: usize = 8192;
+/// The chunks' windows may together span at most this many times the node count.
+const MAX_WINDOW_SPAN: usize = 4;
 
 /// Internal (elastic plus damping) forces (N) on the four nodes of one tetrahedron, for node
 /// positions `x` (m) and velocities `v` (m/s). They sum to zero and have zero net torque.
@@ -87,19 +90,7 @@ impl FvmMesh {
                 }
             })
             .collect();
-        let windows = if tet_count > CHUNK_TETS {
-            tets[..tet_count]
-                .chunks(CHUNK_TETS)
-                .map(|chunk| {
-                    let nodes = chunk.iter().flatten();
-                    let first = *nodes.clone().min().unwrap_or(&0) as usize;
-                    let last = *nodes.max().unwrap_or(&0) as usize;
-                    (first, vec![DVec3::ZERO; last + 1 - first])
-                })
-                .collect()
-        } else {
-            Vec::new()
-        };
+        let windows = chunk_windows(&tets[..tet_count], node_count);
         Self {
             tets,
             tet_count,
@@ -145,6 +136,9 @@ impl FvmMesh {
 
     /// Writes into `out` the internal force (N) on every node, for positions `x` (m) and
     /// velocities `v` (m/s), one entry per node.
+    ///
+    /// # Panics
+    /// If `x`, `v` or `out` does not have one entry per node.
     pub fn internal_forces<M: HyperelasticModel>(
         &mut self,
         model: &M,
@@ -153,8 +147,12 @@ impl FvmMesh {
         v: &[DVec3],
         out: &mut [DVec3],
     ) {
-        debug_assert!(x.len() == self.node_count && v.len() == self.node_count);
-        debug_assert!(out.len() == self.node_count);
+        assert!(
+            x.len() == self.node_count
+                && v.len() == self.node_count
+                && out.len() == self.node_count,
+            "positions, velocities and forces need one entry per node"
+        );
         out.fill(DVec3::ZERO);
         if self.windows.is_empty() {
             add_chunk_forces(
@@ -275,6 +273,31 @@ fn lane_edges(tets: &[[u32; 4]], values: &[DVec3]) -> Mat3x4 {
         |c: usize| Vec3x4::from_lanes(std::array::from_fn(|l| values[tets[l][c] as usize]));
     let origin = corner(0);
     Mat3x4::from_cols(corner(1) - origin, corner(2) - origin, corner(3) - origin)
+}
+
+/// The force windows of the chunks of `tets`: empty for a single chunk, or when the windows
+/// would together span more than [`MAX_WINDOW_SPAN`] times the node count (a mesh numbered
+/// without spatial order), in which case the mesh is summed serially.
+fn chunk_windows(tets: &[[u32; 4]], node_count: usize) -> Vec<(usize, Vec<DVec3>)> {
+    if tets.len() <= CHUNK_TETS {
+        return Vec::new();
+    }
+    let spans: Vec<(usize, usize)> = tets
+        .chunks(CHUNK_TETS)
+        .map(|chunk| {
+            let nodes = chunk.iter().flatten();
+            let first = *nodes.clone().min().unwrap_or(&0) as usize;
+            let last = *nodes.max().unwrap_or(&0) as usize;
+            (first, last + 1 - first)
+        })
+        .collect();
+    if spans.iter().map(|(_, len)| len).sum::<usize>() > MAX_WINDOW_SPAN * node_count {
+        return Vec::new();
+    }
+    spans
+        .into_iter()
+        .map(|(first, len)| (first, vec![DVec3::ZERO; len]))
+        .collect()
 }
 
 fn wave_length_scale(tets: &[[u32; 4]], rest: &[TetRest], node_count: usize) -> f64 {

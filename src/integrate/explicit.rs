@@ -15,10 +15,11 @@ use crate::body::SoftBody;
 use rapier3d::glamx::DVec3;
 
 /// Ratio of the critical explicit step to `ℓ / c_p`. The true limit `2/ω_max` (power iteration
-/// on `M⁻¹K`) measured on the generated boxes, beams, plates, cylinders and spheres lies between
-/// 1.53 and 1.89 `ℓ / c_p` for `0 <= ν <= 0.49`; 1.5 stays below all of them (see the
-/// `explicit_stability` tests). The smallest element altitude `h_min` in place of `ℓ` spreads
-/// from 0.93 to 1.75 on the same meshes, which would cost up to twice the substeps.
+/// on `M⁻¹K`) measured on generated boxes, beams, plates, cylinders and spheres lies between
+/// 1.54 and 1.89 `ℓ / c_p` for `-0.5 <= ν <= 0.49`; 1.5 stays below all of them (see the
+/// `explicit_stability` tests), and the default safety factor halves it again. The smallest
+/// element altitude `h_min` in place of `ℓ` spreads from 0.93 to 1.75 on the same meshes, which
+/// would cost up to twice the substeps.
 pub const COURANT_NUMBER: f64 = 1.5;
 
 /// How a frame step is split into substeps.
@@ -38,6 +39,9 @@ pub struct SymplecticEuler {
     pub safety_factor: f64,
     /// How frames are split into substeps.
     pub substeps: Substeps,
+    /// The most substeps [`Substeps::Automatic`] may take in one frame; a frame needing more is
+    /// refused with [`Error::TooManySubsteps`] instead of running for minutes.
+    pub max_substeps: u32,
 }
 
 impl Default for SymplecticEuler {
@@ -47,6 +51,7 @@ impl Default for SymplecticEuler {
         Self {
             safety_factor: 0.5,
             substeps: Substeps::Automatic,
+            max_substeps: 100_000,
         }
     }
 }
@@ -83,9 +88,11 @@ impl SymplecticEuler {
     /// Advances `body` by `frame_dt` (s) under uniform gravity (m/s²), in substeps.
     ///
     /// # Errors
-    /// [`Error::InvalidTimeStep`] for a non-positive or non-finite `frame_dt`, a zero fixed
-    /// substep count or a safety factor outside (0, 1]; [`Error::NonFiniteState`] if the step
-    /// produced a NaN or infinity, in which case the body is left as it was before the call.
+    /// [`Error::InvalidTimeStep`] for a non-positive or non-finite `frame_dt` or a zero fixed
+    /// substep count; [`Error::InvalidSetting`] for a safety factor outside (0, 1];
+    /// [`Error::NonFiniteInput`] for a non-finite gravity; [`Error::TooManySubsteps`] when the
+    /// stability limit needs more than `max_substeps`; [`Error::NonFiniteState`] if the step
+    /// produced a NaN or infinity. On error the body is left as it was before the call.
     pub fn step(
         &self,
         body: &mut SoftBody,
@@ -96,6 +103,11 @@ impl SymplecticEuler {
             return Err(Error::InvalidTimeStep {
                 dt: frame_dt,
                 reason: "must be positive and finite",
+            });
+        }
+        if !gravity.is_finite() {
+            return Err(Error::NonFiniteInput {
+                parameter: "gravity",
             });
         }
         let substeps = self.substep_count(body, frame_dt)?;
@@ -123,13 +135,21 @@ impl SymplecticEuler {
             Substeps::Fixed(n) => Ok(n),
             Substeps::Automatic => {
                 if !(self.safety_factor > 0.0 && self.safety_factor <= 1.0) {
-                    return Err(Error::InvalidTimeStep {
-                        dt: frame_dt,
-                        reason: "the safety factor must lie in (0, 1]",
+                    return Err(Error::InvalidSetting {
+                        parameter: "safety_factor",
+                        value: self.safety_factor,
+                        reason: "must lie in (0, 1]",
                     });
                 }
-                let n = (frame_dt / self.stable_time_step(body)).ceil();
-                Ok(n.clamp(1.0, f64::from(u32::MAX)) as u32)
+                let needed = (frame_dt / self.stable_time_step(body)).ceil().max(1.0);
+                if needed > f64::from(self.max_substeps) {
+                    return Err(Error::TooManySubsteps {
+                        frame_dt,
+                        needed,
+                        max: self.max_substeps,
+                    });
+                }
+                Ok(needed as u32)
             }
         }
     }

@@ -67,6 +67,7 @@ impl BackwardEuler {
     ///
     /// # Errors
     /// [`Error::InvalidTimeStep`] for a non-positive or non-finite `frame_dt` or zero substeps;
+    /// [`Error::NonFiniteInput`] for a non-finite gravity;
     /// [`Error::IndefiniteStiffness`] if a linear system cannot be factored;
     /// [`Error::NonFiniteState`] if the step produced a NaN. On error the body is left as it was.
     pub fn step(
@@ -79,6 +80,11 @@ impl BackwardEuler {
             return Err(Error::InvalidTimeStep {
                 dt: frame_dt,
                 reason: "must be positive and finite",
+            });
+        }
+        if !gravity.is_finite() {
+            return Err(Error::NonFiniteInput {
+                parameter: "gravity",
             });
         }
         if self.substeps == 0 {

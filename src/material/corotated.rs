@@ -108,7 +108,8 @@ impl HyperelasticModel for Corotated {
         let stretch_trace = trace(&s);
         let rt_df = r.transpose() * *df;
         let system = DMat3::IDENTITY * stretch_trace - s;
-        let w = if system.determinant().abs() > f64::EPSILON {
+        // Singular only when two stretches sum to zero (a flattened or inverted element).
+        let w = if system.determinant().abs() > 1e-12 * stretch_trace.abs().powi(3) {
             system.inverse() * axial(&(rt_df - rt_df.transpose()))
         } else {
             DVec3::ZERO

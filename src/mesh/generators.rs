@@ -68,6 +68,10 @@ pub fn cylinder(
     check_cells_along(cells_along)?;
     let core = (cells_across / 2).max(1);
     let layers = (cells_across / 4).max(1);
+    check_node_budget(block_node_bound(&[
+        [core, cells_along, core],
+        [4 * core, cells_along, layers],
+    ]))?;
     let mut hexes = HexMesher::new(radius.max(half_height));
     let height = |t: f64| (2.0 * t - 1.0) * half_height;
     // The core: a straight box of half-size r/2 in x and z.
@@ -113,6 +117,7 @@ pub fn sphere(radius: f64, cells_across: usize) -> Result<TetMesh, Error> {
     check_cells_across(cells_across)?;
     let core = ((cells_across as f64 * 0.4).round() as usize).max(1);
     let layers = ((core as f64 * 0.6).round() as usize).max(1);
+    check_node_budget(block_node_bound(&[[core; 3], [core, 6 * core, layers]]))?;
     let mut hexes = HexMesher::new(radius);
     hexes.add_block([core; 3], |u| {
         (u * 2.0 - DVec3::ONE) * (SPHERE_CORE * radius)
@@ -135,6 +140,32 @@ pub fn sphere(radius: f64, cells_across: usize) -> Result<TetMesh, Error> {
         }
     }
     hexes.finish()
+}
+
+/// Refuses meshes whose node count would not fit the 32-bit node indices.
+fn check_node_budget(nodes: f64) -> Result<(), Error> {
+    if nodes <= f64::from(u32::MAX) {
+        Ok(())
+    } else {
+        Err(Error::InvalidGeneratorParameter {
+            parameter: "cells",
+            value: nodes,
+            reason: "the mesh would have more nodes than 32-bit indices address",
+        })
+    }
+}
+
+/// Upper bound on the nodes of a block-structured mesh: every block's lattice nodes plus one
+/// centre node per cell.
+fn block_node_bound(blocks: &[[usize; 3]]) -> f64 {
+    blocks
+        .iter()
+        .map(|b| {
+            let cells: f64 = b.iter().map(|&c| c as f64).product();
+            let nodes: f64 = b.iter().map(|&c| c as f64 + 1.0).product();
+            cells + nodes
+        })
+        .sum()
 }
 
 fn check_length(parameter: &'static str, value: f64) -> Result<(), Error> {
@@ -195,6 +226,7 @@ fn lattice(cells: [usize; 3], map: impl Fn(DVec3) -> DVec3) -> Result<TetMesh, E
         });
     }
     let [nx, ny, nz] = cells;
+    check_node_budget(cells.iter().map(|&c| c as f64 + 1.0).product())?;
     let node = |i: usize, j: usize, k: usize| (i + (nx + 1) * (j + (ny + 1) * k)) as u32;
     let lattice_point = |i: usize, j: usize, k: usize| {
         DVec3::new(

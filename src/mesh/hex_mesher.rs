@@ -68,9 +68,37 @@ impl HexMesher {
         }
     }
 
-    /// The validated mesh.
+    /// The validated mesh, renumbered in spatial order (nodes sorted by z, then y, then x;
+    /// tetrahedra by their lowest node) so that consecutive tetrahedra share nearby nodes, which
+    /// keeps the force loop's memory windows small.
     pub(super) fn finish(self) -> Result<TetMesh, Error> {
-        TetMesh::new(self.positions, self.tets)
+        let mut order: Vec<u32> = (0..self.positions.len() as u32).collect();
+        let key = |n: &u32| {
+            let p = self.positions[*n as usize];
+            [p.z, p.y, p.x]
+        };
+        order.sort_by(|a, b| {
+            let (ka, kb) = (key(a), key(b));
+            ka[0]
+                .total_cmp(&kb[0])
+                .then(ka[1].total_cmp(&kb[1]))
+                .then(ka[2].total_cmp(&kb[2]))
+        });
+        let mut new_index = vec![0u32; order.len()];
+        for (new, &old) in order.iter().enumerate() {
+            new_index[old as usize] = new as u32;
+        }
+        let positions = order
+            .iter()
+            .map(|&old| self.positions[old as usize])
+            .collect();
+        let mut tets: Vec<[u32; 4]> = self
+            .tets
+            .iter()
+            .map(|t| t.map(|n| new_index[n as usize]))
+            .collect();
+        tets.sort_by_key(|t| *t.iter().min().unwrap_or(&0));
+        TetMesh::new(positions, tets)
     }
 
     /// The node at `p`, created unless one already sits there.

@@ -46,8 +46,8 @@ impl TetMesh {
     ///
     /// # Errors
     /// [`Error::EmptyMesh`], [`Error::NonFiniteCoordinate`], [`Error::NodeIndexOutOfRange`],
-    /// [`Error::RepeatedNode`], [`Error::DegenerateTet`] or [`Error::InvertedTet`], naming the
-    /// first offending node or tetrahedron.
+    /// [`Error::RepeatedNode`], [`Error::UnreferencedNode`], [`Error::DegenerateTet`] or
+    /// [`Error::InvertedTet`], naming the first offending node or tetrahedron.
     pub fn new(positions: Vec<DVec3>, tets: Vec<[u32; 4]>) -> Result<Self, Error> {
         validate_topology(&positions, &tets)?;
         for (tet, nodes) in tets.iter().enumerate() {
@@ -115,8 +115,8 @@ impl TetMesh {
         (0..self.tet_count()).map(|t| self.tet_volume(t)).sum()
     }
 
-    /// The smallest altitude (vertex to opposite face distance) over all tetrahedra (m): the
-    /// length scale of the explicit stability limit.
+    /// The smallest altitude (vertex to opposite face distance) over all tetrahedra (m), a measure
+    /// of the thinnest element.
     pub fn min_altitude(&self) -> f64 {
         self.tets
             .iter()
@@ -183,6 +183,7 @@ fn validate_topology(positions: &[DVec3], tets: &[[u32; 4]]) -> Result<(), Error
             position: positions[node].to_array(),
         });
     }
+    let mut referenced = vec![false; positions.len()];
     for (tet, nodes) in tets.iter().enumerate() {
         if let Some(&node) = nodes.iter().find(|&&n| n as usize >= positions.len()) {
             return Err(Error::NodeIndexOutOfRange {
@@ -198,9 +199,13 @@ fn validate_topology(positions: &[DVec3], tets: &[[u32; 4]]) -> Result<(), Error
                     node: nodes[i],
                 });
             }
+            referenced[nodes[i] as usize] = true;
         }
     }
-    Ok(())
+    match referenced.iter().position(|&r| !r) {
+        Some(node) => Err(Error::UnreferencedNode { node }),
+        None => Ok(()),
+    }
 }
 
 fn check_not_degenerate(

@@ -48,9 +48,33 @@ pub struct StaticReport {
 /// with pinned nodes held where they are and all velocities set to zero.
 ///
 /// # Errors
-/// [`Error::IndefiniteStiffness`] if the tangent stiffness cannot be factored (too few pinned
-/// nodes, or a buckled state), [`Error::StaticSolveDidNotConverge`] if the tolerance is not met.
+/// [`Error::NonFiniteInput`] for a non-finite gravity, [`Error::NoFreeNode`] if every node is
+/// pinned, [`Error::IndefiniteStiffness`] if the tangent stiffness cannot be factored (too few
+/// pinned nodes), [`Error::StaticSolveDidNotConverge`] if the tolerance is not met. On error the
+/// body is left as it was.
 pub fn solve_equilibrium(
+    body: &mut SoftBody,
+    gravity: DVec3,
+    settings: &StaticSettings,
+) -> Result<StaticReport, Error> {
+    if !gravity.is_finite() {
+        return Err(Error::NonFiniteInput {
+            parameter: "gravity",
+        });
+    }
+    if body.pinned.iter().all(|&p| p) {
+        return Err(Error::NoFreeNode);
+    }
+    body.save_state();
+    let result = newton(body, gravity, settings);
+    if result.is_err() {
+        body.restore_state();
+    }
+    result
+}
+
+/// Newton's iterations of [`solve_equilibrium`].
+fn newton(
     body: &mut SoftBody,
     gravity: DVec3,
     settings: &StaticSettings,
@@ -119,9 +143,12 @@ pub fn solve_equilibrium(
 /// with pinned nodes held: `K φ = ω² M φ` solved by inverse iteration with the lumped mass.
 ///
 /// # Errors
-/// [`Error::IndefiniteStiffness`] if the tangent stiffness cannot be factored (e.g. no pinned
-/// node, so rigid modes have zero frequency).
+/// [`Error::NoFreeNode`] if every node is pinned; [`Error::IndefiniteStiffness`] if the tangent
+/// stiffness cannot be factored (e.g. no pinned node, so rigid modes have zero frequency).
 pub fn fundamental_frequency(body: &SoftBody) -> Result<f64, Error> {
+    if body.pinned.iter().all(|&p| p) {
+        return Err(Error::NoFreeNode);
+    }
     const MAX_ITERATIONS: usize = 500;
     const TOLERANCE: f64 = 1e-13;
     let mut stiffness = Stiffness::new(body);
@@ -129,10 +156,16 @@ pub fn fundamental_frequency(body: &SoftBody) -> Result<f64, Error> {
     let factor = factorize(&stiffness, 0)?;
     let masses = &body.masses;
     let free = |n: usize| !body.pinned[n];
-    // Start from a uniform motion along (1, 1, 1) of the free nodes, which has a component on
-    // every bending mode of a body not aligned with an axis.
+    // Start from a fixed pseudo-random motion of the free nodes, which has a component on every
+    // mode (a uniform start would miss modes of zero net motion, such as torsion).
     let mut mode: Vec<DVec3> = (0..body.node_count())
-        .map(|n| if free(n) { DVec3::ONE } else { DVec3::ZERO })
+        .map(|n| {
+            if free(n) {
+                DVec3::new(hash_unit(3 * n), hash_unit(3 * n + 1), hash_unit(3 * n + 2))
+            } else {
+                DVec3::ZERO
+            }
+        })
         .collect();
     let mut eigenvalue = f64::INFINITY;
     for _ in 0..MAX_ITERATIONS {
@@ -207,4 +240,13 @@ fn potential_energy(body: &SoftBody, load: &[DVec3]) -> f64 {
         .map(|(f, x)| f.dot(*x))
         .sum();
     body.elastic_energy() - load_work
+}
+
+/// A fixed pseudo-random number in [-1, 1) for index `i` (`SplitMix64`).
+fn hash_unit(i: usize) -> f64 {
+    let mut z = (i as u64).wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^= z >> 31;
+    (z >> 11) as f64 / (1u64 << 52) as f64 - 1.0
 }
