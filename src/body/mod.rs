@@ -173,6 +173,24 @@ impl SoftBody {
             .sum()
     }
 
+    /// Number of tetrahedra whose current volume is zero or negative (inverted elements).
+    pub fn inverted_tet_count(&self) -> usize {
+        self.mesh
+            .tets()
+            .iter()
+            .filter(|tet| crate::mesh::signed_volume(&self.positions, tet) <= 0.0)
+            .count()
+    }
+
+    /// Current volume (m³): the sum of the tetrahedra's signed volumes.
+    pub fn deformed_volume(&self) -> f64 {
+        self.mesh
+            .tets()
+            .iter()
+            .map(|tet| crate::mesh::signed_volume(&self.positions, tet))
+            .sum()
+    }
+
     /// Centre of mass (m).
     pub fn center_of_mass(&self) -> DVec3 {
         let weighted: DVec3 = self

@@ -63,6 +63,8 @@ pub struct StepReport {
     pub substeps: u32,
     /// Length of each substep (s).
     pub substep_dt: f64,
+    /// Tetrahedra inverted (zero or negative volume) at the end of the frame.
+    pub inverted_tets: usize,
 }
 
 impl SymplecticEuler {
@@ -123,6 +125,7 @@ impl SymplecticEuler {
         Ok(StepReport {
             substeps,
             substep_dt: h,
+            inverted_tets: body.inverted_tet_count(),
         })
     }
 

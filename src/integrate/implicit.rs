@@ -50,6 +50,8 @@ pub struct ImplicitReport {
     pub relative_residual: f64,
     /// Whether every substep met the tolerance.
     pub converged: bool,
+    /// Tetrahedra inverted (zero or negative volume) at the end of the frame.
+    pub inverted_tets: usize,
 }
 
 /// Per-step data: the start of the step and the inertial target.
@@ -100,6 +102,7 @@ impl BackwardEuler {
             newton_iterations: 0,
             relative_residual: 0.0,
             converged: true,
+            inverted_tets: 0,
         };
         let mut stiffness = Stiffness::new(body);
         for _ in 0..self.substeps {
@@ -124,6 +127,7 @@ impl BackwardEuler {
             body.restore_state();
             return Err(Error::NonFiniteState { node });
         }
+        report.inverted_tets = body.inverted_tet_count();
         Ok(report)
     }
 
