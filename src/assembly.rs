@@ -12,7 +12,7 @@ use crate::Error;
 use crate::body::SoftBody;
 use crate::fvm::{TetRest, gather};
 use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::Llt;
+use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Col, Side};
 use rapier3d::glamx::{DMat3, DVec3};
@@ -23,6 +23,7 @@ use rapier3d::na;
 pub(crate) type StressTangent = na::SMatrix<f64, 9, 9>;
 
 /// The sparsity pattern of the lower triangle of the 3n x 3n tangent of a mesh, and its values.
+#[derive(Debug, Clone)]
 pub(crate) struct Stiffness {
     dofs: usize,
     col_ptr: Vec<usize>,
@@ -31,6 +32,9 @@ pub(crate) struct Stiffness {
     lower_neighbours: Vec<Vec<u32>>,
     /// Matrix entries in compressed-column order (N/m).
     pub(crate) values: Vec<f64>,
+    /// The symbolic Cholesky factorization (fill-reducing ordering and elimination tree) of the
+    /// pattern, computed at the first factorization and reused by every later one.
+    symbolic: Option<SymbolicLlt<usize>>,
 }
 
 impl Stiffness {
@@ -69,6 +73,7 @@ impl Stiffness {
             col_ptr,
             row_idx,
             lower_neighbours,
+            symbolic: None,
         }
     }
 
@@ -150,11 +155,22 @@ impl Stiffness {
 }
 
 /// The Cholesky factor of an assembled matrix.
-pub(crate) fn factorize(stiffness: &Stiffness, iteration: usize) -> Result<Llt<usize, f64>, Error> {
-    stiffness
-        .as_faer()
-        .sp_cholesky(Side::Lower)
-        .map_err(|_| Error::IndefiniteStiffness { iteration })
+pub(crate) fn factorize(
+    stiffness: &mut Stiffness,
+    iteration: usize,
+) -> Result<Llt<usize, f64>, Error> {
+    let indefinite = Error::IndefiniteStiffness { iteration };
+    let symbolic = match &stiffness.symbolic {
+        Some(symbolic) => symbolic.clone(),
+        None => {
+            let pattern = stiffness.as_faer().symbolic();
+            let symbolic =
+                SymbolicLlt::try_new(pattern, Side::Lower).map_err(|_| indefinite.clone())?;
+            stiffness.symbolic = Some(symbolic.clone());
+            symbolic
+        }
+    };
+    Llt::try_new_with_symbolic(symbolic, stiffness.as_faer(), Side::Lower).map_err(|_| indefinite)
 }
 
 /// Solves `K u = rhs` for per-node vectors.

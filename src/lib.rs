@@ -66,7 +66,7 @@ pub mod prelude {
     pub use crate::body::{SoftBody, SoftBodyBuilder};
     pub use crate::damping::RayleighDamping;
     pub use crate::integrate::{
-        BackwardEuler, ImplicitReport, StepReport, Substeps, SymplecticEuler,
+        ImplicitIntegrator, ImplicitReport, ImplicitScheme, StepReport, Substeps, SymplecticEuler,
     };
     pub use crate::material::{LameParameters, Material, MaterialModel, YoungPoisson};
     pub use crate::mesh::{self, TetMesh};

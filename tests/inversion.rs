@@ -23,7 +23,7 @@ fn soft_cube(model: MaterialModel) -> SoftBody {
 fn recover(body: &mut SoftBody, frames: usize) -> Vec<usize> {
     (0..frames)
         .map(|_| {
-            BackwardEuler::default()
+            ImplicitIntegrator::default()
                 .step(body, 1.0 / 60.0, DVec3::ZERO)
                 .unwrap()
                 .inverted_tets

@@ -135,6 +135,8 @@ impl SoftBodyBuilder {
                 Vec::with_capacity(node_count),
                 Vec::with_capacity(node_count),
             ),
+            previous_step: None,
+            tangent: None,
             mesh: self.mesh,
             material: self.material,
             damping: self.damping,

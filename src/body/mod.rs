@@ -5,6 +5,7 @@ mod builder;
 
 pub use builder::SoftBodyBuilder;
 
+use crate::assembly::Stiffness;
 use crate::damping::RayleighDamping;
 use crate::fvm::FvmMesh;
 use crate::material::{Material, with_hyperelastic_model};
@@ -30,6 +31,12 @@ pub struct SoftBody {
     pub(crate) forces: Vec<DVec3>,
     /// Positions and velocities saved before a step, restored if the step fails.
     pub(crate) saved_state: (Vec<DVec3>, Vec<DVec3>),
+    /// The state at the start of the last implicit substep, for two-step schemes; cleared by any
+    /// other change of the state.
+    pub(crate) previous_step: Option<PreviousStep>,
+    /// The sparse tangent's pattern and symbolic factorization, built by the first implicit or
+    /// static solve and kept for the next.
+    pub(crate) tangent: Option<Stiffness>,
     /// Arbitrary user data, as on rapier's bodies.
     pub user_data: u128,
 }
@@ -60,8 +67,9 @@ impl SoftBody {
         &self.positions
     }
 
-    /// Mutable world positions of the nodes (m).
+    /// Mutable world positions of the nodes (m). Editing the state restarts two-step integrators.
     pub fn positions_mut(&mut self) -> &mut [DVec3] {
+        self.previous_step = None;
         &mut self.positions
     }
 
@@ -70,8 +78,9 @@ impl SoftBody {
         &self.velocities
     }
 
-    /// Mutable node velocities (m/s).
+    /// Mutable node velocities (m/s). Editing the state restarts two-step integrators.
     pub fn velocities_mut(&mut self) -> &mut [DVec3] {
+        self.previous_step = None;
         &mut self.velocities
     }
 
@@ -116,6 +125,11 @@ impl SoftBody {
     pub(crate) fn restore_state(&mut self) {
         self.positions.clone_from(&self.saved_state.0);
         self.velocities.clone_from(&self.saved_state.1);
+    }
+
+    /// The tangent workspace, built on first use; give it back with `self.tangent = Some(..)`.
+    pub(crate) fn take_tangent(&mut self) -> Stiffness {
+        self.tangent.take().unwrap_or_else(|| Stiffness::new(self))
     }
 
     /// Recomputes `self.forces`.
@@ -214,4 +228,12 @@ pub(crate) fn lumped_masses(mesh: &TetMesh, density: f64) -> Vec<f64> {
         }
     }
     masses
+}
+
+/// The state at the start of an implicit substep of length `h` (s), kept for the next one.
+#[derive(Debug, Clone)]
+pub(crate) struct PreviousStep {
+    pub(crate) h: f64,
+    pub(crate) positions: Vec<DVec3>,
+    pub(crate) velocities: Vec<DVec3>,
 }

@@ -115,6 +115,7 @@ impl SymplecticEuler {
         let substeps = self.substep_count(body, frame_dt)?;
         let h = frame_dt / f64::from(substeps);
         body.save_state();
+        body.previous_step = None;
         for _ in 0..substeps {
             substep(body, h, gravity);
         }

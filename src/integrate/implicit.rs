@@ -1,24 +1,41 @@
-//! Backward (implicit) Euler on the incremental potential. Each step of length `h` finds
-//! `x_{n+1} = argmin E(x)` with
-//! `E(x) = Σ m |x - x̂|² / (2h²) + Ψ(x) + Φ(x) - Σ m g·x`, `x̂ = x_n + h v_n`,
-//! where `Ψ` is the elastic energy and `Φ` the damping's dissipation potential over the step; then
-//! `v_{n+1} = (x_{n+1} - x_n)/h`. The minimization is Newton's method: element Hessians projected
-//! to be positive semi-definite, a sparse Cholesky solve, and a backtracking line search that
-//! guarantees `E` decreases. Stable at any step; it damps high frequencies numerically (a mode of
-//! angular frequency `ω` loses about `ωh/2` of critical damping per step when `ωh` is small).
+//! Implicit integration on the incremental potential. Each step finds `x_{n+1} = argmin E(x)` with
+//! `E(x) = Σ m |x - x̂|² / (2ĥ²) + Ψ(x) + Φ(x) - Σ m g·x`, where `Ψ` is the elastic energy and `Φ`
+//! the damping's dissipation potential over the step, then sets `v_{n+1} = (x_{n+1} - a)/ĥ`:
+//!
+//! - backward Euler: `ĥ = h`, `a = x_n`, `x̂ = x_n + h v_n`. First order; a mode of angular
+//!   frequency `ω` is damped numerically at about `ωh/2`.
+//! - BDF2: `ĥ = 2h/3`, `a = (4 x_n - x_{n-1})/3`, `x̂ = a + ĥ (4 v_n - v_{n-1})/3`. Second order,
+//!   numerical damping of order `(ωh)³`; the first step after a change of state or step length is
+//!   a backward Euler step.
+//!
+//! The minimization is Newton's method: element Hessians projected to be positive semi-definite,
+//! a sparse Cholesky solve, and a backtracking line search that makes `E` decrease. Both schemes
+//! are stable at any step length.
 
 use crate::Error;
 use crate::assembly::{Stiffness, factorize, solve, stress_tangent};
-use crate::body::SoftBody;
+use crate::body::{PreviousStep, SoftBody};
 use crate::damping::RayleighDamping;
 use crate::fvm::gather;
 use crate::material::{HyperelasticModel, green_strain, with_hyperelastic_model};
 use crate::newton::{line_search, norm};
 use rapier3d::glamx::{DMat3, DVec3};
 
-/// The backward Euler integrator and its settings.
+/// Which implicit scheme [`ImplicitIntegrator`] uses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ImplicitScheme {
+    /// Backward Euler: first order, strongly damps high frequencies. The most robust.
+    #[default]
+    BackwardEuler,
+    /// Second-order backward differentiation: far less numerical damping at the same cost.
+    Bdf2,
+}
+
+/// The implicit integrator and its settings.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct BackwardEuler {
+pub struct ImplicitIntegrator {
+    /// The time discretization.
+    pub scheme: ImplicitScheme,
     /// Newton stops when the out-of-balance force is below this fraction of the step's force
     /// scale (inertia, gravity and elastic forces) (dimensionless).
     pub tolerance: f64,
@@ -29,9 +46,10 @@ pub struct BackwardEuler {
     pub substeps: u32,
 }
 
-impl Default for BackwardEuler {
+impl Default for ImplicitIntegrator {
     fn default() -> Self {
         Self {
+            scheme: ImplicitScheme::BackwardEuler,
             tolerance: 1e-6,
             max_newton_iterations: 20,
             substeps: 1,
@@ -54,17 +72,22 @@ pub struct ImplicitReport {
     pub inverted_tets: usize,
 }
 
-/// Per-step data: the start of the step and the inertial target.
+/// Per-step data of the incremental potential.
 struct StepStart {
+    /// The effective step `ĥ` (s).
     h: f64,
+    /// Positions at the start of the step (m).
     positions: Vec<DVec3>,
+    /// `a` (m): the new velocity is `(x - a)/ĥ`.
+    anchor: Vec<DVec3>,
+    /// `x̂` (m), the inertial target.
     target: Vec<DVec3>,
-    /// Green strain of every tetrahedron at the start of the step (when damped).
+    /// Per tetrahedron, the Green strain the damping's rate is measured from (when damped).
     green: Vec<DMat3>,
     load: Vec<DVec3>,
 }
 
-impl BackwardEuler {
+impl ImplicitIntegrator {
     /// Advances `body` by `frame_dt` (s) under uniform gravity (m/s²).
     ///
     /// # Errors
@@ -104,7 +127,7 @@ impl BackwardEuler {
             converged: true,
             inverted_tets: 0,
         };
-        let mut stiffness = Stiffness::new(body);
+        let mut stiffness = body.take_tangent();
         for _ in 0..self.substeps {
             match self.substep(body, &mut stiffness, h, gravity) {
                 Ok((iterations, residual, converged)) => {
@@ -114,10 +137,13 @@ impl BackwardEuler {
                 }
                 Err(error) => {
                     body.restore_state();
+                    body.previous_step = None;
+                    body.tangent = Some(stiffness);
                     return Err(error);
                 }
             }
         }
+        body.tangent = Some(stiffness);
         let non_finite = body
             .positions
             .iter()
@@ -125,6 +151,7 @@ impl BackwardEuler {
             .position(|(x, v)| !(x.is_finite() && v.is_finite()));
         if let Some(node) = non_finite {
             body.restore_state();
+            body.previous_step = None;
             return Err(Error::NonFiniteState { node });
         }
         report.inverted_tets = body.inverted_tet_count();
@@ -139,10 +166,19 @@ impl BackwardEuler {
         h: f64,
         gravity: DVec3,
     ) -> Result<(usize, f64, bool), Error> {
-        let start = StepStart::new(body, h, gravity);
+        let start = StepStart::new(body, h, gravity, self.scheme);
+        let step_start = PreviousStep {
+            h,
+            positions: body.positions.clone(),
+            velocities: body.velocities.clone(),
+        };
         body.positions.clone_from(&start.target);
         body.velocities.fill(DVec3::ZERO);
-        let inertia: Vec<f64> = body.masses.iter().map(|m| m / (h * h)).collect();
+        let inertia: Vec<f64> = body
+            .masses
+            .iter()
+            .map(|m| m / (start.h * start.h))
+            .collect();
         let mut residual = start.residual(body);
         let reference = start.force_scale(body, &residual);
         let mut previous = f64::INFINITY;
@@ -168,42 +204,77 @@ impl BackwardEuler {
             body.velocities[n] = if body.pinned[n] {
                 DVec3::ZERO
             } else {
-                (body.positions[n] - start.positions[n]) / h
+                (body.positions[n] - start.anchor[n]) / start.h
             };
         }
+        body.previous_step = Some(step_start);
         Ok(outcome)
     }
 }
 
 impl StepStart {
-    fn new(body: &SoftBody, h: f64, gravity: DVec3) -> Self {
+    /// The potential of a step of length `h` from the body's state; BDF2 uses the previous
+    /// step when it had the same length, backward Euler otherwise.
+    fn new(body: &SoftBody, h: f64, gravity: DVec3, scheme: ImplicitScheme) -> Self {
         let positions = body.positions.clone();
+        let previous = match scheme {
+            ImplicitScheme::Bdf2 => body.previous_step.as_ref().filter(|p| p.h == h),
+            ImplicitScheme::BackwardEuler => None,
+        };
+        let green_at = |x: &[DVec3]| -> Vec<DMat3> {
+            let tets = body.fvm.tets();
+            (0..tets.len())
+                .map(|t| green_strain(&body.fvm.tet_rest(t).gradient(&gather(&tets[t], x))))
+                .collect()
+        };
+        let damped = body.damping.is_some();
+        let (effective_h, anchor, velocity, green) = match previous {
+            Some(previous) => {
+                let combine = |now: &[DVec3], before: &[DVec3]| -> Vec<DVec3> {
+                    now.iter()
+                        .zip(before)
+                        .map(|(a, b)| (*a * 4.0 - *b) / 3.0)
+                        .collect()
+                };
+                let green = if damped {
+                    let (now, before) = (green_at(&positions), green_at(&previous.positions));
+                    now.iter()
+                        .zip(&before)
+                        .map(|(a, b)| (*a * 4.0 - *b) * (1.0 / 3.0))
+                        .collect()
+                } else {
+                    Vec::new()
+                };
+                (
+                    2.0 * h / 3.0,
+                    combine(&positions, &previous.positions),
+                    combine(&body.velocities, &previous.velocities),
+                    green,
+                )
+            }
+            None => {
+                let green = if damped {
+                    green_at(&positions)
+                } else {
+                    Vec::new()
+                };
+                (h, positions.clone(), body.velocities.clone(), green)
+            }
+        };
         let target = (0..positions.len())
             .map(|n| {
                 if body.pinned[n] {
                     positions[n]
                 } else {
-                    positions[n] + body.velocities[n] * h
+                    anchor[n] + velocity[n] * effective_h
                 }
             })
             .collect();
-        let green = if body.damping.is_some() {
-            (0..body.fvm.tets().len())
-                .map(|t| {
-                    let f = body
-                        .fvm
-                        .tet_rest(t)
-                        .gradient(&gather(&body.fvm.tets()[t], &positions));
-                    green_strain(&f)
-                })
-                .collect()
-        } else {
-            Vec::new()
-        };
         let load = body.masses.iter().map(|m| gravity * *m).collect();
         Self {
-            h,
+            h: effective_h,
             positions,
+            anchor,
             target,
             green,
             load,

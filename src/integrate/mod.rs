@@ -4,4 +4,4 @@ mod explicit;
 mod implicit;
 
 pub use explicit::{COURANT_NUMBER, StepReport, Substeps, SymplecticEuler};
-pub use implicit::{BackwardEuler, ImplicitReport};
+pub use implicit::{ImplicitIntegrator, ImplicitReport, ImplicitScheme};

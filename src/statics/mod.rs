@@ -66,7 +66,10 @@ pub fn solve_equilibrium(
         return Err(Error::NoFreeNode);
     }
     body.save_state();
-    let result = newton(body, gravity, settings);
+    body.previous_step = None;
+    let mut stiffness = body.take_tangent();
+    let result = newton(body, &mut stiffness, gravity, settings);
+    body.tangent = Some(stiffness);
     if result.is_err() {
         body.restore_state();
     }
@@ -76,11 +79,11 @@ pub fn solve_equilibrium(
 /// Newton's iterations of [`solve_equilibrium`].
 fn newton(
     body: &mut SoftBody,
+    stiffness: &mut Stiffness,
     gravity: DVec3,
     settings: &StaticSettings,
 ) -> Result<StaticReport, Error> {
     body.velocities.fill(DVec3::ZERO);
-    let mut stiffness = Stiffness::new(body);
     let load: Vec<DVec3> = (0..body.node_count())
         .map(|n| {
             if body.pinned[n] {
@@ -113,12 +116,12 @@ fn newton(
         previous = relative;
         // The exact tangent converges quadratically; where the body is in an unstable (buckling)
         // state it is indefinite, and the projected tangent still gives a descent direction.
-        assemble_elastic(&mut stiffness, body, false);
-        let factor = match factorize(&stiffness, iteration) {
+        assemble_elastic(stiffness, body, false);
+        let factor = match factorize(stiffness, iteration) {
             Ok(factor) => factor,
             Err(_) => {
-                assemble_elastic(&mut stiffness, body, true);
-                factorize(&stiffness, iteration)?
+                assemble_elastic(stiffness, body, true);
+                factorize(stiffness, iteration)?
             }
         };
         let step = solve(&factor, &residual);
@@ -153,7 +156,7 @@ pub fn fundamental_frequency(body: &SoftBody) -> Result<f64, Error> {
     const TOLERANCE: f64 = 1e-13;
     let mut stiffness = Stiffness::new(body);
     assemble_elastic(&mut stiffness, body, false);
-    let factor = factorize(&stiffness, 0)?;
+    let factor = factorize(&mut stiffness, 0)?;
     let masses = &body.masses;
     let free = |n: usize| !body.pinned[n];
     // Start from a fixed pseudo-random motion of the free nodes, which has a component on every
