@@ -66,7 +66,8 @@ pub mod prelude {
     pub use crate::body::{SoftBody, SoftBodyBuilder};
     pub use crate::damping::RayleighDamping;
     pub use crate::integrate::{
-        ImplicitIntegrator, ImplicitReport, ImplicitScheme, StepReport, Substeps, SymplecticEuler,
+        AutomaticIntegrator, ImplicitIntegrator, ImplicitReport, ImplicitScheme, IntegratorKind,
+        StepReport, Substeps, SymplecticEuler,
     };
     pub use crate::material::{LameParameters, Material, MaterialModel, YoungPoisson};
     pub use crate::mesh::{self, TetMesh};

@@ -102,11 +102,12 @@ impl SoftBody {
         self.pinned[node]
     }
 
-    /// The mesh's wave length scale (m), see [`FvmMesh::wave_length_scale`]: the explicit
-    /// critical step is about [`COURANT_NUMBER`](crate::integrate::COURANT_NUMBER) times this over
-    /// the pressure wave speed.
+    /// The mesh's wave length scale (m) at the current positions, see
+    /// [`FvmMesh::wave_length_scale`]: the explicit critical step is about
+    /// [`COURANT_NUMBER`](crate::integrate::COURANT_NUMBER) times this over the pressure wave
+    /// speed.
     pub fn wave_length_scale(&self) -> f64 {
-        self.fvm.wave_length_scale()
+        self.fvm.wave_length_scale(&self.positions)
     }
 
     /// Internal forces (N per node): elastic plus damping, at the current positions and velocities.

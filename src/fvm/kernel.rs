@@ -64,7 +64,6 @@ pub struct FvmMesh {
     tet_count: usize,
     blocks: Vec<RestBlock>,
     node_count: usize,
-    wave_length_scale: f64,
     /// Per chunk of [`CHUNK_TETS`] tetrahedra: the first node it touches and its force window;
     /// empty for meshes of a single chunk.
     windows: Vec<(usize, Vec<DVec3>)>,
@@ -76,7 +75,6 @@ impl FvmMesh {
         let tet_count = mesh.tet_count();
         let rest = TetRest::of_mesh(mesh);
         let node_count = mesh.node_count();
-        let wave_length_scale = wave_length_scale(mesh.tets(), &rest, node_count);
         let padded = tet_count.div_ceil(LANES) * LANES;
         let mut tets = mesh.tets().to_vec();
         tets.resize(padded, tets[tet_count - 1]);
@@ -96,7 +94,6 @@ impl FvmMesh {
             tet_count,
             blocks,
             node_count,
-            wave_length_scale,
             windows,
         }
     }
@@ -124,14 +121,42 @@ impl FvmMesh {
         self.node_count
     }
 
-    /// The length `ℓ` (m) such that a wave of speed `c` through the mesh has its highest angular
-    /// frequency below `2c/ℓ`: the smallest over the nodes of
-    /// `ℓ_i = 2 sqrt(V_i / Σ_e V_e |∇N_i| Σ_j |∇N_j|)`, with `V_i` the node's control volume and
-    /// the sums over the tetrahedra `e` at node `i` (Gershgorin's bound on the lumped-mass wave
-    /// operator). Unlike the smallest element altitude it accounts for how many elements share a
-    /// node, so it tracks the true limit on every kind of mesh.
-    pub fn wave_length_scale(&self) -> f64 {
-        self.wave_length_scale
+    /// The length `ℓ` (m) such that a pressure wave of speed `c` through the mesh at positions
+    /// `x` has its highest angular frequency below about `2c/ℓ`: the smallest over the nodes of
+    /// `ℓ_i = 2 sqrt(V_i / Σ_e V_e |∇N_i| Σ_j |∇N_j|)`, with `V_i` the node's rest control volume,
+    /// the sums over the tetrahedra `e` at node `i` and the shape-function gradients taken in the
+    /// deformed configuration (Gershgorin's bound on the lumped-mass wave operator, with the
+    /// spatial stiffness of a compressed element). Unlike the smallest element altitude it counts
+    /// how many elements share a node, and it shrinks as elements are crushed; zero if one is flat.
+    pub fn wave_length_scale(&self, x: &[DVec3]) -> f64 {
+        let mut control_volume = vec![0.0; self.node_count];
+        let mut row_sum = vec![0.0; self.node_count];
+        for (t, tet) in self.tets().iter().enumerate() {
+            let rest = self.tet_rest(t);
+            let [x0, x1, x2, x3] = gather(tet, x);
+            let edges = rapier3d::glamx::DMat3::from_cols(x1 - x0, x2 - x0, x3 - x0);
+            if edges.determinant().abs() <= f64::EPSILON * rest.volume.abs() {
+                return 0.0;
+            }
+            let g = edges.inverse().transpose();
+            let gradients = [
+                -(g.x_axis + g.y_axis + g.z_axis),
+                g.x_axis,
+                g.y_axis,
+                g.z_axis,
+            ];
+            let total: f64 = gradients.iter().map(|g| g.length()).sum();
+            for (corner, &n) in tet.iter().enumerate() {
+                control_volume[n as usize] += 0.25 * rest.volume;
+                row_sum[n as usize] += rest.volume * gradients[corner].length() * total;
+            }
+        }
+        control_volume
+            .iter()
+            .zip(&row_sum)
+            .filter(|(_, row)| **row > 0.0)
+            .map(|(volume, row)| 2.0 * (volume / row).sqrt())
+            .fold(f64::INFINITY, f64::min)
     }
 
     /// Writes into `out` the internal force (N) on every node, for positions `x` (m) and
@@ -298,31 +323,6 @@ fn chunk_windows(tets: &[[u32; 4]], node_count: usize) -> Vec<(usize, Vec<DVec3>
         .into_iter()
         .map(|(first, len)| (first, vec![DVec3::ZERO; len]))
         .collect()
-}
-
-fn wave_length_scale(tets: &[[u32; 4]], rest: &[TetRest], node_count: usize) -> f64 {
-    let mut control_volume = vec![0.0; node_count];
-    let mut row_sum = vec![0.0; node_count];
-    for (tet, rest) in tets.iter().zip(rest) {
-        let g = rest.inverse_rest_edges.transpose();
-        let gradients = [
-            -(g.x_axis + g.y_axis + g.z_axis),
-            g.x_axis,
-            g.y_axis,
-            g.z_axis,
-        ];
-        let total: f64 = gradients.iter().map(|g| g.length()).sum();
-        for (corner, &n) in tet.iter().enumerate() {
-            control_volume[n as usize] += 0.25 * rest.volume;
-            row_sum[n as usize] += rest.volume * gradients[corner].length() * total;
-        }
-    }
-    control_volume
-        .iter()
-        .zip(&row_sum)
-        .filter(|(_, row)| **row > 0.0)
-        .map(|(volume, row)| 2.0 * (volume / row).sqrt())
-        .fold(f64::INFINITY, f64::min)
 }
 
 /// The four entries of `values` at the nodes of `tet`.

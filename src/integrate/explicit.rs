@@ -2,10 +2,11 @@
 //! `v ← v + h (f_int(x, v)/m + g)`, then `x ← x + h v`, for each substep `h`.
 //!
 //! The substep is limited by the Courant–Friedrichs–Lewy condition: a pressure wave must not cross
-//! a cell in one step. The critical step of the undamped scheme is estimated as
-//! `h_crit = C ℓ / c_p`, with `c_p = sqrt((λ+2μ)/ρ)` the pressure wave speed, `ℓ` the mesh's
-//! [`wave_length_scale`](crate::fvm::FvmMesh::wave_length_scale) (a per-node cell size that counts
-//! the elements sharing the node) and `C` the [`COURANT_NUMBER`] measured on this crate's meshes.
+//! a cell in one step. The critical step of the undamped scheme is estimated at the start of each
+//! frame as `h_crit = C ℓ / c_p`, with `c_p = sqrt((λ+2μ)/ρ)` the pressure wave speed, `ℓ` the
+//! mesh's [`wave_length_scale`](crate::fvm::FvmMesh::wave_length_scale) in its current shape (a
+//! per-node cell size that counts the elements sharing the node and shrinks as they are crushed)
+//! and `C` the [`COURANT_NUMBER`] measured on this crate's meshes.
 //! Damping lowers it: with the highest mode at `ω = 2/h_crit` damped at `ζ = β ω/2`
 //! (`β = (φ+2ψ)/(λ+2μ)`), the limit becomes `(2/ω)(sqrt(1+ζ²) - ζ)`. The automatic substep is that
 //! limit times a safety factor.
@@ -68,8 +69,8 @@ pub struct StepReport {
 }
 
 impl SymplecticEuler {
-    /// Estimated critical time step (s) of the explicit scheme for `body` at rest: steps above it
-    /// make the highest modes grow.
+    /// Estimated critical time step (s) of the explicit scheme for `body` in its current shape:
+    /// steps above it make the highest modes grow. Zero if an element is flat.
     pub fn critical_time_step(body: &SoftBody) -> f64 {
         let undamped =
             COURANT_NUMBER * body.wave_length_scale() / body.material().dilatational_wave_speed();

@@ -1,7 +1,9 @@
 //! Time integration of soft bodies: `M v̇ = f_int(x, v) + M g`, `ẋ = v`, with pinned nodes held.
 
+mod automatic;
 mod explicit;
 mod implicit;
 
+pub use automatic::{AutomaticIntegrator, AutomaticReport, CostPrediction, IntegratorKind};
 pub use explicit::{COURANT_NUMBER, StepReport, Substeps, SymplecticEuler};
 pub use implicit::{ImplicitIntegrator, ImplicitReport, ImplicitScheme};
