@@ -39,8 +39,9 @@ pub struct ImplicitIntegrator {
     /// Newton stops when the out-of-balance force is below this fraction of the step's force
     /// scale (inertia, gravity and elastic forces) (dimensionless).
     pub tolerance: f64,
-    /// Newton iterations per substep at most; a step that has not met the tolerance by then is
-    /// kept (its energy decreased) and reported as unconverged.
+    /// Newton iterations per substep at most; a step that has not met the tolerance by then, or
+    /// whose residual stops falling (its round-off floor), is kept (its energy decreased) and
+    /// reported as unconverged.
     pub max_newton_iterations: usize,
     /// Equal substeps per frame (at least 1).
     pub substeps: u32,
@@ -181,20 +182,25 @@ impl ImplicitIntegrator {
             .collect();
         let mut residual = start.residual(body);
         let reference = start.force_scale(body, &residual);
-        let mut previous = f64::INFINITY;
+        // Relative residuals of the last iterations, newest last.
+        let mut history: Vec<f64> = Vec::with_capacity(self.max_newton_iterations + 1);
         let mut outcome = (self.max_newton_iterations, f64::INFINITY, false);
         for iteration in 0..=self.max_newton_iterations {
             let relative = norm(&residual) / reference;
+            let previous = history.last().copied().unwrap_or(f64::INFINITY);
             let at_round_off = relative > 0.5 * previous && relative <= 1e-9;
             if relative <= self.tolerance || at_round_off {
                 outcome = (iteration, relative, true);
                 break;
             }
-            if iteration == self.max_newton_iterations {
+            // Three iterations without a 10 % gain: the residual sits on its round-off floor
+            // (very stiff or nearly incompressible material against a small load); stop there.
+            let stalled = history.len() >= 3 && relative > 0.9 * history[history.len() - 3];
+            if iteration == self.max_newton_iterations || stalled {
                 outcome = (iteration, relative, false);
                 break;
             }
-            previous = relative;
+            history.push(relative);
             start.assemble(body, stiffness, &inertia);
             let direction = solve(&factorize(stiffness, iteration)?, &residual);
             line_search(body, &residual, &direction, |body| start.energy(body));
