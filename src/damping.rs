@@ -128,3 +128,49 @@ impl RayleighDamping {
         *df * self.stress_of_rate(&rate) + *f * self.stress_of_rate(&d_rate)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::material::green_strain;
+
+    /// The step potential's stress is its derivative and the differential is the stress's
+    /// derivative (central differences, 1e-6 relative): the implicit integrator's Newton
+    /// direction and line search rely on both.
+    #[test]
+    fn step_potential_derivatives_match_finite_differences() {
+        let damping = RayleighDamping::new(300.0, 200.0).unwrap();
+        let f = DMat3::from_cols_array(&[1.1, 0.05, -0.02, 0.03, 0.95, 0.04, -0.01, 0.02, 1.05]);
+        let previous = green_strain(&DMat3::from_cols_array(&[
+            1.0, 0.01, 0.0, 0.0, 1.02, 0.01, 0.02, 0.0, 0.98,
+        ]));
+        let (h, eps) = (1e-3, 1e-7);
+        let stress = damping.step_first_piola(&f, &previous, h);
+        let scale = stress
+            .to_cols_array()
+            .iter()
+            .fold(0.0f64, |m, x| m.max(x.abs()));
+        for k in 0..9 {
+            let mut unit = [0.0; 9];
+            unit[k] = 1.0;
+            let df = DMat3::from_cols_array(&unit);
+            let plus = damping.step_potential(&(f + df * eps), &previous, h);
+            let minus = damping.step_potential(&(f - df * eps), &previous, h);
+            let numeric = (plus - minus) / (2.0 * eps);
+            assert!((numeric - stress.to_cols_array()[k]).abs() < 1e-6 * scale);
+            let numeric_dp = (damping.step_first_piola(&(f + df * eps), &previous, h)
+                - damping.step_first_piola(&(f - df * eps), &previous, h))
+                * (0.5 / eps);
+            let analytic_dp = damping.step_first_piola_differential(&f, &previous, h, &df);
+            let dp_scale = analytic_dp
+                .to_cols_array()
+                .iter()
+                .fold(1e-30f64, |m, x| m.max(x.abs()));
+            let error = (numeric_dp - analytic_dp)
+                .to_cols_array()
+                .iter()
+                .fold(0.0f64, |m, x| m.max(x.abs()));
+            assert!(error < 1e-6 * dp_scale);
+        }
+    }
+}

@@ -9,7 +9,7 @@
 //! whose polar decomposition dominates), an implicit Newton iteration about 6 µs (7 µs), and an
 //! implicit frame takes about 3.5 Newton iterations. Only their ratio matters for the choice.
 
-use super::{ImplicitIntegrator, ImplicitReport, StepReport, SymplecticEuler};
+use super::{ImplicitIntegrator, ImplicitReport, StepReport, Substeps, SymplecticEuler};
 use crate::Error;
 use crate::body::SoftBody;
 use crate::material::MaterialModel;
@@ -94,9 +94,12 @@ impl AutomaticIntegrator {
     pub fn predict(&self, body: &SoftBody, frame_dt: f64) -> CostPrediction {
         let tets = body.mesh().tet_count() as f64;
         let model = body.material().model();
-        let explicit_substeps = (frame_dt / self.explicit.stable_time_step(body))
-            .ceil()
-            .max(1.0);
+        let explicit_substeps = match self.explicit.substeps {
+            Substeps::Fixed(n) => f64::from(n.max(1)),
+            Substeps::Automatic => (frame_dt / self.explicit.stable_time_step(body))
+                .ceil()
+                .max(1.0),
+        };
         let implicit_frames = f64::from(self.implicit.substeps.max(1));
         CostPrediction {
             explicit_substeps,
@@ -112,7 +115,9 @@ impl AutomaticIntegrator {
     /// forced one).
     ///
     /// # Errors
-    /// The errors of [`SymplecticEuler::step`] or [`ImplicitIntegrator::step`], whichever ran.
+    /// [`Error::InvalidTimeStep`] for a non-positive or non-finite `frame_dt`,
+    /// [`Error::InvalidSetting`] for an explicit safety factor outside (0, 1], then the errors of
+    /// [`SymplecticEuler::step`] or [`ImplicitIntegrator::step`], whichever ran.
     pub fn step(
         &self,
         body: &mut SoftBody,
@@ -123,6 +128,14 @@ impl AutomaticIntegrator {
             return Err(Error::InvalidTimeStep {
                 dt: frame_dt,
                 reason: "must be positive and finite",
+            });
+        }
+        let safety = self.explicit.safety_factor;
+        if !(safety > 0.0 && safety <= 1.0) {
+            return Err(Error::InvalidSetting {
+                parameter: "explicit.safety_factor",
+                value: safety,
+                reason: "must lie in (0, 1]",
             });
         }
         let prediction = self.predict(body, frame_dt);

@@ -116,12 +116,13 @@ impl SymplecticEuler {
         let substeps = self.substep_count(body, frame_dt)?;
         let h = frame_dt / f64::from(substeps);
         body.save_state();
-        body.previous_step = None;
+        let history = body.previous_step.take();
         for _ in 0..substeps {
             substep(body, h, gravity);
         }
         if let Some(node) = first_non_finite_node(body) {
             body.restore_state();
+            body.previous_step = history;
             return Err(Error::NonFiniteState { node });
         }
         Ok(StepReport {

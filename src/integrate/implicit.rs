@@ -18,7 +18,7 @@ use crate::body::{PreviousStep, SoftBody};
 use crate::damping::RayleighDamping;
 use crate::fvm::gather;
 use crate::material::{HyperelasticModel, green_strain, with_hyperelastic_model};
-use crate::newton::{line_search, norm};
+use crate::newton::{descend, norm};
 use rapier3d::glamx::{DMat3, DVec3};
 
 /// Newton stops early on a stalled residual only below this relative value; above it, a slow
@@ -43,9 +43,10 @@ pub struct ImplicitIntegrator {
     /// Newton stops when the out-of-balance force is below this fraction of the step's force
     /// scale (inertia, gravity and elastic forces) (dimensionless).
     pub tolerance: f64,
-    /// Newton iterations per substep at most; a step that has not met the tolerance by then, or
-    /// whose residual stops falling (its round-off floor), is kept (its energy decreased) and
-    /// reported as unconverged.
+    /// Newton iterations per substep at most (at least 1); a step that has not met the tolerance
+    /// by then, whose residual stops falling (its round-off floor), or along which no descent is
+    /// left, keeps its last iterate (each accepted iterate lowered the incremental potential) and
+    /// is reported as unconverged.
     pub max_newton_iterations: usize,
     /// Equal substeps per frame (at least 1).
     pub substeps: u32,
@@ -97,7 +98,8 @@ impl ImplicitIntegrator {
     ///
     /// # Errors
     /// [`Error::InvalidTimeStep`] for a non-positive or non-finite `frame_dt` or zero substeps;
-    /// [`Error::NonFiniteInput`] for a non-finite gravity;
+    /// [`Error::NonFiniteInput`] for a non-finite gravity; [`Error::InvalidSetting`] for a
+    /// non-positive tolerance or zero Newton iterations;
     /// [`Error::IndefiniteStiffness`] if a linear system cannot be factored;
     /// [`Error::NonFiniteState`] if the step produced a NaN. On error the body is left as it was.
     pub fn step(
@@ -123,7 +125,22 @@ impl ImplicitIntegrator {
                 reason: "at least one substep is needed",
             });
         }
+        if !(self.tolerance.is_finite() && self.tolerance > 0.0) {
+            return Err(Error::InvalidSetting {
+                parameter: "tolerance",
+                value: self.tolerance,
+                reason: "must be positive and finite",
+            });
+        }
+        if self.max_newton_iterations == 0 {
+            return Err(Error::InvalidSetting {
+                parameter: "max_newton_iterations",
+                value: 0.0,
+                reason: "at least one Newton iteration is needed",
+            });
+        }
         body.save_state();
+        let history = body.previous_step.clone();
         let h = frame_dt / f64::from(self.substeps);
         let mut report = ImplicitReport {
             substeps: self.substeps,
@@ -142,7 +159,7 @@ impl ImplicitIntegrator {
                 }
                 Err(error) => {
                     body.restore_state();
-                    body.previous_step = None;
+                    body.previous_step = history;
                     body.tangent = Some(stiffness);
                     return Err(error);
                 }
@@ -156,7 +173,7 @@ impl ImplicitIntegrator {
             .position(|(x, v)| !(x.is_finite() && v.is_finite()));
         if let Some(node) = non_finite {
             body.restore_state();
-            body.previous_step = None;
+            body.previous_step = history;
             return Err(Error::NonFiniteState { node });
         }
         report.inverted_tets = body.inverted_tet_count();
@@ -191,9 +208,11 @@ impl ImplicitIntegrator {
         let mut outcome = (self.max_newton_iterations, f64::INFINITY, false);
         for iteration in 0..=self.max_newton_iterations {
             let relative = norm(&residual) / reference;
-            let previous = history.last().copied().unwrap_or(f64::INFINITY);
-            let at_round_off = relative > 0.5 * previous && relative <= 1e-9;
-            if relative <= self.tolerance || at_round_off {
+            if !relative.is_finite() {
+                let node = residual.iter().position(|r| !r.is_finite()).unwrap_or(0);
+                return Err(Error::NonFiniteState { node });
+            }
+            if relative <= self.tolerance {
                 outcome = (iteration, relative, true);
                 break;
             }
@@ -207,10 +226,27 @@ impl ImplicitIntegrator {
                 break;
             }
             history.push(relative);
-            start.assemble(body, stiffness, &inertia);
-            let direction = solve(&factorize(stiffness, iteration)?, &residual);
-            line_search(body, &residual, &direction, |body| start.energy(body));
-            residual = start.residual(body);
+            // The exact Hessian converges fastest; where it is indefinite (compressed elements)
+            // the per-element projection restores a descent direction.
+            start.assemble(body, stiffness, &inertia, false);
+            let factor = match factorize(stiffness, iteration) {
+                Ok(factor) => factor,
+                Err(_) => {
+                    start.assemble(body, stiffness, &inertia, true);
+                    factorize(stiffness, iteration)?
+                }
+            };
+            let direction = solve(&factor, &residual);
+            let energy = |body: &SoftBody| start.energy(body);
+            match descend(body, &residual, &direction, energy, |body| {
+                start.residual(body)
+            }) {
+                Some(next) => residual = next,
+                None => {
+                    outcome = (iteration, relative, false);
+                    break;
+                }
+            }
         }
         for n in 0..body.positions.len() {
             body.velocities[n] = if body.pinned[n] {
@@ -282,7 +318,15 @@ impl StepStart {
                 }
             })
             .collect();
-        let load = body.masses.iter().map(|m| gravity * *m).collect();
+        let load = (0..positions.len())
+            .map(|n| {
+                if body.pinned[n] {
+                    DVec3::ZERO
+                } else {
+                    gravity * body.masses[n]
+                }
+            })
+            .collect();
         Self {
             h: effective_h,
             positions,
@@ -350,11 +394,12 @@ impl StepStart {
             .map(|n| 0.5 * body.masses[n] * (body.positions[n] - self.target[n]).length_squared())
             .sum::<f64>()
             / (self.h * self.h);
+        // The load's work is measured from the start of the step.
         let load: f64 = self
             .load
             .iter()
-            .zip(&body.positions)
-            .map(|(f, x)| f.dot(*x))
+            .zip(body.positions.iter().zip(&self.positions))
+            .map(|(f, (x, x0))| f.dot(*x - *x0))
             .sum();
         let dissipation = match body.damping {
             Some(damping) => (0..body.fvm.tets().len())
@@ -370,13 +415,13 @@ impl StepStart {
     }
 
     /// `M/h² + K_elastic + K_damping`, each element's stress tangent projected to be positive
-    /// semi-definite.
-    fn assemble(&self, body: &SoftBody, stiffness: &mut Stiffness, inertia: &[f64]) {
+    /// semi-definite if `project`.
+    fn assemble(&self, body: &SoftBody, stiffness: &mut Stiffness, inertia: &[f64], project: bool) {
         let damping = body.damping;
         with_hyperelastic_model!(body.material, |model| stiffness.assemble(
             body,
             Some(inertia),
-            true,
+            project,
             |t, f| stress_tangent(|df| {
                 let elastic = model.first_piola_differential(f, df);
                 match &damping {

@@ -10,7 +10,7 @@ use crate::Error;
 use crate::assembly::{Stiffness, factorize, solve, stress_tangent};
 use crate::body::SoftBody;
 use crate::material::{HyperelasticModel, with_hyperelastic_model};
-use crate::newton::{line_search, norm};
+use crate::newton::{descend, norm};
 use rapier3d::glamx::DVec3;
 
 /// The largest relative residual accepted as round-off when Newton stops reducing it.
@@ -66,12 +66,13 @@ pub fn solve_equilibrium(
         return Err(Error::NoFreeNode);
     }
     body.save_state();
-    body.previous_step = None;
+    let history = body.previous_step.take();
     let mut stiffness = body.take_tangent();
     let result = newton(body, &mut stiffness, gravity, settings);
     body.tangent = Some(stiffness);
     if result.is_err() {
         body.restore_state();
+        body.previous_step = history;
     }
     result
 }
@@ -101,19 +102,24 @@ fn newton(
             relative_residual: 0.0,
         });
     }
-    let mut previous = f64::INFINITY;
+    let mut history: Vec<f64> = Vec::new();
     for iteration in 0..settings.max_iterations {
         let relative = norm(&residual) / reference;
         // Newton more than halves the residual each iteration until round-off in the force sum
-        // sets a floor (about 1e-9 on 1e5 elements); a tiny residual that stops falling is there.
-        let at_round_off = relative > 0.5 * previous && relative <= ROUND_OFF_CEILING;
+        // sets a floor (about 1e-9 on 1e5 elements); a tiny residual that fails to halve twice in
+        // a row is there.
+        let failed_to_halve = |older: f64, newer: f64| newer > 0.5 * older;
+        let at_round_off = relative <= ROUND_OFF_CEILING
+            && history.len() >= 2
+            && failed_to_halve(history[history.len() - 1], relative)
+            && failed_to_halve(history[history.len() - 2], history[history.len() - 1]);
         if relative <= settings.tolerance || at_round_off {
             return Ok(StaticReport {
                 iterations: iteration,
                 relative_residual: relative,
             });
         }
-        previous = relative;
+        history.push(relative);
         // The exact tangent converges quadratically; where the body is in an unstable (buckling)
         // state it is indefinite, and the projected tangent still gives a descent direction.
         assemble_elastic(stiffness, body, false);
@@ -125,8 +131,25 @@ fn newton(
             }
         };
         let step = solve(&factor, &residual);
-        line_search(body, &residual, &step, |body| potential_energy(body, &load));
-        residual = out_of_balance(body, &load);
+        let energy = |body: &SoftBody| potential_energy(body, &load);
+        match descend(body, &residual, &step, energy, |body| {
+            out_of_balance(body, &load)
+        }) {
+            Some(next) => residual = next,
+            // No descent left above round-off: accept a tiny residual, refuse anything else.
+            None if relative <= ROUND_OFF_CEILING => {
+                return Ok(StaticReport {
+                    iterations: iteration,
+                    relative_residual: relative,
+                });
+            }
+            None => {
+                return Err(Error::StaticSolveDidNotConverge {
+                    iterations: iteration,
+                    residual: relative,
+                });
+            }
+        }
     }
     let relative = norm(&residual) / reference;
     if relative <= settings.tolerance {
@@ -237,10 +260,11 @@ fn out_of_balance(body: &mut SoftBody, load: &[DVec3]) -> Vec<DVec3> {
 
 /// Total potential energy (J): elastic energy minus the work of the constant load.
 fn potential_energy(body: &SoftBody, load: &[DVec3]) -> f64 {
+    // The load's work is measured from the positions at the start of the solve.
     let load_work: f64 = load
         .iter()
-        .zip(&body.positions)
-        .map(|(f, x)| f.dot(*x))
+        .zip(body.positions.iter().zip(&body.saved_state.0))
+        .map(|(f, (x, x0))| f.dot(*x - *x0))
         .sum();
     body.elastic_energy() - load_work
 }
