@@ -133,6 +133,15 @@ impl SoftBody {
         self.tangent.take().unwrap_or_else(|| Stiffness::new(self))
     }
 
+    /// The weight of every free node, `m g` (N); zero on pinned nodes.
+    pub(crate) fn gravity_load(&self, gravity: DVec3) -> Vec<DVec3> {
+        self.masses
+            .iter()
+            .zip(&self.pinned)
+            .map(|(m, &pinned)| if pinned { DVec3::ZERO } else { gravity * *m })
+            .collect()
+    }
+
     /// Recomputes `self.forces`.
     pub(crate) fn compute_internal_forces(&mut self) {
         let Self {

@@ -115,7 +115,8 @@ impl AutomaticIntegrator {
     /// forced one).
     ///
     /// # Errors
-    /// [`Error::InvalidTimeStep`] for a non-positive or non-finite `frame_dt`,
+    /// [`Error::InvalidTimeStep`] for a non-positive or non-finite `frame_dt`, [`Error::NonFiniteInput`]
+    /// for a non-finite gravity,
     /// [`Error::InvalidSetting`] for an explicit safety factor outside (0, 1], then the errors of
     /// [`SymplecticEuler::step`] or [`ImplicitIntegrator::step`], whichever ran.
     pub fn step(
@@ -124,12 +125,7 @@ impl AutomaticIntegrator {
         frame_dt: f64,
         gravity: DVec3,
     ) -> Result<AutomaticReport, Error> {
-        if !(frame_dt.is_finite() && frame_dt > 0.0) {
-            return Err(Error::InvalidTimeStep {
-                dt: frame_dt,
-                reason: "must be positive and finite",
-            });
-        }
+        super::check_step(frame_dt, gravity)?;
         let safety = self.explicit.safety_factor;
         if !(safety > 0.0 && safety <= 1.0) {
             return Err(Error::InvalidSetting {

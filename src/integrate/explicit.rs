@@ -11,6 +11,7 @@
 //! (`β = (φ+2ψ)/(λ+2μ)`), the limit becomes `(2/ω)(sqrt(1+ζ²) - ζ)`. The automatic substep is that
 //! limit times a safety factor.
 
+use super::check_step;
 use crate::Error;
 use crate::body::SoftBody;
 use rapier3d::glamx::DVec3;
@@ -102,17 +103,7 @@ impl SymplecticEuler {
         frame_dt: f64,
         gravity: DVec3,
     ) -> Result<StepReport, Error> {
-        if !(frame_dt.is_finite() && frame_dt > 0.0) {
-            return Err(Error::InvalidTimeStep {
-                dt: frame_dt,
-                reason: "must be positive and finite",
-            });
-        }
-        if !gravity.is_finite() {
-            return Err(Error::NonFiniteInput {
-                parameter: "gravity",
-            });
-        }
+        check_step(frame_dt, gravity)?;
         let substeps = self.substep_count(body, frame_dt)?;
         let h = frame_dt / f64::from(substeps);
         body.save_state();

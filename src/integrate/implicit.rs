@@ -12,6 +12,7 @@
 //! a sparse Cholesky solve, and a backtracking line search that makes `E` decrease. Both schemes
 //! are stable at any step length.
 
+use super::check_step;
 use crate::Error;
 use crate::assembly::{Stiffness, factorize, solve, stress_tangent};
 use crate::body::{PreviousStep, SoftBody};
@@ -108,17 +109,7 @@ impl ImplicitIntegrator {
         frame_dt: f64,
         gravity: DVec3,
     ) -> Result<ImplicitReport, Error> {
-        if !(frame_dt.is_finite() && frame_dt > 0.0) {
-            return Err(Error::InvalidTimeStep {
-                dt: frame_dt,
-                reason: "must be positive and finite",
-            });
-        }
-        if !gravity.is_finite() {
-            return Err(Error::NonFiniteInput {
-                parameter: "gravity",
-            });
-        }
+        check_step(frame_dt, gravity)?;
         if self.substeps == 0 {
             return Err(Error::InvalidTimeStep {
                 dt: frame_dt,
@@ -318,15 +309,7 @@ impl StepStart {
                 }
             })
             .collect();
-        let load = (0..positions.len())
-            .map(|n| {
-                if body.pinned[n] {
-                    DVec3::ZERO
-                } else {
-                    gravity * body.masses[n]
-                }
-            })
-            .collect();
+        let load = body.gravity_load(gravity);
         Self {
             h: effective_h,
             positions,

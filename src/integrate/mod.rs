@@ -7,3 +7,23 @@ mod implicit;
 pub use automatic::{AutomaticIntegrator, AutomaticReport, CostPrediction, IntegratorKind};
 pub use explicit::{COURANT_NUMBER, StepReport, Substeps, SymplecticEuler};
 pub use implicit::{ImplicitIntegrator, ImplicitReport, ImplicitScheme};
+
+use crate::Error;
+use rapier3d::glamx::DVec3;
+
+/// The checks every integrator makes before stepping: a positive, finite frame step (s) and a
+/// finite gravity (m/s²).
+fn check_step(frame_dt: f64, gravity: DVec3) -> Result<(), Error> {
+    if !(frame_dt.is_finite() && frame_dt > 0.0) {
+        return Err(Error::InvalidTimeStep {
+            dt: frame_dt,
+            reason: "must be positive and finite",
+        });
+    }
+    if !gravity.is_finite() {
+        return Err(Error::NonFiniteInput {
+            parameter: "gravity",
+        });
+    }
+    Ok(())
+}

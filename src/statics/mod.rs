@@ -85,15 +85,7 @@ fn newton(
     settings: &StaticSettings,
 ) -> Result<StaticReport, Error> {
     body.velocities.fill(DVec3::ZERO);
-    let load: Vec<DVec3> = (0..body.node_count())
-        .map(|n| {
-            if body.pinned[n] {
-                DVec3::ZERO
-            } else {
-                gravity * body.masses[n]
-            }
-        })
-        .collect();
+    let load = body.gravity_load(gravity);
     let mut residual = out_of_balance(body, &load);
     let reference = norm(&load).max(norm(&residual));
     if reference == 0.0 {
