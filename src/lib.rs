@@ -15,8 +15,10 @@
 //!    `f_i = P b_i` per tetrahedron ([`fvm::tet_forces`]).
 //! 4. Mass is lumped on the nodes from the same control volumes.
 //! 5. [`integrate::SymplecticEuler`] advances velocities then positions, splitting each frame
-//!    into as many substeps as stability requires; [`statics`] finds equilibria and natural
-//!    frequencies directly.
+//!    into as many substeps as stability requires; [`integrate::ImplicitIntegrator`] takes steps
+//!    of any length (backward Euler or BDF2 by Newton's method on the incremental potential);
+//!    [`integrate::AutomaticIntegrator`] picks the cheaper of the two each frame; [`statics`]
+//!    finds equilibria and natural frequencies directly.
 //!
 //! ## Example
 //! ```
