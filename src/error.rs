@@ -68,6 +68,19 @@ pub enum Error {
         /// Its signed rest volume (m^3).
         volume: f64,
     },
+    /// A tetrahedron is too thin to simulate: its quality (smallest altitude over longest edge) is
+    /// below the body's threshold.
+    #[error(
+        "tetrahedron {tet} is a sliver: quality {quality:.2e} is below the threshold {threshold:.2e}"
+    )]
+    SliverTet {
+        /// Index of the offending tetrahedron.
+        tet: usize,
+        /// Its quality, smallest altitude over longest edge (dimensionless).
+        quality: f64,
+        /// The threshold it fell below.
+        threshold: f64,
+    },
     /// A node index given to a body (pin, selection) does not exist.
     #[error("node {node} does not exist: the body has {node_count} nodes")]
     NodeOutOfRange {

@@ -133,25 +133,6 @@ fn box_split_has_no_directional_bias() {
     }
 }
 
-/// Smallest altitude over longest edge: 0 for a flat element, sqrt(2/3) for a regular one.
-fn worst_shape_ratio(mesh: &TetMesh) -> f64 {
-    let p = mesh.positions();
-    mesh.tets()
-        .iter()
-        .map(|t| {
-            let x = t.map(|n| p[n as usize]);
-            let mut longest: f64 = 0.0;
-            for i in 0..4 {
-                for j in i + 1..4 {
-                    longest = longest.max(x[i].distance(x[j]));
-                }
-            }
-            let single = TetMesh::new(x.to_vec(), vec![[0, 1, 2, 3]]).unwrap();
-            single.min_altitude() / longest
-        })
-        .fold(f64::INFINITY, f64::min)
-}
-
 #[test]
 fn cylinder_volume_converges_and_elements_are_well_shaped() {
     let (radius, half_height) = (0.1, 0.25);
@@ -161,7 +142,7 @@ fn cylinder_volume_converges_and_elements_are_well_shaped() {
         // Axial cells as long as the cross-section's, so the elements stay near-cubic.
         let mesh = mesh::cylinder(radius, half_height, cells, cells * 5 / 2).unwrap();
         let error = (mesh.volume() - exact).abs() / exact;
-        let shape = worst_shape_ratio(&mesh);
+        let shape = mesh.worst_tet().1;
         println!(
             "cylinder {cells} cells across: volume error {error:.2e}, worst altitude/edge {shape:.3}"
         );
@@ -181,7 +162,7 @@ fn sphere_volume_converges_and_elements_are_well_shaped() {
     for cells in [5, 10, 20] {
         let mesh = mesh::sphere(radius, cells).unwrap();
         let error = (mesh.volume() - exact).abs() / exact;
-        let shape = worst_shape_ratio(&mesh);
+        let shape = mesh.worst_tet().1;
         println!(
             "sphere {cells} cells across: volume error {error:.2e}, worst altitude/edge {shape:.3}"
         );
@@ -333,4 +314,43 @@ fn round_shapes_have_closed_outward_surfaces() {
         assert_closed_outward_surface(&mesh::sphere(0.1, cells).unwrap());
     }
     assert_closed_outward_surface(&mesh::cuboid(DVec3::new(0.3, 0.2, 0.1), [3, 4, 2]).unwrap());
+}
+
+#[test]
+fn slivers_are_refused_before_stepping() {
+    // A tetrahedron 1e-5 high on a unit base: valid, but 1e-5 thin.
+    let positions = vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::new(0.3, 0.3, 1e-5)];
+    let mesh = TetMesh::new(positions, vec![[0, 1, 2, 3]]).unwrap();
+    let (tet, quality) = mesh.worst_tet();
+    assert!(tet == 0 && quality < 1e-4);
+    let material = Material::new(MaterialModel::Linear, 1e6, 0.3, 1000.0).unwrap();
+    match SoftBodyBuilder::new(mesh.clone(), material).build() {
+        Err(Error::SliverTet {
+            tet: 0, threshold, ..
+        }) => {
+            assert_eq!(threshold, rapier_fvm::body::DEFAULT_MIN_ELEMENT_QUALITY)
+        }
+        other => panic!("expected a sliver error, got {other:?}"),
+    }
+    // The threshold is the user's to lower.
+    assert!(
+        SoftBodyBuilder::new(mesh, material)
+            .min_element_quality(0.0)
+            .build()
+            .is_ok()
+    );
+    // A regular tetrahedron has quality sqrt(2/3).
+    let s = 1.0 / 2f64.sqrt();
+    let regular = TetMesh::new_reoriented(
+        vec![
+            DVec3::new(s, 0.0, -0.5),
+            DVec3::new(-s, 0.0, -0.5),
+            DVec3::new(0.0, s, 0.5),
+            DVec3::new(0.0, -s, 0.5),
+        ],
+        vec![[0, 1, 2, 3]],
+    )
+    .unwrap()
+    .0;
+    assert!((regular.tet_quality(0) - (2.0f64 / 3.0).sqrt()).abs() < 1e-12);
 }

@@ -36,7 +36,12 @@ pub struct SoftBodyBuilder {
     linvel: DVec3,
     pinned: Vec<u32>,
     user_data: u128,
+    min_quality: f64,
 }
+
+/// Default [`SoftBodyBuilder::min_element_quality`]: a tetrahedron whose smallest altitude is a
+/// thousandth of its longest edge is refused.
+pub const DEFAULT_MIN_ELEMENT_QUALITY: f64 = 1e-3;
 
 impl SoftBodyBuilder {
     /// A body of `mesh` (rest positions in m) made of `material`, at rest where the mesh lies,
@@ -51,6 +56,7 @@ impl SoftBodyBuilder {
             linvel: DVec3::ZERO,
             pinned: Vec::new(),
             user_data: 0,
+            min_quality: DEFAULT_MIN_ELEMENT_QUALITY,
         }
     }
 
@@ -84,6 +90,14 @@ impl SoftBodyBuilder {
         self
     }
 
+    /// The smallest tetrahedron quality (smallest altitude over longest edge, dimensionless)
+    /// accepted by [`SoftBodyBuilder::build`]; default [`DEFAULT_MIN_ELEMENT_QUALITY`], 0 accepts
+    /// every valid mesh.
+    pub fn min_element_quality(mut self, quality: f64) -> Self {
+        self.min_quality = quality;
+        self
+    }
+
     /// User data stored on the body.
     pub fn user_data(mut self, user_data: u128) -> Self {
         self.user_data = user_data;
@@ -94,8 +108,17 @@ impl SoftBodyBuilder {
     ///
     /// # Errors
     /// [`Error::NodeOutOfRange`] for a pinned node that does not exist;
-    /// [`Error::NonFiniteInput`] for a non-finite velocity or translation or a zero rotation.
+    /// [`Error::NonFiniteInput`] for a non-finite velocity or translation or a zero rotation;
+    /// [`Error::SliverTet`] for a tetrahedron below the minimum quality.
     pub fn build(self) -> Result<SoftBody, Error> {
+        let (tet, quality) = self.mesh.worst_tet();
+        if quality < self.min_quality {
+            return Err(Error::SliverTet {
+                tet,
+                quality,
+                threshold: self.min_quality,
+            });
+        }
         let node_count = self.mesh.node_count();
         let mut pinned = vec![false; node_count];
         for &node in &self.pinned {

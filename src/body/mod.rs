@@ -3,7 +3,7 @@
 
 mod builder;
 
-pub use builder::SoftBodyBuilder;
+pub use builder::{DEFAULT_MIN_ELEMENT_QUALITY, SoftBodyBuilder};
 
 use crate::assembly::Stiffness;
 use crate::damping::RayleighDamping;

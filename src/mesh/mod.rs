@@ -124,6 +124,31 @@ impl TetMesh {
             .fold(f64::INFINITY, f64::min)
     }
 
+    /// Shape quality of tetrahedron `tet` (dimensionless): its smallest altitude over its longest
+    /// edge, `sqrt(2/3) ≈ 0.82` for a regular tetrahedron, 0 for a flat one. Slivers make the
+    /// explicit step tiny and the implicit systems ill-conditioned.
+    ///
+    /// # Panics
+    /// If `tet >= self.tet_count()`.
+    pub fn tet_quality(&self, tet: usize) -> f64 {
+        let nodes = &self.tets[tet];
+        let p = nodes.map(|i| self.positions[i as usize]);
+        let mut longest: f64 = 0.0;
+        for i in 0..4 {
+            for j in i + 1..4 {
+                longest = longest.max(p[i].distance(p[j]));
+            }
+        }
+        min_tet_altitude(&self.positions, nodes) / longest
+    }
+
+    /// The tetrahedron of lowest [`TetMesh::tet_quality`] and its quality.
+    pub fn worst_tet(&self) -> (usize, f64) {
+        (0..self.tets.len())
+            .map(|t| (t, self.tet_quality(t)))
+            .fold((0, f64::INFINITY), |a, b| if b.1 < a.1 { b } else { a })
+    }
+
     /// Indices of the nodes whose rest position satisfies `predicate`, ascending; e.g. the nodes of
     /// a clamped face: `mesh.nodes_where(|p| p.x <= 1e-9)`.
     pub fn nodes_where(&self, predicate: impl Fn(DVec3) -> bool) -> Vec<u32> {
