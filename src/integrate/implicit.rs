@@ -83,8 +83,9 @@ pub struct ImplicitReport {
 struct StepStart {
     /// The effective step `ĥ` (s).
     h: f64,
-    /// Positions at the start of the step (m).
+    /// Positions (m) and velocities (m/s) at the start of the step.
     positions: Vec<DVec3>,
+    velocities: Vec<DVec3>,
     /// `a` (m): the new velocity is `(x - a)/ĥ`.
     anchor: Vec<DVec3>,
     /// `x̂` (m), the inertial target.
@@ -180,13 +181,32 @@ impl ImplicitIntegrator {
         gravity: DVec3,
     ) -> Result<(usize, f64, bool), Error> {
         let start = StepStart::new(body, h, gravity, self.scheme);
-        let step_start = PreviousStep {
-            h,
-            positions: body.positions.clone(),
-            velocities: body.velocities.clone(),
-        };
         body.positions.clone_from(&start.target);
         body.velocities.fill(DVec3::ZERO);
+        let outcome = self.minimize(body, stiffness, &start)?;
+        for n in 0..body.positions.len() {
+            body.velocities[n] = if body.pinned[n] {
+                DVec3::ZERO
+            } else {
+                (body.positions[n] - start.anchor[n]) / start.h
+            };
+        }
+        body.previous_step = Some(PreviousStep {
+            h,
+            positions: start.positions,
+            velocities: start.velocities,
+        });
+        Ok(outcome)
+    }
+
+    /// Newton's method on the step's incremental potential, from the body's current positions;
+    /// returns iterations, final relative residual and convergence.
+    fn minimize(
+        &self,
+        body: &mut SoftBody,
+        stiffness: &mut Stiffness,
+        start: &StepStart,
+    ) -> Result<(usize, f64, bool), Error> {
         let inertia: Vec<f64> = body
             .masses
             .iter()
@@ -194,18 +214,17 @@ impl ImplicitIntegrator {
             .collect();
         let mut residual = start.residual(body);
         let reference = start.force_scale(body, &residual);
-        // Relative residuals of the last iterations, newest last.
+        // Relative residuals of the earlier iterations, newest last.
         let mut history: Vec<f64> = Vec::with_capacity(self.max_newton_iterations + 1);
-        let mut outcome = (self.max_newton_iterations, f64::INFINITY, false);
-        for iteration in 0..=self.max_newton_iterations {
+        let mut iteration = 0;
+        loop {
             let relative = norm(&residual) / reference;
             if !relative.is_finite() {
                 let node = residual.iter().position(|r| !r.is_finite()).unwrap_or(0);
                 return Err(Error::NonFiniteState { node });
             }
             if relative <= self.tolerance {
-                outcome = (iteration, relative, true);
-                break;
+                return Ok((iteration, relative, true));
             }
             // A small residual that three iterations could not cut by 10 % sits on its round-off
             // floor (very stiff or nearly incompressible material against a small load).
@@ -213,8 +232,7 @@ impl ImplicitIntegrator {
                 && history.len() >= 3
                 && relative > 0.9 * history[history.len() - 3];
             if iteration == self.max_newton_iterations || stalled {
-                outcome = (iteration, relative, false);
-                break;
+                return Ok((iteration, relative, false));
             }
             history.push(relative);
             // The exact Hessian converges fastest; where it is indefinite (compressed elements)
@@ -233,21 +251,10 @@ impl ImplicitIntegrator {
                 start.residual(body)
             }) {
                 Some(next) => residual = next,
-                None => {
-                    outcome = (iteration, relative, false);
-                    break;
-                }
+                None => return Ok((iteration, relative, false)),
             }
+            iteration += 1;
         }
-        for n in 0..body.positions.len() {
-            body.velocities[n] = if body.pinned[n] {
-                DVec3::ZERO
-            } else {
-                (body.positions[n] - start.anchor[n]) / start.h
-            };
-        }
-        body.previous_step = Some(step_start);
-        Ok(outcome)
     }
 }
 
@@ -313,6 +320,7 @@ impl StepStart {
         Self {
             h: effective_h,
             positions,
+            velocities: body.velocities.clone(),
             anchor,
             target,
             green,
