@@ -65,7 +65,7 @@ pub use rapier3d::glamx;
 /// The types most programs need.
 pub mod prelude {
     pub use crate::Error;
-    pub use crate::body::{SoftBody, SoftBodyBuilder};
+    pub use crate::body::{SoftBody, SoftBodyBuilder, SoftBodyHandle, SoftBodySet};
     pub use crate::damping::RayleighDamping;
     pub use crate::integrate::{
         AutomaticIntegrator, ImplicitIntegrator, ImplicitReport, ImplicitScheme, IntegratorKind,

@@ -2,8 +2,10 @@
 //! (m/s) and lumped masses (kg), plus pinned (Dirichlet) nodes.
 
 mod builder;
+mod set;
 
 pub use builder::{DEFAULT_MIN_ELEMENT_QUALITY, SoftBodyBuilder};
+pub use set::{SoftBodyHandle, SoftBodySet};
 
 use crate::assembly::Stiffness;
 use crate::damping::RayleighDamping;

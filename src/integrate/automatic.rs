@@ -11,7 +11,7 @@
 
 use super::{ImplicitIntegrator, ImplicitReport, StepReport, Substeps, SymplecticEuler};
 use crate::Error;
-use crate::body::SoftBody;
+use crate::body::{SoftBody, SoftBodyHandle, SoftBodySet};
 use crate::material::MaterialModel;
 use rapier3d::glamx::DVec3;
 
@@ -109,6 +109,21 @@ impl AutomaticIntegrator {
                 * tets
                 * newton_cost_per_tet(model),
         }
+    }
+
+    /// Advances every body of `bodies` by `frame_dt` (s) under gravity (m/s²), each with its own
+    /// choice of integrator. Each body's outcome is returned with its handle; a body whose step
+    /// failed keeps the state it had, the others are advanced.
+    pub fn step_all(
+        &self,
+        bodies: &mut SoftBodySet,
+        frame_dt: f64,
+        gravity: DVec3,
+    ) -> Vec<(SoftBodyHandle, Result<AutomaticReport, Error>)> {
+        bodies
+            .iter_mut()
+            .map(|(handle, body)| (handle, self.step(body, frame_dt, gravity)))
+            .collect()
     }
 
     /// Advances `body` by `frame_dt` (s) under gravity (m/s²) with the cheaper integrator (or the

@@ -1,0 +1,162 @@
+//! [`SoftBodySet`]: the soft bodies of a world, addressed by [`SoftBodyHandle`]s, as rapier keeps
+//! rigid bodies in a `RigidBodySet`.
+
+use super::SoftBody;
+
+/// A stable reference to a body of a [`SoftBodySet`]. A handle whose body was removed stays
+/// invalid even if its slot is reused (the generation differs).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct SoftBodyHandle {
+    index: u32,
+    generation: u32,
+}
+
+impl SoftBodyHandle {
+    /// The slot index and generation, e.g. for logging or serialization.
+    pub fn into_raw_parts(self) -> (u32, u32) {
+        (self.index, self.generation)
+    }
+}
+
+#[derive(Debug, Clone)]
+struct Slot {
+    generation: u32,
+    body: Option<SoftBody>,
+}
+
+/// A collection of soft bodies with generational handles.
+///
+/// # Example
+/// ```
+/// use rapier_fvm::prelude::*;
+///
+/// let mut bodies = SoftBodySet::new();
+/// let material = Material::new(MaterialModel::StableNeoHookean, 1e5, 0.4, 1000.0)?;
+/// let ball = SoftBodyBuilder::new(mesh::sphere(0.1, 4)?, material).build()?;
+/// let handle = bodies.insert(ball);
+/// assert_eq!(bodies.len(), 1);
+/// let removed = bodies.remove(handle).expect("the body was there");
+/// assert!(bodies.get(handle).is_none());
+/// // The slot is reused, but the old handle stays invalid.
+/// let again = bodies.insert(removed);
+/// assert!(bodies.contains(again) && !bodies.contains(handle));
+/// # Ok::<(), rapier_fvm::Error>(())
+/// ```
+#[derive(Debug, Clone, Default)]
+pub struct SoftBodySet {
+    slots: Vec<Slot>,
+    free: Vec<u32>,
+    len: usize,
+}
+
+impl SoftBodySet {
+    /// An empty set.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Adds a body and returns its handle.
+    pub fn insert(&mut self, body: SoftBody) -> SoftBodyHandle {
+        self.len += 1;
+        if let Some(index) = self.free.pop() {
+            let slot = &mut self.slots[index as usize];
+            slot.body = Some(body);
+            return SoftBodyHandle {
+                index,
+                generation: slot.generation,
+            };
+        }
+        self.slots.push(Slot {
+            generation: 0,
+            body: Some(body),
+        });
+        SoftBodyHandle {
+            index: (self.slots.len() - 1) as u32,
+            generation: 0,
+        }
+    }
+
+    /// Removes and returns the body of `handle`, or `None` if it is not in the set.
+    pub fn remove(&mut self, handle: SoftBodyHandle) -> Option<SoftBody> {
+        let slot = self.slots.get_mut(handle.index as usize)?;
+        if slot.generation != handle.generation {
+            return None;
+        }
+        let body = slot.body.take()?;
+        slot.generation = slot.generation.wrapping_add(1);
+        self.free.push(handle.index);
+        self.len -= 1;
+        Some(body)
+    }
+
+    /// The body of `handle`, if it is in the set.
+    pub fn get(&self, handle: SoftBodyHandle) -> Option<&SoftBody> {
+        let slot = self.slots.get(handle.index as usize)?;
+        (slot.generation == handle.generation).then_some(slot.body.as_ref()?)
+    }
+
+    /// The body of `handle`, mutably, if it is in the set.
+    pub fn get_mut(&mut self, handle: SoftBodyHandle) -> Option<&mut SoftBody> {
+        let slot = self.slots.get_mut(handle.index as usize)?;
+        if slot.generation != handle.generation {
+            return None;
+        }
+        slot.body.as_mut()
+    }
+
+    /// Whether `handle` refers to a body of the set.
+    pub fn contains(&self, handle: SoftBodyHandle) -> bool {
+        self.get(handle).is_some()
+    }
+
+    /// Number of bodies.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// Whether the set has no body.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// The bodies and their handles, in slot order.
+    pub fn iter(&self) -> impl Iterator<Item = (SoftBodyHandle, &SoftBody)> {
+        self.slots.iter().enumerate().filter_map(|(index, slot)| {
+            let handle = SoftBodyHandle {
+                index: index as u32,
+                generation: slot.generation,
+            };
+            slot.body.as_ref().map(|body| (handle, body))
+        })
+    }
+
+    /// The bodies and their handles, mutably, in slot order.
+    pub fn iter_mut(&mut self) -> impl Iterator<Item = (SoftBodyHandle, &mut SoftBody)> {
+        self.slots
+            .iter_mut()
+            .enumerate()
+            .filter_map(|(index, slot)| {
+                let handle = SoftBodyHandle {
+                    index: index as u32,
+                    generation: slot.generation,
+                };
+                slot.body.as_mut().map(|body| (handle, body))
+            })
+    }
+}
+
+impl std::ops::Index<SoftBodyHandle> for SoftBodySet {
+    type Output = SoftBody;
+
+    /// # Panics
+    /// If `handle` is not in the set, as rapier's sets do.
+    fn index(&self, handle: SoftBodyHandle) -> &SoftBody {
+        self.get(handle).expect("no soft body with this handle")
+    }
+}
+
+impl std::ops::IndexMut<SoftBodyHandle> for SoftBodySet {
+    fn index_mut(&mut self, handle: SoftBodyHandle) -> &mut SoftBody {
+        self.get_mut(handle).expect("no soft body with this handle")
+    }
+}
