@@ -1,5 +1,6 @@
-//! The crate's typed errors: every invalid input is reported with the element, node or parameter
-//! at fault, never as a panic.
+//! The crate's typed errors: invalid data (meshes, materials, settings, time steps, states that
+//! turned NaN) is reported with the element, node or parameter at fault, never as a panic. Asking
+//! for a node or tetrahedron index that does not exist panics, as slice indexing does.
 
 use thiserror::Error;
 
@@ -141,7 +142,7 @@ pub enum Error {
     /// Every node is pinned: there is nothing to solve for.
     #[error("every node is pinned")]
     NoFreeNode,
-    /// A time step or substep count is not usable.
+    /// A time step is not usable.
     #[error("invalid time step {dt} s: {reason}")]
     InvalidTimeStep {
         /// The step given (s).
@@ -157,8 +158,8 @@ pub enum Error {
         /// First node found with a non-finite position or velocity.
         node: usize,
     },
-    /// The static solver met a stiffness matrix it cannot factor (not positive definite), e.g. an
-    /// unconstrained body with no pinned node, or a material state that lost stability.
+    /// A Newton solver (static equilibrium, implicit step) or the modal analysis met a matrix it
+    /// cannot factor (not positive definite), e.g. the stiffness of a body with no pinned node.
     #[error("the tangent stiffness is not positive definite at Newton iteration {iteration}")]
     IndefiniteStiffness {
         /// Newton iteration (0-based) at which factorization failed.

@@ -59,7 +59,9 @@ pub use error::Error;
 #[doc = include_str!("../README.md")]
 #[cfg(doctest)]
 pub struct ReadmeDoctests;
-/// glam math types (f64 `DVec3`, `DMat3`, `DQuat` for this crate's API), re-exported from rapier.
+/// glam math types, re-exported from rapier. This crate's API uses the f64 types (`DVec3`,
+/// `DMat3`, `DQuat`); rapier3d's own `Vec3` and `Quat` are f32, so values crossing between the two
+/// are converted (`as_dvec3()`, `as_vec3()`).
 pub use rapier3d::glamx;
 
 /// The types most programs need.

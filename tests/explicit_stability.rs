@@ -224,7 +224,10 @@ fn invalid_steps_are_typed_errors() {
     };
     assert!(matches!(
         zero_substeps.step(&mut body, 0.01, DVec3::ZERO),
-        Err(Error::InvalidTimeStep { .. })
+        Err(Error::InvalidSetting {
+            parameter: "substeps",
+            ..
+        })
     ));
     let bad_safety = SymplecticEuler {
         safety_factor: 1.5,
@@ -252,6 +255,23 @@ fn invalid_steps_are_typed_errors() {
     assert!(matches!(
         capped.step(&mut body, 1.0, DVec3::ZERO),
         Err(Error::TooManySubsteps { max: 10, .. })
+    ));
+    assert_eq!(body.positions(), &before[..]);
+}
+
+#[test]
+fn a_damped_body_with_a_flat_element_is_refused_not_stepped() {
+    // A flat element makes the stable step zero; with damping the estimate must stay zero (not
+    // NaN, which would let a single huge substep through).
+    let mut body = excited_beam(1e-3);
+    for x in body.positions_mut() {
+        x.z = 0.0;
+    }
+    assert_eq!(SymplecticEuler::critical_time_step(&body), 0.0);
+    let before = body.positions().to_vec();
+    assert!(matches!(
+        SymplecticEuler::default().step(&mut body, 1.0 / 60.0, DVec3::ZERO),
+        Err(Error::TooManySubsteps { .. })
     ));
     assert_eq!(body.positions(), &before[..]);
 }

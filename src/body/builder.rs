@@ -72,9 +72,16 @@ impl SoftBodyBuilder {
         self
     }
 
-    /// Rotation applied to the rest mesh (about the mesh origin, before the translation).
-    pub fn rotation(mut self, rotation: DQuat) -> Self {
-        self.rotation = rotation;
+    /// Rotation applied to the rest mesh (about the mesh origin, before the translation), as a
+    /// scaled axis: the rotation axis times the angle (rad), as rapier's `RigidBodyBuilder` takes it.
+    pub fn rotation(mut self, scaled_axis: DVec3) -> Self {
+        self.rotation = DQuat::from_scaled_axis(scaled_axis);
+        self
+    }
+
+    /// Rotation applied to the rest mesh, as a unit quaternion.
+    pub fn orientation(mut self, orientation: DQuat) -> Self {
+        self.rotation = orientation;
         self
     }
 
@@ -106,11 +113,21 @@ impl SoftBodyBuilder {
 
     /// Creates the body.
     ///
+    /// The minimum element quality must lie in `[0, 1)`.
+    ///
     /// # Errors
     /// [`Error::NodeOutOfRange`] for a pinned node that does not exist;
     /// [`Error::NonFiniteInput`] for a non-finite velocity or translation or a zero rotation;
-    /// [`Error::SliverTet`] for a tetrahedron below the minimum quality.
+    /// [`Error::SliverTet`] for a tetrahedron below the minimum quality;
+    /// [`Error::InvalidSetting`] for a minimum quality outside `[0, 1)`.
     pub fn build(self) -> Result<SoftBody, Error> {
+        if !(0.0..1.0).contains(&self.min_quality) {
+            return Err(Error::InvalidSetting {
+                parameter: "min_element_quality",
+                value: self.min_quality,
+                reason: "must lie in [0, 1)",
+            });
+        }
         let (tet, quality) = self.mesh.worst_tet();
         if quality < self.min_quality {
             return Err(Error::SliverTet {

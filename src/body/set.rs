@@ -16,6 +16,12 @@ impl SoftBodyHandle {
     pub fn into_raw_parts(self) -> (u32, u32) {
         (self.index, self.generation)
     }
+
+    /// The handle of slot `index` at `generation`, as given by
+    /// [`SoftBodyHandle::into_raw_parts`].
+    pub fn from_raw_parts(index: u32, generation: u32) -> Self {
+        Self { index, generation }
+    }
 }
 
 #[derive(Debug, Clone)]

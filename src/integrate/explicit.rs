@@ -30,7 +30,8 @@ pub enum Substeps {
     /// As many equal substeps as needed to stay below the stable step.
     #[default]
     Automatic,
-    /// Exactly this many equal substeps, whatever the stability limit (at least 1).
+    /// Exactly this many equal substeps, whatever the stability limit (at least 1; not capped
+    /// by `max_substeps`).
     Fixed(u32),
 }
 
@@ -81,7 +82,8 @@ impl SymplecticEuler {
         let omega = 2.0 / undamped;
         let beta = damping.p_wave_viscosity() / body.material().lame().p_wave_modulus();
         let zeta = 0.5 * beta * omega;
-        (2.0 / omega) * ((1.0 + zeta * zeta).sqrt() - zeta)
+        // (2/ω)(sqrt(1+ζ²) - ζ), written so that a flat element (ω = ∞) gives 0, not NaN.
+        2.0 / (omega * ((1.0 + zeta * zeta).sqrt() + zeta))
     }
 
     /// The substep (s) used by [`Substeps::Automatic`]: the critical step times the safety factor.
@@ -92,8 +94,8 @@ impl SymplecticEuler {
     /// Advances `body` by `frame_dt` (s) under uniform gravity (m/s²), in substeps.
     ///
     /// # Errors
-    /// [`Error::InvalidTimeStep`] for a non-positive or non-finite `frame_dt` or a zero fixed
-    /// substep count; [`Error::InvalidSetting`] for a safety factor outside (0, 1];
+    /// [`Error::InvalidTimeStep`] for a non-positive or non-finite `frame_dt`;
+    /// [`Error::InvalidSetting`] for a zero fixed substep count or a safety factor outside (0, 1];
     /// [`Error::NonFiniteInput`] for a non-finite gravity; [`Error::TooManySubsteps`] when the
     /// stability limit needs more than `max_substeps`; [`Error::NonFiniteState`] if the step
     /// produced a NaN or infinity. On error the body is left as it was before the call.
@@ -125,8 +127,9 @@ impl SymplecticEuler {
 
     fn substep_count(&self, body: &SoftBody, frame_dt: f64) -> Result<u32, Error> {
         match self.substeps {
-            Substeps::Fixed(0) => Err(Error::InvalidTimeStep {
-                dt: frame_dt,
+            Substeps::Fixed(0) => Err(Error::InvalidSetting {
+                parameter: "substeps",
+                value: 0.0,
                 reason: "a fixed substep count must be at least 1",
             }),
             Substeps::Fixed(n) => Ok(n),
@@ -139,7 +142,7 @@ impl SymplecticEuler {
                     });
                 }
                 let needed = (frame_dt / self.stable_time_step(body)).ceil().max(1.0);
-                if needed > f64::from(self.max_substeps) {
+                if needed.is_nan() || needed > f64::from(self.max_substeps) {
                     return Err(Error::TooManySubsteps {
                         frame_dt,
                         needed,

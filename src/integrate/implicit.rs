@@ -49,7 +49,7 @@ pub struct ImplicitIntegrator {
     /// left, keeps its last iterate (each accepted iterate lowered the incremental potential) and
     /// is reported as unconverged.
     pub max_newton_iterations: usize,
-    /// Equal substeps per frame (at least 1).
+    /// Equal substeps per frame (at least 1); each costs a Newton solve.
     pub substeps: u32,
 }
 
@@ -99,9 +99,9 @@ impl ImplicitIntegrator {
     /// Advances `body` by `frame_dt` (s) under uniform gravity (m/s²).
     ///
     /// # Errors
-    /// [`Error::InvalidTimeStep`] for a non-positive or non-finite `frame_dt` or zero substeps;
-    /// [`Error::NonFiniteInput`] for a non-finite gravity; [`Error::InvalidSetting`] for a
-    /// non-positive tolerance or zero Newton iterations;
+    /// [`Error::InvalidTimeStep`] for a non-positive or non-finite `frame_dt`;
+    /// [`Error::NonFiniteInput`] for a non-finite gravity; [`Error::InvalidSetting`] for zero
+    /// substeps, a non-positive tolerance or zero Newton iterations;
     /// [`Error::IndefiniteStiffness`] if a linear system cannot be factored;
     /// [`Error::NonFiniteState`] if the step produced a NaN. On error the body is left as it was.
     pub fn step(
@@ -112,8 +112,9 @@ impl ImplicitIntegrator {
     ) -> Result<ImplicitReport, Error> {
         check_step(frame_dt, gravity)?;
         if self.substeps == 0 {
-            return Err(Error::InvalidTimeStep {
-                dt: frame_dt,
+            return Err(Error::InvalidSetting {
+                parameter: "substeps",
+                value: 0.0,
                 reason: "at least one substep is needed",
             });
         }
@@ -215,7 +216,7 @@ impl ImplicitIntegrator {
         let mut residual = start.residual(body);
         let reference = start.force_scale(body, &residual);
         // Relative residuals of the earlier iterations, newest last.
-        let mut history: Vec<f64> = Vec::with_capacity(self.max_newton_iterations + 1);
+        let mut history: Vec<f64> = Vec::new();
         let mut iteration = 0;
         loop {
             let relative = norm(&residual) / reference;

@@ -48,7 +48,8 @@ pub struct StaticReport {
 /// with pinned nodes held where they are and all velocities set to zero.
 ///
 /// # Errors
-/// [`Error::NonFiniteInput`] for a non-finite gravity, [`Error::NoFreeNode`] if every node is
+/// [`Error::NonFiniteInput`] for a non-finite gravity, [`Error::InvalidSetting`] for a
+/// non-positive tolerance, [`Error::NoFreeNode`] if every node is
 /// pinned, [`Error::IndefiniteStiffness`] if the tangent stiffness cannot be factored (too few
 /// pinned nodes), [`Error::StaticSolveDidNotConverge`] if the tolerance is not met. On error the
 /// body is left as it was.
@@ -60,6 +61,13 @@ pub fn solve_equilibrium(
     if !gravity.is_finite() {
         return Err(Error::NonFiniteInput {
             parameter: "gravity",
+        });
+    }
+    if !(settings.tolerance.is_finite() && settings.tolerance > 0.0) {
+        return Err(Error::InvalidSetting {
+            parameter: "tolerance",
+            value: settings.tolerance,
+            reason: "must be positive and finite",
         });
     }
     if body.pinned.iter().all(|&p| p) {
@@ -158,7 +166,10 @@ fn newton(
 }
 
 /// The lowest natural frequency (Hz) of small undamped vibrations about the current positions,
-/// with pinned nodes held: `K φ = ω² M φ` solved by inverse iteration with the lumped mass.
+/// with pinned nodes held: `K φ = ω² M φ` solved by inverse iteration with the lumped mass until
+/// the Rayleigh quotient changes by less than 1e-13 (relative), or 500 iterations, after which
+/// the current estimate is returned (convergence is geometric in the ratio of the two lowest
+/// distinct frequencies, so 500 iterations are only reached for nearly equal ones).
 ///
 /// # Errors
 /// [`Error::NoFreeNode`] if every node is pinned; [`Error::IndefiniteStiffness`] if the tangent
