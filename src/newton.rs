@@ -10,9 +10,9 @@ pub(crate) fn norm(v: &[DVec3]) -> f64 {
 }
 
 /// One Newton update of `body`'s positions along `direction`: the line search below, or, when
-/// the energy's decrease is lost in its round-off (close to the solution), the full step if it
-/// lowers the out-of-balance force. Returns the new residual, or `None` (positions unchanged)
-/// if neither descends.
+/// the energy's decrease is lost in its round-off (close to the solution), the largest step of
+/// the same sequence that lowers the out-of-balance force. Returns the new residual, or `None`
+/// (positions unchanged) if neither descends.
 pub(crate) fn descend(
     body: &mut SoftBody,
     residual: &[DVec3],
@@ -24,17 +24,24 @@ pub(crate) fn descend(
         return Some(residual_at(body));
     }
     let start = body.positions.clone();
-    for (x, s) in body.positions.iter_mut().zip(direction) {
-        *x += *s;
+    let current = norm(residual);
+    let mut alpha = 1.0;
+    while alpha >= MIN_STEP {
+        for ((x, x0), s) in body.positions.iter_mut().zip(&start).zip(direction) {
+            *x = *x0 + *s * alpha;
+        }
+        let next = residual_at(body);
+        if norm(&next) < current {
+            return Some(next);
+        }
+        alpha *= 0.5;
     }
-    let next = residual_at(body);
-    if norm(&next) < norm(residual) {
-        Some(next)
-    } else {
-        body.positions.copy_from_slice(&start);
-        None
-    }
+    body.positions.copy_from_slice(&start);
+    None
 }
+
+/// The smallest step fraction the searches try.
+const MIN_STEP: f64 = 1.0 / 1024.0;
 
 /// Moves `body` along `direction` from its current positions by the largest step `α` in
 /// `1, 1/2, 1/4, …, 1/1024` that satisfies the Armijo condition on `energy` (J), whose gradient
@@ -47,7 +54,6 @@ fn line_search(
     energy: impl Fn(&SoftBody) -> f64,
 ) -> bool {
     const ARMIJO: f64 = 1e-4;
-    const MIN_STEP: f64 = 1.0 / 1024.0;
     let start = body.positions.clone();
     let initial = energy(body);
     let slope: f64 = -residual

@@ -357,3 +357,32 @@ fn every_model_has_the_linear_elastic_tangent_at_rest() {
         }
     }
 }
+
+#[test]
+fn small_strain_energies_keep_their_digits() {
+    // At a 1e-6 strain every model's energy must match linear elasticity's μ ε:ε + λ/2 tr(ε)²
+    // to its own order, O(ε) = 1e-6 relative (tolerance 1e-5): an energy computed by subtracting
+    // order-ε invariants would be wrong in the fourth digit and blind the Newton line searches.
+    let lame = Material::new(MaterialModel::Linear, 1e9, 0.45, 1.0)
+        .unwrap()
+        .lame();
+    let mut rng = Lcg(23);
+    for _ in 0..10 {
+        let h = DMat3::from_cols(rng.vector(), rng.vector(), rng.vector()) * 1e-6;
+        let f = DMat3::IDENTITY + (h + h.transpose()) * 0.5;
+        let linear = LinearElastic(lame).energy_density(&f);
+        for (name, energy) in [
+            ("StVK", StVenantKirchhoff(lame).energy_density(&f)),
+            ("corotated", Corotated(lame).energy_density(&f)),
+            (
+                "stable Neo-Hookean",
+                StableNeoHookean::new(lame).energy_density(&f),
+            ),
+        ] {
+            assert!(
+                (energy / linear - 1.0).abs() < 1e-5,
+                "{name}: {energy:e} vs {linear:e}"
+            );
+        }
+    }
+}

@@ -32,13 +32,9 @@ fn huge_steps_on_a_stiff_beam_stay_stable_and_never_gain_energy() {
         let mut iterations = 0;
         for _ in 0..30 {
             let report = integrator.step(&mut body, 1.0 / 30.0, gravity()).unwrap();
-            // Converged, or within 10x of the tolerance: for this stiff beam under its small weight
-            // the out-of-balance force cannot go much below 1e-6 of the force scale, because
-            // `det F - 1` computed from positions loses digits (round-off floor, reported as
-            // unconverged).
             assert!(
-                report.converged || report.relative_residual < 1e-5,
-                "{model:?}: Newton stopped far from the solution: {report:?}"
+                report.converged,
+                "{model:?}: Newton did not converge: {report:?}"
             );
             iterations += report.newton_iterations;
             let next = total_energy(&body);

@@ -4,9 +4,12 @@
 //! `λ' = λ + μ` so that the small-strain limit is exactly linear elasticity with `(λ, μ)`.
 //! `P = μ F + (λ' (J - 1) - μ) cof(F)`, defined for inverted elements (`J <= 0`) too.
 
-use super::{HyperelasticModel, LameParameters, double_dot};
+use super::{HyperelasticModel, LameParameters, double_dot, green_strain, trace};
 use crate::lanes::{Mat3x4, f64x4};
 use rapier3d::glamx::DMat3;
+
+/// Green strain above which the energy is evaluated in its direct form.
+const LARGE_STRAIN: f64 = 0.1;
 
 /// Stable Neo-Hookean material.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -46,11 +49,29 @@ fn cofactor_differential(f: &DMat3, df: &DMat3) -> DMat3 {
 }
 
 impl HyperelasticModel for StableNeoHookean {
+    /// Evaluated from the Green strain `G`, without the cancellation of the textbook form: at a
+    /// strain `ε`, `(I_C - 3)/2` and `J - 1` are both of order `ε` while the energy is of order
+    /// `ε²`, so subtracting them would lose `1/ε` of the digits (the energy of a 1e-6 strain only
+    /// to 1e-4 relative), which blinds line searches near equilibrium.
     fn energy_density(&self, f: &DMat3) -> f64 {
-        let i_c = double_dot(f, f);
         let j = f.determinant();
-        0.5 * self.mu * (i_c - 3.0) - self.mu * (j - 1.0)
-            + 0.5 * self.lambda_prime * (j - 1.0).powi(2)
+        let g = green_strain(f);
+        let largest_strain = g.to_cols_array().iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        if j <= 0.0 || largest_strain > LARGE_STRAIN {
+            // Large strain or inverted: nothing cancels and the direct form is accurate.
+            let i_c = double_dot(f, f);
+            return 0.5 * self.mu * (i_c - 3.0) - self.mu * (j - 1.0)
+                + 0.5 * self.lambda_prime * (j - 1.0).powi(2);
+        }
+        let tr = trace(&g);
+        // det(I + 2G) - 1 = J² - 1, expanded in G.
+        let quadratic = tr * tr - trace(&(g * g));
+        let d = 2.0 * tr + 2.0 * quadratic + 8.0 * g.determinant();
+        let s = (1.0 + d).sqrt();
+        let j_minus_one = d / (s + 1.0);
+        // (I_C - 3)/2 - (J - 1) = tr G - (J - 1), with the order-ε terms cancelled analytically.
+        let deviatoric = (tr * (s - 1.0) - 2.0 * quadratic - 8.0 * g.determinant()) / (s + 1.0);
+        self.mu * deviatoric + 0.5 * self.lambda_prime * j_minus_one * j_minus_one
     }
 
     #[inline(always)]
