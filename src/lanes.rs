@@ -159,6 +159,23 @@ impl Mat3x4 {
         std::array::from_fn(|i| DMat3::from_cols(a[i], b[i], c[i]))
     }
 
+    /// The matrix of lane `lane` alone.
+    #[inline(always)]
+    pub fn lane(&self, lane: usize) -> DMat3 {
+        let column = |c: &Vec3x4| {
+            DVec3::new(
+                c.x.as_array()[lane],
+                c.y.as_array()[lane],
+                c.z.as_array()[lane],
+            )
+        };
+        DMat3::from_cols(
+            column(&self.cols[0]),
+            column(&self.cols[1]),
+            column(&self.cols[2]),
+        )
+    }
+
     /// Lane-wise transpose.
     #[inline(always)]
     pub fn transpose(&self) -> Self {

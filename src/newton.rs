@@ -1,8 +1,22 @@
 //! Pieces shared by the Newton solvers (static equilibrium, implicit integration): the residual
 //! norm and a backtracking line search that guarantees the minimized energy decreases.
 
+use crate::Error;
 use crate::body::SoftBody;
 use rapier3d::glamx::DVec3;
+
+/// Refuses a Newton tolerance that is not positive and finite.
+pub(crate) fn check_tolerance(tolerance: f64) -> Result<(), Error> {
+    if tolerance.is_finite() && tolerance > 0.0 {
+        Ok(())
+    } else {
+        Err(Error::InvalidSetting {
+            parameter: "tolerance",
+            value: tolerance,
+            reason: "must be positive and finite",
+        })
+    }
+}
 
 /// Euclidean norm of a field of per-node vectors.
 pub(crate) fn norm(v: &[DVec3]) -> f64 {

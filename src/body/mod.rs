@@ -199,6 +199,14 @@ impl SoftBody {
             .sum()
     }
 
+    /// The first node whose position or velocity is NaN or infinite, if any.
+    pub(crate) fn first_non_finite_node(&self) -> Option<usize> {
+        self.positions
+            .iter()
+            .zip(&self.velocities)
+            .position(|(x, v)| !(x.is_finite() && v.is_finite()))
+    }
+
     /// Number of tetrahedra whose current volume is zero or negative (inverted elements).
     pub fn inverted_tet_count(&self) -> usize {
         self.mesh

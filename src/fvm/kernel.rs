@@ -111,8 +111,8 @@ impl FvmMesh {
         assert!(tet < self.tet_count, "tetrahedron {tet} does not exist");
         let block = &self.blocks[tet / LANES];
         TetRest {
-            inverse_rest_edges: block.inverse_rest_edges.to_lanes()[tet % LANES],
-            volume: block.volume.to_array()[tet % LANES],
+            inverse_rest_edges: block.inverse_rest_edges.lane(tet % LANES),
+            volume: block.volume.as_array()[tet % LANES],
         }
     }
 

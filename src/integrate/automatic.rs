@@ -9,7 +9,7 @@
 //! damping adds about half), an implicit Newton iteration about 6 µs (7 µs), and an implicit frame
 //! takes about 3.5 Newton iterations. Only their ratio matters for the choice.
 
-use super::{ImplicitIntegrator, ImplicitReport, StepReport, Substeps, SymplecticEuler};
+use super::{ImplicitIntegrator, ImplicitReport, StepReport, SymplecticEuler};
 use crate::Error;
 use crate::body::{SoftBody, SoftBodyHandle, SoftBodySet};
 use crate::material::MaterialModel;
@@ -90,16 +90,20 @@ pub struct AutomaticIntegrator {
 }
 
 impl AutomaticIntegrator {
-    /// The predicted cost of a frame of `frame_dt` (s) for `body` with each integrator.
+    /// The predicted cost of a frame of `frame_dt` (s) for `body` with each integrator; an
+    /// invalid explicit setting predicts an infinite explicit cost.
     pub fn predict(&self, body: &SoftBody, frame_dt: f64) -> CostPrediction {
+        let needed = self
+            .explicit
+            .needed_substeps(body, frame_dt)
+            .unwrap_or(f64::INFINITY);
+        self.prediction(body, needed)
+    }
+
+    /// The prediction for a frame whose explicit version takes `explicit_substeps`.
+    fn prediction(&self, body: &SoftBody, explicit_substeps: f64) -> CostPrediction {
         let tets = body.mesh().tet_count() as f64;
         let model = body.material().model();
-        let explicit_substeps = match self.explicit.substeps {
-            Substeps::Fixed(n) => f64::from(n.max(1)),
-            Substeps::Automatic => (frame_dt / self.explicit.stable_time_step(body))
-                .ceil()
-                .max(1.0),
-        };
         let implicit_frames = f64::from(self.implicit.substeps.max(1));
         CostPrediction {
             explicit_substeps,
@@ -132,7 +136,7 @@ impl AutomaticIntegrator {
     /// # Errors
     /// [`Error::InvalidTimeStep`] for a non-positive or non-finite `frame_dt`, [`Error::NonFiniteInput`]
     /// for a non-finite gravity,
-    /// [`Error::InvalidSetting`] for an explicit safety factor outside (0, 1], then the errors of
+    /// [`Error::InvalidSetting`] for an invalid explicit setting, then the errors of
     /// [`SymplecticEuler::step`] or [`ImplicitIntegrator::step`], whichever ran.
     pub fn step(
         &self,
@@ -141,18 +145,15 @@ impl AutomaticIntegrator {
         gravity: DVec3,
     ) -> Result<AutomaticReport, Error> {
         super::check_step(frame_dt, gravity)?;
-        let safety = self.explicit.safety_factor;
-        if !(safety > 0.0 && safety <= 1.0) {
-            return Err(Error::InvalidSetting {
-                parameter: "explicit.safety_factor",
-                value: safety,
-                reason: "must lie in (0, 1]",
-            });
-        }
-        let prediction = self.predict(body, frame_dt);
+        // The stability limit is evaluated once and serves both the prediction and the step.
+        let needed = self.explicit.needed_substeps(body, frame_dt)?;
+        let prediction = self.prediction(body, needed);
         let choice = self.force.unwrap_or_else(|| prediction.cheaper());
         let (explicit, implicit) = match choice {
-            IntegratorKind::Explicit => (Some(self.explicit.step(body, frame_dt, gravity)?), None),
+            IntegratorKind::Explicit => (
+                Some(self.explicit.advance(body, frame_dt, gravity, needed)?),
+                None,
+            ),
             IntegratorKind::Implicit => (None, Some(self.implicit.step(body, frame_dt, gravity)?)),
         };
         Ok(AutomaticReport {

@@ -106,14 +106,35 @@ impl SymplecticEuler {
         gravity: DVec3,
     ) -> Result<StepReport, Error> {
         check_step(frame_dt, gravity)?;
-        let substeps = self.substep_count(body, frame_dt)?;
+        let needed = self.needed_substeps(body, frame_dt)?;
+        self.advance(body, frame_dt, gravity, needed)
+    }
+
+    /// Runs a frame in `needed` substeps (as given by [`SymplecticEuler::needed_substeps`]),
+    /// refusing more than `max_substeps` when they are automatic.
+    pub(crate) fn advance(
+        &self,
+        body: &mut SoftBody,
+        frame_dt: f64,
+        gravity: DVec3,
+        needed: f64,
+    ) -> Result<StepReport, Error> {
+        let automatic = self.substeps == Substeps::Automatic;
+        if automatic && (needed.is_nan() || needed > f64::from(self.max_substeps)) {
+            return Err(Error::TooManySubsteps {
+                frame_dt,
+                needed,
+                max: self.max_substeps,
+            });
+        }
+        let substeps = needed as u32;
         let h = frame_dt / f64::from(substeps);
         body.save_state();
         let history = body.previous_step.take();
         for _ in 0..substeps {
             substep(body, h, gravity);
         }
-        if let Some(node) = first_non_finite_node(body) {
+        if let Some(node) = body.first_non_finite_node() {
             body.restore_state();
             body.previous_step = history;
             return Err(Error::NonFiniteState { node });
@@ -125,14 +146,17 @@ impl SymplecticEuler {
         })
     }
 
-    fn substep_count(&self, body: &SoftBody, frame_dt: f64) -> Result<u32, Error> {
+    /// The substeps a frame of `frame_dt` (s) takes: the fixed count, or as many as the
+    /// stability limit of the body's current shape asks for (possibly infinite or more than
+    /// `max_substeps`, which [`SymplecticEuler::step`] then refuses).
+    pub(crate) fn needed_substeps(&self, body: &SoftBody, frame_dt: f64) -> Result<f64, Error> {
         match self.substeps {
             Substeps::Fixed(0) => Err(Error::InvalidSetting {
                 parameter: "substeps",
                 value: 0.0,
                 reason: "a fixed substep count must be at least 1",
             }),
-            Substeps::Fixed(n) => Ok(n),
+            Substeps::Fixed(n) => Ok(f64::from(n)),
             Substeps::Automatic => {
                 if !(self.safety_factor > 0.0 && self.safety_factor <= 1.0) {
                     return Err(Error::InvalidSetting {
@@ -141,15 +165,7 @@ impl SymplecticEuler {
                         reason: "must lie in (0, 1]",
                     });
                 }
-                let needed = (frame_dt / self.stable_time_step(body)).ceil().max(1.0);
-                if needed.is_nan() || needed > f64::from(self.max_substeps) {
-                    return Err(Error::TooManySubsteps {
-                        frame_dt,
-                        needed,
-                        max: self.max_substeps,
-                    });
-                }
-                Ok(needed as u32)
+                Ok((frame_dt / self.stable_time_step(body)).ceil().max(1.0))
             }
         }
     }
@@ -174,11 +190,4 @@ fn substep(body: &mut SoftBody, h: f64, gravity: DVec3) {
         velocities[n] += (forces[n] / masses[n] + gravity) * h;
         positions[n] += velocities[n] * h;
     }
-}
-
-fn first_non_finite_node(body: &SoftBody) -> Option<usize> {
-    body.positions
-        .iter()
-        .zip(&body.velocities)
-        .position(|(x, v)| !(x.is_finite() && v.is_finite()))
 }

@@ -19,7 +19,7 @@ use crate::body::{PreviousStep, SoftBody};
 use crate::damping::RayleighDamping;
 use crate::fvm::gather;
 use crate::material::{HyperelasticModel, green_strain, with_hyperelastic_model};
-use crate::newton::{descend, norm};
+use crate::newton::{check_tolerance, descend, norm};
 use rapier3d::glamx::{DMat3, DVec3};
 
 /// Newton stops early on a stalled residual only below this relative value; above it, a slow
@@ -118,13 +118,7 @@ impl ImplicitIntegrator {
                 reason: "at least one substep is needed",
             });
         }
-        if !(self.tolerance.is_finite() && self.tolerance > 0.0) {
-            return Err(Error::InvalidSetting {
-                parameter: "tolerance",
-                value: self.tolerance,
-                reason: "must be positive and finite",
-            });
-        }
+        check_tolerance(self.tolerance)?;
         if self.max_newton_iterations == 0 {
             return Err(Error::InvalidSetting {
                 parameter: "max_newton_iterations",
@@ -159,12 +153,7 @@ impl ImplicitIntegrator {
             }
         }
         body.tangent = Some(stiffness);
-        let non_finite = body
-            .positions
-            .iter()
-            .zip(&body.velocities)
-            .position(|(x, v)| !(x.is_finite() && v.is_finite()));
-        if let Some(node) = non_finite {
+        if let Some(node) = body.first_non_finite_node() {
             body.restore_state();
             body.previous_step = history;
             return Err(Error::NonFiniteState { node });

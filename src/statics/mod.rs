@@ -10,7 +10,7 @@ use crate::Error;
 use crate::assembly::{Stiffness, factorize, solve, stress_tangent};
 use crate::body::SoftBody;
 use crate::material::{HyperelasticModel, with_hyperelastic_model};
-use crate::newton::{descend, norm};
+use crate::newton::{check_tolerance, descend, norm};
 use rapier3d::glamx::DVec3;
 
 /// The largest relative residual accepted as round-off when Newton stops reducing it.
@@ -63,13 +63,7 @@ pub fn solve_equilibrium(
             parameter: "gravity",
         });
     }
-    if !(settings.tolerance.is_finite() && settings.tolerance > 0.0) {
-        return Err(Error::InvalidSetting {
-            parameter: "tolerance",
-            value: settings.tolerance,
-            reason: "must be positive and finite",
-        });
-    }
+    check_tolerance(settings.tolerance)?;
     if body.pinned.iter().all(|&p| p) {
         return Err(Error::NoFreeNode);
     }
