@@ -17,7 +17,7 @@ use crate::damping::RayleighDamping;
 use crate::lanes::{LANES, Mat3x4, Vec3x4, f64x4};
 use crate::material::HyperelasticModel;
 use crate::mesh::TetMesh;
-use rapier3d::glamx::DVec3;
+use rapier3d::glamx::{DMat3, DVec3};
 
 /// Tetrahedra per chunk (a multiple of [`LANES`]); meshes of one chunk are summed directly.
 const CHUNK_TETS: usize = 8192;
@@ -39,7 +39,14 @@ pub fn tet_forces<M: HyperelasticModel>(
     if let Some(damping) = damping {
         stress += damping.first_piola(&f, &rest.gradient(v));
     }
-    let forces = stress * rest.control_normals();
+    stress_forces(rest, &stress)
+}
+
+/// The forces (N) a constant first Piola–Kirchhoff stress (Pa) puts on the four nodes of a
+/// tetrahedron: `f_i = P b_i`, `f_0 = -(f_1 + f_2 + f_3)`.
+#[inline(always)]
+pub fn stress_forces(rest: &TetRest, stress: &DMat3) -> [DVec3; 4] {
+    let forces = *stress * rest.control_normals();
     [
         -(forces.x_axis + forces.y_axis + forces.z_axis),
         forces.x_axis,
@@ -134,7 +141,7 @@ impl FvmMesh {
         for (t, tet) in self.tets().iter().enumerate() {
             let rest = self.tet_rest(t);
             let [x0, x1, x2, x3] = gather(tet, x);
-            let edges = rapier3d::glamx::DMat3::from_cols(x1 - x0, x2 - x0, x3 - x0);
+            let edges = DMat3::from_cols(x1 - x0, x2 - x0, x3 - x0);
             if edges.determinant().abs() <= f64::EPSILON * rest.volume.abs() {
                 return 0.0;
             }
@@ -281,7 +288,7 @@ fn block_forces<M: HyperelasticModel>(
         Some(damping) => {
             damping.second_piola_lanes(&f, &(lane_edges(tets, v) * rest.inverse_rest_edges))
         }
-        None => Mat3x4::splat(rapier3d::glamx::DMat3::ZERO),
+        None => Mat3x4::splat(DMat3::ZERO),
     };
     let stress = model.first_piola_plus_lanes(&f, &extra);
     // Forces on nodes 1..3 are the columns of P b = -V P Dm⁻ᵀ.

@@ -10,5 +10,5 @@ mod kernel;
 mod rest;
 
 pub(crate) use kernel::gather;
-pub use kernel::{FvmMesh, tet_forces};
+pub use kernel::{FvmMesh, stress_forces, tet_forces};
 pub use rest::TetRest;

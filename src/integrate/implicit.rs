@@ -17,7 +17,7 @@ use crate::Error;
 use crate::assembly::{Stiffness, factorize, solve, stress_tangent};
 use crate::body::{PreviousStep, SoftBody};
 use crate::damping::RayleighDamping;
-use crate::fvm::gather;
+use crate::fvm::{gather, stress_forces};
 use crate::material::{HyperelasticModel, green_strain, with_hyperelastic_model};
 use crate::newton::{check_tolerance, descend, norm};
 use rapier3d::glamx::{DMat3, DVec3};
@@ -346,13 +346,8 @@ impl StepStart {
             let rest = body.fvm.tet_rest(t);
             let f = rest.gradient(&gather(tet, &body.positions));
             let stress = damping.step_first_piola(&f, &self.green[t], self.h);
-            let forces = stress * rest.control_normals();
-            let node0 = -(forces.x_axis + forces.y_axis + forces.z_axis);
-            for (corner, force) in [node0, forces.x_axis, forces.y_axis, forces.z_axis]
-                .iter()
-                .enumerate()
-            {
-                out[tet[corner] as usize] += *force;
+            for (&n, force) in tet.iter().zip(stress_forces(&rest, &stress)) {
+                out[n as usize] += force;
             }
         }
     }
