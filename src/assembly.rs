@@ -10,7 +10,8 @@
 
 use crate::Error;
 use crate::body::SoftBody;
-use crate::fvm::{TetRest, gather};
+use crate::fvm::{NodalAveraging, TetRest, gather};
+use crate::material::{HyperelasticModel, with_hyperelastic_model};
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
@@ -38,7 +39,8 @@ pub(crate) struct Stiffness {
 }
 
 impl Stiffness {
-    /// The pattern of `body`'s mesh, values zero.
+    /// The pattern of `body`'s mesh, values zero: nodes sharing a tetrahedron, and with nodal
+    /// averaging also nodes sharing a neighbour (the patches' coupling).
     pub(crate) fn new(body: &SoftBody) -> Self {
         let n = body.node_count();
         let mut lower_neighbours: Vec<Vec<u32>> = (0..n as u32).map(|b| vec![b]).collect();
@@ -54,6 +56,27 @@ impl Stiffness {
         for list in &mut lower_neighbours {
             list.sort_unstable();
             list.dedup();
+        }
+        if body.nodal_averaging.is_some() {
+            let mut patches: Vec<Vec<u32>> = lower_neighbours.clone();
+            for (b, list) in lower_neighbours.iter().enumerate() {
+                for &a in &list[1..] {
+                    patches[a as usize].push(b as u32);
+                }
+            }
+            for patch in &patches {
+                for &a in patch {
+                    for &b in patch {
+                        if a > b {
+                            lower_neighbours[b as usize].push(a);
+                        }
+                    }
+                }
+            }
+            for list in &mut lower_neighbours {
+                list.sort_unstable();
+                list.dedup();
+            }
         }
         let mut col_ptr = Vec::with_capacity(3 * n + 1);
         let mut row_idx = Vec::new();
@@ -86,29 +109,49 @@ impl Stiffness {
         }
         let k = self.lower_neighbours[b]
             .binary_search(&(a as u32))
-            .expect("the pattern contains every pair of nodes sharing a tetrahedron");
+            .expect("the pattern contains every pair of coupled nodes");
         start + (3 - j) + 3 * (k - 1) + i
     }
 
-    /// Fills the values with `diagonal[n] I` on each free node plus, for every tetrahedron,
-    /// `V Gᵀ A G` with `A = tangent(t, F)`, projected to be positive semi-definite if `project`;
-    /// `F` is taken at the body's current positions.
+    /// Fills the values with the body's tangent stiffness at its current positions: for every
+    /// tetrahedron `V Gᵀ A G` with `A` the stress tangent of the elastic stress differential plus
+    /// `extra(t, F, dF)` (a further stress differential, Pa), projected to be positive
+    /// semi-definite if `project`; the coupling of nodal averaging if the body uses it; and
+    /// `diagonal[n] I` on each free node.
     pub(crate) fn assemble(
         &mut self,
         body: &SoftBody,
         diagonal: Option<&[f64]>,
         project: bool,
-        tangent: impl Fn(usize, &DMat3) -> StressTangent,
+        extra: impl Fn(usize, &DMat3, &DMat3) -> DMat3,
     ) {
         self.values.fill(0.0);
         let fvm = &body.fvm;
-        for (t, tet) in fvm.tets().iter().enumerate() {
-            let rest = fvm.tet_rest(t);
-            let f = rest.gradient(&gather(tet, body.positions()));
-            let a = tangent(t, &f);
-            let k = element_matrix(&rest, &if project { project_positive(a) } else { a });
-            self.add_element(tet, &k, &body.pinned);
-        }
+        with_hyperelastic_model!(body.material, |model| {
+            let averaging = body.nodal_averaging.as_ref();
+            let measures = averaging.map(|a| a.measures(&model, fvm, body.positions()));
+            for (t, tet) in fvm.tets().iter().enumerate() {
+                let rest = fvm.tet_rest(t);
+                let f = rest.gradient(&gather(tet, body.positions()));
+                let a = stress_tangent(|df| {
+                    let elastic = match &measures {
+                        Some(m) => {
+                            NodalAveraging::element_differential(&model, &f, m.excess(tet, t), df)
+                        }
+                        None => model.first_piola_differential(&f, df),
+                    };
+                    elastic + extra(t, &f, df)
+                });
+                let k = element_matrix(&rest, &if project { project_positive(a) } else { a });
+                self.add_element(tet, &k, &body.pinned);
+            }
+            // The coupling is positive semi-definite (K > 0), so it needs no projection.
+            if let Some(averaging) = averaging {
+                averaging.for_each_coupling(&model, fvm, body.positions(), |gradient, weight| {
+                    self.add_outer(gradient, weight, &body.pinned)
+                });
+            }
+        });
         for (node, &pinned) in body.pinned.iter().enumerate() {
             for i in 0..3 {
                 let e = self.entry(node, i, node, i);
@@ -116,6 +159,27 @@ impl Stiffness {
                     self.values[e] = 1.0;
                 } else if let Some(diagonal) = diagonal {
                     self.values[e] += diagonal[node];
+                }
+            }
+        }
+    }
+
+    /// Adds `weight g gᵀ` (N/m), `g` given per node, skipping pinned nodes.
+    fn add_outer(&mut self, gradient: &[(u32, DVec3)], weight: f64, pinned: &[bool]) {
+        for &(b, gb) in gradient {
+            for &(a, ga) in gradient {
+                let (a, b) = (a as usize, b as usize);
+                if a < b || pinned[a] || pinned[b] {
+                    continue;
+                }
+                for j in 0..3 {
+                    for i in 0..3 {
+                        if a == b && i < j {
+                            continue;
+                        }
+                        let e = self.entry(a, i, b, j);
+                        self.values[e] += weight * ga[i] * gb[j];
+                    }
                 }
             }
         }
@@ -139,6 +203,25 @@ impl Stiffness {
                 }
             }
         }
+    }
+
+    /// The product of the assembled symmetric matrix with a per-node vector field.
+    #[cfg(test)]
+    pub(crate) fn multiply(&self, v: &[DVec3]) -> Vec<DVec3> {
+        let mut out = vec![0.0; self.dofs];
+        for column in 0..self.dofs {
+            let x = v[column / 3][column % 3];
+            for k in self.col_ptr[column]..self.col_ptr[column + 1] {
+                let row = self.row_idx[k];
+                out[row] += self.values[k] * x;
+                if row != column {
+                    out[column] += self.values[k] * v[row / 3][row % 3];
+                }
+            }
+        }
+        out.chunks(3)
+            .map(|c| DVec3::new(c[0], c[1], c[2]))
+            .collect()
     }
 
     /// A view of the assembled matrix for faer.
@@ -212,13 +295,7 @@ pub(crate) fn project_positive(a: StressTangent) -> StressTangent {
 /// `K_e[3a+i][3b+j] = V Σ A[(i,c),(j,d)] g_a,c g_b,d` (N/m): the element matrix of a stress
 /// tangent, `g_a` the gradient of node `a`'s shape function.
 fn element_matrix(rest: &TetRest, tangent: &StressTangent) -> [[f64; 12]; 12] {
-    let g = rest.inverse_rest_edges.transpose();
-    let gradients = [
-        -(g.x_axis + g.y_axis + g.z_axis),
-        g.x_axis,
-        g.y_axis,
-        g.z_axis,
-    ];
+    let gradients = rest.shape_gradients();
     // G: 9 x 12, vec(dF) = G dx with dF_rc = Σ_b dx_b,r g_b,c at row 3c + r.
     let mut map = na::SMatrix::<f64, 9, 12>::zeros();
     for (b, gradient) in gradients.iter().enumerate() {

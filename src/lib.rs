@@ -69,6 +69,7 @@ pub mod prelude {
     pub use crate::Error;
     pub use crate::body::{SoftBody, SoftBodyBuilder, SoftBodyHandle, SoftBodySet};
     pub use crate::damping::RayleighDamping;
+    pub use crate::fvm::VolumetricTreatment;
     pub use crate::integrate::{
         AutomaticIntegrator, ImplicitIntegrator, ImplicitReport, ImplicitScheme, IntegratorKind,
         StepReport, Substeps, SymplecticEuler,

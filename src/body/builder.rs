@@ -3,7 +3,7 @@
 use super::{SoftBody, lumped_masses};
 use crate::Error;
 use crate::damping::RayleighDamping;
-use crate::fvm::FvmMesh;
+use crate::fvm::{FvmMesh, NodalAveraging, VolumetricTreatment};
 use crate::material::Material;
 use crate::mesh::TetMesh;
 use rapier3d::glamx::{DQuat, DVec3};
@@ -31,6 +31,7 @@ pub struct SoftBodyBuilder {
     mesh: TetMesh,
     material: Material,
     damping: Option<RayleighDamping>,
+    volumetric: VolumetricTreatment,
     rotation: DQuat,
     translation: DVec3,
     linvel: DVec3,
@@ -51,6 +52,7 @@ impl SoftBodyBuilder {
             mesh,
             material,
             damping: None,
+            volumetric: VolumetricTreatment::PerElement,
             rotation: DQuat::IDENTITY,
             translation: DVec3::ZERO,
             linvel: DVec3::ZERO,
@@ -63,6 +65,14 @@ impl SoftBodyBuilder {
     /// Rayleigh damping on the strain rate.
     pub fn damping(mut self, damping: RayleighDamping) -> Self {
         self.damping = Some(damping);
+        self
+    }
+
+    /// How the volumetric part of the energy is evaluated; default per element. Choose
+    /// [`VolumetricTreatment::NodalAverage`] for nearly incompressible materials (`ν` above
+    /// about 0.45), whose linear tetrahedra otherwise lock.
+    pub fn volumetric(mut self, treatment: VolumetricTreatment) -> Self {
+        self.volumetric = treatment;
         self
     }
 
@@ -167,8 +177,14 @@ impl SoftBodyBuilder {
         let velocities = (0..node_count)
             .map(|n| if pinned[n] { DVec3::ZERO } else { self.linvel })
             .collect();
+        let fvm = FvmMesh::new(&self.mesh);
+        let nodal_averaging = match self.volumetric {
+            VolumetricTreatment::PerElement => None,
+            VolumetricTreatment::NodalAverage => Some(NodalAveraging::new(&fvm)),
+        };
         Ok(SoftBody {
-            fvm: FvmMesh::new(&self.mesh),
+            fvm,
+            nodal_averaging,
             masses: lumped_masses(&self.mesh, self.material.density()),
             forces: vec![DVec3::ZERO; node_count],
             saved_state: (

@@ -9,7 +9,7 @@ pub use set::{SoftBodyHandle, SoftBodySet};
 
 use crate::assembly::Stiffness;
 use crate::damping::RayleighDamping;
-use crate::fvm::FvmMesh;
+use crate::fvm::{FvmMesh, NodalAveraging, VolumetricTreatment};
 use crate::material::{Material, with_hyperelastic_model};
 use crate::mesh::TetMesh;
 use rapier3d::glamx::DVec3;
@@ -25,6 +25,8 @@ pub struct SoftBody {
     pub(crate) fvm: FvmMesh,
     pub(crate) material: Material,
     pub(crate) damping: Option<RayleighDamping>,
+    /// The incidence data of nodal averaging, when the body uses it.
+    pub(crate) nodal_averaging: Option<NodalAveraging>,
     pub(crate) positions: Vec<DVec3>,
     pub(crate) velocities: Vec<DVec3>,
     pub(crate) masses: Vec<f64>,
@@ -57,6 +59,14 @@ impl SoftBody {
     /// The Rayleigh damping, if any.
     pub fn damping(&self) -> Option<&RayleighDamping> {
         self.damping.as_ref()
+    }
+
+    /// How the volumetric part of the energy is evaluated.
+    pub fn volumetric_treatment(&self) -> VolumetricTreatment {
+        match self.nodal_averaging {
+            Some(_) => VolumetricTreatment::NodalAverage,
+            None => VolumetricTreatment::PerElement,
+        }
     }
 
     /// Number of nodes.
@@ -150,25 +160,26 @@ impl SoftBody {
             fvm,
             material,
             damping,
+            nodal_averaging,
             positions,
             velocities,
             forces,
             ..
         } = self;
-        with_hyperelastic_model!(material, |model| fvm.internal_forces(
-            &model,
-            damping.as_ref(),
-            positions,
-            velocities,
-            forces
-        ));
+        with_hyperelastic_model!(material, |model| {
+            fvm.internal_forces(&model, damping.as_ref(), positions, velocities, forces);
+            if let Some(averaging) = nodal_averaging {
+                averaging.add_forces(&model, fvm, positions, forces);
+            }
+        });
     }
 
     /// Elastic strain energy (J) at the current positions.
     pub fn elastic_energy(&self) -> f64 {
-        with_hyperelastic_model!(self.material, |model| self
-            .fvm
-            .elastic_energy(&model, &self.positions))
+        with_hyperelastic_model!(self.material, |model| match &self.nodal_averaging {
+            Some(averaging) => averaging.elastic_energy(&model, &self.fvm, &self.positions),
+            None => self.fvm.elastic_energy(&model, &self.positions),
+        })
     }
 
     /// Kinetic energy `Σ m v²/2` (J).

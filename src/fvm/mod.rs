@@ -7,8 +7,11 @@
 //! of that boundary piece: one third of the area-weighted outward normal of the face opposite `i`.
 
 mod kernel;
+mod nodal_averaging;
 mod rest;
 
 pub(crate) use kernel::gather;
 pub use kernel::{FvmMesh, stress_forces, tet_forces};
+pub(crate) use nodal_averaging::NodalAveraging;
+pub use nodal_averaging::VolumetricTreatment;
 pub use rest::TetRest;

@@ -40,6 +40,19 @@ impl TetRest {
         DMat3::from_cols(x[1] - x[0], x[2] - x[0], x[3] - x[0]) * self.inverse_rest_edges
     }
 
+    /// The gradients `∇N_0 … ∇N_3` (1/m) of the four linear shape functions in the rest
+    /// configuration: the rows of `Dm⁻¹` for nodes 1 to 3, and minus their sum for node 0.
+    #[inline(always)]
+    pub fn shape_gradients(&self) -> [DVec3; 4] {
+        let g = self.inverse_rest_edges.transpose();
+        [
+            -(g.x_axis + g.y_axis + g.z_axis),
+            g.x_axis,
+            g.y_axis,
+            g.z_axis,
+        ]
+    }
+
     /// Columns `b1, b2, b3` (m²): the rest area-weighted normals of the control-volume boundary
     /// pieces of nodes 1 to 3 inside this tetrahedron, `b_i = (1/3) A_i n_i` with `A_i n_i` the
     /// area-weighted outward normal of the face opposite node `i`; `b0 = -(b1 + b2 + b3)`.

@@ -14,11 +14,11 @@
 
 use super::check_step;
 use crate::Error;
-use crate::assembly::{Stiffness, factorize, solve, stress_tangent};
+use crate::assembly::{Stiffness, factorize, solve};
 use crate::body::{PreviousStep, SoftBody};
 use crate::damping::RayleighDamping;
 use crate::fvm::{gather, stress_forces};
-use crate::material::{HyperelasticModel, green_strain, with_hyperelastic_model};
+use crate::material::green_strain;
 use crate::newton::{check_tolerance, descend, norm};
 use rapier3d::glamx::{DMat3, DVec3};
 
@@ -394,19 +394,9 @@ impl StepStart {
     /// semi-definite if `project`.
     fn assemble(&self, body: &SoftBody, stiffness: &mut Stiffness, inertia: &[f64], project: bool) {
         let damping = body.damping;
-        with_hyperelastic_model!(body.material, |model| stiffness.assemble(
-            body,
-            Some(inertia),
-            project,
-            |t, f| stress_tangent(|df| {
-                let elastic = model.first_piola_differential(f, df);
-                match &damping {
-                    Some(d) => {
-                        elastic + d.step_first_piola_differential(f, &self.green[t], self.h, df)
-                    }
-                    None => elastic,
-                }
-            })
-        ));
+        stiffness.assemble(body, Some(inertia), project, |t, f, df| match &damping {
+            Some(d) => d.step_first_piola_differential(f, &self.green[t], self.h, df),
+            None => DMat3::ZERO,
+        });
     }
 }

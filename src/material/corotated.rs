@@ -100,23 +100,30 @@ impl HyperelasticModel for Corotated {
         (*f - r) * (2.0 * mu) + r * (lambda * (stretch_trace - 3.0))
     }
 
-    /// Uses `dR = R [w]x` with `w = (tr(S) I - S)⁻¹ axial(Rᵀ dF - dFᵀ R)` (`McAdams` et al. 2011).
+    /// Uses the rotation's differential, [`rotation_differential`].
     fn first_piola_differential(&self, f: &DMat3, df: &DMat3) -> DMat3 {
         let r = polar_rotation(f);
         let LameParameters { lambda, mu } = self.0;
-        let s = r.transpose() * *f;
-        let stretch_trace = trace(&s);
-        let rt_df = r.transpose() * *df;
-        let system = DMat3::IDENTITY * stretch_trace - s;
-        // Singular only when two stretches sum to zero (a flattened or inverted element).
-        let w = if system.determinant().abs() > 1e-12 * stretch_trace.abs().powi(3) {
-            system.inverse() * axial(&(rt_df - rt_df.transpose()))
-        } else {
-            DVec3::ZERO
-        };
-        let dr = r * cross_matrix(w);
+        let stretch_trace = trace(&(r.transpose() * *f));
+        let dr = rotation_differential(f, &r, df);
         (*df - dr) * (2.0 * mu)
-            + r * (lambda * trace(&rt_df))
+            + r * (lambda * trace(&(r.transpose() * *df)))
             + dr * (lambda * (stretch_trace - 3.0))
     }
+}
+
+/// The differential `dR` of the polar rotation `r` of `f` for a change `df`:
+/// `dR = R [w]x` with `w = (tr(S) I - S)⁻¹ axial(Rᵀ dF - dFᵀ R)` (`McAdams` et al. 2011); zero
+/// where that system is singular (two stretches summing to zero: a flattened or inverted element).
+pub(crate) fn rotation_differential(f: &DMat3, r: &DMat3, df: &DMat3) -> DMat3 {
+    let s = r.transpose() * *f;
+    let stretch_trace = trace(&s);
+    let rt_df = r.transpose() * *df;
+    let system = DMat3::IDENTITY * stretch_trace - s;
+    let w = if system.determinant().abs() > 1e-12 * stretch_trace.abs().powi(3) {
+        system.inverse() * axial(&(rt_df - rt_df.transpose()))
+    } else {
+        DVec3::ZERO
+    };
+    *r * cross_matrix(w)
 }

@@ -10,12 +10,14 @@ mod corotated;
 mod linear;
 mod neo_hookean;
 mod stvk;
+mod volumetric;
 
 pub use corotated::Corotated;
 pub use linear::LinearElastic;
 pub use neo_hookean::StableNeoHookean;
 pub use stvk::StVenantKirchhoff;
 pub(crate) use stvk::green_strain;
+pub use volumetric::VolumetricTerm;
 
 use crate::Error;
 use crate::lanes::{Mat3x4, f64x4};

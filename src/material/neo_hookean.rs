@@ -14,9 +14,9 @@ const LARGE_STRAIN: f64 = 0.1;
 /// Stable Neo-Hookean material.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StableNeoHookean {
-    mu: f64,
+    pub(super) mu: f64,
     /// `λ' = λ + μ` (Pa), the volumetric coefficient of this energy.
-    lambda_prime: f64,
+    pub(super) lambda_prime: f64,
 }
 
 impl StableNeoHookean {
@@ -40,7 +40,7 @@ pub(crate) fn cofactor(f: &DMat3) -> DMat3 {
 }
 
 /// Differential of the cofactor matrix for a change `df` of `f`.
-fn cofactor_differential(f: &DMat3, df: &DMat3) -> DMat3 {
+pub(crate) fn cofactor_differential(f: &DMat3, df: &DMat3) -> DMat3 {
     DMat3::from_cols(
         df.y_axis.cross(f.z_axis) + f.y_axis.cross(df.z_axis),
         df.z_axis.cross(f.x_axis) + f.z_axis.cross(df.x_axis),
@@ -48,30 +48,51 @@ fn cofactor_differential(f: &DMat3, df: &DMat3) -> DMat3 {
     )
 }
 
+/// The Green-strain quantities the energy is evaluated from at small strain: `J - 1` and
+/// `tr G - (J - 1) = (I_C - 3)/2 - (J - 1)`, with the order-ε terms cancelled analytically; `None`
+/// at large strain or inversion, where the direct forms are accurate.
+///
+/// At a strain `ε`, `(I_C - 3)/2` and `J - 1` are both of order `ε` while the energy is of order
+/// `ε²`, so subtracting them would lose `1/ε` of the digits (the energy of a 1e-6 strain only to
+/// 1e-4 relative), which blinds line searches near equilibrium.
+fn small_strain_terms(f: &DMat3) -> Option<(f64, f64)> {
+    let g = green_strain(f);
+    let largest_strain = g.to_cols_array().iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    if f.determinant() <= 0.0 || largest_strain > LARGE_STRAIN {
+        return None;
+    }
+    let tr = trace(&g);
+    // det(I + 2G) - 1 = J² - 1, expanded in G.
+    let quadratic = tr * tr - trace(&(g * g));
+    let d = 2.0 * tr + 2.0 * quadratic + 8.0 * g.determinant();
+    let s = (1.0 + d).sqrt();
+    let j_minus_one = d / (s + 1.0);
+    let deviatoric = (tr * (s - 1.0) - 2.0 * quadratic - 8.0 * g.determinant()) / (s + 1.0);
+    Some((j_minus_one, deviatoric))
+}
+
+impl StableNeoHookean {
+    /// `J - 1` (dimensionless), accurate at small strain.
+    pub(super) fn volume_change(&self, f: &DMat3) -> f64 {
+        small_strain_terms(f).map_or_else(|| f.determinant() - 1.0, |(j_minus_one, _)| j_minus_one)
+    }
+
+    /// `μ/2 (I_C - 3) - μ (J - 1)` (J/m³): the energy without its volumetric term.
+    pub(super) fn shear_energy_density(&self, f: &DMat3) -> f64 {
+        let deviatoric = small_strain_terms(f).map_or_else(
+            || 0.5 * (double_dot(f, f) - 3.0) - (f.determinant() - 1.0),
+            |(_, deviatoric)| deviatoric,
+        );
+        self.mu * deviatoric
+    }
+}
+
 impl HyperelasticModel for StableNeoHookean {
-    /// Evaluated from the Green strain `G`, without the cancellation of the textbook form: at a
-    /// strain `ε`, `(I_C - 3)/2` and `J - 1` are both of order `ε` while the energy is of order
-    /// `ε²`, so subtracting them would lose `1/ε` of the digits (the energy of a 1e-6 strain only
-    /// to 1e-4 relative), which blinds line searches near equilibrium.
+    /// Evaluated from the Green strain at small strain, without the cancellation of the textbook
+    /// form (see [`StableNeoHookean`]'s shear and volume terms).
     fn energy_density(&self, f: &DMat3) -> f64 {
-        let j = f.determinant();
-        let g = green_strain(f);
-        let largest_strain = g.to_cols_array().iter().fold(0.0f64, |m, x| m.max(x.abs()));
-        if j <= 0.0 || largest_strain > LARGE_STRAIN {
-            // Large strain or inverted: nothing cancels and the direct form is accurate.
-            let i_c = double_dot(f, f);
-            return 0.5 * self.mu * (i_c - 3.0) - self.mu * (j - 1.0)
-                + 0.5 * self.lambda_prime * (j - 1.0).powi(2);
-        }
-        let tr = trace(&g);
-        // det(I + 2G) - 1 = J² - 1, expanded in G.
-        let quadratic = tr * tr - trace(&(g * g));
-        let d = 2.0 * tr + 2.0 * quadratic + 8.0 * g.determinant();
-        let s = (1.0 + d).sqrt();
-        let j_minus_one = d / (s + 1.0);
-        // (I_C - 3)/2 - (J - 1) = tr G - (J - 1), with the order-ε terms cancelled analytically.
-        let deviatoric = (tr * (s - 1.0) - 2.0 * quadratic - 8.0 * g.determinant()) / (s + 1.0);
-        self.mu * deviatoric + 0.5 * self.lambda_prime * j_minus_one * j_minus_one
+        let j_minus_one = self.volume_change(f);
+        self.shear_energy_density(f) + 0.5 * self.lambda_prime * j_minus_one * j_minus_one
     }
 
     #[inline(always)]

@@ -7,11 +7,10 @@
 //! rigid motion.
 
 use crate::Error;
-use crate::assembly::{Stiffness, factorize, solve, stress_tangent};
+use crate::assembly::{Stiffness, factorize, solve};
 use crate::body::SoftBody;
-use crate::material::{HyperelasticModel, with_hyperelastic_model};
 use crate::newton::{check_tolerance, descend, norm};
-use rapier3d::glamx::DVec3;
+use rapier3d::glamx::{DMat3, DVec3};
 
 /// The largest relative residual accepted as round-off when Newton stops reducing it.
 const ROUND_OFF_CEILING: f64 = 1e-6;
@@ -224,26 +223,13 @@ pub fn fundamental_frequency(body: &SoftBody) -> Result<f64, Error> {
 /// The elastic tangent stiffness at the body's current positions, projected per element to be
 /// positive semi-definite if `project`.
 fn assemble_elastic(stiffness: &mut Stiffness, body: &SoftBody, project: bool) {
-    with_hyperelastic_model!(body.material, |model| stiffness.assemble(
-        body,
-        None,
-        project,
-        |_, f| stress_tangent(|df| model.first_piola_differential(f, df))
-    ));
+    stiffness.assemble(body, None, project, |_, _, _| DMat3::ZERO);
 }
 
 /// `f_int(x) + load`, zero on pinned nodes (N).
 fn out_of_balance(body: &mut SoftBody, load: &[DVec3]) -> Vec<DVec3> {
-    let SoftBody {
-        fvm,
-        material,
-        positions,
-        velocities,
-        forces,
-        ..
-    } = body;
-    with_hyperelastic_model!(material, |model| fvm
-        .internal_forces(&model, None, positions, velocities, forces));
+    // The velocities are zero, so the damping adds nothing.
+    body.compute_internal_forces();
     (0..load.len())
         .map(|n| {
             if body.pinned[n] {

@@ -22,13 +22,24 @@ pub fn damped_cantilever(
     material: Material,
     damping: Option<RayleighDamping>,
 ) -> (SoftBody, usize) {
+    cantilever_with(cells, material, damping, VolumetricTreatment::PerElement)
+}
+
+/// [`cantilever`] with optional Rayleigh damping and a choice of volumetric treatment.
+pub fn cantilever_with(
+    cells: [usize; 3],
+    material: Material,
+    damping: Option<RayleighDamping>,
+    treatment: VolumetricTreatment,
+) -> (SoftBody, usize) {
     let half = DVec3::new(LENGTH / 2.0, SIDE / 2.0, SIDE / 2.0);
     let mesh = mesh::cuboid(half, cells).unwrap();
     let clamped = mesh.nodes_where(|p| p.x <= -half.x + 1e-9);
     let tip = mesh.nearest_node(DVec3::new(half.x, 0.0, 0.0)) as usize;
     let mut builder = SoftBodyBuilder::new(mesh, material)
         .translation(DVec3::new(half.x, 0.0, 0.0))
-        .pinned_nodes(clamped);
+        .pinned_nodes(clamped)
+        .volumetric(treatment);
     if let Some(damping) = damping {
         builder = builder.damping(damping);
     }
