@@ -164,6 +164,16 @@ impl Stiffness {
         }
     }
 
+    /// Adds the 3 x 3 block `block` (N/m) to the diagonal block of a free node.
+    pub(crate) fn add_node_block(&mut self, node: usize, block: &DMat3) {
+        for j in 0..3 {
+            for i in j..3 {
+                let e = self.entry(node, i, node, j);
+                self.values[e] += block.col(j)[i];
+            }
+        }
+    }
+
     /// Adds `weight g gᵀ` (N/m), `g` given per node, skipping pinned nodes.
     fn add_outer(&mut self, gradient: &[(u32, DVec3)], weight: f64, pinned: &[bool]) {
         for &(b, gb) in gradient {

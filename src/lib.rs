@@ -43,6 +43,7 @@
 
 mod assembly;
 pub mod body;
+pub mod contact;
 pub mod damping;
 mod error;
 pub mod fvm;
@@ -68,6 +69,7 @@ pub use rapier3d::glamx;
 pub mod prelude {
     pub use crate::Error;
     pub use crate::body::{SoftBody, SoftBodyBuilder, SoftBodyHandle, SoftBodySet};
+    pub use crate::contact::{ContactSettings, NodeContact};
     pub use crate::damping::RayleighDamping;
     pub use crate::fvm::VolumetricTreatment;
     pub use crate::integrate::{

@@ -2,6 +2,7 @@
 
 use super::{SoftBody, lumped_masses};
 use crate::Error;
+use crate::contact::ContactSettings;
 use crate::damping::RayleighDamping;
 use crate::fvm::{FvmMesh, NodalAveraging, VolumetricTreatment};
 use crate::material::Material;
@@ -178,6 +179,14 @@ impl SoftBodyBuilder {
             .map(|n| if pinned[n] { DVec3::ZERO } else { self.linvel })
             .collect();
         let fvm = FvmMesh::new(&self.mesh);
+        let mut surface_nodes: Vec<u32> = self
+            .mesh
+            .surface_triangles()
+            .into_iter()
+            .flatten()
+            .collect();
+        surface_nodes.sort_unstable();
+        surface_nodes.dedup();
         let nodal_averaging = match self.volumetric {
             VolumetricTreatment::PerElement => None,
             VolumetricTreatment::NodalAverage => Some(NodalAveraging::new(&fvm)),
@@ -199,6 +208,9 @@ impl SoftBodyBuilder {
             positions,
             velocities,
             pinned,
+            surface_nodes,
+            contacts: Vec::new(),
+            contact_settings: ContactSettings::default(),
             user_data: self.user_data,
         })
     }

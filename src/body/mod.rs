@@ -8,6 +8,7 @@ pub use builder::{DEFAULT_MIN_ELEMENT_QUALITY, SoftBodyBuilder};
 pub use set::{SoftBodyHandle, SoftBodySet};
 
 use crate::assembly::Stiffness;
+use crate::contact::{ContactSettings, NodeContact};
 use crate::damping::RayleighDamping;
 use crate::fvm::{FvmMesh, NodalAveraging, VolumetricTreatment};
 use crate::material::{Material, with_hyperelastic_model};
@@ -41,6 +42,12 @@ pub struct SoftBody {
     /// The sparse tangent's pattern and symbolic factorization, built by the first implicit or
     /// static solve and kept for the next.
     pub(crate) tangent: Option<Stiffness>,
+    /// The nodes on the mesh's boundary, which contacts are detected for.
+    pub(crate) surface_nodes: Vec<u32>,
+    /// The contacts the integrators enforce, from the last detection.
+    pub(crate) contacts: Vec<NodeContact>,
+    /// The settings of the last contact detection.
+    pub(crate) contact_settings: ContactSettings,
     /// Arbitrary user data, as on rapier's bodies.
     pub user_data: u128,
 }

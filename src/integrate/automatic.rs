@@ -76,6 +76,9 @@ pub struct AutomaticReport {
     pub explicit: Option<StepReport>,
     /// The implicit frame's report, if implicit.
     pub implicit: Option<ImplicitReport>,
+    /// Whether the frame was chosen explicit but redone implicitly, because crushed elements
+    /// lowered the stability limit partway below what `max_substeps` allows.
+    pub fell_back: bool,
 }
 
 /// Picks, frame by frame, the cheaper of an explicit and an implicit integrator.
@@ -149,18 +152,33 @@ impl AutomaticIntegrator {
         let needed = self.explicit.needed_substeps(body, frame_dt)?;
         let prediction = self.prediction(body, needed);
         let choice = self.force.unwrap_or_else(|| prediction.cheaper());
-        let (explicit, implicit) = match choice {
-            IntegratorKind::Explicit => (
-                Some(self.explicit.advance(body, frame_dt, gravity, needed)?),
-                None,
-            ),
-            IntegratorKind::Implicit => (None, Some(self.implicit.step(body, frame_dt, gravity)?)),
+        let explicit = match choice {
+            IntegratorKind::Explicit => {
+                Some(self.explicit.advance(body, frame_dt, gravity, needed))
+            }
+            IntegratorKind::Implicit => None,
+        };
+        let (explicit, fell_back) = match explicit {
+            Some(Ok(report)) => (Some(report), false),
+            // The explicit frame left the body as it was: redo it implicitly, unless forced.
+            Some(Err(Error::TooManySubsteps { .. })) if self.force.is_none() => (None, true),
+            Some(Err(error)) => return Err(error),
+            None => (None, false),
+        };
+        let implicit = match explicit {
+            Some(_) => None,
+            None => Some(self.implicit.step(body, frame_dt, gravity)?),
         };
         Ok(AutomaticReport {
-            choice,
+            choice: if fell_back {
+                IntegratorKind::Implicit
+            } else {
+                choice
+            },
             prediction,
             explicit,
             implicit,
+            fell_back,
         })
     }
 }

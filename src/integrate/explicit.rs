@@ -14,6 +14,7 @@
 use super::check_step;
 use crate::Error;
 use crate::body::SoftBody;
+use crate::contact;
 use rapier3d::glamx::DVec3;
 
 /// Ratio of the critical explicit step to `ℓ / c_p`. The true limit `2/ω_max` (power iteration
@@ -23,6 +24,9 @@ use rapier3d::glamx::DVec3;
 /// element altitude `h_min` in place of `ℓ` spreads from 0.93 to 1.75 on the same meshes, which
 /// would cost up to twice the substeps.
 pub const COURANT_NUMBER: f64 = 1.5;
+
+/// Automatic substeps re-evaluate the stability limit every this many substeps.
+const RECHECK_INTERVAL: u32 = 16;
 
 /// How a frame step is split into substeps.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -64,7 +68,8 @@ impl Default for SymplecticEuler {
 pub struct StepReport {
     /// Number of substeps taken.
     pub substeps: u32,
-    /// Length of each substep (s).
+    /// Length of the shortest substep (s): automatic substeps shorten within a frame when the
+    /// stability limit drops (elements crushed by an impact).
     pub substep_dt: f64,
     /// Tetrahedra inverted (zero or negative volume) at the end of the frame.
     pub inverted_tets: usize,
@@ -127,21 +132,53 @@ impl SymplecticEuler {
                 max: self.max_substeps,
             });
         }
-        let substeps = needed as u32;
-        let h = frame_dt / f64::from(substeps);
+        let mut h = frame_dt / needed;
+        let mut left = needed as u32;
+        let (mut taken, mut elapsed, mut smallest) = (0u32, 0.0, h);
         body.save_state();
         let history = body.previous_step.take();
-        for _ in 0..substeps {
-            substep(body, h, gravity);
-        }
-        if let Some(node) = body.first_non_finite_node() {
+        let fail = |body: &mut SoftBody, history, error| {
             body.restore_state();
             body.previous_step = history;
-            return Err(Error::NonFiniteState { node });
+            Err(error)
+        };
+        while left > 0 {
+            substep(body, h, gravity);
+            left -= 1;
+            taken += 1;
+            elapsed += h;
+            // Crushing elements lowers the limit within a frame (an impact flattens a soft
+            // body in a few substeps): re-evaluate it now and then and shorten the rest.
+            if automatic && left > 0 && taken % RECHECK_INTERVAL == 0 {
+                let stable = self.stable_time_step(body);
+                if stable < h {
+                    let remaining = frame_dt - elapsed;
+                    let more = (remaining / stable).ceil();
+                    if more.is_nan() || f64::from(taken) + more > f64::from(self.max_substeps) {
+                        let needed = f64::from(taken) + more;
+                        let max = self.max_substeps;
+                        return fail(
+                            body,
+                            history,
+                            Error::TooManySubsteps {
+                                frame_dt,
+                                needed,
+                                max,
+                            },
+                        );
+                    }
+                    left = more as u32;
+                    h = remaining / more;
+                    smallest = h;
+                }
+            }
+        }
+        if let Some(node) = body.first_non_finite_node() {
+            return fail(body, history, Error::NonFiniteState { node });
         }
         Ok(StepReport {
-            substeps,
-            substep_dt: h,
+            substeps: taken,
+            substep_dt: smallest,
             inverted_tets: body.inverted_tet_count(),
         })
     }
@@ -175,19 +212,29 @@ impl SymplecticEuler {
 fn substep(body: &mut SoftBody, h: f64, gravity: DVec3) {
     body.compute_internal_forces();
     let SoftBody {
-        positions,
         velocities,
         masses,
         pinned,
         forces,
         ..
     } = body;
+    for n in 0..velocities.len() {
+        if !pinned[n] {
+            velocities[n] += (forces[n] / masses[n] + gravity) * h;
+        }
+    }
+    contact::constrain_velocities(body, h);
+    let SoftBody {
+        positions,
+        velocities,
+        pinned,
+        ..
+    } = body;
     for n in 0..positions.len() {
         if pinned[n] {
             velocities[n] = DVec3::ZERO;
-            continue;
+        } else {
+            positions[n] += velocities[n] * h;
         }
-        velocities[n] += (forces[n] / masses[n] + gravity) * h;
-        positions[n] += velocities[n] * h;
     }
 }

@@ -16,6 +16,7 @@ use super::check_step;
 use crate::Error;
 use crate::assembly::{Stiffness, factorize, solve};
 use crate::body::{PreviousStep, SoftBody};
+use crate::contact;
 use crate::damping::RayleighDamping;
 use crate::fvm::{gather, stress_forces};
 use crate::material::green_strain;
@@ -171,8 +172,17 @@ impl ImplicitIntegrator {
         gravity: DVec3,
     ) -> Result<(usize, f64, bool), Error> {
         let start = StepStart::new(body, h, gravity, self.scheme);
-        body.positions.clone_from(&start.target);
+        // Newton starts from the inertial prediction `x̂` (free flight: the warm start that makes
+        // smooth motion cost one iteration), or from where the body is when that is the lower
+        // potential (a prediction deep inside an obstacle or crushing elements).
         body.velocities.fill(DVec3::ZERO);
+        let here = start.energy(body);
+        body.positions.clone_from(&start.target);
+        let predicted = start.energy(body);
+        // A NaN prediction is not lower either.
+        if predicted.is_nan() || predicted > here {
+            body.positions.clone_from(&start.positions);
+        }
         let outcome = self.minimize(body, stiffness, &start)?;
         for n in 0..body.positions.len() {
             body.velocities[n] = if body.pinned[n] {
@@ -318,8 +328,8 @@ impl StepStart {
         }
     }
 
-    /// `-∇E` (N): elastic and damping forces, gravity and the inertial pull toward `x̂`; zero on
-    /// pinned nodes.
+    /// `-∇E` (N): elastic and damping forces, gravity, contact penalties and the inertial pull
+    /// toward `x̂`; zero on pinned nodes.
     fn residual(&self, body: &mut SoftBody) -> Vec<DVec3> {
         body.velocities.fill(DVec3::ZERO);
         body.compute_internal_forces();
@@ -333,6 +343,9 @@ impl StepStart {
         if let Some(damping) = body.damping {
             self.add_damping_forces(body, &damping, &mut residual);
         }
+        contact::for_each_active_penalty(body, self.h, |node, stiffness, gap, normal| {
+            residual[node] -= normal * (stiffness * gap);
+        });
         for (r, &pinned) in residual.iter_mut().zip(&body.pinned) {
             if pinned {
                 *r = DVec3::ZERO;
@@ -387,16 +400,23 @@ impl StepStart {
                 .sum(),
             None => 0.0,
         };
-        inertia + body.elastic_energy() + dissipation - load
+        let mut penalty = 0.0;
+        contact::for_each_active_penalty(body, self.h, |_, stiffness, gap, _| {
+            penalty += 0.5 * stiffness * gap * gap;
+        });
+        inertia + body.elastic_energy() + dissipation + penalty - load
     }
 
-    /// `M/h² + K_elastic + K_damping`, each element's stress tangent projected to be positive
+    /// `M/h² + K_elastic + K_damping + K_contact`, each element's stress tangent projected to be positive
     /// semi-definite if `project`.
     fn assemble(&self, body: &SoftBody, stiffness: &mut Stiffness, inertia: &[f64], project: bool) {
         let damping = body.damping;
         stiffness.assemble(body, Some(inertia), project, |t, f, df| match &damping {
             Some(d) => d.step_first_piola_differential(f, &self.green[t], self.h, df),
             None => DMat3::ZERO,
+        });
+        contact::for_each_active_penalty(body, self.h, |node, k, _, normal| {
+            stiffness.add_node_block(node, &contact::penalty_tangent(k, normal));
         });
     }
 }

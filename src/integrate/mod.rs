@@ -13,7 +13,7 @@ use rapier3d::glamx::DVec3;
 
 /// The checks every integrator makes before stepping: a positive, finite frame step (s) and a
 /// finite gravity (m/s²).
-fn check_step(frame_dt: f64, gravity: DVec3) -> Result<(), Error> {
+pub(crate) fn check_step(frame_dt: f64, gravity: DVec3) -> Result<(), Error> {
     if !(frame_dt.is_finite() && frame_dt > 0.0) {
         return Err(Error::InvalidTimeStep {
             dt: frame_dt,

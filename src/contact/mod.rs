@@ -1,0 +1,269 @@
+//! Contact of soft bodies with rapier colliders.
+//!
+//! Detection ([`SoftBody::detect_contacts`]) projects every surface node onto every collider
+//! (parry's point projection, which covers all of rapier's shapes) that the node can reach within
+//! the coming frame, and keeps the nearest surface point and its outward normal as a
+//! [`NodeContact`]: a plane the node must stay on the outer side of during the frame. The
+//! integrators then enforce the planes:
+//!
+//! - [`SymplecticEuler`](crate::integrate::SymplecticEuler), at every substep, as velocity
+//!   constraints: a node's normal velocity is raised so that it does not cross its plane within
+//!   the substep (an inelastic, speculative contact), and its tangential velocity is reduced by at
+//!   most the collider's friction coefficient times that change (Coulomb friction).
+//! - [`ImplicitIntegrator`](crate::integrate::ImplicitIntegrator), as a stiff penalty in the
+//!   incremental potential, `k/2 min(0, g)²` per contact with `g` the signed distance to the plane
+//!   and `k` [`ContactSettings::penalty_factor`] times the node's `m/h²`: the resting penetration
+//!   under a load `w` is `w h²/(factor m)`, micrometres at game steps. Frictionless for now.
+//!
+//! This is one-way coupling: colliders move bodies, not the reverse.
+
+use crate::Error;
+use crate::body::SoftBody;
+use rapier3d::geometry::{ColliderHandle, ColliderSet, Shape, SharedShape};
+use rapier3d::glamx::{DMat3, DVec3};
+use rapier3d::math::Pose;
+
+/// How contacts are detected and enforced.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ContactSettings {
+    /// Nodes within this distance (m) of a collider, beyond the distance they can travel in the
+    /// frame, get a contact.
+    pub margin: f64,
+    /// The implicit penalty stiffness in units of a node's `m/h²` (dimensionless).
+    pub penalty_factor: f64,
+}
+
+impl Default for ContactSettings {
+    fn default() -> Self {
+        Self {
+            margin: 1e-3,
+            penalty_factor: 1e3,
+        }
+    }
+}
+
+/// A surface node's contact with a collider for the coming frame: the plane through `point` with
+/// outward normal `normal` that the node must not cross. The explicit integrator re-projects the
+/// node onto the collider's shape (at its pose when detected) every substep to update the plane.
+#[derive(Clone)]
+pub struct NodeContact {
+    /// The soft body's node.
+    pub node: u32,
+    /// The collider touched.
+    pub collider: ColliderHandle,
+    /// The nearest point of the collider's surface to the node when detected (m).
+    pub point: DVec3,
+    /// The collider's outward unit normal there.
+    pub normal: DVec3,
+    /// Coulomb friction coefficient (the collider's).
+    pub friction: f64,
+    shape: SharedShape,
+    pose: Pose,
+}
+
+impl std::fmt::Debug for NodeContact {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("NodeContact")
+            .field("node", &self.node)
+            .field("collider", &self.collider)
+            .field("point", &self.point)
+            .field("normal", &self.normal)
+            .field("friction", &self.friction)
+            .finish_non_exhaustive()
+    }
+}
+
+impl NodeContact {
+    /// Signed distance (m) of position `x` from the contact plane, negative inside.
+    pub fn gap(&self, x: DVec3) -> f64 {
+        (x - self.point).dot(self.normal)
+    }
+
+    /// Moves the plane to the collider's surface point nearest to `x` (m), if defined there.
+    fn refresh(&mut self, x: DVec3) {
+        if let Some((point, normal, _)) = nearest_surface_point(&*self.shape, &self.pose, x) {
+            self.point = point;
+            self.normal = normal;
+        }
+    }
+}
+
+impl ContactSettings {
+    fn check(&self) -> Result<(), Error> {
+        if !(self.margin.is_finite() && self.margin >= 0.0) {
+            return Err(Error::InvalidSetting {
+                parameter: "margin",
+                value: self.margin,
+                reason: "must be non-negative and finite (m)",
+            });
+        }
+        if !(self.penalty_factor.is_finite() && self.penalty_factor > 0.0) {
+            return Err(Error::InvalidSetting {
+                parameter: "penalty_factor",
+                value: self.penalty_factor,
+                reason: "must be positive and finite",
+            });
+        }
+        Ok(())
+    }
+}
+
+impl SoftBody {
+    /// Finds the contacts of the body's surface nodes with `colliders` for a frame of `frame_dt`
+    /// (s) under `gravity` (m/s²), replacing the previous ones: a node gets a contact with each
+    /// non-sensor collider it is within `margin` of, plus twice the distance the body's fastest
+    /// node can travel in the frame (`2 (|v|max + |g| dt) dt`). The integrators enforce them until
+    /// the next detection.
+    ///
+    /// # Errors
+    /// [`Error::InvalidTimeStep`], [`Error::NonFiniteInput`] or [`Error::InvalidSetting`] for a bad
+    /// step, gravity or setting; the contacts are then left as they were.
+    pub fn detect_contacts(
+        &mut self,
+        colliders: &ColliderSet,
+        frame_dt: f64,
+        gravity: DVec3,
+        settings: &ContactSettings,
+    ) -> Result<&[NodeContact], Error> {
+        crate::integrate::check_step(frame_dt, gravity)?;
+        settings.check()?;
+        let mut contacts = Vec::new();
+        // Elastic waves can speed a node up within the frame: reach as far as the body's fastest
+        // node, twice over.
+        let fastest = self
+            .velocities
+            .iter()
+            .map(|v| v.length())
+            .fold(0.0, f64::max);
+        let reach = settings.margin + 2.0 * (fastest + gravity.length() * frame_dt) * frame_dt;
+        for (handle, collider) in colliders.iter() {
+            if collider.is_sensor() {
+                continue;
+            }
+            let aabb = collider.compute_aabb();
+            for &node in &self.surface_nodes {
+                let n = node as usize;
+                if self.pinned[n] {
+                    continue;
+                }
+                let x = self.positions[n];
+                let (lo, hi) = (aabb.mins.as_dvec3(), aabb.maxs.as_dvec3());
+                if (x + DVec3::splat(reach)).cmplt(lo).any()
+                    || (x - DVec3::splat(reach)).cmpgt(hi).any()
+                {
+                    continue;
+                }
+                let (shape, pose) = (collider.shared_shape(), collider.position());
+                if let Some((point, normal, distance)) = nearest_surface_point(&**shape, pose, x)
+                    && distance <= reach
+                {
+                    contacts.push(NodeContact {
+                        node,
+                        collider: handle,
+                        point,
+                        normal,
+                        friction: f64::from(collider.friction()),
+                        shape: shape.clone(),
+                        pose: *pose,
+                    });
+                }
+            }
+        }
+        self.contacts = contacts;
+        self.contact_settings = *settings;
+        Ok(&self.contacts)
+    }
+
+    /// The contacts found by the last [`SoftBody::detect_contacts`].
+    pub fn contacts(&self) -> &[NodeContact] {
+        &self.contacts
+    }
+
+    /// Removes every contact.
+    pub fn clear_contacts(&mut self) {
+        self.contacts.clear();
+    }
+}
+
+/// The point of a shape's surface (at `pose`) nearest to `x` (m), the outward normal there, and
+/// the signed distance of `x` (negative inside); `None` where the normal is undefined.
+fn nearest_surface_point(shape: &dyn Shape, pose: &Pose, x: DVec3) -> Option<(DVec3, DVec3, f64)> {
+    let (projection, feature) = shape.project_point_and_get_feature(pose, x.as_vec3());
+    let point = projection.point.as_dvec3();
+    let local = pose.inverse_transform_point(projection.point);
+    let feature_normal = shape
+        .feature_normal_at_point(0, feature, local)
+        .map(|n| (pose.rotation * n).as_dvec3());
+    let offset = x - point;
+    let sign = if projection.is_inside { -1.0 } else { 1.0 };
+    // The feature's normal where parry has one (balls, cuboids, convex shapes, meshes), the
+    // plane's for half-spaces, else the direction from the surface point to the node; a node
+    // exactly on such a surface has no defined normal.
+    let normal = match (feature_normal, shape.as_halfspace()) {
+        (Some(n), _) if n.is_finite() && n.length() > 0.5 => n.normalize(),
+        (_, Some(half_space)) => (pose.rotation * half_space.normal).as_dvec3().normalize(),
+        _ if offset.length() > 0.0 => offset.normalize() * sign,
+        _ => return None,
+    };
+    Some((point, normal, sign * offset.length()))
+}
+
+/// Enforces the contacts as velocity constraints for a substep of `h` (s): called after the
+/// velocity update, before positions move. A node found inside is first put back on its plane
+/// (no velocity is added to push it out).
+pub(crate) fn constrain_velocities(body: &mut SoftBody, h: f64) {
+    let SoftBody {
+        contacts,
+        positions,
+        velocities,
+        ..
+    } = body;
+    for contact in contacts.iter_mut() {
+        let n = contact.node as usize;
+        contact.refresh(positions[n]);
+        let gap = contact.gap(positions[n]);
+        if gap < 0.0 {
+            positions[n] -= contact.normal * gap;
+        }
+        // Arrive at the plane, never cross it.
+        let lowest = -gap.max(0.0) / h;
+        let v = velocities[n];
+        let normal_speed = v.dot(contact.normal);
+        if normal_speed >= lowest {
+            continue;
+        }
+        let change = lowest - normal_speed;
+        let tangential = v - contact.normal * normal_speed;
+        let slip = tangential.length();
+        let kept = if slip > 0.0 {
+            (1.0 - contact.friction * change / slip).max(0.0)
+        } else {
+            0.0
+        };
+        velocities[n] = contact.normal * lowest + tangential * kept;
+    }
+}
+
+/// The implicit penalty of the contacts for an effective step `h` (s), at the body's positions:
+/// calls `each(node, stiffness k (N/m), gap g (m), normal)` for every contact whose node is
+/// inside its plane (`g < 0`); the penalty energy is `Σ k g²/2`, its force on the node `-k g n`
+/// and its tangent `k n nᵀ`.
+pub(crate) fn for_each_active_penalty(
+    body: &SoftBody,
+    h: f64,
+    mut each: impl FnMut(usize, f64, f64, DVec3),
+) {
+    for contact in &body.contacts {
+        let n = contact.node as usize;
+        let gap = contact.gap(body.positions[n]);
+        if gap < 0.0 {
+            let stiffness = body.contact_settings.penalty_factor * body.masses[n] / (h * h);
+            each(n, stiffness, gap, contact.normal);
+        }
+    }
+}
+
+/// `k n nᵀ` (N/m).
+pub(crate) fn penalty_tangent(stiffness: f64, normal: DVec3) -> DMat3 {
+    DMat3::from_cols(normal * normal.x, normal * normal.y, normal * normal.z) * stiffness
+}
