@@ -18,7 +18,7 @@
 //! Run with `cargo run --release --example extremes`.
 
 use rapier_fvm::prelude::*;
-use rapier3d::prelude::{ColliderBuilder, ColliderSet, SharedShape};
+use rapier3d::prelude::{ColliderBuilder, ColliderSet, RigidBodySet, SharedShape};
 use std::time::Instant;
 
 /// Young's moduli (Pa) of the sweep.
@@ -154,7 +154,13 @@ pub fn run_case(scene: Scene, young: f64, poisson: f64, frame_dt: f64, frames: u
     let start = Instant::now();
     for _ in 0..frames {
         let stepped = body
-            .detect_contacts(&colliders, frame_dt, gravity, &ContactSettings::default())
+            .detect_contacts(
+                &colliders,
+                &RigidBodySet::new(),
+                frame_dt,
+                gravity,
+                &ContactSettings::default(),
+            )
             .map(|_| ())
             .and_then(|()| integrator.step(&mut body, frame_dt, gravity));
         match stepped {

@@ -53,6 +53,7 @@ pub mod material;
 pub mod mesh;
 mod newton;
 pub mod statics;
+pub mod world;
 
 pub use error::Error;
 

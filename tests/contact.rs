@@ -2,7 +2,7 @@
 //! a block on a slope sticks or slides as Coulomb's law says.
 
 use rapier_fvm::prelude::*;
-use rapier3d::prelude::{ColliderBuilder, ColliderSet, SharedShape};
+use rapier3d::prelude::{ColliderBuilder, ColliderSet, RigidBodySet, SharedShape};
 
 const GRAVITY: DVec3 = DVec3::new(0.0, -9.81, 0.0);
 
@@ -62,8 +62,14 @@ fn a_dropped_cube_comes_to_rest_on_the_ground() {
         };
         let mut deepest = f64::INFINITY;
         for _ in 0..120 {
-            body.detect_contacts(&colliders, 1.0 / 60.0, GRAVITY, &settings)
-                .unwrap();
+            body.detect_contacts(
+                &colliders,
+                &RigidBodySet::new(),
+                1.0 / 60.0,
+                GRAVITY,
+                &settings,
+            )
+            .unwrap();
             integrator.step(&mut body, 1.0 / 60.0, GRAVITY).unwrap();
             deepest = deepest.min(lowest(&body));
         }
@@ -101,7 +107,7 @@ fn a_block_on_a_slope_sticks_or_slides_as_coulomb_says() {
         let frame = 1.0 / 240.0;
         let mut history = Vec::new();
         for _ in 0..240 {
-            body.detect_contacts(&colliders, frame, GRAVITY, &settings)
+            body.detect_contacts(&colliders, &RigidBodySet::new(), frame, GRAVITY, &settings)
                 .unwrap();
             integrator.step(&mut body, frame, GRAVITY).unwrap();
             history.push(body.center_of_mass().dot(downhill));

@@ -210,6 +210,8 @@ impl SoftBodyBuilder {
             pinned,
             surface_nodes,
             contacts: Vec::new(),
+            rigid_proxies: Vec::new(),
+            saved_proxies: Vec::new(),
             contact_settings: ContactSettings::default(),
             user_data: self.user_data,
         })

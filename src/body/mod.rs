@@ -8,7 +8,7 @@ pub use builder::{DEFAULT_MIN_ELEMENT_QUALITY, SoftBodyBuilder};
 pub use set::{SoftBodyHandle, SoftBodySet};
 
 use crate::assembly::Stiffness;
-use crate::contact::{ContactSettings, NodeContact};
+use crate::contact::{ContactSettings, NodeContact, RigidProxy};
 use crate::damping::RayleighDamping;
 use crate::fvm::{FvmMesh, NodalAveraging, VolumetricTreatment};
 use crate::material::{Material, with_hyperelastic_model};
@@ -46,6 +46,10 @@ pub struct SoftBody {
     pub(crate) surface_nodes: Vec<u32>,
     /// The contacts the integrators enforce, from the last detection.
     pub(crate) contacts: Vec<NodeContact>,
+    /// The rigid bodies the contacts touch, as the soft step sees them.
+    pub(crate) rigid_proxies: Vec<RigidProxy>,
+    /// The proxies saved with the state, restored with it.
+    pub(crate) saved_proxies: Vec<RigidProxy>,
     /// The settings of the last contact detection.
     pub(crate) contact_settings: ContactSettings,
     /// Arbitrary user data, as on rapier's bodies.
@@ -135,16 +139,25 @@ impl SoftBody {
         &self.forces
     }
 
-    /// Copies positions and velocities aside (no allocation after the first call).
+    /// Copies positions, velocities and the touched rigid bodies aside (no allocation after the
+    /// first call), and starts counting the contact impulses of a new step.
     pub(crate) fn save_state(&mut self) {
         self.saved_state.0.clone_from(&self.positions);
         self.saved_state.1.clone_from(&self.velocities);
+        for contact in &mut self.contacts {
+            contact.impulse = DVec3::ZERO;
+        }
+        self.saved_proxies.clone_from(&self.rigid_proxies);
     }
 
     /// Puts back the state saved by [`SoftBody::save_state`].
     pub(crate) fn restore_state(&mut self) {
         self.positions.clone_from(&self.saved_state.0);
         self.velocities.clone_from(&self.saved_state.1);
+        for contact in &mut self.contacts {
+            contact.impulse = DVec3::ZERO;
+        }
+        self.rigid_proxies.clone_from(&self.saved_proxies);
     }
 
     /// The tangent workspace, built on first use; give it back with `self.tangent = Some(..)`.

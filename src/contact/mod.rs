@@ -15,10 +15,19 @@
 //!   and `k` [`ContactSettings::penalty_factor`] times the node's `m/h²`: the resting penetration
 //!   under a load `w` is `w h²/(factor m)`, micrometres at game steps. Frictionless for now.
 //!
-//! This is one-way coupling: colliders move bodies, not the reverse.
+//! A collider attached to a rigid body takes the body's motion into account (its velocity at the
+//! contact point) and, when the body is dynamic, receives the opposite of every impulse the soft
+//! body gets, at the node's position, so that linear and angular momentum are exchanged exactly.
+//! Within a soft step the rigid bodies are frozen in pose and their velocities follow the
+//! impulses; the total is handed to rapier when the step is accepted.
+
+mod rigid;
+
+pub(crate) use rigid::RigidProxy;
 
 use crate::Error;
 use crate::body::SoftBody;
+use rapier3d::dynamics::RigidBodySet;
 use rapier3d::geometry::{ColliderHandle, ColliderSet, Shape, SharedShape};
 use rapier3d::glamx::{DMat3, DVec3};
 use rapier3d::math::Pose;
@@ -31,6 +40,10 @@ pub struct ContactSettings {
     pub margin: f64,
     /// The implicit penalty stiffness in units of a node's `m/h²` (dimensionless).
     pub penalty_factor: f64,
+    /// The speed (m/s) at which explicit contacts push a node found inside a collider back out
+    /// (it entered between detections, e.g. pushed by a rigid body that moved): an impulse, so
+    /// that momentum stays exchanged exactly, rather than a jump of position.
+    pub depenetration_speed: f64,
 }
 
 impl Default for ContactSettings {
@@ -38,6 +51,7 @@ impl Default for ContactSettings {
         Self {
             margin: 1e-3,
             penalty_factor: 1e3,
+            depenetration_speed: 0.1,
         }
     }
 }
@@ -57,6 +71,10 @@ pub struct NodeContact {
     pub normal: DVec3,
     /// Coulomb friction coefficient (the collider's).
     pub friction: f64,
+    /// The impulse (N s) the contact gave the node over the last step.
+    pub impulse: DVec3,
+    /// Index of the collider's rigid body among the body's proxies, if it has one.
+    proxy: Option<usize>,
     shape: SharedShape,
     pose: Pose,
 }
@@ -69,6 +87,7 @@ impl std::fmt::Debug for NodeContact {
             .field("point", &self.point)
             .field("normal", &self.normal)
             .field("friction", &self.friction)
+            .field("impulse", &self.impulse)
             .finish_non_exhaustive()
     }
 }
@@ -97,6 +116,13 @@ impl ContactSettings {
                 reason: "must be non-negative and finite (m)",
             });
         }
+        if !(self.depenetration_speed.is_finite() && self.depenetration_speed >= 0.0) {
+            return Err(Error::InvalidSetting {
+                parameter: "depenetration_speed",
+                value: self.depenetration_speed,
+                reason: "must be non-negative and finite (m/s)",
+            });
+        }
         if !(self.penalty_factor.is_finite() && self.penalty_factor > 0.0) {
             return Err(Error::InvalidSetting {
                 parameter: "penalty_factor",
@@ -121,6 +147,7 @@ impl SoftBody {
     pub fn detect_contacts(
         &mut self,
         colliders: &ColliderSet,
+        bodies: &RigidBodySet,
         frame_dt: f64,
         gravity: DVec3,
         settings: &ContactSettings,
@@ -128,6 +155,7 @@ impl SoftBody {
         crate::integrate::check_step(frame_dt, gravity)?;
         settings.check()?;
         let mut contacts = Vec::new();
+        let mut proxies: Vec<RigidProxy> = Vec::new();
         // Elastic waves can speed a node up within the frame: reach as far as the body's fastest
         // node, twice over.
         let fastest = self
@@ -141,6 +169,10 @@ impl SoftBody {
                 continue;
             }
             let aabb = collider.compute_aabb();
+            let parent = collider
+                .parent()
+                .and_then(|handle| bodies.get(handle).map(|body| (handle, body)));
+            let mut proxy = None;
             for &node in &self.surface_nodes {
                 let n = node as usize;
                 if self.pinned[n] {
@@ -157,12 +189,20 @@ impl SoftBody {
                 if let Some((point, normal, distance)) = nearest_surface_point(&**shape, pose, x)
                     && distance <= reach
                 {
+                    if proxy.is_none()
+                        && let Some((handle, body)) = parent
+                    {
+                        proxies.push(RigidProxy::new(handle, body));
+                        proxy = Some(proxies.len() - 1);
+                    }
                     contacts.push(NodeContact {
                         node,
                         collider: handle,
                         point,
                         normal,
                         friction: f64::from(collider.friction()),
+                        impulse: DVec3::ZERO,
+                        proxy,
                         shape: shape.clone(),
                         pose: *pose,
                     });
@@ -170,6 +210,7 @@ impl SoftBody {
             }
         }
         self.contacts = contacts;
+        self.rigid_proxies = proxies;
         self.contact_settings = *settings;
         Ok(&self.contacts)
     }
@@ -182,6 +223,33 @@ impl SoftBody {
     /// Removes every contact.
     pub fn clear_contacts(&mut self) {
         self.contacts.clear();
+        self.rigid_proxies.clear();
+    }
+
+    /// Hands the impulses the contacts of the last step gave rigid bodies to rapier's set (the
+    /// opposite of what the soft body received), and forgets them.
+    pub fn transfer_contact_impulses(&mut self, bodies: &mut RigidBodySet) {
+        for proxy in &mut self.rigid_proxies {
+            proxy.transfer(bodies);
+            proxy.impulse = DVec3::ZERO;
+            proxy.angular_impulse = DVec3::ZERO;
+        }
+    }
+
+    /// The total force (N) and torque about the world origin (N m) the soft body's contacts
+    /// exerted on `collider` over the last step of length `dt` (s): its impulses over `dt`.
+    pub fn contact_force_on(&self, collider: ColliderHandle, dt: f64) -> (DVec3, DVec3) {
+        let positions = &self.positions;
+        self.contacts
+            .iter()
+            .filter(|c| c.collider == collider)
+            .fold((DVec3::ZERO, DVec3::ZERO), |(force, torque), c| {
+                let on_collider = -c.impulse / dt;
+                (
+                    force + on_collider,
+                    torque + positions[c.node as usize].cross(on_collider),
+                )
+            })
     }
 }
 
@@ -208,39 +276,90 @@ fn nearest_surface_point(shape: &dyn Shape, pose: &Pose, x: DVec3) -> Option<(DV
     Some((point, normal, sign * offset.length()))
 }
 
-/// Enforces the contacts as velocity constraints for a substep of `h` (s): called after the
-/// velocity update, before positions move. A node found inside is first put back on its plane
-/// (no velocity is added to push it out).
-pub(crate) fn constrain_velocities(body: &mut SoftBody, h: f64) {
+/// Enforces the contacts as velocity constraints for a substep of `h` (s) under `gravity`
+/// (m/s²): called after the velocity update, before positions move. A node found inside leaves at
+/// most at the depenetration speed. Against a rigid body the constraint is on the relative
+/// velocity, with the body's effective mass, and the body receives the opposite impulse at the
+/// node.
+pub(crate) fn constrain_velocities(body: &mut SoftBody, h: f64, gravity: DVec3) {
     let SoftBody {
         contacts,
+        rigid_proxies,
         positions,
         velocities,
+        masses,
+        contact_settings,
         ..
     } = body;
+    for proxy in rigid_proxies.iter_mut() {
+        proxy.fall(gravity, h);
+    }
     for contact in contacts.iter_mut() {
         let n = contact.node as usize;
         contact.refresh(positions[n]);
         let gap = contact.gap(positions[n]);
-        if gap < 0.0 {
-            positions[n] -= contact.normal * gap;
-        }
-        // Arrive at the plane, never cross it.
-        let lowest = -gap.max(0.0) / h;
-        let v = velocities[n];
-        let normal_speed = v.dot(contact.normal);
+        let x = positions[n];
+        let mut proxy = contact.proxy.map(|p| &mut rigid_proxies[p]);
+        let surface_velocity = proxy.as_ref().map_or(DVec3::ZERO, |p| p.velocity_at(x));
+        // Arrive at the plane, never cross it; from inside, leave it.
+        let lowest = if gap >= 0.0 {
+            -gap / h
+        } else {
+            (-gap / h).min(contact_settings.depenetration_speed)
+        };
+        let relative = velocities[n] - surface_velocity;
+        let normal_speed = relative.dot(contact.normal);
         if normal_speed >= lowest {
             continue;
         }
-        let change = lowest - normal_speed;
-        let tangential = v - contact.normal * normal_speed;
-        let slip = tangential.length();
-        let kept = if slip > 0.0 {
-            (1.0 - contact.friction * change / slip).max(0.0)
-        } else {
-            0.0
+        let inverse_mass = |direction: DVec3| {
+            1.0 / masses[n]
+                + proxy
+                    .as_ref()
+                    .map_or(0.0, |p| p.inverse_mass_along(x, direction))
         };
-        velocities[n] = contact.normal * lowest + tangential * kept;
+        let normal_impulse = (lowest - normal_speed) / inverse_mass(contact.normal);
+        let tangential = relative - contact.normal * normal_speed;
+        let slip = tangential.length();
+        let friction_impulse = if slip > 0.0 {
+            let direction = tangential / slip;
+            let stop = slip / inverse_mass(direction);
+            -direction * stop.min(contact.friction * normal_impulse)
+        } else {
+            DVec3::ZERO
+        };
+        let impulse = contact.normal * normal_impulse + friction_impulse;
+        velocities[n] += impulse / masses[n];
+        contact.impulse += impulse;
+        if let Some(proxy) = proxy.as_mut() {
+            proxy.apply(-impulse, x);
+        }
+    }
+}
+
+/// Records the impulses (N s) the implicit penalty gave the nodes over a substep of length `h`
+/// (s), at the positions that ended it, and hands their opposite to the rigid bodies.
+pub(crate) fn record_penalty_impulses(body: &mut SoftBody, effective_h: f64, h: f64) {
+    let SoftBody {
+        contacts,
+        rigid_proxies,
+        positions,
+        masses,
+        contact_settings,
+        ..
+    } = body;
+    for contact in contacts.iter_mut() {
+        let n = contact.node as usize;
+        let gap = contact.gap(positions[n]);
+        if gap < 0.0 {
+            let stiffness =
+                contact_settings.penalty_factor * masses[n] / (effective_h * effective_h);
+            let impulse = contact.normal * (-stiffness * gap * h);
+            contact.impulse += impulse;
+            if let Some(p) = contact.proxy {
+                rigid_proxies[p].apply(-impulse, positions[n]);
+            }
+        }
     }
 }
 

@@ -223,7 +223,7 @@ fn substep(body: &mut SoftBody, h: f64, gravity: DVec3) {
             velocities[n] += (forces[n] / masses[n] + gravity) * h;
         }
     }
-    contact::constrain_velocities(body, h);
+    contact::constrain_velocities(body, h, gravity);
     let SoftBody {
         positions,
         velocities,

@@ -184,6 +184,7 @@ impl ImplicitIntegrator {
             body.positions.clone_from(&start.positions);
         }
         let outcome = self.minimize(body, stiffness, &start)?;
+        contact::record_penalty_impulses(body, start.h, h);
         for n in 0..body.positions.len() {
             body.velocities[n] = if body.pinned[n] {
                 DVec3::ZERO

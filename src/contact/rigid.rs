@@ -1,0 +1,99 @@
+//! The rigid bodies a soft body touches, as the soft step sees them: velocity, centre of mass and
+//! inverse mass, frozen in pose for the step, updated by the contact impulses as they are applied,
+//! and the total impulse to hand back to rapier when the step is accepted.
+
+use rapier3d::dynamics::{RigidBody, RigidBodyHandle, RigidBodySet};
+use rapier3d::glamx::{DMat3, DVec3};
+
+/// A rigid body in contact with a soft body during one soft step.
+#[derive(Debug, Clone)]
+pub(crate) struct RigidProxy {
+    /// The body in rapier's set.
+    pub(crate) handle: RigidBodyHandle,
+    /// Linear velocity (m/s) and angular velocity (rad/s), updated by the contact impulses.
+    linvel: DVec3,
+    angvel: DVec3,
+    /// World centre of mass (m).
+    com: DVec3,
+    /// The body's gravity scale if dynamic, zero otherwise.
+    fall: f64,
+    /// Per-axis inverse mass (1/kg) and world inverse inertia (1/(kg m²)); zero unless dynamic.
+    inv_mass: DVec3,
+    inv_inertia: DMat3,
+    /// Impulse (N s) and angular impulse about the centre of mass (N m s) received so far.
+    pub(crate) impulse: DVec3,
+    pub(crate) angular_impulse: DVec3,
+}
+
+impl RigidProxy {
+    /// The proxy of `body`, stored in rapier's set under `handle`.
+    pub(crate) fn new(handle: RigidBodyHandle, body: &RigidBody) -> Self {
+        let props = body.mass_properties();
+        let fall = if body.is_dynamic() {
+            f64::from(body.gravity_scale())
+        } else {
+            0.0
+        };
+        let (inv_mass, inv_inertia) = if body.is_dynamic() {
+            let i = props.effective_world_inv_inertia;
+            let inertia = DMat3::from_cols_array(
+                &[
+                    i.m11, i.m12, i.m13, i.m12, i.m22, i.m23, i.m13, i.m23, i.m33,
+                ]
+                .map(f64::from),
+            );
+            (props.effective_inv_mass.as_dvec3(), inertia)
+        } else {
+            (DVec3::ZERO, DMat3::ZERO)
+        };
+        Self {
+            handle,
+            linvel: body.linvel().as_dvec3(),
+            angvel: body.angvel().as_dvec3(),
+            com: props.world_com.as_dvec3(),
+            fall,
+            inv_mass,
+            inv_inertia,
+            impulse: DVec3::ZERO,
+            angular_impulse: DVec3::ZERO,
+        }
+    }
+
+    /// Lets the body fall under `gravity` (m/s²) for `h` (s), as rapier will make it: the soft
+    /// side then sees a resting body pressing on it rather than one that floats until rapier's
+    /// step. Only the contact impulses are handed back.
+    pub(crate) fn fall(&mut self, gravity: DVec3, h: f64) {
+        self.linvel += gravity * (self.fall * h);
+    }
+
+    /// Velocity (m/s) of the body's material point at `point` (m).
+    pub(crate) fn velocity_at(&self, point: DVec3) -> DVec3 {
+        self.linvel + self.angvel.cross(point - self.com)
+    }
+
+    /// The inverse effective mass (1/kg) of the body at `point` along unit `direction`.
+    pub(crate) fn inverse_mass_along(&self, point: DVec3, direction: DVec3) -> f64 {
+        let arm = (point - self.com).cross(direction);
+        direction.dot(self.inv_mass * direction) + arm.dot(self.inv_inertia * arm)
+    }
+
+    /// Applies `impulse` (N s) at `point` (m).
+    pub(crate) fn apply(&mut self, impulse: DVec3, point: DVec3) {
+        let angular = (point - self.com).cross(impulse);
+        self.linvel += self.inv_mass * impulse;
+        self.angvel += self.inv_inertia * angular;
+        self.impulse += impulse;
+        self.angular_impulse += angular;
+    }
+
+    /// Hands the impulses received back to the body in rapier's set.
+    pub(crate) fn transfer(&self, bodies: &mut RigidBodySet) {
+        if let Some(body) = bodies.get_mut(self.handle)
+            && body.is_dynamic()
+            && (self.impulse != DVec3::ZERO || self.angular_impulse != DVec3::ZERO)
+        {
+            body.apply_impulse(self.impulse.as_vec3(), true);
+            body.apply_torque_impulse(self.angular_impulse.as_vec3(), true);
+        }
+    }
+}

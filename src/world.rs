@@ -1,0 +1,129 @@
+//! [`FvmWorld`]: rapier's [`PhysicsWorld`] and a set of finite-volume soft bodies, advanced
+//! together frame by frame.
+//!
+//! rapier offers no callback inside its step, so the frame is cut into
+//! [`FvmWorld::coupling_substeps`] rapier steps, and the soft bodies step between them: each
+//! detects its contacts with the colliders, steps (explicit or implicit, as the automatic
+//! integrator chooses), and hands the impulses its contacts gave dynamic rigid bodies to rapier,
+//! which then solves its own contacts and joints over the same interval. Sub-cycling keeps the
+//! rigid bodies' view of the soft bodies one short substep old, which removes the friction
+//! ratchet and the rocking that a single rapier step per frame shows.
+
+use crate::Error;
+use crate::body::{SoftBodyHandle, SoftBodySet};
+use crate::contact::ContactSettings;
+use crate::integrate::{AutomaticIntegrator, AutomaticReport};
+use rapier3d::pipeline::{EventHandler, PhysicsHooks, PhysicsWorld};
+
+/// Rigid and soft bodies in one world.
+///
+/// # Example
+/// ```
+/// use rapier3d::prelude::{ColliderBuilder, SharedShape};
+/// use rapier_fvm::prelude::*;
+/// use rapier_fvm::world::FvmWorld;
+///
+/// let mut world = FvmWorld::default();
+/// world.physics.insert_collider(
+///     ColliderBuilder::new(SharedShape::halfspace(rapier_fvm::glamx::Vec3::Y)).build(),
+///     None,
+/// );
+/// let rubber = Material::new(MaterialModel::StableNeoHookean, 1e5, 0.3, 1000.0)?;
+/// let cube = SoftBodyBuilder::new(mesh::cuboid(DVec3::splat(0.05), [2, 2, 2])?, rubber)
+///     .translation(DVec3::new(0.0, 0.2, 0.0))
+///     .build()?;
+/// let handle = world.soft_bodies.insert(cube);
+/// for _ in 0..30 {
+///     for (_, outcome) in world.step() {
+///         outcome?;
+///     }
+/// }
+/// assert!(world.soft_bodies[handle].positions().iter().all(|x| x.y > -2e-3));
+/// # Ok::<(), rapier_fvm::Error>(())
+/// ```
+pub struct FvmWorld {
+    /// The rapier world: rigid bodies, colliders, joints and the integration parameters, whose
+    /// `dt` is the frame step (s) and whose `gravity` (m/s²) acts on the soft bodies too.
+    pub physics: PhysicsWorld,
+    /// The soft bodies.
+    pub soft_bodies: SoftBodySet,
+    /// How soft bodies are stepped.
+    pub integrator: AutomaticIntegrator,
+    /// How soft contacts are detected and enforced.
+    pub contact: ContactSettings,
+    /// Rapier steps per frame, with the soft bodies stepped between them (at least 1).
+    pub coupling_substeps: u32,
+}
+
+impl Default for FvmWorld {
+    fn default() -> Self {
+        Self {
+            physics: PhysicsWorld::default(),
+            soft_bodies: SoftBodySet::new(),
+            integrator: AutomaticIntegrator::default(),
+            contact: ContactSettings::default(),
+            coupling_substeps: 4,
+        }
+    }
+}
+
+impl FvmWorld {
+    /// Advances the world by one frame (`physics.integration_parameters.dt`), without hooks or
+    /// events; see [`FvmWorld::step_with_events`].
+    pub fn step(&mut self) -> Vec<(SoftBodyHandle, Result<AutomaticReport, Error>)> {
+        self.step_with_events(&(), &())
+    }
+
+    /// Advances the world by one frame, passing `hooks` and `events` to rapier. Returns, per
+    /// soft body, the report of its last substep or the first error it met; a body whose step
+    /// failed keeps the state it had before that substep and skips the rest of the frame.
+    pub fn step_with_events(
+        &mut self,
+        hooks: &dyn PhysicsHooks,
+        events: &dyn EventHandler,
+    ) -> Vec<(SoftBodyHandle, Result<AutomaticReport, Error>)> {
+        let substeps = self.coupling_substeps.max(1);
+        let frame = self.physics.integration_parameters;
+        let h = f64::from(frame.dt) / f64::from(substeps);
+        let gravity = self.physics.gravity.as_dvec3();
+        let mut outcomes: Vec<(SoftBodyHandle, Option<Result<AutomaticReport, Error>>)> = self
+            .soft_bodies
+            .iter()
+            .map(|(handle, _)| (handle, None))
+            .collect();
+        let mut failed = vec![false; outcomes.len()];
+        self.physics.integration_parameters.dt = frame.dt / substeps as f32;
+        self.physics.integration_parameters.num_solver_iterations =
+            (frame.num_solver_iterations / substeps as usize).max(1);
+        for _ in 0..substeps {
+            for (i, (_, body)) in self.soft_bodies.iter_mut().enumerate() {
+                if failed[i] {
+                    continue;
+                }
+                let physics = &mut self.physics;
+                let outcome = body
+                    .detect_contacts(
+                        &physics.colliders,
+                        &physics.bodies,
+                        h,
+                        gravity,
+                        &self.contact,
+                    )
+                    .map(|_| ())
+                    .and_then(|()| self.integrator.step(body, h, gravity));
+                if outcome.is_ok() {
+                    body.transfer_contact_impulses(&mut physics.bodies);
+                } else {
+                    failed[i] = true;
+                }
+                outcomes[i].1 = Some(outcome);
+            }
+            self.physics.step_with_events(hooks, events);
+        }
+        self.physics.integration_parameters = frame;
+        outcomes
+            .into_iter()
+            .filter_map(|(handle, outcome)| outcome.map(|outcome| (handle, outcome)))
+            .collect()
+    }
+}
