@@ -58,18 +58,18 @@ pub enum LinearSolver {
     ///   early iterations of a nonlinear one are not solved beyond use.
     ///
     /// Calibration (`cargo run --release --example solver_knobs calibrate`, one core of a 2-core
-    /// AMD EPYC shared with other work, so timings are noisy to a factor of about 2): measured
-    /// iterations to 1e-3 over `sqrt(κ) ln(2/tol) / 2` were 0.16–0.17 on stiff beams (E = 1e9 Pa,
-    /// 1/60 s, 1.6k–100k tetrahedra) and 0.345–0.36 on soft cubes (E = 1e5 Pa, 1/240 s, 5k–98k
-    /// tetrahedra), hence `C = 0.35`; a Cholesky factorization cost 46–160 matrix-vector
-    /// products on the beams of 1.6k and 13k tetrahedra and 480–920 at 100k (`R/sqrt(n)` from
-    /// 1.6 to 3.5), 170–2500 on the cubes (`R/sqrt(n)` from 2.8 to 10: compact bodies fill
-    /// more), hence `A = 2`, which leans toward the direct solve. Below 1000 free degrees of
-    /// freedom both cost about the same (0.38 ms per frame either way on a beam of 270 free
-    /// degrees of freedom at 0.2 ms steps) and the direct solve is exact. On frames, the rule
-    /// picks the direct solve for the stiff beams (1.3–2 times faster at 1.6k and 13k
-    /// tetrahedra, within noise at 100k) and the conjugate gradient for the soft cubes (1.5
-    /// times faster at 5k tetrahedra, 5 at 20k, 10 at 53k, 20 at 98k).
+    /// AMD EPYC shared with other work, so timings vary by up to a factor of 2 between runs):
+    /// measured iterations to 1e-3 over `sqrt(κ) ln(2/tol) / 2` were 0.16–0.17 on stiff beams
+    /// (E = 1e9 Pa, 1/60 s, 1.6k–100k tetrahedra) and 0.345–0.36 on soft cubes (E = 1e5 Pa,
+    /// 1/240 s, 5k–98k tetrahedra), hence `C = 0.35`; a Cholesky factorization and solve cost
+    /// `R/sqrt(n)` = 1.2–3.5 matrix-vector products on the beams and 2.8–10 on the cubes
+    /// (compact bodies fill more), hence `A = 2`, which leans toward the direct solve. Below
+    /// 1000 free degrees of freedom both cost about the same (0.5 ms per frame on a beam of 270
+    /// free degrees of freedom at 0.2 ms steps) and the direct solve is exact. On whole frames
+    /// the rule picks the direct solve for the stiff beams (about twice as fast as the
+    /// conjugate gradient at 1.6k and 13k tetrahedra, within noise at 100k) and the conjugate
+    /// gradient for the soft cubes (2 times faster at 5k tetrahedra, 3–6 at 20k, 10 at 53k,
+    /// 14–20 at 98k).
     #[default]
     Automatic,
     /// The sparse Cholesky factorization: exact to round-off, cost independent of the
