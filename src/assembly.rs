@@ -215,20 +215,49 @@ impl Stiffness {
         }
     }
 
+    /// Number of rows (and columns): three per node.
+    pub(crate) fn dofs(&self) -> usize {
+        self.dofs
+    }
+
+    /// The 3 x 3 diagonal block of node `node` (N/m).
+    pub(crate) fn diagonal_block(&self, node: usize) -> DMat3 {
+        let mut block = [0.0; 9];
+        for j in 0..3 {
+            for i in j..3 {
+                let value = self.values[self.entry(node, i, node, j)];
+                block[3 * j + i] = value;
+                block[3 * i + j] = value;
+            }
+        }
+        DMat3::from_cols_array(&block)
+    }
+
+    /// `out = K x` for the assembled symmetric matrix `K` (from its lower triangle), `x` and
+    /// `out` flat with three entries per node.
+    pub(crate) fn multiply_into(&self, x: &[f64], out: &mut [f64]) {
+        out.fill(0.0);
+        for column in 0..self.dofs {
+            let (start, end) = (self.col_ptr[column], self.col_ptr[column + 1]);
+            // The first entry of every column is its diagonal.
+            let xc = x[column];
+            let mut transposed = self.values[start] * xc;
+            for k in start + 1..end {
+                let row = self.row_idx[k];
+                let value = self.values[k];
+                out[row] += value * xc;
+                transposed += value * x[row];
+            }
+            out[column] += transposed;
+        }
+    }
+
     /// The product of the assembled symmetric matrix with a per-node vector field.
     #[cfg(test)]
     pub(crate) fn multiply(&self, v: &[DVec3]) -> Vec<DVec3> {
+        let x: Vec<f64> = v.iter().flat_map(|v| v.to_array()).collect();
         let mut out = vec![0.0; self.dofs];
-        for column in 0..self.dofs {
-            let x = v[column / 3][column % 3];
-            for k in self.col_ptr[column]..self.col_ptr[column + 1] {
-                let row = self.row_idx[k];
-                out[row] += self.values[k] * x;
-                if row != column {
-                    out[column] += self.values[k] * v[row / 3][row % 3];
-                }
-            }
-        }
+        self.multiply_into(&x, &mut out);
         out.chunks(3)
             .map(|c| DVec3::new(c[0], c[1], c[2]))
             .collect()

@@ -49,6 +49,7 @@ mod error;
 pub mod fvm;
 pub mod integrate;
 pub mod lanes;
+pub mod linear_solver;
 pub mod material;
 pub mod mesh;
 mod newton;
@@ -77,6 +78,7 @@ pub mod prelude {
         AutomaticIntegrator, ImplicitIntegrator, ImplicitReport, ImplicitScheme, IntegratorKind,
         StepReport, Substeps, SymplecticEuler,
     };
+    pub use crate::linear_solver::LinearSolver;
     pub use crate::material::{LameParameters, Material, MaterialModel, YoungPoisson};
     pub use crate::mesh::{self, TetMesh};
     pub use rapier3d::glamx::{DMat3, DQuat, DVec3};

@@ -328,3 +328,125 @@ fn invalid_implicit_steps_are_typed_errors() {
         })
     ));
 }
+
+fn conjugate_gradient(tolerance: f64, max_iterations: usize) -> LinearSolver {
+    LinearSolver::ConjugateGradient {
+        tolerance,
+        max_iterations,
+    }
+}
+
+/// The largest distance (m) between the nodes of two bodies.
+fn largest_gap(a: &[DVec3], b: &[DVec3]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(a, b)| (*a - *b).length())
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn conjugate_gradient_and_direct_steps_agree() {
+    // Ten frames of 1/60 s of a beam (E = 1 MPa) swinging far, so that Newton is nonlinear.
+    // - Newton tolerance 1e-10, CG tolerance 1e-10: both minimize the same incremental potential
+    //   to the same tolerance; a solve's error only enters through Newton's last (tiny) step, so
+    //   the positions agree to about 1e-10 of the motion at worst. 1e-8 is allowed.
+    // - Newton tolerance 1e-6 (the default) with CG at 1e-3: each run stops within 1e-6 of the
+    //   force scale of the minimum, about 1e-6 of the motion; 1e-5 is allowed.
+    let material =
+        Material::new(MaterialModel::StableNeoHookean, 1e6, 0.3, common::DENSITY).unwrap();
+    let (beam, _) = cantilever([20, 2, 2], material);
+    let run = |tolerance, linear_solver| {
+        let integrator = ImplicitIntegrator {
+            tolerance,
+            linear_solver,
+            ..Default::default()
+        };
+        let mut body = beam.clone();
+        let mut linear_iterations = 0;
+        for _ in 0..10 {
+            let report = integrator.step(&mut body, 1.0 / 60.0, gravity()).unwrap();
+            assert!(report.converged);
+            linear_iterations += report.linear_iterations;
+        }
+        (body, linear_iterations)
+    };
+    for (newton, cg, allowed) in [(1e-10, 1e-10, 1e-8), (1e-6, 1e-3, 1e-5)] {
+        let (direct, direct_iterations) = run(newton, LinearSolver::Direct);
+        let (iterative, cg_iterations) = run(newton, conjugate_gradient(cg, 10_000));
+        let gap = largest_gap(direct.positions(), iterative.positions());
+        let motion = largest_gap(direct.positions(), beam.positions());
+        println!(
+            "Newton {newton:e}, CG {cg:e}: largest gap {gap:.3e} m of {motion:.4} m of motion; {cg_iterations} CG iterations"
+        );
+        assert_eq!(direct_iterations, 0);
+        assert!(cg_iterations > 0);
+        assert!(gap < allowed * motion, "gap {gap} m");
+    }
+}
+
+#[test]
+fn conjugate_gradient_falls_back_to_the_projected_tangent_on_negative_curvature() {
+    // A stable Neo-Hookean cube crushed flat (heights within ±1 mm), partly inverted: the exact
+    // tangent is indefinite there, the conjugate gradient meets negative curvature and the
+    // projected tangent is solved instead. Backward Euler only dissipates, so the energy
+    // (kinetic + elastic, no gravity) must not rise beyond round-off (1e-9 relative).
+    let material = Material::new(MaterialModel::StableNeoHookean, 1e5, 0.3, 1000.0).unwrap();
+    let mesh = mesh::cuboid(DVec3::splat(0.1), [4, 4, 4]).unwrap();
+    let mut body = SoftBodyBuilder::new(mesh, material).build().unwrap();
+    let mut rng = Lcg(7);
+    for x in body.positions_mut() {
+        x.y = 1e-3 * rng.next();
+    }
+    let integrator = ImplicitIntegrator {
+        linear_solver: conjugate_gradient(1e-6, 2000),
+        ..Default::default()
+    };
+    let energy = |body: &SoftBody| body.kinetic_energy() + body.elastic_energy();
+    let (inverted, mut last) = (body.inverted_tet_count(), energy(&body));
+    let (mut projected, mut cg_iterations) = (0, 0);
+    for _ in 0..30 {
+        let report = integrator.step(&mut body, 1.0 / 60.0, DVec3::ZERO).unwrap();
+        projected += report.projected_tangents;
+        cg_iterations += report.linear_iterations;
+        assert!(body.positions().iter().all(|x| x.is_finite()));
+        let next = energy(&body);
+        assert!(
+            next <= last * (1.0 + 1e-9),
+            "energy rose: {last} -> {next} J"
+        );
+        last = next;
+    }
+    println!(
+        "{inverted} tets inverted at the start; {projected} projected tangents, {cg_iterations} CG iterations over 30 frames; {} inverted, energy {last:.3e} J at the end",
+        body.inverted_tet_count()
+    );
+    assert!(inverted > 0);
+    assert!(projected > 0);
+}
+
+#[test]
+fn invalid_conjugate_gradient_settings_are_typed_errors() {
+    let material = Material::new(MaterialModel::Linear, 1e6, 0.3, 1000.0).unwrap();
+    let (mut body, _) = cantilever([4, 1, 1], material);
+    let before = body.positions().to_vec();
+    for (solver, parameter) in [
+        (conjugate_gradient(0.0, 100), "linear_solver.tolerance"),
+        (conjugate_gradient(-1e-3, 100), "linear_solver.tolerance"),
+        (conjugate_gradient(f64::NAN, 100), "linear_solver.tolerance"),
+        (
+            conjugate_gradient(f64::INFINITY, 100),
+            "linear_solver.tolerance",
+        ),
+        (conjugate_gradient(1e-3, 0), "linear_solver.max_iterations"),
+    ] {
+        let integrator = ImplicitIntegrator {
+            linear_solver: solver,
+            ..Default::default()
+        };
+        match integrator.step(&mut body, 0.01, gravity()) {
+            Err(Error::InvalidSetting { parameter: p, .. }) => assert_eq!(p, parameter),
+            other => panic!("{solver:?}: {other:?}"),
+        }
+    }
+    assert_eq!(body.positions(), &before[..]);
+}

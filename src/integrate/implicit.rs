@@ -8,17 +8,23 @@
 //!   numerical damping of order `(ωh)³`; the first step after a change of state or step length is
 //!   a backward Euler step.
 //!
-//! The minimization is Newton's method: element Hessians projected to be positive semi-definite,
-//! a sparse Cholesky solve, and a backtracking line search that makes `E` decrease. Both schemes
-//! are stable at any step length.
+//! The minimization is Newton's method from the inertial prediction `x̂` (for backward Euler
+//! `x_n + h v_n`: the previous step's velocity extrapolated, the warm start across steps), or
+//! from the current positions when those have the lower potential: each
+//! iteration solves the Newton system with the exact tangent (or, where that is not positive
+//! definite, with element stress tangents projected to be positive semi-definite) by the chosen
+//! [`LinearSolver`] (a sparse Cholesky factorization or a preconditioned conjugate gradient),
+//! then a backtracking line search makes `E` decrease. Both schemes are stable at any step
+//! length.
 
 use super::check_step;
 use crate::Error;
-use crate::assembly::{Stiffness, factorize, solve};
+use crate::assembly::Stiffness;
 use crate::body::{PreviousStep, SoftBody};
 use crate::contact;
 use crate::damping::RayleighDamping;
 use crate::fvm::{gather, stress_forces};
+use crate::linear_solver::{LinearSolver, Method, solve_newton_system};
 use crate::material::green_strain;
 use crate::newton::{check_tolerance, descend, norm};
 use rapier3d::glamx::{DMat3, DVec3};
@@ -38,6 +44,14 @@ pub enum ImplicitScheme {
 }
 
 /// The implicit integrator and its settings.
+///
+/// Warm start across steps: each step's Newton iteration starts from the inertial prediction
+/// `x̂` (backward Euler: `x_n + h v_n`, the last velocity carried over the step; BDF2 its
+/// two-step counterpart), so a body at rest in equilibrium or in rigid uniform motion takes no
+/// iteration, and a smoothly moving one starts `O(h²)` from the solution; when the prediction has
+/// a higher potential than the current positions (a body predicted deep inside an obstacle, or
+/// crushing its elements), Newton starts from the current positions instead. The linear solves
+/// start from zero (they solve for the Newton correction).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ImplicitIntegrator {
     /// The time discretization.
@@ -52,6 +66,8 @@ pub struct ImplicitIntegrator {
     pub max_newton_iterations: usize,
     /// Equal substeps per frame (at least 1); each costs a Newton solve.
     pub substeps: u32,
+    /// How each Newton iteration's linear system is solved.
+    pub linear_solver: LinearSolver,
 }
 
 impl Default for ImplicitIntegrator {
@@ -61,6 +77,7 @@ impl Default for ImplicitIntegrator {
             tolerance: 1e-6,
             max_newton_iterations: 20,
             substeps: 1,
+            linear_solver: LinearSolver::Automatic,
         }
     }
 }
@@ -72,12 +89,33 @@ pub struct ImplicitReport {
     pub substeps: u32,
     /// Newton iterations over all substeps.
     pub newton_iterations: usize,
+    /// Conjugate gradient iterations over all substeps (zero when every system was solved by
+    /// the direct method).
+    pub linear_iterations: usize,
+    /// Newton iterations whose exact tangent was not positive definite (the Cholesky
+    /// factorization failed or the conjugate gradient met negative curvature), so that the
+    /// tangent with element stress tangents projected to be positive semi-definite was solved.
+    pub projected_tangents: usize,
     /// Largest final relative residual over the substeps.
     pub relative_residual: f64,
     /// Whether every substep met the tolerance.
     pub converged: bool,
     /// Tetrahedra inverted (zero or negative volume) at the end of the frame.
     pub inverted_tets: usize,
+}
+
+/// What one substep's Newton solve did.
+struct Outcome {
+    /// Newton iterations.
+    iterations: usize,
+    /// Conjugate gradient iterations.
+    linear_iterations: usize,
+    /// Iterations that solved the projected tangent.
+    projected_tangents: usize,
+    /// Final relative residual.
+    residual: f64,
+    /// Whether the tolerance was met.
+    converged: bool,
 }
 
 /// Per-step data of the incremental potential.
@@ -102,7 +140,8 @@ impl ImplicitIntegrator {
     /// # Errors
     /// [`Error::InvalidTimeStep`] for a non-positive or non-finite `frame_dt`;
     /// [`Error::NonFiniteInput`] for a non-finite gravity; [`Error::InvalidSetting`] for zero
-    /// substeps, a non-positive tolerance or zero Newton iterations;
+    /// substeps, a non-positive tolerance, zero Newton iterations or an invalid
+    /// [`LinearSolver::ConjugateGradient`] setting;
     /// [`Error::IndefiniteStiffness`] if a linear system cannot be factored;
     /// [`Error::NonFiniteState`] if the step produced a NaN. On error the body is left as it was.
     pub fn step(
@@ -127,21 +166,33 @@ impl ImplicitIntegrator {
                 reason: "at least one Newton iteration is needed",
             });
         }
+        self.linear_solver.check()?;
         body.save_state();
         let history = body.previous_step.clone();
         let h = frame_dt / f64::from(self.substeps);
         let mut report = ImplicitReport {
             substeps: self.substeps,
             newton_iterations: 0,
+            linear_iterations: 0,
+            projected_tangents: 0,
             relative_residual: 0.0,
             converged: true,
             inverted_tets: 0,
         };
         let mut stiffness = body.take_tangent();
+        let mut method = self.linear_solver.method(body, h);
         for _ in 0..self.substeps {
-            match self.substep(body, &mut stiffness, h, gravity) {
-                Ok((iterations, residual, converged)) => {
+            match self.substep(body, &mut stiffness, &mut method, h, gravity) {
+                Ok(Outcome {
+                    iterations,
+                    linear_iterations,
+                    projected_tangents,
+                    residual,
+                    converged,
+                }) => {
                     report.newton_iterations += iterations;
+                    report.linear_iterations += linear_iterations;
+                    report.projected_tangents += projected_tangents;
                     report.relative_residual = report.relative_residual.max(residual);
                     report.converged &= converged;
                 }
@@ -163,14 +214,15 @@ impl ImplicitIntegrator {
         Ok(report)
     }
 
-    /// One substep; returns Newton iterations, final relative residual and convergence.
+    /// One substep.
     fn substep(
         &self,
         body: &mut SoftBody,
         stiffness: &mut Stiffness,
+        method: &mut Method,
         h: f64,
         gravity: DVec3,
-    ) -> Result<(usize, f64, bool), Error> {
+    ) -> Result<Outcome, Error> {
         let start = StepStart::new(body, h, gravity, self.scheme);
         // Newton starts from the inertial prediction `x̂` (free flight: the warm start that makes
         // smooth motion cost one iteration), or from where the body is when that is the lower
@@ -183,7 +235,7 @@ impl ImplicitIntegrator {
         if predicted.is_nan() || predicted > here {
             body.positions.clone_from(&start.positions);
         }
-        let outcome = self.minimize(body, stiffness, &start)?;
+        let outcome = self.minimize(body, stiffness, method, &start)?;
         contact::record_penalty_impulses(body, start.h, h);
         for n in 0..body.positions.len() {
             body.velocities[n] = if body.pinned[n] {
@@ -200,14 +252,15 @@ impl ImplicitIntegrator {
         Ok(outcome)
     }
 
-    /// Newton's method on the step's incremental potential, from the body's current positions;
-    /// returns iterations, final relative residual and convergence.
+    /// Newton's method on the step's incremental potential, from the body's current positions.
+    /// A conjugate gradient that falls back to the direct solve switches `method` to it.
     fn minimize(
         &self,
         body: &mut SoftBody,
         stiffness: &mut Stiffness,
+        method: &mut Method,
         start: &StepStart,
-    ) -> Result<(usize, f64, bool), Error> {
+    ) -> Result<Outcome, Error> {
         let inertia: Vec<f64> = body
             .masses
             .iter()
@@ -218,6 +271,15 @@ impl ImplicitIntegrator {
         // Relative residuals of the earlier iterations, newest last.
         let mut history: Vec<f64> = Vec::new();
         let mut iteration = 0;
+        let (mut linear_iterations, mut projected_tangents) = (0, 0);
+        let outcome =
+            |iterations, (linear_iterations, projected_tangents), residual, converged| Outcome {
+                iterations,
+                linear_iterations,
+                projected_tangents,
+                residual,
+                converged,
+            };
         loop {
             let relative = norm(&residual) / reference;
             if !relative.is_finite() {
@@ -225,7 +287,12 @@ impl ImplicitIntegrator {
                 return Err(Error::NonFiniteState { node });
             }
             if relative <= self.tolerance {
-                return Ok((iteration, relative, true));
+                return Ok(outcome(
+                    iteration,
+                    (linear_iterations, projected_tangents),
+                    relative,
+                    true,
+                ));
             }
             // A small residual that three iterations could not cut by 10 % sits on its round-off
             // floor (very stiff or nearly incompressible material against a small load).
@@ -233,26 +300,43 @@ impl ImplicitIntegrator {
                 && history.len() >= 3
                 && relative > 0.9 * history[history.len() - 3];
             if iteration == self.max_newton_iterations || stalled {
-                return Ok((iteration, relative, false));
+                return Ok(outcome(
+                    iteration,
+                    (linear_iterations, projected_tangents),
+                    relative,
+                    false,
+                ));
             }
             history.push(relative);
             // The exact Hessian converges fastest; where it is indefinite (compressed elements)
             // the per-element projection restores a descent direction.
-            start.assemble(body, stiffness, &inertia, false);
-            let factor = match factorize(stiffness, iteration) {
-                Ok(factor) => factor,
-                Err(_) => {
-                    start.assemble(body, stiffness, &inertia, true);
-                    factorize(stiffness, iteration)?
-                }
-            };
-            let direction = solve(&factor, &residual);
+            let solution = solve_newton_system(
+                *method,
+                self.tolerance / relative,
+                stiffness,
+                &residual,
+                iteration,
+                |stiffness, project| start.assemble(body, stiffness, &inertia, project),
+            )?;
+            linear_iterations += solution.cg_iterations;
+            projected_tangents += usize::from(solution.projected);
+            if solution.fell_back {
+                *method = Method::Direct;
+            }
+            let direction = solution.direction;
             let energy = |body: &SoftBody| start.energy(body);
             match descend(body, &residual, &direction, energy, |body| {
                 start.residual(body)
             }) {
                 Some(next) => residual = next,
-                None => return Ok((iteration, relative, false)),
+                None => {
+                    return Ok(outcome(
+                        iteration,
+                        (linear_iterations, projected_tangents),
+                        relative,
+                        false,
+                    ));
+                }
             }
             iteration += 1;
         }

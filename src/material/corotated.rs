@@ -100,7 +100,7 @@ impl HyperelasticModel for Corotated {
         (*f - r) * (2.0 * mu) + r * (lambda * (stretch_trace - 3.0))
     }
 
-    /// Uses the rotation's differential, [`rotation_differential`].
+    /// Uses the rotation's differential, `rotation_differential`.
     fn first_piola_differential(&self, f: &DMat3, df: &DMat3) -> DMat3 {
         let r = polar_rotation(f);
         let LameParameters { lambda, mu } = self.0;

@@ -9,6 +9,7 @@
 use crate::Error;
 use crate::assembly::{Stiffness, factorize, solve};
 use crate::body::SoftBody;
+use crate::linear_solver::{Method, solve_newton_system};
 use crate::newton::{check_tolerance, descend, norm};
 use rapier3d::glamx::{DMat3, DVec3};
 
@@ -115,15 +116,15 @@ fn newton(
         history.push(relative);
         // The exact tangent converges quadratically; where the body is in an unstable (buckling)
         // state it is indefinite, and the projected tangent still gives a descent direction.
-        assemble_elastic(stiffness, body, false);
-        let factor = match factorize(stiffness, iteration) {
-            Ok(factor) => factor,
-            Err(_) => {
-                assemble_elastic(stiffness, body, true);
-                factorize(stiffness, iteration)?
-            }
-        };
-        let step = solve(&factor, &residual);
+        let step = solve_newton_system(
+            Method::Direct,
+            1.0,
+            stiffness,
+            &residual,
+            iteration,
+            |stiffness, project| assemble_elastic(stiffness, body, project),
+        )?
+        .direction;
         let energy = |body: &SoftBody| potential_energy(body, &load);
         match descend(body, &residual, &step, energy, |body| {
             out_of_balance(body, &load)
