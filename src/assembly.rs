@@ -44,39 +44,19 @@ impl Stiffness {
     pub(crate) fn new(body: &SoftBody) -> Self {
         let n = body.node_count();
         let mut lower_neighbours: Vec<Vec<u32>> = (0..n as u32).map(|b| vec![b]).collect();
-        for tet in body.mesh().tets() {
-            for &a in tet {
-                for &b in tet {
-                    if a > b {
-                        lower_neighbours[b as usize].push(a);
-                    }
-                }
-            }
-        }
-        for list in &mut lower_neighbours {
-            list.sort_unstable();
-            list.dedup();
-        }
+        couple_all_pairs(
+            &mut lower_neighbours,
+            body.mesh().tets().iter().map(|t| &t[..]),
+        );
         if body.nodal_averaging.is_some() {
+            // A node's patch: itself and every node sharing a tetrahedron with it.
             let mut patches: Vec<Vec<u32>> = lower_neighbours.clone();
             for (b, list) in lower_neighbours.iter().enumerate() {
                 for &a in &list[1..] {
                     patches[a as usize].push(b as u32);
                 }
             }
-            for patch in &patches {
-                for &a in patch {
-                    for &b in patch {
-                        if a > b {
-                            lower_neighbours[b as usize].push(a);
-                        }
-                    }
-                }
-            }
-            for list in &mut lower_neighbours {
-                list.sort_unstable();
-                list.dedup();
-            }
+            couple_all_pairs(&mut lower_neighbours, patches.iter().map(|p| &p[..]));
         }
         let mut col_ptr = Vec::with_capacity(3 * n + 1);
         let mut row_idx = Vec::new();
@@ -273,6 +253,27 @@ impl Stiffness {
             &self.row_idx,
         );
         SparseColMatRef::new(symbolic, &self.values)
+    }
+}
+
+/// Adds to `lower_neighbours` (per node `b`, the nodes `a >= b` it is coupled with, ascending)
+/// every pair of nodes within each group of `groups`.
+fn couple_all_pairs<'a>(
+    lower_neighbours: &mut [Vec<u32>],
+    groups: impl Iterator<Item = &'a [u32]>,
+) {
+    for group in groups {
+        for &a in group {
+            for &b in group {
+                if a > b {
+                    lower_neighbours[b as usize].push(a);
+                }
+            }
+        }
+    }
+    for list in lower_neighbours.iter_mut() {
+        list.sort_unstable();
+        list.dedup();
     }
 }
 
