@@ -1,19 +1,21 @@
 //! The finite-volume force kernel in ns per tetrahedron per step: St. Venant–Kirchhoff with
 //! Rayleigh damping, f64, on a 40 x 40 x 40-cube box (320 000 tetrahedra), on one thread and on
-//! all of rayon's threads. Also the other material models on one thread.
+//! all of rayon's threads. Also the other material models on one thread, and St.
+//! Venant–Kirchhoff with nodal averaging of the volumetric term.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use rapier_fvm::prelude::*;
 use std::hint::black_box;
 
 /// A deformed, moving 40^3-cube box so every branch of the kernel does real work.
-fn box_body(model: MaterialModel) -> SoftBody {
+fn box_body(model: MaterialModel, treatment: VolumetricTreatment) -> SoftBody {
     let mesh = mesh::cuboid(DVec3::splat(0.2), [40, 40, 40]).expect("valid generator input");
     let material = Material::new(model, 1e6, 0.3, 1000.0).expect("valid material");
     let damping =
         RayleighDamping::stiffness_proportional(1e-3, material.lame()).expect("valid damping");
     let mut body = SoftBodyBuilder::new(mesh, material)
         .damping(damping)
+        .volumetric(treatment)
         .build()
         .expect("valid body");
     for x in body.positions_mut() {
@@ -38,7 +40,7 @@ fn kernel(c: &mut Criterion) {
         MaterialModel::Corotated,
         MaterialModel::StableNeoHookean,
     ] {
-        let mut body = box_body(model);
+        let mut body = box_body(model, VolumetricTreatment::PerElement);
         group.throughput(Throughput::Elements(body.mesh().tet_count() as u64));
         group.bench_function(format!("{model:?}+damping/1_thread"), |b| {
             single.install(|| b.iter(|| black_box(body.internal_forces()[0])))
@@ -46,6 +48,10 @@ fn kernel(c: &mut Criterion) {
         if model == MaterialModel::StVenantKirchhoff {
             group.bench_function(format!("{model:?}+damping/all_threads"), |b| {
                 b.iter(|| black_box(body.internal_forces()[0]))
+            });
+            let mut averaged = box_body(model, VolumetricTreatment::NodalAverage);
+            group.bench_function(format!("{model:?}+damping+nodal_average/1_thread"), |b| {
+                single.install(|| b.iter(|| black_box(averaged.internal_forces()[0])))
             });
         }
     }

@@ -66,7 +66,8 @@ pub struct Case {
     pub frame_dt: f64,
     /// The outcome.
     pub outcome: Outcome,
-    /// Integrator of the last frame, explicit substeps or Newton iterations per frame.
+    /// Integrator of the last frame: explicit substeps, or Newton and conjugate-gradient
+    /// iterations.
     pub integrator: String,
     /// Wall time per frame (ms).
     pub ms_per_frame: f64,
@@ -168,7 +169,10 @@ pub fn run_case(scene: Scene, young: f64, poisson: f64, frame_dt: f64, frames: u
                 case.integrator = match (report.explicit, report.implicit) {
                     (Some(explicit), _) => format!("explicit x{}", explicit.substeps),
                     (_, Some(implicit)) => {
-                        format!("implicit, {} Newton", implicit.newton_iterations)
+                        format!(
+                            "implicit, {} Newton, {} CG",
+                            implicit.newton_iterations, implicit.linear_iterations
+                        )
                     }
                     _ => String::from("-"),
                 };
@@ -203,7 +207,7 @@ pub fn run_case(scene: Scene, young: f64, poisson: f64, frame_dt: f64, frames: u
 #[allow(dead_code)]
 fn main() {
     println!(
-        "{:>12} {:>8} {:>8} {:>9} {:>10} {:>28} {:>10} {:>11}",
+        "{:>12} {:>8} {:>8} {:>9} {:>10} {:>34} {:>10} {:>11}",
         "scene",
         "E (Pa)",
         "nu",
@@ -238,7 +242,7 @@ fn main() {
                         .tip_error
                         .map_or(String::from("-"), |e| format!("{:+.1} %", 100.0 * e));
                     println!(
-                        "{:>12} {young:>8.0e} {poisson:>8} {frame_dt:>9.2e} {outcome:>10} {:>28} {:>10.2} {error:>11}",
+                        "{:>12} {young:>8.0e} {poisson:>8} {frame_dt:>9.2e} {outcome:>10} {:>34} {:>10.2} {error:>11}",
                         format!("{scene:?}"),
                         case.integrator,
                         case.ms_per_frame
