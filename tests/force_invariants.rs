@@ -238,9 +238,14 @@ fn simd_mesh_loop_matches_the_scalar_kernel() {
     use rapier_fvm::fvm::{FvmMesh, tet_forces};
     // 80 tetrahedra (one chunk), 20 250 (three chunks of the parallel loop, the last block
     // padded) and a 29 184-tetrahedron ball (block-structured, renumbered in spatial order).
+    // A St. Venant–Kirchhoff bar crushed and inverted in places (4 cm moves on 5 cm cells)
+    // sends blocks below its compression threshold through the lane-by-lane fallback.
+    let crushed = random_body(MaterialModel::StVenantKirchhoff, 31, 0.04);
+    assert!(crushed.inverted_tet_count() > 0);
     let bodies = MODELS
         .map(|model| random_body(model, 21, 0.01))
         .into_iter()
+        .chain([crushed])
         .chain([randomized(
             mesh::cuboid(DVec3::new(0.3, 0.3, 0.05), [27, 30, 5]).unwrap(),
             MaterialModel::StVenantKirchhoff,
@@ -385,4 +390,99 @@ fn small_strain_energies_keep_their_digits() {
             );
         }
     }
+}
+
+#[test]
+fn continued_stvk_stays_consistent_when_crushed_and_inverted() {
+    // Below its compression threshold (stretch 0.6) St. Venant–Kirchhoff continues its principal
+    // strains. Its stress must stay the derivative of its energy and dP that of the stress (the
+    // 1e-6 tolerances above), for stretches crushed, nearly flat and inverted; an inverted
+    // stretch must be pushed back (the energy falls as it grows toward positive); and energy,
+    // stress and dP must join continuously at the threshold (the continuation is C²).
+    let lame = Material::new(MaterialModel::Linear, 1e6, 0.3, 1.0)
+        .unwrap()
+        .lame();
+    let model = StVenantKirchhoff(lame);
+    let mut rng = Lcg(29);
+    let stretches: [[f64; 3]; 9] = [
+        [1.1, 0.9, 0.3],
+        [1.2, 0.5, 0.45],
+        [0.55, 0.5, 0.4],
+        [1.0, 0.9, 0.02],
+        [1.0, 0.9, 0.59],
+        [1.0, 0.8, -0.5],
+        [1.05, 1.0, -0.95],
+        [0.9, 0.3, -0.2],
+        [1.3, 0.7, -1e-3],
+    ];
+    let (mut worst_stress, mut worst_differential): (f64, f64) = (0.0, 0.0);
+    for sigma in stretches {
+        let mut rotation = || DMat3::from_axis_angle(rng.vector().normalize(), 3.0 * rng.next());
+        let (u, v) = (rotation(), rotation());
+        let f = u * DMat3::from_diagonal(DVec3::from(sigma)) * v.transpose();
+        let stress = model.first_piola(&f);
+        let h = 1e-6;
+        let mut error: f64 = 0.0;
+        for c in 0..3 {
+            for r in 0..3 {
+                let (mut plus, mut minus) = (f, f);
+                plus.col_mut(c)[r] += h;
+                minus.col_mut(c)[r] -= h;
+                let derivative =
+                    (model.energy_density(&plus) - model.energy_density(&minus)) / (2.0 * h);
+                error = error.max((derivative - stress.col(c)[r]).abs());
+            }
+        }
+        worst_stress = worst_stress.max(error / largest(stress));
+        for _ in 0..3 {
+            let df = DMat3::from_cols(rng.vector(), rng.vector(), rng.vector());
+            let numeric =
+                (model.first_piola(&(f + df * h)) - model.first_piola(&(f - df * h))) / (2.0 * h);
+            let analytic = model.first_piola_differential(&f, &df);
+            worst_differential =
+                worst_differential.max(largest(numeric - analytic) / largest(numeric));
+        }
+        if sigma[2] < 0.0 {
+            // Growing the inverted stretch: dF = u e3 e3ᵀ vᵀ.
+            let grow = u * DMat3::from_diagonal(DVec3::Z) * v.transpose();
+            let power = double_dot(&stress, &grow);
+            assert!(power < 0.0, "{sigma:?}: P : dF = {power:e} Pa");
+        }
+    }
+    // Just above the threshold (closed form) and just below it (continuation), 2e-9 apart.
+    let (u, v) = (
+        DMat3::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 0.7),
+        DMat3::from_axis_angle(DVec3::new(-2.0, 1.0, 0.5).normalize(), 1.9),
+    );
+    let df = DMat3::from_cols(rng.vector(), rng.vector(), rng.vector());
+    let [above, below] = [1e-9, -1e-9].map(|offset| {
+        let f = u * DMat3::from_diagonal(DVec3::new(1.1, 0.9, 0.6 + offset)) * v.transpose();
+        (
+            model.energy_density(&f),
+            model.first_piola(&f),
+            model.first_piola_differential(&f, &df),
+        )
+    });
+    let join = [
+        (above.0 - below.0).abs() / above.0.abs(),
+        largest(above.1 - below.1) / largest(above.1),
+        largest(above.2 - below.2) / largest(above.2),
+    ];
+    println!(
+        "continued StVK: worst |dΨ/dF - P| / max|P| = {worst_stress:.2e}, worst relative error of dP = {worst_differential:.2e}; relative jumps of Ψ, P, dP across the threshold {:.1e}, {:.1e}, {:.1e}",
+        join[0], join[1], join[2]
+    );
+    assert!(worst_stress < 1e-6, "{worst_stress:e}");
+    assert!(worst_differential < 1e-6, "{worst_differential:e}");
+    assert!(join.iter().all(|&jump| jump < 1e-6), "{join:?}");
+}
+
+/// `A : B`, the Frobenius inner product.
+fn double_dot(a: &DMat3, b: &DMat3) -> f64 {
+    a.x_axis.dot(b.x_axis) + a.y_axis.dot(b.y_axis) + a.z_axis.dot(b.z_axis)
+}
+
+/// The largest absolute entry of `m`.
+fn largest(m: DMat3) -> f64 {
+    m.to_cols_array().iter().fold(0.0f64, |a, x| a.max(x.abs()))
 }

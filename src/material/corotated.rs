@@ -7,9 +7,9 @@
 //! Irving, Teran and Fedkiw (2004): when `det F < 0` the smallest singular value is negated so that
 //! `R` stays a rotation and the energy pushes the element back to positive volume.
 
+use super::diagonal::signed_svd;
 use super::{HyperelasticModel, LameParameters, trace};
 use rapier3d::glamx::{DMat3, DVec3};
-use rapier3d::na;
 
 /// Corotated linear elastic material with the given Lamé parameters.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -54,20 +54,11 @@ fn polar_rotation_newton(f: &DMat3) -> Option<DMat3> {
 
 /// The polar rotation from the SVD with the inversion sign fix.
 fn polar_rotation_svd(f: &DMat3) -> DMat3 {
-    let m = na::Matrix3::from_column_slice(&f.to_cols_array());
-    let svd = m.svd(true, true);
-    // Both are present because they were requested above.
-    let (Some(mut u), Some(mut v_t)) = (svd.u, svd.v_t) else {
+    // `U` and `V` are always present: the decomposition was asked for both.
+    let Some(svd) = signed_svd(f) else {
         return DMat3::IDENTITY;
     };
-    let smallest = svd.singular_values.imin();
-    if u.determinant() < 0.0 {
-        u.column_mut(smallest).neg_mut();
-    }
-    if v_t.determinant() < 0.0 {
-        v_t.row_mut(smallest).neg_mut();
-    }
-    DMat3::from_cols_slice((u * v_t).as_slice())
+    DMat3::from_cols_slice((svd.u * svd.v_t).as_slice())
 }
 
 /// Axial vector `a` of a skew matrix `[a]x`.

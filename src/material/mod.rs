@@ -7,6 +7,7 @@
 //! `σ = λ tr(ε) I + 2 μ ε` for small strains.
 
 mod corotated;
+mod diagonal;
 mod linear;
 mod neo_hookean;
 mod stvk;
@@ -58,8 +59,9 @@ pub enum MaterialModel {
     /// that stay close to their rest orientation.
     Linear,
     /// St. Venant–Kirchhoff: the linear law on the Green strain `G = (FᵀF - I)/2`. Exact under any
-    /// rigid motion; fine for large rotations with moderate strain; softens and can collapse under
-    /// strong compression.
+    /// rigid motion; fine for large rotations with moderate strain; softens under strong
+    /// compression, where below a stretch of 0.6 its principal strains are continued (Irving, Teran
+    /// and Fedkiw 2004) so that crushed and inverted elements are pushed back to positive volume.
     StVenantKirchhoff,
     /// Corotated linear elasticity: linear elasticity in the element's rotated frame (polar
     /// decomposition `F = R S`). Rotation-exact, robust, a good default for games.
