@@ -90,6 +90,9 @@ pub enum Error {
         /// Number of nodes in the body.
         node_count: usize,
     },
+    /// A rigid body handle given to a soft body (attachment) is not in the rigid-body set.
+    #[error("the rigid body is not in the rigid-body set")]
+    UnknownRigidBody,
     /// A generator was asked for a shape it cannot mesh (zero cells, non-positive size).
     #[error("invalid mesh generator parameter `{parameter}` = {value}: {reason}")]
     InvalidGeneratorParameter {

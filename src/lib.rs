@@ -42,6 +42,7 @@
 //! ```
 
 mod assembly;
+pub mod attachment;
 pub mod body;
 pub mod contact;
 pub mod damping;

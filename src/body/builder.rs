@@ -210,8 +210,10 @@ impl SoftBodyBuilder {
             pinned,
             surface_nodes,
             contacts: Vec::new(),
+            attachments: Vec::new(),
             rigid_proxies: Vec::new(),
             saved_proxies: Vec::new(),
+            saved_anchors: Vec::new(),
             contact_settings: ContactSettings::default(),
             user_data: self.user_data,
         })

@@ -8,6 +8,7 @@ pub use builder::{DEFAULT_MIN_ELEMENT_QUALITY, SoftBodyBuilder};
 pub use set::{SoftBodyHandle, SoftBodySet};
 
 use crate::assembly::Stiffness;
+use crate::attachment::Attachment;
 use crate::contact::{ContactSettings, NodeContact, RigidProxy};
 use crate::damping::RayleighDamping;
 use crate::fvm::{FvmMesh, NodalAveraging, VolumetricTreatment};
@@ -46,10 +47,13 @@ pub struct SoftBody {
     pub(crate) surface_nodes: Vec<u32>,
     /// The contacts the integrators enforce, from the last detection.
     pub(crate) contacts: Vec<NodeContact>,
-    /// The rigid bodies the contacts touch, as the soft step sees them.
+    /// The nodes glued to rigid bodies.
+    pub(crate) attachments: Vec<Attachment>,
+    /// The rigid bodies the contacts and attachments touch, as the soft step sees them.
     pub(crate) rigid_proxies: Vec<RigidProxy>,
-    /// The proxies saved with the state, restored with it.
+    /// The proxies and attachment anchors saved with the state, restored with it.
     pub(crate) saved_proxies: Vec<RigidProxy>,
+    pub(crate) saved_anchors: Vec<DVec3>,
     /// The settings of the last contact detection.
     pub(crate) contact_settings: ContactSettings,
     /// Arbitrary user data, as on rapier's bodies.
@@ -148,6 +152,9 @@ impl SoftBody {
             contact.impulse = DVec3::ZERO;
         }
         self.saved_proxies.clone_from(&self.rigid_proxies);
+        self.saved_anchors.clear();
+        self.saved_anchors
+            .extend(self.attachments.iter().map(|a| a.anchor));
     }
 
     /// Puts back the state saved by [`SoftBody::save_state`].
@@ -158,6 +165,9 @@ impl SoftBody {
             contact.impulse = DVec3::ZERO;
         }
         self.rigid_proxies.clone_from(&self.saved_proxies);
+        for (attachment, anchor) in self.attachments.iter_mut().zip(&self.saved_anchors) {
+            attachment.anchor = *anchor;
+        }
     }
 
     /// The tangent workspace, built on first use; give it back with `self.tangent = Some(..)`.

@@ -139,7 +139,8 @@ impl SoftBody {
     /// (s) under `gravity` (m/s²), replacing the previous ones: a node gets a contact with each
     /// non-sensor collider it is within `margin` of, plus twice the distance the body's fastest
     /// node can travel in the frame (`2 (|v|max + |g| dt) dt`). The integrators enforce them until
-    /// the next detection.
+    /// the next detection. It also places the attachments' anchors where their rigid bodies are
+    /// now, ready for the step.
     ///
     /// # Errors
     /// [`Error::InvalidTimeStep`], [`Error::NonFiniteInput`] or [`Error::InvalidSetting`] for a bad
@@ -209,6 +210,7 @@ impl SoftBody {
                 }
             }
         }
+        crate::attachment::ready(&mut self.attachments, &mut proxies, bodies);
         self.contacts = contacts;
         self.rigid_proxies = proxies;
         self.contact_settings = *settings;

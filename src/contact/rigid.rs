@@ -59,11 +59,17 @@ impl RigidProxy {
         }
     }
 
-    /// Lets the body fall under `gravity` (m/s²) for `h` (s), as rapier will make it: the soft
-    /// side then sees a resting body pressing on it rather than one that floats until rapier's
-    /// step. Only the contact impulses are handed back.
+    /// Lets the body fall under `gravity` (m/s²) for `h` (s), as rapier will make it unless held
+    /// (see [`RigidProxy::hold`]): the soft side then sees a body resting on it pressing on it
+    /// rather than one that floats until rapier's step. Only the contact impulses are handed back.
     pub(crate) fn fall(&mut self, gravity: DVec3, h: f64) {
         self.linvel += gravity * (self.fall * h);
+    }
+
+    /// Keeps the body from falling during the soft step: for a body that rapier's own contacts
+    /// hold up (standing on rigid ground), whose weight rapier's step will carry.
+    pub(crate) fn hold(&mut self) {
+        self.fall = 0.0;
     }
 
     /// Velocity (m/s) of the body's material point at `point` (m).
@@ -75,6 +81,18 @@ impl RigidProxy {
     pub(crate) fn inverse_mass_along(&self, point: DVec3, direction: DVec3) -> f64 {
         let arm = (point - self.com).cross(direction);
         direction.dot(self.inv_mass * direction) + arm.dot(self.inv_inertia * arm)
+    }
+
+    /// The 3 x 3 inverse effective mass (1/kg) of the body at `point` (m): the change of the
+    /// point's velocity per unit impulse there, `diag(1/m) - [r]x I⁻¹ [r]x`.
+    pub(crate) fn inverse_mass_matrix(&self, point: DVec3) -> DMat3 {
+        let r = point - self.com;
+        let cross = DMat3::from_cols(
+            DVec3::new(0.0, r.z, -r.y),
+            DVec3::new(-r.z, 0.0, r.x),
+            DVec3::new(r.y, -r.x, 0.0),
+        );
+        DMat3::from_diagonal(self.inv_mass) - cross * self.inv_inertia * cross
     }
 
     /// Applies `impulse` (N s) at `point` (m).

@@ -14,7 +14,7 @@
 use super::check_step;
 use crate::Error;
 use crate::body::SoftBody;
-use crate::contact;
+use crate::{attachment, contact};
 use rapier3d::glamx::DVec3;
 
 /// Ratio of the critical explicit step to `ℓ / c_p`. The true limit `2/ω_max` (power iteration
@@ -224,6 +224,7 @@ fn substep(body: &mut SoftBody, h: f64, gravity: DVec3) {
         }
     }
     contact::constrain_velocities(body, h, gravity);
+    attachment::constrain_velocities(body, h);
     let SoftBody {
         positions,
         velocities,

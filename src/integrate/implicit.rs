@@ -21,12 +21,12 @@ use super::check_step;
 use crate::Error;
 use crate::assembly::Stiffness;
 use crate::body::{PreviousStep, SoftBody};
-use crate::contact;
 use crate::damping::RayleighDamping;
 use crate::fvm::{gather, stress_forces};
 use crate::linear_solver::{LinearSolver, Method, solve_newton_system};
 use crate::material::green_strain;
 use crate::newton::{check_tolerance, descend, norm};
+use crate::{attachment, contact};
 use rapier3d::glamx::{DMat3, DVec3};
 
 /// Newton stops early on a stalled residual only below this relative value; above it, a slow
@@ -237,6 +237,7 @@ impl ImplicitIntegrator {
         }
         let outcome = self.minimize(body, stiffness, method, &start)?;
         contact::record_penalty_impulses(body, start.h, h);
+        attachment::record_spring_impulses(body, start.h, h);
         for n in 0..body.positions.len() {
             body.velocities[n] = if body.pinned[n] {
                 DVec3::ZERO
@@ -431,6 +432,9 @@ impl StepStart {
         contact::for_each_active_penalty(body, self.h, |node, stiffness, gap, normal| {
             residual[node] -= normal * (stiffness * gap);
         });
+        attachment::for_each_spring(body, self.h, |node, stiffness, target| {
+            residual[node] += (target - body.positions[node]) * stiffness;
+        });
         for (r, &pinned) in residual.iter_mut().zip(&body.pinned) {
             if pinned {
                 *r = DVec3::ZERO;
@@ -489,6 +493,9 @@ impl StepStart {
         contact::for_each_active_penalty(body, self.h, |_, stiffness, gap, _| {
             penalty += 0.5 * stiffness * gap * gap;
         });
+        attachment::for_each_spring(body, self.h, |node, stiffness, target| {
+            penalty += 0.5 * stiffness * (body.positions[node] - target).length_squared();
+        });
         inertia + body.elastic_energy() + dissipation + penalty - load
     }
 
@@ -502,6 +509,9 @@ impl StepStart {
         });
         contact::for_each_active_penalty(body, self.h, |node, k, _, normal| {
             stiffness.add_node_block(node, &contact::penalty_tangent(k, normal));
+        });
+        attachment::for_each_spring(body, self.h, |node, k, _| {
+            stiffness.add_node_block(node, &(DMat3::IDENTITY * k));
         });
     }
 }

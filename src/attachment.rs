@@ -1,0 +1,183 @@
+//! Nodes glued to rapier rigid bodies, two-way: the node follows the body's material point it was
+//! attached at, and the body feels the node's pull.
+//!
+//! The explicit integrator enforces each attachment at every substep as a point constraint on
+//! velocity (the node's velocity relative to the anchor's, with a fifth of the position drift
+//! corrected per substep), solved with the 3 x 3 effective mass of node and body; the body gets
+//! the opposite impulse at the node. The implicit integrator adds a stiff spring to the anchor's
+//! predicted position at the end of the step, `k = penalty_factor m/ĥ²`, to its potential. In
+//! both, the body is frozen in pose for the soft step and its velocity follows the impulses, as
+//! for contacts.
+
+use crate::Error;
+use crate::body::SoftBody;
+use crate::contact::RigidProxy;
+use rapier3d::dynamics::{RigidBodyHandle, RigidBodySet};
+use rapier3d::glamx::{DMat3, DVec3};
+
+/// Fraction of an attachment's position drift corrected per explicit substep.
+const DRIFT_CORRECTION: f64 = 0.2;
+
+/// A node glued to a point of a rigid body.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Attachment {
+    /// The soft body's node.
+    pub node: u32,
+    /// The rigid body.
+    pub body: RigidBodyHandle,
+    /// The anchor point in the rigid body's local frame (m).
+    pub local_anchor: DVec3,
+    /// The anchor in the world (m), moved with the body during a soft step.
+    pub(crate) anchor: DVec3,
+    /// Index of the body among the soft body's rigid proxies.
+    pub(crate) proxy: usize,
+}
+
+impl SoftBody {
+    /// Glues `nodes` to the rigid body `body` of `bodies` where they are now: each node keeps
+    /// following the body's material point it sits at, and the body feels it (two-way when the
+    /// body is dynamic; a kinematic or fixed body drags the nodes along). The attachments act from
+    /// the next [`SoftBody::detect_contacts`], which readies them for the coming step.
+    ///
+    /// # Errors
+    /// [`Error::NodeOutOfRange`] for a node that does not exist, [`Error::UnknownRigidBody`] if
+    /// `body` is not in `bodies`; nothing is attached then.
+    pub fn attach(
+        &mut self,
+        nodes: impl IntoIterator<Item = u32>,
+        body: RigidBodyHandle,
+        bodies: &RigidBodySet,
+    ) -> Result<(), Error> {
+        let rigid = bodies.get(body).ok_or(Error::UnknownRigidBody)?;
+        let pose = rigid.position();
+        let node_count = self.node_count();
+        let mut added = Vec::new();
+        for node in nodes {
+            let x = *self
+                .positions
+                .get(node as usize)
+                .ok_or(Error::NodeOutOfRange {
+                    node: node as usize,
+                    node_count,
+                })?;
+            let local_anchor = pose.inverse_transform_point(x.as_vec3()).as_dvec3();
+            added.push(Attachment {
+                node,
+                body,
+                local_anchor,
+                anchor: x,
+                proxy: usize::MAX,
+            });
+        }
+        self.attachments.extend(added);
+        Ok(())
+    }
+
+    /// The attachments.
+    pub fn attachments(&self) -> &[Attachment] {
+        &self.attachments
+    }
+
+    /// Removes every attachment to `body`.
+    pub fn detach(&mut self, body: RigidBodyHandle) {
+        self.attachments.retain(|a| a.body != body);
+    }
+}
+
+/// Places the attachments' anchors where their bodies are now and gives each body a proxy
+/// (shared with the contacts'); attachments to bodies no longer in `bodies` are dropped.
+pub(crate) fn ready(
+    attachments: &mut Vec<Attachment>,
+    proxies: &mut Vec<RigidProxy>,
+    bodies: &RigidBodySet,
+) {
+    attachments.retain(|a| bodies.get(a.body).is_some());
+    for attachment in attachments.iter_mut() {
+        let Some(rigid) = bodies.get(attachment.body) else {
+            continue;
+        };
+        attachment.anchor = rigid
+            .position()
+            .transform_point(attachment.local_anchor.as_vec3())
+            .as_dvec3();
+        attachment.proxy = match proxies.iter().position(|p| p.handle == attachment.body) {
+            Some(index) => index,
+            None => {
+                proxies.push(RigidProxy::new(attachment.body, rigid));
+                proxies.len() - 1
+            }
+        };
+    }
+}
+
+/// Enforces the attachments on velocity for an explicit substep of `h` (s), after the contacts.
+pub(crate) fn constrain_velocities(body: &mut SoftBody, h: f64) {
+    let SoftBody {
+        attachments,
+        rigid_proxies,
+        positions,
+        velocities,
+        masses,
+        pinned,
+        ..
+    } = body;
+    for attachment in attachments.iter_mut() {
+        let n = attachment.node as usize;
+        if pinned[n] {
+            continue;
+        }
+        let proxy = &mut rigid_proxies[attachment.proxy];
+        let x = positions[n];
+        let anchor_velocity = proxy.velocity_at(attachment.anchor);
+        let wanted = anchor_velocity + (attachment.anchor - x) * (DRIFT_CORRECTION / h);
+        let effective = DMat3::IDENTITY * (1.0 / masses[n]) + proxy.inverse_mass_matrix(x);
+        let impulse = effective.inverse() * (wanted - velocities[n]);
+        velocities[n] += impulse / masses[n];
+        proxy.apply(-impulse, x);
+        attachment.anchor += proxy.velocity_at(attachment.anchor) * h;
+    }
+}
+
+/// Calls `each(node, stiffness k (N/m), target (m))` for every attachment in an implicit step of
+/// effective length `h` (s): the node is pulled toward the anchor's predicted end position with
+/// the energy `k/2 |x - target|²`.
+pub(crate) fn for_each_spring(body: &SoftBody, h: f64, mut each: impl FnMut(usize, f64, DVec3)) {
+    for attachment in &body.attachments {
+        let n = attachment.node as usize;
+        if body.pinned[n] {
+            continue;
+        }
+        let proxy = &body.rigid_proxies[attachment.proxy];
+        let target = attachment.anchor + proxy.velocity_at(attachment.anchor) * h;
+        let stiffness = body.contact_settings.penalty_factor * body.masses[n] / (h * h);
+        each(n, stiffness, target);
+    }
+}
+
+/// Records the impulses (N s) the implicit springs gave the nodes over a substep of length `h`
+/// (s), hands their opposite to the bodies, and moves the anchors with them.
+pub(crate) fn record_spring_impulses(body: &mut SoftBody, effective_h: f64, h: f64) {
+    let mut impulses = Vec::with_capacity(body.attachments.len());
+    for_each_spring(body, effective_h, |node, stiffness, target| {
+        impulses.push((node, (target - body.positions[node]) * (stiffness * h)));
+    });
+    let SoftBody {
+        attachments,
+        rigid_proxies,
+        positions,
+        pinned,
+        ..
+    } = body;
+    let mut impulses = impulses.into_iter();
+    for attachment in attachments.iter_mut() {
+        if pinned[attachment.node as usize] {
+            continue;
+        }
+        let Some((node, impulse)) = impulses.next() else {
+            break;
+        };
+        let proxy = &mut rigid_proxies[attachment.proxy];
+        proxy.apply(-impulse, positions[node]);
+        attachment.anchor += proxy.velocity_at(attachment.anchor) * h;
+    }
+}
