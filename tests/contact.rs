@@ -6,6 +6,29 @@ use rapier3d::prelude::{ColliderBuilder, ColliderSet, RigidBodySet, SharedShape}
 
 const GRAVITY: DVec3 = DVec3::new(0.0, -9.81, 0.0);
 
+/// A plane through the origin with normal `normal`, as a rapier triangle mesh of two large
+/// triangles, friction `friction`.
+fn ground_mesh(normal: DVec3, friction: f64) -> ColliderSet {
+    let normal = normal.normalize();
+    let u = normal.cross(DVec3::Z).normalize() * 10.0;
+    let w = normal.cross(u).normalize() * 10.0;
+    let vertices = [-u - w, u - w, u + w, -u + w].map(|v| v.as_vec3()).to_vec();
+    // Counter-clockwise seen from the normal's side.
+    let triangles = if (u.cross(w)).dot(normal) > 0.0 {
+        vec![[0, 1, 2], [0, 2, 3]]
+    } else {
+        vec![[0, 2, 1], [0, 3, 2]]
+    };
+    let mut colliders = ColliderSet::new();
+    colliders.insert(
+        ColliderBuilder::trimesh(vertices, triangles)
+            .unwrap()
+            .friction(friction as f32)
+            .build(),
+    );
+    colliders
+}
+
 /// A ground half-space through the origin with outward normal `normal` and friction `friction`.
 fn ground(normal: DVec3, friction: f64) -> ColliderSet {
     let mut colliders = ColliderSet::new();
@@ -92,15 +115,25 @@ fn a_dropped_cube_comes_to_rest_on_the_ground() {
 
 #[test]
 fn a_block_on_a_slope_sticks_or_slides_as_coulomb_says() {
-    // A 20° slope: tan 20° = 0.364. With μ = 0.6 the block holds; with μ = 0.2 it slides with
+    // A 20° slope (a half-space, and a two-triangle mesh): tan 20° = 0.364. With μ = 0.6 the
+    // block holds; with μ = 0.2 it slides with
     // acceleration g (sin θ - μ cos θ) = 1.513 m/s², checked over 0.5 s to 5 % (the block
     // settles onto the slope in the first frames, and rubber rocks a little as it slides).
     let angle = 20f64.to_radians();
     let normal = DVec3::new(-angle.sin(), angle.cos(), 0.0);
     let downhill = DVec3::new(angle.cos(), angle.sin(), 0.0) * -1.0;
     let settings = ContactSettings::default();
-    for (friction, expected) in [(0.6, 0.0), (0.2, 9.81 * (angle.sin() - 0.2 * angle.cos()))] {
-        let colliders = ground(normal, friction);
+    let sliding = 9.81 * (angle.sin() - 0.2 * angle.cos());
+    // The slope as a half-space and as a triangle mesh.
+    for (shape, friction, expected) in [
+        ("half-space", 0.6, 0.0),
+        ("half-space", 0.2, sliding),
+        ("triangle mesh", 0.2, sliding),
+    ] {
+        let colliders = match shape {
+            "half-space" => ground(normal, friction),
+            _ => ground_mesh(normal, friction),
+        };
         // The cube resting on the slope, tilted with it.
         let mut body = rubber_cube(normal * 0.0505, DVec3::new(0.0, 0.0, angle));
         let integrator = SymplecticEuler::default();
@@ -118,7 +151,7 @@ fn a_block_on_a_slope_sticks_or_slides_as_coulomb_says() {
         let t = 60.0 * frame;
         let acceleration = (s2 - 2.0 * s1 + s0) / (t * t);
         println!(
-            "μ = {friction}: slid {:.2} mm in 1 s, acceleration {acceleration:.3} m/s² (expected {expected:.3})",
+            "{shape}, μ = {friction}: slid {:.2} mm in 1 s, acceleration {acceleration:.3} m/s² (expected {expected:.3})",
             (s2 - history[0]) * 1e3
         );
         if expected == 0.0 {

@@ -214,6 +214,7 @@ impl SoftBodyBuilder {
             rigid_proxies: Vec::new(),
             saved_proxies: Vec::new(),
             saved_anchors: Vec::new(),
+            saved_planes: Vec::new(),
             contact_settings: ContactSettings::default(),
             user_data: self.user_data,
         })

@@ -54,6 +54,8 @@ pub struct SoftBody {
     /// The proxies and attachment anchors saved with the state, restored with it.
     pub(crate) saved_proxies: Vec<RigidProxy>,
     pub(crate) saved_anchors: Vec<DVec3>,
+    /// The contact planes saved with the state (explicit substeps move them).
+    pub(crate) saved_planes: Vec<(DVec3, DVec3)>,
     /// The settings of the last contact detection.
     pub(crate) contact_settings: ContactSettings,
     /// Arbitrary user data, as on rapier's bodies.
@@ -155,6 +157,9 @@ impl SoftBody {
         self.saved_anchors.clear();
         self.saved_anchors
             .extend(self.attachments.iter().map(|a| a.anchor));
+        self.saved_planes.clear();
+        self.saved_planes
+            .extend(self.contacts.iter().map(|c| (c.point, c.normal)));
     }
 
     /// Puts back the state saved by [`SoftBody::save_state`].
@@ -167,6 +172,10 @@ impl SoftBody {
         self.rigid_proxies.clone_from(&self.saved_proxies);
         for (attachment, anchor) in self.attachments.iter_mut().zip(&self.saved_anchors) {
             attachment.anchor = *anchor;
+        }
+        for (contact, (point, normal)) in self.contacts.iter_mut().zip(&self.saved_planes) {
+            contact.point = *point;
+            contact.normal = *normal;
         }
     }
 

@@ -173,6 +173,14 @@ impl SoftBody {
             let parent = collider
                 .parent()
                 .and_then(|handle| bodies.get(handle).map(|body| (handle, body)));
+            // The collider's own travel in the frame, at its fastest point.
+            let collider_reach = parent.map_or(0.0, |(_, body)| {
+                let radius = f64::from(aabb.half_extents().length());
+                2.0 * (body.linvel().as_dvec3().length()
+                    + body.angvel().as_dvec3().length() * radius)
+                    * frame_dt
+            });
+            let reach = reach + collider_reach.min(MAX_COLLIDER_REACH);
             let mut proxy = None;
             for &node in &self.surface_nodes {
                 let n = node as usize;
@@ -193,8 +201,14 @@ impl SoftBody {
                     if proxy.is_none()
                         && let Some((handle, body)) = parent
                     {
-                        proxies.push(RigidProxy::new(handle, body));
-                        proxy = Some(proxies.len() - 1);
+                        // One proxy per rigid body, whatever its number of colliders.
+                        proxy = Some(match proxies.iter().position(|p| p.handle == handle) {
+                            Some(index) => index,
+                            None => {
+                                proxies.push(RigidProxy::new(handle, body));
+                                proxies.len() - 1
+                            }
+                        });
                     }
                     contacts.push(NodeContact {
                         node,
@@ -238,11 +252,27 @@ impl SoftBody {
         }
     }
 
-    /// The total force (N) and torque about the world origin (N m) the soft body's contacts
-    /// exerted on `collider` over the last step of length `dt` (s): its impulses over `dt`.
-    pub fn contact_force_on(&self, collider: ColliderHandle, dt: f64) -> (DVec3, DVec3) {
+    /// The mean force (N) and torque about the world origin (N m) the soft body's contacts
+    /// exerted on `collider` over the last step, of length `dt` (s): their impulses over `dt`
+    /// (the torque taken at the nodes' end-of-step positions). In an
+    /// [`FvmWorld`](crate::world::FvmWorld) the last step is the frame's last coupling substep.
+    ///
+    /// # Errors
+    /// [`Error::InvalidTimeStep`] for a non-positive or non-finite `dt`.
+    pub fn contact_force_on(
+        &self,
+        collider: ColliderHandle,
+        dt: f64,
+    ) -> Result<(DVec3, DVec3), Error> {
+        if !(dt.is_finite() && dt > 0.0) {
+            return Err(Error::InvalidTimeStep {
+                dt,
+                reason: "must be positive and finite",
+            });
+        }
         let positions = &self.positions;
-        self.contacts
+        Ok(self
+            .contacts
             .iter()
             .filter(|c| c.collider == collider)
             .fold((DVec3::ZERO, DVec3::ZERO), |(force, torque), c| {
@@ -251,9 +281,19 @@ impl SoftBody {
                     force + on_collider,
                     torque + positions[c.node as usize].cross(on_collider),
                 )
-            })
+            }))
     }
 }
+
+/// The most (m) a rigid collider's own motion widens the detection reach (a body flung across
+/// the world in one frame would otherwise make every node a candidate).
+const MAX_COLLIDER_REACH: f64 = 1.0;
+
+/// Below this distance (m) from a surface, the offset of a node from its projection is f32
+/// round-off and gives no direction.
+const ROUND_OFF_DISTANCE: f64 = 1e-6;
+/// How far (m) outside a surface the normal of a node lying on it is probed.
+const PROBE_DISTANCE: f64 = 1e-4;
 
 /// The point of a shape's surface (at `pose`) nearest to `x` (m), the outward normal there, and
 /// the signed distance of `x` (negative inside); `None` where the normal is undefined.
@@ -262,7 +302,7 @@ fn nearest_surface_point(shape: &dyn Shape, pose: &Pose, x: DVec3) -> Option<(DV
     let point = projection.point.as_dvec3();
     let local = pose.inverse_transform_point(projection.point);
     let feature_normal = shape
-        .feature_normal_at_point(0, feature, local)
+        .feature_normal_at_point(projection.subshape, feature, local)
         .map(|n| (pose.rotation * n).as_dvec3());
     let offset = x - point;
     let sign = if projection.is_inside { -1.0 } else { 1.0 };
@@ -272,8 +312,19 @@ fn nearest_surface_point(shape: &dyn Shape, pose: &Pose, x: DVec3) -> Option<(DV
     let normal = match (feature_normal, shape.as_halfspace()) {
         (Some(n), _) if n.is_finite() && n.length() > 0.5 => n.normalize(),
         (_, Some(half_space)) => (pose.rotation * half_space.normal).as_dvec3().normalize(),
-        _ if offset.length() > 0.0 => offset.normalize() * sign,
-        _ => return None,
+        _ if offset.length() > ROUND_OFF_DISTANCE => offset.normalize() * sign,
+        _ => {
+            // On the surface, where the offset is f32 round-off: probe a little outward from
+            // the shape's origin (exact for convex shapes) and take the normal there.
+            let outward = (x - pose.translation.as_dvec3()).normalize_or_zero();
+            let probe = x + outward * PROBE_DISTANCE;
+            let projected = shape.project_point(pose, probe.as_vec3(), false);
+            let offset = probe - projected.point.as_dvec3();
+            if projected.is_inside || offset.length() <= ROUND_OFF_DISTANCE {
+                return None;
+            }
+            offset.normalize()
+        }
     };
     Some((point, normal, sign * offset.length()))
 }

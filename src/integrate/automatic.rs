@@ -77,7 +77,8 @@ pub struct AutomaticReport {
     /// The implicit frame's report, if implicit.
     pub implicit: Option<ImplicitReport>,
     /// Whether the frame was chosen explicit but redone implicitly, because crushed elements
-    /// lowered the stability limit partway below what `max_substeps` allows.
+    /// lowered the stability limit partway below what `max_substeps` allows, or the explicit
+    /// frame produced a non-finite state.
     pub fell_back: bool,
 }
 
@@ -161,7 +162,11 @@ impl AutomaticIntegrator {
         let (explicit, fell_back) = match explicit {
             Some(Ok(report)) => (Some(report), false),
             // The explicit frame left the body as it was: redo it implicitly, unless forced.
-            Some(Err(Error::TooManySubsteps { .. })) if self.force.is_none() => (None, true),
+            Some(Err(Error::TooManySubsteps { .. } | Error::NonFiniteState { .. }))
+                if self.force.is_none() =>
+            {
+                (None, true)
+            }
             Some(Err(error)) => return Err(error),
             None => (None, false),
         };

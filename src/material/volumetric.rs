@@ -12,7 +12,15 @@
 //!
 //! In every case `m` is the volume strain to first order and `Ψ_rest` is, at small strain, the
 //! deviatoric energy `μ dev(ε) : dev(ε)` of linear elasticity, which does not resist volume
-//! change; for the first three models it is non-negative at any strain.
+//! change; for the linear and corotated models it is non-negative at any strain. St.
+//! Venant–Kirchhoff's `Ψ_rest` is `Ψ - K/2 tr(G)²`, with `Ψ` its inversion-safe energy: beyond its
+//! compression threshold (see [`StVenantKirchhoff`]) that continued energy and the raw `tr(G)`
+//! part differ, so with nodal averaging its resistance to inversion comes from `Ψ_rest` alone and
+//! is weaker; prefer stable Neo-Hookean for crushed, nearly incompressible bodies.
+//!
+//! Damping is not averaged: its volumetric viscosity `φ` still acts per element, so nearly
+//! incompressible bodies with nodal averaging should be damped in shear only (`φ = 0`), or their
+//! bending modes are over-damped.
 
 use super::corotated::{polar_rotation, rotation_differential};
 use super::neo_hookean::{cofactor, cofactor_differential};
