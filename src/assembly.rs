@@ -158,19 +158,9 @@ impl Stiffness {
     fn add_outer(&mut self, gradient: &[(u32, DVec3)], weight: f64, pinned: &[bool]) {
         for &(b, gb) in gradient {
             for &(a, ga) in gradient {
-                let (a, b) = (a as usize, b as usize);
-                if a < b || pinned[a] || pinned[b] {
-                    continue;
-                }
-                for j in 0..3 {
-                    for i in 0..3 {
-                        if a == b && i < j {
-                            continue;
-                        }
-                        let e = self.entry(a, i, b, j);
-                        self.values[e] += weight * ga[i] * gb[j];
-                    }
-                }
+                self.add_pair_block(a as usize, b as usize, pinned, |i, j| {
+                    weight * ga[i] * gb[j]
+                });
             }
         }
     }
@@ -178,19 +168,32 @@ impl Stiffness {
     fn add_element(&mut self, tet: &[u32; 4], k: &[[f64; 12]; 12], pinned: &[bool]) {
         for (cb, &b) in tet.iter().enumerate() {
             for (ca, &a) in tet.iter().enumerate() {
-                let (a, b) = (a as usize, b as usize);
-                if a < b || pinned[a] || pinned[b] {
+                self.add_pair_block(a as usize, b as usize, pinned, |i, j| {
+                    k[3 * ca + i][3 * cb + j]
+                });
+            }
+        }
+    }
+
+    /// Adds `value(i, j)` to the entries (row `3a + i`, column `3b + j`) of the lower triangle,
+    /// unless either node is pinned or the block lies above the diagonal.
+    fn add_pair_block(
+        &mut self,
+        a: usize,
+        b: usize,
+        pinned: &[bool],
+        value: impl Fn(usize, usize) -> f64,
+    ) {
+        if a < b || pinned[a] || pinned[b] {
+            return;
+        }
+        for j in 0..3 {
+            for i in 0..3 {
+                if a == b && i < j {
                     continue;
                 }
-                for j in 0..3 {
-                    for i in 0..3 {
-                        if a == b && i < j {
-                            continue;
-                        }
-                        let e = self.entry(a, i, b, j);
-                        self.values[e] += k[3 * ca + i][3 * cb + j];
-                    }
-                }
+                let e = self.entry(a, i, b, j);
+                self.values[e] += value(i, j);
             }
         }
     }
