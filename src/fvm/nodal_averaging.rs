@@ -40,10 +40,12 @@ pub(crate) struct NodalAveraging {
     /// The tetrahedra of node `n` are `node_tets[tet_start[n]..tet_start[n + 1]]`.
     tet_start: Vec<usize>,
     node_tets: Vec<u32>,
+    /// Storage reused by the force evaluation.
+    scratch: VolumeMeasures,
 }
 
 /// The volume measures of one configuration.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 pub(crate) struct VolumeMeasures {
     /// `m_e` per tetrahedron.
     pub(crate) element: Vec<f64>,
@@ -85,6 +87,7 @@ impl NodalAveraging {
             patch_volume,
             tet_start,
             node_tets,
+            scratch: VolumeMeasures::default(),
         }
     }
 
@@ -100,38 +103,49 @@ impl NodalAveraging {
         fvm: &FvmMesh,
         x: &[DVec3],
     ) -> VolumeMeasures {
-        let mut weighted = vec![0.0; fvm.node_count()];
-        let element: Vec<f64> = fvm
-            .tets()
-            .iter()
-            .enumerate()
-            .map(|(t, tet)| {
-                let rest = fvm.tet_rest(t);
-                let m = model.volume_measure(&rest.gradient(&gather(tet, x)));
-                for &n in tet {
-                    weighted[n as usize] += rest.volume * m;
-                }
-                m
-            })
-            .collect();
-        let nodal = weighted
-            .iter()
-            .zip(&self.patch_volume)
-            .map(|(w, v)| w / v)
-            .collect();
-        VolumeMeasures { element, nodal }
+        let mut measures = VolumeMeasures {
+            element: Vec::new(),
+            nodal: Vec::new(),
+        };
+        self.measure_into(model, fvm, x, &mut measures);
+        measures
+    }
+
+    /// [`NodalAveraging::measures`] into `out`, reusing its storage.
+    fn measure_into<M: VolumetricTerm>(
+        &self,
+        model: &M,
+        fvm: &FvmMesh,
+        x: &[DVec3],
+        out: &mut VolumeMeasures,
+    ) {
+        out.nodal.clear();
+        out.nodal.resize(fvm.node_count(), 0.0);
+        out.element.clear();
+        for (t, tet) in fvm.tets().iter().enumerate() {
+            let rest = fvm.tet_rest(t);
+            let m = model.volume_measure(&rest.gradient(&gather(tet, x)));
+            for &n in tet {
+                out.nodal[n as usize] += rest.volume * m;
+            }
+            out.element.push(m);
+        }
+        for (theta, volume) in out.nodal.iter_mut().zip(&self.patch_volume) {
+            *theta /= volume;
+        }
     }
 
     /// Adds to `out` the change of the internal forces (N per node) from per-element to nodally
-    /// averaged volumetric term, at positions `x` (m).
+    /// averaged volumetric term, at positions `x` (m). Allocates nothing after the first call.
     pub(crate) fn add_forces<M: VolumetricTerm>(
-        &self,
+        &mut self,
         model: &M,
         fvm: &FvmMesh,
         x: &[DVec3],
         out: &mut [DVec3],
     ) {
-        let measures = self.measures(model, fvm, x);
+        let mut measures = std::mem::take(&mut self.scratch);
+        self.measure_into(model, fvm, x, &mut measures);
         let bulk = model.volumetric_modulus();
         for (t, tet) in fvm.tets().iter().enumerate() {
             let rest = fvm.tet_rest(t);
@@ -141,6 +155,7 @@ impl NodalAveraging {
                 out[n as usize] += force;
             }
         }
+        self.scratch = measures;
     }
 
     /// The elastic energy `E` (J) with the averaged volumetric term, at positions `x` (m).
