@@ -100,13 +100,7 @@ pub(crate) fn ready(
             .position()
             .transform_point(attachment.local_anchor.as_vec3())
             .as_dvec3();
-        attachment.proxy = match proxies.iter().position(|p| p.handle == attachment.body) {
-            Some(index) => index,
-            None => {
-                proxies.push(RigidProxy::new(attachment.body, rigid));
-                proxies.len() - 1
-            }
-        };
+        attachment.proxy = RigidProxy::index_in(proxies, attachment.body, rigid);
     }
 }
 
@@ -138,46 +132,58 @@ pub(crate) fn constrain_velocities(body: &mut SoftBody, h: f64) {
     }
 }
 
+impl Attachment {
+    /// Where the implicit spring pulls the node at the end of a step of effective length `h`
+    /// (s): the anchor carried by the body's velocity there (m).
+    fn spring_target(&self, proxies: &[RigidProxy], h: f64) -> DVec3 {
+        self.anchor + proxies[self.proxy].velocity_at(self.anchor) * h
+    }
+}
+
 /// Calls `each(node, stiffness k (N/m), target (m))` for every attachment in an implicit step of
 /// effective length `h` (s): the node is pulled toward the anchor's predicted end position with
 /// the energy `k/2 |x - target|²`.
 pub(crate) fn for_each_spring(body: &SoftBody, h: f64, mut each: impl FnMut(usize, f64, DVec3)) {
     for attachment in &body.attachments {
         let n = attachment.node as usize;
-        if body.pinned[n] {
-            continue;
+        if !body.pinned[n] {
+            let stiffness = body.contact_settings.penalty_stiffness(body.masses[n], h);
+            each(
+                n,
+                stiffness,
+                attachment.spring_target(&body.rigid_proxies, h),
+            );
         }
-        let proxy = &body.rigid_proxies[attachment.proxy];
-        let target = attachment.anchor + proxy.velocity_at(attachment.anchor) * h;
-        let stiffness = body.contact_settings.penalty_factor * body.masses[n] / (h * h);
-        each(n, stiffness, target);
     }
 }
 
 /// Records the impulses (N s) the implicit springs gave the nodes over a substep of length `h`
-/// (s), hands their opposite to the bodies, and moves the anchors with them.
+/// (s), hands their opposite to the bodies, and moves the anchors with them. The targets are
+/// taken before any impulse is handed over, as the step's solve saw them.
 pub(crate) fn record_spring_impulses(body: &mut SoftBody, effective_h: f64, h: f64) {
-    let mut impulses = Vec::with_capacity(body.attachments.len());
-    for_each_spring(body, effective_h, |node, stiffness, target| {
-        impulses.push((node, (target - body.positions[node]) * (stiffness * h)));
-    });
+    let targets: Vec<DVec3> = body
+        .attachments
+        .iter()
+        .map(|a| a.spring_target(&body.rigid_proxies, effective_h))
+        .collect();
     let SoftBody {
         attachments,
         rigid_proxies,
         positions,
+        masses,
         pinned,
+        contact_settings,
         ..
     } = body;
-    let mut impulses = impulses.into_iter();
-    for attachment in attachments.iter_mut() {
-        if pinned[attachment.node as usize] {
+    for (attachment, target) in attachments.iter_mut().zip(targets) {
+        let n = attachment.node as usize;
+        if pinned[n] {
             continue;
         }
-        let Some((node, impulse)) = impulses.next() else {
-            break;
-        };
+        let stiffness = contact_settings.penalty_stiffness(masses[n], effective_h);
+        let impulse = (target - positions[n]) * (stiffness * h);
         let proxy = &mut rigid_proxies[attachment.proxy];
-        proxy.apply(-impulse, positions[node]);
+        proxy.apply(-impulse, positions[n]);
         attachment.anchor += proxy.velocity_at(attachment.anchor) * h;
     }
 }

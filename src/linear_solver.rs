@@ -29,6 +29,7 @@
 use crate::Error;
 use crate::assembly::{Stiffness, factorize, solve};
 use crate::body::SoftBody;
+use crate::material::is_positive_definite;
 use rapier3d::glamx::{DMat3, DVec3};
 
 /// How the Newton system of each implicit iteration is solved.
@@ -422,9 +423,7 @@ fn block_jacobi(stiffness: &Stiffness) -> Option<Vec<DMat3>> {
     (0..stiffness.dofs() / 3)
         .map(|node| {
             let a = stiffness.diagonal_block(node);
-            // Sylvester's criterion on the leading minors.
-            let minor = a.x_axis.x * a.y_axis.y - a.x_axis.y * a.y_axis.x;
-            (a.x_axis.x > 0.0 && minor > 0.0 && a.determinant() > 0.0).then(|| a.inverse())
+            is_positive_definite(&a).then(|| a.inverse())
         })
         .collect()
 }

@@ -116,15 +116,14 @@ impl FvmWorld {
             .iter()
             .map(|(handle, _)| (handle, None))
             .collect();
-        let mut failed = vec![false; outcomes.len()];
         self.physics.integration_parameters.dt = frame.dt / substeps as f32;
         self.physics.integration_parameters.num_solver_iterations = frame
             .num_solver_iterations
             .div_ceil(substeps as usize)
             .max(1);
         for _ in 0..substeps {
-            for (i, (_, body)) in self.soft_bodies.iter_mut().enumerate() {
-                if failed[i] {
+            for ((_, body), (_, outcome)) in self.soft_bodies.iter_mut().zip(&mut outcomes) {
+                if matches!(outcome, Some(Err(_))) {
                     continue;
                 }
                 let physics = &mut self.physics;
@@ -137,16 +136,14 @@ impl FvmWorld {
                         &self.contact,
                     )
                     .map(|_| ());
-                let outcome = detected.and_then(|()| {
+                let stepped = detected.and_then(|()| {
                     hold_supported_bodies(body, physics);
                     self.integrator.step(body, h, gravity)
                 });
-                if outcome.is_ok() {
+                if stepped.is_ok() {
                     body.transfer_contact_impulses(&mut physics.bodies);
-                } else {
-                    failed[i] = true;
                 }
-                outcomes[i].1 = Some(outcome);
+                *outcome = Some(stepped);
             }
             self.physics.step_with_events(hooks, events);
         }

@@ -98,6 +98,19 @@ impl NodeContact {
         (x - self.point).dot(self.normal)
     }
 
+    /// The penalty stiffness (N/m) and gap (m) of the contact's node at `x` (m), of mass `mass`
+    /// (kg), in an implicit step of effective length `h` (s); `None` outside its plane.
+    fn penalty(
+        &self,
+        x: DVec3,
+        mass: f64,
+        settings: &ContactSettings,
+        h: f64,
+    ) -> Option<(f64, f64)> {
+        let gap = self.gap(x);
+        (gap < 0.0).then(|| (settings.penalty_stiffness(mass, h), gap))
+    }
+
     /// Moves the plane to the collider's surface point nearest to `x` (m), if defined there.
     fn refresh(&mut self, x: DVec3) {
         if let Some((point, normal, _)) = nearest_surface_point(&*self.shape, &self.pose, x) {
@@ -108,6 +121,12 @@ impl NodeContact {
 }
 
 impl ContactSettings {
+    /// The implicit penalty stiffness (N/m) on a node of mass `mass` (kg) for an effective step
+    /// `h` (s): `penalty_factor m/h²`. Attachments' springs use it too.
+    pub(crate) fn penalty_stiffness(&self, mass: f64, h: f64) -> f64 {
+        self.penalty_factor * mass / (h * h)
+    }
+
     fn check(&self) -> Result<(), Error> {
         if !(self.margin.is_finite() && self.margin >= 0.0) {
             return Err(Error::InvalidSetting {
@@ -138,7 +157,8 @@ impl SoftBody {
     /// Finds the contacts of the body's surface nodes with `colliders` for a frame of `frame_dt`
     /// (s) under `gravity` (m/s²), replacing the previous ones: a node gets a contact with each
     /// non-sensor collider it is within `margin` of, plus twice the distance the body's fastest
-    /// node can travel in the frame (`2 (|v|max + |g| dt) dt`). The integrators enforce them until
+    /// node can travel in the frame (`2 (|v|max + |g| dt) dt`), plus twice the collider's own
+    /// travel (at most 1 m). The integrators enforce them until
     /// the next detection. It also places the attachments' anchors where their rigid bodies are
     /// now, ready for the step.
     ///
@@ -181,6 +201,8 @@ impl SoftBody {
                     * frame_dt
             });
             let reach = reach + collider_reach.min(MAX_COLLIDER_REACH);
+            let (lo, hi) = (aabb.mins.as_dvec3(), aabb.maxs.as_dvec3());
+            let (shape, pose) = (collider.shared_shape(), collider.position());
             let mut proxy = None;
             for &node in &self.surface_nodes {
                 let n = node as usize;
@@ -188,27 +210,18 @@ impl SoftBody {
                     continue;
                 }
                 let x = self.positions[n];
-                let (lo, hi) = (aabb.mins.as_dvec3(), aabb.maxs.as_dvec3());
                 if (x + DVec3::splat(reach)).cmplt(lo).any()
                     || (x - DVec3::splat(reach)).cmpgt(hi).any()
                 {
                     continue;
                 }
-                let (shape, pose) = (collider.shared_shape(), collider.position());
                 if let Some((point, normal, distance)) = nearest_surface_point(&**shape, pose, x)
                     && distance <= reach
                 {
                     if proxy.is_none()
                         && let Some((handle, body)) = parent
                     {
-                        // One proxy per rigid body, whatever its number of colliders.
-                        proxy = Some(match proxies.iter().position(|p| p.handle == handle) {
-                            Some(index) => index,
-                            None => {
-                                proxies.push(RigidProxy::new(handle, body));
-                                proxies.len() - 1
-                            }
-                        });
+                        proxy = Some(RigidProxy::index_in(&mut proxies, handle, body));
                     }
                     contacts.push(NodeContact {
                         node,
@@ -329,12 +342,12 @@ fn nearest_surface_point(shape: &dyn Shape, pose: &Pose, x: DVec3) -> Option<(DV
     Some((point, normal, sign * offset.length()))
 }
 
-/// Enforces the contacts as velocity constraints for a substep of `h` (s) under `gravity`
-/// (m/s²): called after the velocity update, before positions move. A node found inside leaves at
+/// Enforces the contacts as velocity constraints for a substep of `h` (s): called after the
+/// velocity update, before positions move. A node found inside leaves at
 /// most at the depenetration speed. Against a rigid body the constraint is on the relative
 /// velocity, with the body's effective mass, and the body receives the opposite impulse at the
 /// node.
-pub(crate) fn constrain_velocities(body: &mut SoftBody, h: f64, gravity: DVec3) {
+pub(crate) fn constrain_velocities(body: &mut SoftBody, h: f64) {
     let SoftBody {
         contacts,
         rigid_proxies,
@@ -344,9 +357,6 @@ pub(crate) fn constrain_velocities(body: &mut SoftBody, h: f64, gravity: DVec3) 
         contact_settings,
         ..
     } = body;
-    for proxy in rigid_proxies.iter_mut() {
-        proxy.fall(gravity, h);
-    }
     for contact in contacts.iter_mut() {
         let n = contact.node as usize;
         contact.refresh(positions[n]);
@@ -403,10 +413,9 @@ pub(crate) fn record_penalty_impulses(body: &mut SoftBody, effective_h: f64, h: 
     } = body;
     for contact in contacts.iter_mut() {
         let n = contact.node as usize;
-        let gap = contact.gap(positions[n]);
-        if gap < 0.0 {
-            let stiffness =
-                contact_settings.penalty_factor * masses[n] / (effective_h * effective_h);
+        if let Some((stiffness, gap)) =
+            contact.penalty(positions[n], masses[n], contact_settings, effective_h)
+        {
             let impulse = contact.normal * (-stiffness * gap * h);
             contact.impulse += impulse;
             if let Some(p) = contact.proxy {
@@ -427,9 +436,9 @@ pub(crate) fn for_each_active_penalty(
 ) {
     for contact in &body.contacts {
         let n = contact.node as usize;
-        let gap = contact.gap(body.positions[n]);
-        if gap < 0.0 {
-            let stiffness = body.contact_settings.penalty_factor * body.masses[n] / (h * h);
+        if let Some((stiffness, gap)) =
+            contact.penalty(body.positions[n], body.masses[n], &body.contact_settings, h)
+        {
             each(n, stiffness, gap, contact.normal);
         }
     }

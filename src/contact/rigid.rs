@@ -72,6 +72,22 @@ impl RigidProxy {
         self.fall = 0.0;
     }
 
+    /// The index of `body`'s proxy in `proxies`, added if missing: one proxy per rigid body,
+    /// whatever its number of colliders and attachments.
+    pub(crate) fn index_in(
+        proxies: &mut Vec<RigidProxy>,
+        handle: RigidBodyHandle,
+        body: &RigidBody,
+    ) -> usize {
+        match proxies.iter().position(|p| p.handle == handle) {
+            Some(index) => index,
+            None => {
+                proxies.push(RigidProxy::new(handle, body));
+                proxies.len() - 1
+            }
+        }
+    }
+
     /// Velocity (m/s) of the body's material point at `point` (m).
     pub(crate) fn velocity_at(&self, point: DVec3) -> DVec3 {
         self.linvel + self.angvel.cross(point - self.com)

@@ -92,7 +92,7 @@ impl NodalAveraging {
     }
 
     /// The tetrahedra around node `node`.
-    pub(crate) fn tets_of(&self, node: usize) -> &[u32] {
+    fn tets_of(&self, node: usize) -> &[u32] {
         &self.node_tets[self.tet_start[node]..self.tet_start[node + 1]]
     }
 
@@ -211,6 +211,15 @@ impl NodalAveraging {
         mut add: impl FnMut(&[(u32, DVec3)], f64),
     ) {
         let bulk = model.volumetric_modulus();
+        // ∂m/∂F once per tetrahedron; each serves the four patches it belongs to.
+        let measure_gradients: Vec<DMat3> = fvm
+            .tets()
+            .iter()
+            .enumerate()
+            .map(|(t, tet)| {
+                model.volume_measure_gradient(&fvm.tet_rest(t).gradient(&gather(tet, x)))
+            })
+            .collect();
         let mut gradient: Vec<(u32, DVec3)> = Vec::new();
         for a in 0..fvm.node_count() {
             gradient.clear();
@@ -218,7 +227,7 @@ impl NodalAveraging {
                 let t = t as usize;
                 let rest = fvm.tet_rest(t);
                 let tet = &fvm.tets()[t];
-                let dm = model.volume_measure_gradient(&rest.gradient(&gather(tet, x)));
+                let dm = measure_gradients[t];
                 let share = rest.volume / self.patch_volume[a];
                 for (&n, g) in tet.iter().zip(rest.shape_gradients()) {
                     gradient.push((n, dm * g * share));

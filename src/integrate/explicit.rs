@@ -216,6 +216,7 @@ fn substep(body: &mut SoftBody, h: f64, gravity: DVec3) {
         masses,
         pinned,
         forces,
+        rigid_proxies,
         ..
     } = body;
     for n in 0..velocities.len() {
@@ -223,7 +224,11 @@ fn substep(body: &mut SoftBody, h: f64, gravity: DVec3) {
             velocities[n] += (forces[n] / masses[n] + gravity) * h;
         }
     }
-    contact::constrain_velocities(body, h, gravity);
+    // The rigid bodies touched fall too, as rapier will make them (unless held).
+    for proxy in rigid_proxies.iter_mut() {
+        proxy.fall(gravity, h);
+    }
+    contact::constrain_velocities(body, h);
     attachment::constrain_velocities(body, h);
     let SoftBody {
         positions,

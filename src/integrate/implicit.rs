@@ -271,42 +271,32 @@ impl ImplicitIntegrator {
         let reference = start.force_scale(body, &residual);
         // Relative residuals of the earlier iterations, newest last.
         let mut history: Vec<f64> = Vec::new();
-        let mut iteration = 0;
-        let (mut linear_iterations, mut projected_tangents) = (0, 0);
-        let outcome =
-            |iterations, (linear_iterations, projected_tangents), residual, converged| Outcome {
-                iterations,
-                linear_iterations,
-                projected_tangents,
-                residual,
-                converged,
-            };
+        // Filled in as Newton goes; `residual` and `converged` are set on return.
+        let mut outcome = Outcome {
+            iterations: 0,
+            linear_iterations: 0,
+            projected_tangents: 0,
+            residual: f64::NAN,
+            converged: false,
+        };
         loop {
             let relative = norm(&residual) / reference;
+            outcome.residual = relative;
             if !relative.is_finite() {
                 let node = residual.iter().position(|r| !r.is_finite()).unwrap_or(0);
                 return Err(Error::NonFiniteState { node });
             }
             if relative <= self.tolerance {
-                return Ok(outcome(
-                    iteration,
-                    (linear_iterations, projected_tangents),
-                    relative,
-                    true,
-                ));
+                outcome.converged = true;
+                return Ok(outcome);
             }
             // A small residual that three iterations could not cut by 10 % sits on its round-off
             // floor (very stiff or nearly incompressible material against a small load).
             let stalled = relative <= STALL_CEILING
                 && history.len() >= 3
                 && relative > 0.9 * history[history.len() - 3];
-            if iteration == self.max_newton_iterations || stalled {
-                return Ok(outcome(
-                    iteration,
-                    (linear_iterations, projected_tangents),
-                    relative,
-                    false,
-                ));
+            if outcome.iterations == self.max_newton_iterations || stalled {
+                return Ok(outcome);
             }
             history.push(relative);
             // The exact Hessian converges fastest; where it is indefinite (compressed elements)
@@ -316,11 +306,11 @@ impl ImplicitIntegrator {
                 self.tolerance / relative,
                 stiffness,
                 &residual,
-                iteration,
+                outcome.iterations,
                 |stiffness, project| start.assemble(body, stiffness, &inertia, project),
             )?;
-            linear_iterations += solution.cg_iterations;
-            projected_tangents += usize::from(solution.projected);
+            outcome.linear_iterations += solution.cg_iterations;
+            outcome.projected_tangents += usize::from(solution.projected);
             if solution.fell_back {
                 *method = Method::Direct;
             }
@@ -330,16 +320,9 @@ impl ImplicitIntegrator {
                 start.residual(body)
             }) {
                 Some(next) => residual = next,
-                None => {
-                    return Ok(outcome(
-                        iteration,
-                        (linear_iterations, projected_tangents),
-                        relative,
-                        false,
-                    ));
-                }
+                None => return Ok(outcome),
             }
-            iteration += 1;
+            outcome.iterations += 1;
         }
     }
 }

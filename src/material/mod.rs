@@ -246,6 +246,15 @@ pub(crate) fn double_dot(a: &DMat3, b: &DMat3) -> f64 {
     a.x_axis.dot(b.x_axis) + a.y_axis.dot(b.y_axis) + a.z_axis.dot(b.z_axis)
 }
 
+/// Whether a symmetric 3x3 matrix is positive definite (Sylvester's criterion: its leading
+/// principal minors are positive). False for a non-finite matrix.
+#[inline(always)]
+pub(crate) fn is_positive_definite(m: &DMat3) -> bool {
+    m.x_axis.x > 0.0
+        && m.x_axis.x * m.y_axis.y - m.y_axis.x * m.x_axis.y > 0.0
+        && m.determinant() > 0.0
+}
+
 /// Trace of a 3x3 matrix.
 #[inline(always)]
 pub(crate) fn trace(m: &DMat3) -> f64 {

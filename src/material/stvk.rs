@@ -117,10 +117,7 @@ fn continued_green(sigma: f64) -> [f64; 3] {
 #[inline(always)]
 fn above_threshold(f: &DMat3, ftf: &DMat3) -> bool {
     let d = *ftf - DMat3::IDENTITY * (COMPRESSION_THRESHOLD * COMPRESSION_THRESHOLD);
-    f.determinant() > 0.0
-        && d.x_axis.x > 0.0
-        && d.x_axis.x * d.y_axis.y - d.y_axis.x * d.x_axis.y > 0.0
-        && d.determinant() > 0.0
+    f.determinant() > 0.0 && super::is_positive_definite(&d)
 }
 
 /// The sign-fixed decomposition of `F` when the continued energy differs from the closed form
