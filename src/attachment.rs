@@ -31,6 +31,11 @@ pub struct Attachment {
     pub(crate) anchor: DVec3,
     /// Index of the body among the soft body's rigid proxies.
     pub(crate) proxy: usize,
+    /// Within an explicit substep: the velocity (m/s) of the node relative to the anchor that
+    /// corrects part of the drift, and the inverse of the node's and body's joint inverse mass
+    /// (kg).
+    drift_velocity: DVec3,
+    effective_mass: DMat3,
 }
 
 impl SoftBody {
@@ -67,6 +72,8 @@ impl SoftBody {
                 local_anchor,
                 anchor: x,
                 proxy: usize::MAX,
+                drift_velocity: DVec3::ZERO,
+                effective_mass: DMat3::ZERO,
             });
         }
         self.attachments.extend(added);
@@ -104,8 +111,22 @@ pub(crate) fn ready(
     }
 }
 
-/// Enforces the attachments on velocity for an explicit substep of `h` (s), after the contacts.
-pub(crate) fn constrain_velocities(body: &mut SoftBody, h: f64) {
+/// Readies the attachments' velocity constraints for an explicit substep of `h` (s), before the
+/// sweeps of [`solve_velocities`].
+pub(crate) fn prepare_velocities(body: &mut SoftBody, h: f64) {
+    for attachment in &mut body.attachments {
+        let n = attachment.node as usize;
+        let x = body.positions[n];
+        attachment.drift_velocity = (attachment.anchor - x) * (DRIFT_CORRECTION / h);
+        attachment.effective_mass = (DMat3::IDENTITY * (1.0 / body.masses[n])
+            + body.rigid_proxies[attachment.proxy].inverse_mass_matrix(x))
+        .inverse();
+    }
+}
+
+/// One sweep over the attachments' velocity constraints, after the contacts': each node's
+/// velocity is set to its anchor's plus the drift correction by an impulse shared with the body.
+pub(crate) fn solve_velocities(body: &mut SoftBody) {
     let SoftBody {
         attachments,
         rigid_proxies,
@@ -115,19 +136,23 @@ pub(crate) fn constrain_velocities(body: &mut SoftBody, h: f64) {
         pinned,
         ..
     } = body;
-    for attachment in attachments.iter_mut() {
+    for attachment in attachments.iter() {
         let n = attachment.node as usize;
         if pinned[n] {
             continue;
         }
         let proxy = &mut rigid_proxies[attachment.proxy];
-        let x = positions[n];
-        let anchor_velocity = proxy.velocity_at(attachment.anchor);
-        let wanted = anchor_velocity + (attachment.anchor - x) * (DRIFT_CORRECTION / h);
-        let effective = DMat3::IDENTITY * (1.0 / masses[n]) + proxy.inverse_mass_matrix(x);
-        let impulse = effective.inverse() * (wanted - velocities[n]);
+        let wanted = proxy.velocity_at(attachment.anchor) + attachment.drift_velocity;
+        let impulse = attachment.effective_mass * (wanted - velocities[n]);
         velocities[n] += impulse / masses[n];
-        proxy.apply(-impulse, x);
+        proxy.apply(-impulse, positions[n]);
+    }
+}
+
+/// Carries the anchors with their bodies over an explicit substep of `h` (s), after the sweeps.
+pub(crate) fn advance_anchors(body: &mut SoftBody, h: f64) {
+    for attachment in &mut body.attachments {
+        let proxy = &body.rigid_proxies[attachment.proxy];
         attachment.anchor += proxy.velocity_at(attachment.anchor) * h;
     }
 }

@@ -44,6 +44,11 @@ pub struct ContactSettings {
     /// (it entered between detections, e.g. pushed by a rigid body that moved): an impulse, so
     /// that momentum stays exchanged exactly, rather than a jump of position.
     pub depenetration_speed: f64,
+    /// Sweeps per explicit substep over the contacts and attachments of a body touching dynamic
+    /// rigid bodies (at least 1): they are coupled through each rigid body's velocity, and a
+    /// single sweep leaves it rocking on its supports. Contacts with fixed and kinematic bodies
+    /// are independent and take one sweep.
+    pub velocity_iterations: u32,
 }
 
 impl Default for ContactSettings {
@@ -52,6 +57,7 @@ impl Default for ContactSettings {
             margin: 1e-3,
             penalty_factor: 1e3,
             depenetration_speed: 0.1,
+            velocity_iterations: 4,
         }
     }
 }
@@ -75,6 +81,11 @@ pub struct NodeContact {
     pub impulse: DVec3,
     /// Index of the collider's rigid body among the body's proxies, if it has one.
     proxy: Option<usize>,
+    /// Within an explicit substep: the lowest normal velocity (m/s) relative to the collider the
+    /// node may keep, and the normal (N s) and friction impulses accumulated so far.
+    lowest_speed: f64,
+    normal_impulse: f64,
+    friction_impulse: DVec3,
     shape: SharedShape,
     pose: Pose,
 }
@@ -231,6 +242,9 @@ impl SoftBody {
                         friction: f64::from(collider.friction()),
                         impulse: DVec3::ZERO,
                         proxy,
+                        lowest_speed: 0.0,
+                        normal_impulse: 0.0,
+                        friction_impulse: DVec3::ZERO,
                         shape: shape.clone(),
                         pose: *pose,
                     });
@@ -342,61 +356,96 @@ fn nearest_surface_point(shape: &dyn Shape, pose: &Pose, x: DVec3) -> Option<(DV
     Some((point, normal, sign * offset.length()))
 }
 
-/// Enforces the contacts as velocity constraints for a substep of `h` (s): called after the
-/// velocity update, before positions move. A node found inside leaves at
-/// most at the depenetration speed. Against a rigid body the constraint is on the relative
-/// velocity, with the body's effective mass, and the body receives the opposite impulse at the
-/// node.
-pub(crate) fn constrain_velocities(body: &mut SoftBody, h: f64) {
+/// Readies the contacts' velocity constraints for an explicit substep of `h` (s), before the
+/// sweeps of [`solve_velocities`]: each plane moves to the collider's surface point nearest to its
+/// node, and the lowest normal velocity is set so that the node arrives at the plane but does not
+/// cross it within the substep, or, found inside, leaves at most at the depenetration speed.
+pub(crate) fn prepare_velocities(body: &mut SoftBody, h: f64) {
+    let depenetration_speed = body.contact_settings.depenetration_speed;
+    for contact in &mut body.contacts {
+        let x = body.positions[contact.node as usize];
+        contact.refresh(x);
+        let gap = contact.gap(x);
+        contact.lowest_speed = if gap >= 0.0 {
+            -gap / h
+        } else {
+            (-gap / h).min(depenetration_speed)
+        };
+        contact.normal_impulse = 0.0;
+        contact.friction_impulse = DVec3::ZERO;
+    }
+}
+
+/// One sweep over the contacts' velocity constraints (called after the velocity update, before
+/// positions move): each contact's accumulated normal impulse is corrected toward the one that
+/// brings its node's normal velocity relative to the collider to the lowest allowed, kept
+/// pushing, and its friction impulse toward the one that stops the sliding, kept within the
+/// collider's friction coefficient times the normal impulse (Coulomb). Against a rigid body the
+/// velocities are relative, the body's effective mass counts, and the body receives the opposite
+/// impulse at the node; the sweeps converge to the contacts' joint solution.
+pub(crate) fn solve_velocities(body: &mut SoftBody) {
     let SoftBody {
         contacts,
         rigid_proxies,
         positions,
         velocities,
         masses,
-        contact_settings,
         ..
     } = body;
     for contact in contacts.iter_mut() {
         let n = contact.node as usize;
-        contact.refresh(positions[n]);
-        let gap = contact.gap(positions[n]);
         let x = positions[n];
         let mut proxy = contact.proxy.map(|p| &mut rigid_proxies[p]);
-        let surface_velocity = proxy.as_ref().map_or(DVec3::ZERO, |p| p.velocity_at(x));
-        // Arrive at the plane, never cross it; from inside, leave it.
-        let lowest = if gap >= 0.0 {
-            -gap / h
-        } else {
-            (-gap / h).min(contact_settings.depenetration_speed)
-        };
-        let relative = velocities[n] - surface_velocity;
-        let normal_speed = relative.dot(contact.normal);
-        if normal_speed >= lowest {
-            continue;
-        }
-        let inverse_mass = |direction: DVec3| {
+        let inverse_mass = |proxy: &Option<&mut RigidProxy>, direction: DVec3| {
             1.0 / masses[n]
                 + proxy
                     .as_ref()
                     .map_or(0.0, |p| p.inverse_mass_along(x, direction))
         };
-        let normal_impulse = (lowest - normal_speed) / inverse_mass(contact.normal);
-        let tangential = relative - contact.normal * normal_speed;
-        let slip = tangential.length();
-        let friction_impulse = if slip > 0.0 {
-            let direction = tangential / slip;
-            let stop = slip / inverse_mass(direction);
-            -direction * stop.min(contact.friction * normal_impulse)
-        } else {
-            DVec3::ZERO
+        let relative = |proxy: &Option<&mut RigidProxy>, v: DVec3| {
+            v - proxy.as_ref().map_or(DVec3::ZERO, |p| p.velocity_at(x))
         };
-        let impulse = contact.normal * normal_impulse + friction_impulse;
-        velocities[n] += impulse / masses[n];
-        contact.impulse += impulse;
-        if let Some(proxy) = proxy.as_mut() {
-            proxy.apply(-impulse, x);
+
+        let normal_speed = relative(&proxy, velocities[n]).dot(contact.normal);
+        let normal_impulse = (contact.normal_impulse
+            + (contact.lowest_speed - normal_speed) / inverse_mass(&proxy, contact.normal))
+        .max(0.0);
+        let push = |impulse: DVec3,
+                    velocity: &mut DVec3,
+                    recorded: &mut DVec3,
+                    proxy: &mut Option<&mut RigidProxy>| {
+            *velocity += impulse / masses[n];
+            *recorded += impulse;
+            if let Some(proxy) = proxy.as_mut() {
+                proxy.apply(-impulse, x);
+            }
+        };
+        push(
+            contact.normal * (normal_impulse - contact.normal_impulse),
+            &mut velocities[n],
+            &mut contact.impulse,
+            &mut proxy,
+        );
+        contact.normal_impulse = normal_impulse;
+
+        let v = relative(&proxy, velocities[n]);
+        let sliding = v - contact.normal * v.dot(contact.normal);
+        let slip = sliding.length();
+        let mut friction = contact.friction_impulse;
+        if slip > 0.0 {
+            friction -= sliding / inverse_mass(&proxy, sliding / slip);
         }
+        let limit = contact.friction * normal_impulse;
+        if friction.length() > limit {
+            friction *= limit / friction.length();
+        }
+        push(
+            friction - contact.friction_impulse,
+            &mut velocities[n],
+            &mut contact.impulse,
+            &mut proxy,
+        );
+        contact.friction_impulse = friction;
     }
 }
 

@@ -88,6 +88,11 @@ impl RigidProxy {
         }
     }
 
+    /// Whether contact impulses move the body (it is dynamic).
+    pub(crate) fn is_dynamic(&self) -> bool {
+        self.inv_mass != DVec3::ZERO || self.inv_inertia != DMat3::ZERO
+    }
+
     /// Velocity (m/s) of the body's material point at `point` (m).
     pub(crate) fn velocity_at(&self, point: DVec3) -> DVec3 {
         self.linvel + self.angvel.cross(point - self.com)

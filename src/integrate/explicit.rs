@@ -14,6 +14,7 @@
 use super::check_step;
 use crate::Error;
 use crate::body::SoftBody;
+use crate::contact::RigidProxy;
 use crate::{attachment, contact};
 use rapier3d::glamx::DVec3;
 
@@ -228,8 +229,19 @@ fn substep(body: &mut SoftBody, h: f64, gravity: DVec3) {
     for proxy in rigid_proxies.iter_mut() {
         proxy.fall(gravity, h);
     }
-    contact::constrain_velocities(body, h);
-    attachment::constrain_velocities(body, h);
+    contact::prepare_velocities(body, h);
+    attachment::prepare_velocities(body, h);
+    // Constraints are coupled only through the velocities of dynamic rigid bodies.
+    let sweeps = if body.rigid_proxies.iter().any(RigidProxy::is_dynamic) {
+        body.contact_settings.velocity_iterations.max(1)
+    } else {
+        1
+    };
+    for _ in 0..sweeps {
+        contact::solve_velocities(body);
+        attachment::solve_velocities(body);
+    }
+    attachment::advance_anchors(body, h);
     let SoftBody {
         positions,
         velocities,
