@@ -92,11 +92,13 @@ impl SoftBody {
 }
 
 /// Places the attachments' anchors where their bodies are now and gives each body a proxy
-/// (shared with the contacts'); attachments to bodies no longer in `bodies` are dropped.
+/// (shared with the contacts') for a step of `dt` (s); attachments to bodies no longer in
+/// `bodies` are dropped.
 pub(crate) fn ready(
     attachments: &mut Vec<Attachment>,
     proxies: &mut Vec<RigidProxy>,
     bodies: &RigidBodySet,
+    dt: f64,
 ) {
     attachments.retain(|a| bodies.get(a.body).is_some());
     for attachment in attachments.iter_mut() {
@@ -107,7 +109,7 @@ pub(crate) fn ready(
             .position()
             .transform_point(attachment.local_anchor.as_vec3())
             .as_dvec3();
-        attachment.proxy = RigidProxy::index_in(proxies, attachment.body, rigid);
+        attachment.proxy = RigidProxy::index_in(proxies, attachment.body, rigid, dt);
     }
 }
 

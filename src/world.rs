@@ -9,12 +9,17 @@
 //! rigid bodies' view of the soft bodies one short substep old, which removes the friction
 //! ratchet and the rocking that a single rapier step per frame shows. The frame's
 //! `num_solver_iterations` are divided among the substeps (rounded up), so rapier's solver cost
-//! per frame is about unchanged; its collision detection runs once per substep.
+//! per frame is about unchanged; its collision detection runs once per substep. A
+//! position-based kinematic body told where to be at the end of the frame
+//! (`set_next_kinematic_position`) gets there along the straight path (rotation by slerp), a
+//! part per substep, rather than in the first substep.
 
 use crate::Error;
 use crate::body::{SoftBodyHandle, SoftBodySet};
 use crate::contact::ContactSettings;
 use crate::integrate::{AutomaticIntegrator, AutomaticReport};
+use rapier3d::dynamics::{RigidBodyHandle, RigidBodySet, RigidBodyType};
+use rapier3d::math::Pose;
 use rapier3d::pipeline::{EventHandler, PhysicsHooks, PhysicsWorld};
 
 /// Rigid and soft bodies in one world.
@@ -87,6 +92,39 @@ fn hold_supported_bodies(body: &mut crate::body::SoftBody, physics: &PhysicsWorl
     }
 }
 
+/// A position-based kinematic body's motion over a frame: from its pose to the one it was told
+/// to reach.
+struct KinematicPath {
+    handle: RigidBodyHandle,
+    from: Pose,
+    to: Pose,
+}
+
+impl KinematicPath {
+    /// The paths of the position-based kinematic bodies of `bodies` that are told to move.
+    fn all(bodies: &RigidBodySet) -> Vec<Self> {
+        bodies
+            .iter()
+            .filter(|(_, body)| {
+                body.body_type() == RigidBodyType::KinematicPositionBased
+                    && body.position() != body.next_position()
+            })
+            .map(|(handle, body)| Self {
+                handle,
+                from: *body.position(),
+                to: *body.next_position(),
+            })
+            .collect()
+    }
+
+    /// Tells the body to reach `fraction` of its path by the end of the coming rapier step.
+    fn advance(&self, bodies: &mut RigidBodySet, fraction: f32) {
+        if let Some(body) = bodies.get_mut(self.handle) {
+            body.set_next_kinematic_position(self.from.lerp(&self.to, fraction));
+        }
+    }
+}
+
 impl FvmWorld {
     /// Advances the world by one frame (`physics.integration_parameters.dt`), without hooks or
     /// events; see [`FvmWorld::step_with_events`].
@@ -121,7 +159,11 @@ impl FvmWorld {
             .num_solver_iterations
             .div_ceil(substeps as usize)
             .max(1);
-        for _ in 0..substeps {
+        let paths = KinematicPath::all(&self.physics.bodies);
+        for substep in 1..=substeps {
+            for path in &paths {
+                path.advance(&mut self.physics.bodies, substep as f32 / substeps as f32);
+            }
             for ((_, body), (_, outcome)) in self.soft_bodies.iter_mut().zip(&mut outcomes) {
                 if matches!(outcome, Some(Err(_))) {
                     continue;

@@ -13,7 +13,12 @@
 //! - [`ImplicitIntegrator`](crate::integrate::ImplicitIntegrator), as a stiff penalty in the
 //!   incremental potential, `k/2 min(0, g)²` per contact with `g` the signed distance to the plane
 //!   and `k` [`ContactSettings::penalty_factor`] times the node's `m/h²`: the resting penetration
-//!   under a load `w` is `w h²/(factor m)`, micrometres at game steps. Frictionless for now.
+//!   under a load `w` is `w h²/(factor m)`, micrometres at game steps. Friction is the lagged
+//!   dissipation potential of incremental potential contact (Li et al. 2020): the normal force
+//!   is taken from the penalty at the start of the step, and the node's slip relative to the
+//!   surface over the step, `u`, costs `μ λ f(|u|)`, with `f` quadratic below
+//!   [`ContactSettings::stiction_speed`] times the step (static friction as a stiff spring) and
+//!   linear above (sliding friction of exactly `μ λ`).
 //!
 //! A collider attached to a rigid body takes the body's motion into account (its velocity at the
 //! contact point) and, when the body is dynamic, receives the opposite of every impulse the soft
@@ -23,7 +28,7 @@
 
 mod rigid;
 
-pub(crate) use rigid::RigidProxy;
+pub(crate) use rigid::{RigidProxy, coming_velocity};
 
 use crate::Error;
 use crate::body::SoftBody;
@@ -49,6 +54,10 @@ pub struct ContactSettings {
     /// single sweep leaves it rocking on its supports. Contacts with fixed and kinematic bodies
     /// are independent and take one sweep.
     pub velocity_iterations: u32,
+    /// Implicit friction: the slip speed (m/s) below which a contact sticks elastically rather
+    /// than slides; a stuck node creeps at most at this speed, times the ratio of its friction
+    /// force to its friction limit.
+    pub stiction_speed: f64,
 }
 
 impl Default for ContactSettings {
@@ -58,6 +67,7 @@ impl Default for ContactSettings {
             penalty_factor: 1e3,
             depenetration_speed: 0.1,
             velocity_iterations: 4,
+            stiction_speed: 1e-4,
         }
     }
 }
@@ -86,6 +96,11 @@ pub struct NodeContact {
     lowest_speed: f64,
     normal_impulse: f64,
     friction_impulse: DVec3,
+    /// Within an implicit step: the normal force (N) friction is limited by, and the node's
+    /// position and the surface's velocity there at the start of the step (m, m/s).
+    lagged_normal_force: f64,
+    slip_origin: DVec3,
+    surface_velocity: DVec3,
     shape: SharedShape,
     pose: Pose,
 }
@@ -122,6 +137,40 @@ impl NodeContact {
         (gap < 0.0).then(|| (settings.penalty_stiffness(mass, h), gap))
     }
 
+    /// The lagged friction dissipation of the node at `x` (m) over an implicit step of effective
+    /// length `h` (s): its energy `μ λ f(|u|)` (J), force (N) and positive semi-definite tangent
+    /// (N/m), where `u` is the slip relative to the surface in the contact plane and
+    /// `f(s) = s²/2ε` below `ε = stiction_speed h`, `s - ε/2` above; `None` without a friction
+    /// limit.
+    fn friction_term(
+        &self,
+        x: DVec3,
+        settings: &ContactSettings,
+        h: f64,
+    ) -> Option<(f64, DVec3, DMat3)> {
+        let limit = self.friction * self.lagged_normal_force;
+        if limit <= 0.0 {
+            return None;
+        }
+        let plane = DMat3::IDENTITY - penalty_tangent(1.0, self.normal);
+        let slip = plane * (x - self.slip_origin - self.surface_velocity * h);
+        let (s, stick) = (slip.length(), settings.stiction_speed * h);
+        Some(if s < stick {
+            (
+                limit * s * s / (2.0 * stick),
+                -slip * (limit / stick),
+                plane * (limit / stick),
+            )
+        } else {
+            let direction = slip / s;
+            (
+                limit * (s - stick / 2.0),
+                -direction * limit,
+                (plane - penalty_tangent(1.0, direction)) * (limit / s),
+            )
+        })
+    }
+
     /// Moves the plane to the collider's surface point nearest to `x` (m), if defined there.
     fn refresh(&mut self, x: DVec3) {
         if let Some((point, normal, _)) = nearest_surface_point(&*self.shape, &self.pose, x) {
@@ -153,6 +202,13 @@ impl ContactSettings {
                 reason: "must be non-negative and finite (m/s)",
             });
         }
+        if !(self.stiction_speed.is_finite() && self.stiction_speed > 0.0) {
+            return Err(Error::InvalidSetting {
+                parameter: "stiction_speed",
+                value: self.stiction_speed,
+                reason: "must be positive and finite (m/s)",
+            });
+        }
         if !(self.penalty_factor.is_finite() && self.penalty_factor > 0.0) {
             return Err(Error::InvalidSetting {
                 parameter: "penalty_factor",
@@ -169,7 +225,8 @@ impl SoftBody {
     /// (s) under `gravity` (m/s²), replacing the previous ones: a node gets a contact with each
     /// non-sensor collider it is within `margin` of, plus twice the distance the body's fastest
     /// node can travel in the frame (`2 (|v|max + |g| dt) dt`), plus twice the collider's own
-    /// travel (at most 1 m). The integrators enforce them until
+    /// travel (at most 1 m), except the colliders of a rigid body the node is attached to. The
+    /// integrators enforce them until
     /// the next detection. It also places the attachments' anchors where their rigid bodies are
     /// now, ready for the step.
     ///
@@ -207,17 +264,22 @@ impl SoftBody {
             // The collider's own travel in the frame, at its fastest point.
             let collider_reach = parent.map_or(0.0, |(_, body)| {
                 let radius = f64::from(aabb.half_extents().length());
-                2.0 * (body.linvel().as_dvec3().length()
-                    + body.angvel().as_dvec3().length() * radius)
-                    * frame_dt
+                let (linvel, angvel) = coming_velocity(body, frame_dt);
+                2.0 * (linvel.length() + angvel.length() * radius) * frame_dt
             });
             let reach = reach + collider_reach.min(MAX_COLLIDER_REACH);
             let (lo, hi) = (aabb.mins.as_dvec3(), aabb.maxs.as_dvec3());
             let (shape, pose) = (collider.shared_shape(), collider.position());
+            let glued: Vec<u32> = self
+                .attachments
+                .iter()
+                .filter(|a| Some(a.body) == collider.parent())
+                .map(|a| a.node)
+                .collect();
             let mut proxy = None;
             for &node in &self.surface_nodes {
                 let n = node as usize;
-                if self.pinned[n] {
+                if self.pinned[n] || glued.contains(&node) {
                     continue;
                 }
                 let x = self.positions[n];
@@ -232,7 +294,7 @@ impl SoftBody {
                     if proxy.is_none()
                         && let Some((handle, body)) = parent
                     {
-                        proxy = Some(RigidProxy::index_in(&mut proxies, handle, body));
+                        proxy = Some(RigidProxy::index_in(&mut proxies, handle, body, frame_dt));
                     }
                     contacts.push(NodeContact {
                         node,
@@ -245,13 +307,16 @@ impl SoftBody {
                         lowest_speed: 0.0,
                         normal_impulse: 0.0,
                         friction_impulse: DVec3::ZERO,
+                        lagged_normal_force: 0.0,
+                        slip_origin: DVec3::ZERO,
+                        surface_velocity: DVec3::ZERO,
                         shape: shape.clone(),
                         pose: *pose,
                     });
                 }
             }
         }
-        crate::attachment::ready(&mut self.attachments, &mut proxies, bodies);
+        crate::attachment::ready(&mut self.attachments, &mut proxies, bodies, frame_dt);
         self.contacts = contacts;
         self.rigid_proxies = proxies;
         self.contact_settings = *settings;
@@ -449,8 +514,8 @@ pub(crate) fn solve_velocities(body: &mut SoftBody) {
     }
 }
 
-/// Records the impulses (N s) the implicit penalty gave the nodes over a substep of length `h`
-/// (s), at the positions that ended it, and hands their opposite to the rigid bodies.
+/// Records the impulses (N s) the implicit penalty and friction gave the nodes over a substep of
+/// length `h` (s), at the positions that ended it, and hands their opposite to the rigid bodies.
 pub(crate) fn record_penalty_impulses(body: &mut SoftBody, effective_h: f64, h: f64) {
     let SoftBody {
         contacts,
@@ -462,14 +527,59 @@ pub(crate) fn record_penalty_impulses(body: &mut SoftBody, effective_h: f64, h: 
     } = body;
     for contact in contacts.iter_mut() {
         let n = contact.node as usize;
+        let mut force = contact
+            .friction_term(positions[n], contact_settings, effective_h)
+            .map_or(DVec3::ZERO, |(_, force, _)| force);
         if let Some((stiffness, gap)) =
             contact.penalty(positions[n], masses[n], contact_settings, effective_h)
         {
-            let impulse = contact.normal * (-stiffness * gap * h);
-            contact.impulse += impulse;
-            if let Some(p) = contact.proxy {
-                rigid_proxies[p].apply(-impulse, positions[n]);
-            }
+            force -= contact.normal * (stiffness * gap);
+        }
+        let impulse = force * h;
+        contact.impulse += impulse;
+        if let Some(p) = contact.proxy {
+            rigid_proxies[p].apply(-impulse, positions[n]);
+        }
+    }
+}
+
+/// Readies implicit friction for a step of effective length `h` (s) from the body's positions:
+/// each contact's friction limit is its penalty force there, and slip is measured from there.
+pub(crate) fn lag_friction(body: &mut SoftBody, h: f64) {
+    let SoftBody {
+        contacts,
+        rigid_proxies,
+        positions,
+        masses,
+        contact_settings,
+        ..
+    } = body;
+    for contact in contacts.iter_mut() {
+        let x = positions[contact.node as usize];
+        contact.lagged_normal_force = contact
+            .penalty(x, masses[contact.node as usize], contact_settings, h)
+            .map_or(0.0, |(stiffness, gap)| -stiffness * gap);
+        contact.slip_origin = x;
+        contact.surface_velocity = contact
+            .proxy
+            .map_or(DVec3::ZERO, |p| rigid_proxies[p].velocity_at(x));
+    }
+}
+
+/// The implicit friction of the contacts for an effective step `h` (s), at the body's positions:
+/// calls `each(node, energy (J), force (N), tangent (N/m))` for every contact with a friction
+/// limit (see [`lag_friction`]).
+pub(crate) fn for_each_friction(
+    body: &SoftBody,
+    h: f64,
+    mut each: impl FnMut(usize, f64, DVec3, DMat3),
+) {
+    for contact in &body.contacts {
+        let n = contact.node as usize;
+        if let Some((energy, force, tangent)) =
+            contact.friction_term(body.positions[n], &body.contact_settings, h)
+        {
+            each(n, energy, force, tangent);
         }
     }
 }

@@ -2,8 +2,22 @@
 //! inverse mass, frozen in pose for the step, updated by the contact impulses as they are applied,
 //! and the total impulse to hand back to rapier when the step is accepted.
 
-use rapier3d::dynamics::{RigidBody, RigidBodyHandle, RigidBodySet};
+use rapier3d::dynamics::{RigidBody, RigidBodyHandle, RigidBodySet, RigidBodyType};
 use rapier3d::glamx::{DMat3, DVec3};
+
+/// The linear velocity of the centre of mass (m/s) and the angular velocity (rad/s) `body` will
+/// have over the coming step of `dt` (s): its velocities, or, for a position-based kinematic
+/// body, the motion to the pose it was told to reach (as rapier derives them in its step).
+pub(crate) fn coming_velocity(body: &RigidBody, dt: f64) -> (DVec3, DVec3) {
+    if body.body_type() != RigidBodyType::KinematicPositionBased {
+        return (body.linvel().as_dvec3(), body.angvel().as_dvec3());
+    }
+    let (now, next) = (body.position(), body.next_position());
+    let local_com = body.mass_properties().local_mprops.local_com;
+    let travel = next.transform_point(local_com) - now.transform_point(local_com);
+    let turn = (next.rotation * now.rotation.inverse()).to_scaled_axis();
+    (travel.as_dvec3() / dt, turn.as_dvec3() / dt)
+}
 
 /// A rigid body in contact with a soft body during one soft step.
 #[derive(Debug, Clone)]
@@ -26,8 +40,8 @@ pub(crate) struct RigidProxy {
 }
 
 impl RigidProxy {
-    /// The proxy of `body`, stored in rapier's set under `handle`.
-    pub(crate) fn new(handle: RigidBodyHandle, body: &RigidBody) -> Self {
+    /// The proxy of `body`, stored in rapier's set under `handle`, for a step of `dt` (s).
+    pub(crate) fn new(handle: RigidBodyHandle, body: &RigidBody, dt: f64) -> Self {
         let props = body.mass_properties();
         let fall = if body.is_dynamic() {
             f64::from(body.gravity_scale())
@@ -46,10 +60,11 @@ impl RigidProxy {
         } else {
             (DVec3::ZERO, DMat3::ZERO)
         };
+        let (linvel, angvel) = coming_velocity(body, dt);
         Self {
             handle,
-            linvel: body.linvel().as_dvec3(),
-            angvel: body.angvel().as_dvec3(),
+            linvel,
+            angvel,
             com: props.world_com.as_dvec3(),
             fall,
             inv_mass,
@@ -72,17 +87,18 @@ impl RigidProxy {
         self.fall = 0.0;
     }
 
-    /// The index of `body`'s proxy in `proxies`, added if missing: one proxy per rigid body,
-    /// whatever its number of colliders and attachments.
+    /// The index of `body`'s proxy in `proxies` for a step of `dt` (s), added if missing: one
+    /// proxy per rigid body, whatever its number of colliders and attachments.
     pub(crate) fn index_in(
         proxies: &mut Vec<RigidProxy>,
         handle: RigidBodyHandle,
         body: &RigidBody,
+        dt: f64,
     ) -> usize {
         match proxies.iter().position(|p| p.handle == handle) {
             Some(index) => index,
             None => {
-                proxies.push(RigidProxy::new(handle, body));
+                proxies.push(RigidProxy::new(handle, body, dt));
                 proxies.len() - 1
             }
         }

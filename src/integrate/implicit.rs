@@ -224,6 +224,7 @@ impl ImplicitIntegrator {
         gravity: DVec3,
     ) -> Result<Outcome, Error> {
         let start = StepStart::new(body, h, gravity, self.scheme);
+        contact::lag_friction(body, start.h);
         // Newton starts from the inertial prediction `x̂` (free flight: the warm start that makes
         // smooth motion cost one iteration), or from where the body is when that is the lower
         // potential (a prediction deep inside an obstacle or crushing elements).
@@ -415,6 +416,9 @@ impl StepStart {
         contact::for_each_active_penalty(body, self.h, |node, stiffness, gap, normal| {
             residual[node] -= normal * (stiffness * gap);
         });
+        contact::for_each_friction(body, self.h, |node, _, force, _| {
+            residual[node] += force;
+        });
         attachment::for_each_spring(body, self.h, |node, stiffness, target| {
             residual[node] += (target - body.positions[node]) * stiffness;
         });
@@ -476,6 +480,9 @@ impl StepStart {
         contact::for_each_active_penalty(body, self.h, |_, stiffness, gap, _| {
             penalty += 0.5 * stiffness * gap * gap;
         });
+        contact::for_each_friction(body, self.h, |_, energy, _, _| {
+            penalty += energy;
+        });
         attachment::for_each_spring(body, self.h, |node, stiffness, target| {
             penalty += 0.5 * stiffness * (body.positions[node] - target).length_squared();
         });
@@ -492,6 +499,9 @@ impl StepStart {
         });
         contact::for_each_active_penalty(body, self.h, |node, k, _, normal| {
             stiffness.add_node_block(node, &contact::penalty_tangent(k, normal));
+        });
+        contact::for_each_friction(body, self.h, |node, _, _, tangent| {
+            stiffness.add_node_block(node, &tangent);
         });
         attachment::for_each_spring(body, self.h, |node, k, _| {
             stiffness.add_node_block(node, &(DMat3::IDENTITY * k));
