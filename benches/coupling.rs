@@ -1,0 +1,108 @@
+//! What coupling soft bodies to rapier costs per frame of 1/60 s, side by side in one run:
+//!
+//! - (a) `soft_cube_alone`: the drop scene's soft cube (10 cm, stable Neo-Hookean, E = 1e5 Pa,
+//!   ν = 0.3, 1000 kg/m³, 6 x 6 x 6 cells, Rayleigh damping 2e-3 s, as in `examples/drop.rs`)
+//!   falling freely, stepped by the world's automatic integrator `coupling_substeps` times per
+//!   frame at the coupling substep length: the soft step alone, without contacts or rapier.
+//! - (b) `soft_cube_on_ground`: the same cube resting on a fixed half-space ground (friction 0.5)
+//!   in an [`FvmWorld`]: contact detection, contacts enforced, and rapier's sub-cycled step.
+//! - (c) `box_on_soft_block`: `examples/rigid_on_soft.rs`'s scene, a 2 kg rigid box (10 cm)
+//!   resting 4 cm off-centre on a 20 cm soft block (E = 1e6 Pa, 4 x 4 x 4 cells) on the ground,
+//!   in an [`FvmWorld`]: two-way contact with a dynamic rigid body.
+//!
+//! Every scene first runs 1 s of frames outside the timing, so that (b) and (c) measure steady
+//! contact. Times are per frame.
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use rapier_fvm::glamx::Vec3;
+use rapier_fvm::prelude::*;
+use rapier_fvm::world::FvmWorld;
+use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder, SharedShape};
+use std::time::Duration;
+
+/// Frames run before measuring (1 s at 60 frames per second).
+const SETTLING_FRAMES: usize = 60;
+
+/// A damped rubber cube of side `side` (m), `cells` cubes a side, Young's modulus `young` (Pa),
+/// its centre at `centre` (m).
+fn soft_cube(side: f64, cells: usize, young: f64, centre: DVec3) -> SoftBody {
+    let rubber =
+        Material::new(MaterialModel::StableNeoHookean, young, 0.3, 1000.0).expect("valid material");
+    let mesh = mesh::cuboid(DVec3::splat(side / 2.0), [cells; 3]).expect("valid generator input");
+    SoftBodyBuilder::new(mesh, rubber)
+        .damping(
+            RayleighDamping::stiffness_proportional(2e-3, rubber.lame()).expect("valid damping"),
+        )
+        .translation(centre)
+        .build()
+        .expect("valid body")
+}
+
+/// The drop scene's cube with its centre at height `y` (m).
+fn drop_cube(y: f64) -> SoftBody {
+    soft_cube(0.1, 6, 1e5, DVec3::new(0.0, y, 0.0))
+}
+
+/// A world with a fixed half-space ground of friction coefficient `friction`.
+fn world_on_ground(friction: f32) -> FvmWorld {
+    let mut world = FvmWorld::default();
+    world.physics.insert_collider(
+        ColliderBuilder::new(SharedShape::halfspace(Vec3::Y)).friction(friction),
+        None,
+    );
+    world
+}
+
+fn step(world: &mut FvmWorld) {
+    for (_, outcome) in world.step() {
+        outcome.expect("coupled frame");
+    }
+}
+
+fn coupling_frame(c: &mut Criterion) {
+    // (b) The cube resting on the ground.
+    let mut on_ground = world_on_ground(0.5);
+    on_ground.soft_bodies.insert(drop_cube(0.05));
+    // (c) The box on the soft block.
+    let mut box_on_block = world_on_ground(0.8);
+    box_on_block
+        .soft_bodies
+        .insert(soft_cube(0.2, 4, 1e6, DVec3::new(0.0, 0.1, 0.0)));
+    box_on_block.physics.insert(
+        RigidBodyBuilder::dynamic().translation(Vec3::new(0.04, 0.2505, 0.0)),
+        ColliderBuilder::cuboid(0.05, 0.05, 0.05)
+            .density(2000.0)
+            .friction(0.8),
+    );
+    // (a) The cube alone, stepped as the world steps its soft bodies.
+    let mut alone = drop_cube(0.55);
+    let integrator = on_ground.integrator;
+    let substeps = on_ground.coupling_substeps;
+    let h = f64::from(on_ground.physics.integration_parameters.dt) / f64::from(substeps);
+    let gravity = on_ground.physics.gravity.as_dvec3();
+    let frame_alone = |body: &mut SoftBody| {
+        for _ in 0..substeps {
+            integrator.step(body, h, gravity).expect("soft step");
+        }
+    };
+    for _ in 0..SETTLING_FRAMES {
+        frame_alone(&mut alone);
+        step(&mut on_ground);
+        step(&mut box_on_block);
+    }
+
+    let mut group = c.benchmark_group("coupling_frame_1_60");
+    group
+        .sample_size(10)
+        .warm_up_time(Duration::from_secs(1))
+        .measurement_time(Duration::from_secs(4));
+    group.bench_function("a_soft_cube_alone", |b| b.iter(|| frame_alone(&mut alone)));
+    group.bench_function("b_soft_cube_on_ground", |b| b.iter(|| step(&mut on_ground)));
+    group.bench_function("c_box_on_soft_block", |b| {
+        b.iter(|| step(&mut box_on_block))
+    });
+    group.finish();
+}
+
+criterion_group!(benches, coupling_frame);
+criterion_main!(benches);
