@@ -147,7 +147,7 @@ fn a_ball_hanging_from_a_soft_rope_swings_with_the_pendulum_period() {
     // (r = 5 cm) glued 1 cm below its end, released 5° from the vertical. The period of the
     // swing (three periods timed from the ball's crossings) is compared with the compound
     // pendulum's, 2π sqrt(I / (M g d)), for the rope's length as it hangs stretched (by about
-    // 4 cm); tolerance 5 %. The rope's bending stiffness, clamped at the top and glued across
+    // 5.4 cm); tolerance 5 %. The rope's bending stiffness, clamped at the top and glued across
     // its end face to the ball, shortens the period (measured -1.2 %; -4.9 % for a 2 x 2 cm
     // rope), and the 5° amplitude lengthens it by 0.05 %.
     let mut world = FvmWorld::default();
