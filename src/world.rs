@@ -19,6 +19,7 @@ use crate::body::{SoftBodyHandle, SoftBodySet};
 use crate::contact::ContactSettings;
 use crate::integrate::{AutomaticIntegrator, AutomaticReport};
 use rapier3d::dynamics::{RigidBodyHandle, RigidBodySet, RigidBodyType};
+use rapier3d::glamx::DVec3;
 use rapier3d::math::Pose;
 use rapier3d::pipeline::{EventHandler, PhysicsHooks, PhysicsWorld};
 
@@ -60,6 +61,23 @@ pub struct FvmWorld {
     pub contact: ContactSettings,
     /// Rapier steps per frame, with the soft bodies stepped between them (at least 1).
     pub coupling_substeps: u32,
+    /// What each soft body exerted on each rigid body over the last frame.
+    loads: Vec<RigidLoad>,
+}
+
+/// The mean force and torque a soft body exerted on a rigid body over a frame, through its
+/// contacts and attachments (rigid bodies of every type: a fixed or kinematic body feels it too,
+/// though it does not move).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RigidLoad {
+    /// The soft body.
+    pub soft_body: SoftBodyHandle,
+    /// The rigid body.
+    pub rigid_body: RigidBodyHandle,
+    /// The force (N).
+    pub force: DVec3,
+    /// The torque about the rigid body's centre of mass (N m).
+    pub torque: DVec3,
 }
 
 impl Default for FvmWorld {
@@ -70,6 +88,7 @@ impl Default for FvmWorld {
             integrator: AutomaticIntegrator::default(),
             contact: ContactSettings::default(),
             coupling_substeps: 4,
+            loads: Vec::new(),
         }
     }
 }
@@ -89,6 +108,32 @@ fn hold_supported_bodies(body: &mut crate::body::SoftBody, physics: &PhysicsWorl
         if supported {
             proxy.hold();
         }
+    }
+}
+
+/// Adds a substep's impulse (N s) and angular impulse about the centre of mass (N m s) to the
+/// frame's total for the pair; [`FvmWorld::step_with_events`] divides the totals by the frame.
+fn add_load(
+    loads: &mut Vec<RigidLoad>,
+    soft_body: SoftBodyHandle,
+    rigid_body: RigidBodyHandle,
+    impulse: DVec3,
+    angular_impulse: DVec3,
+) {
+    match loads
+        .iter_mut()
+        .find(|load| load.soft_body == soft_body && load.rigid_body == rigid_body)
+    {
+        Some(load) => {
+            load.force += impulse;
+            load.torque += angular_impulse;
+        }
+        None => loads.push(RigidLoad {
+            soft_body,
+            rigid_body,
+            force: impulse,
+            torque: angular_impulse,
+        }),
     }
 }
 
@@ -126,6 +171,23 @@ impl KinematicPath {
 }
 
 impl FvmWorld {
+    /// The mean force and torque each soft body exerted on each rigid body it touched or is
+    /// attached to, over the last frame (the impulses it handed over, divided by the frame's
+    /// `dt`). Colliders without a rigid body (fixed ground) are not listed: see
+    /// [`SoftBody::contact_force_on`](crate::body::SoftBody::contact_force_on).
+    pub fn rigid_loads(&self) -> &[RigidLoad] {
+        &self.loads
+    }
+
+    /// The mean force (N) and torque about its centre of mass (N m) soft body `soft` exerted on
+    /// rigid body `rigid` over the last frame; zero if they did not interact.
+    pub fn load_on(&self, soft: SoftBodyHandle, rigid: RigidBodyHandle) -> (DVec3, DVec3) {
+        self.loads
+            .iter()
+            .find(|load| load.soft_body == soft && load.rigid_body == rigid)
+            .map_or((DVec3::ZERO, DVec3::ZERO), |load| (load.force, load.torque))
+    }
+
     /// Advances the world by one frame (`physics.integration_parameters.dt`), without hooks or
     /// events; see [`FvmWorld::step_with_events`].
     pub fn step(&mut self) -> Vec<(SoftBodyHandle, Result<AutomaticReport, Error>)> {
@@ -160,11 +222,12 @@ impl FvmWorld {
             .div_ceil(substeps as usize)
             .max(1);
         let paths = KinematicPath::all(&self.physics.bodies);
+        self.loads.clear();
         for substep in 1..=substeps {
             for path in &paths {
                 path.advance(&mut self.physics.bodies, substep as f32 / substeps as f32);
             }
-            for ((_, body), (_, outcome)) in self.soft_bodies.iter_mut().zip(&mut outcomes) {
+            for ((handle, body), (_, outcome)) in self.soft_bodies.iter_mut().zip(&mut outcomes) {
                 if matches!(outcome, Some(Err(_))) {
                     continue;
                 }
@@ -183,6 +246,15 @@ impl FvmWorld {
                     self.integrator.step(body, h, gravity)
                 });
                 if stepped.is_ok() {
+                    for (rigid_body, impulse, angular_impulse) in body.rigid_impulses() {
+                        add_load(
+                            &mut self.loads,
+                            handle,
+                            rigid_body,
+                            impulse,
+                            angular_impulse,
+                        );
+                    }
                     body.transfer_contact_impulses(&mut physics.bodies);
                 }
                 *outcome = Some(stepped);
@@ -190,6 +262,11 @@ impl FvmWorld {
             self.physics.step_with_events(hooks, events);
         }
         self.physics.integration_parameters = frame;
+        let per_second = 1.0 / f64::from(frame.dt);
+        for load in &mut self.loads {
+            load.force *= per_second;
+            load.torque *= per_second;
+        }
         outcomes
             .into_iter()
             .filter_map(|(handle, outcome)| outcome.map(|outcome| (handle, outcome)))

@@ -177,3 +177,51 @@ fn a_block_on_a_slope_sticks_or_slides_as_coulomb_says() {
         }
     }
 }
+
+#[test]
+fn collision_groups_decide_which_colliders_a_soft_body_touches() {
+    // The ground is in group 2. A cube whose filter excludes group 2 falls through it (free fall:
+    // g t²/2 = 0.196 m after 0.2 s, less the 5 cm it started above); one whose filter includes
+    // it lands. The same test rapier applies to two colliders (`InteractionGroups::test`).
+    use rapier3d::prelude::{Group, InteractionGroups, InteractionTestMode};
+    let mut colliders = ColliderSet::new();
+    colliders.insert(
+        ColliderBuilder::new(SharedShape::halfspace(rapier_fvm::glamx::Vec3::Y))
+            .collision_groups(InteractionGroups::new(
+                Group::GROUP_2,
+                Group::ALL,
+                InteractionTestMode::And,
+            ))
+            .build(),
+    );
+    for (filter, lands) in [
+        (Group::GROUP_1, false),
+        (Group::GROUP_1 | Group::GROUP_2, true),
+    ] {
+        let mut body = rubber_cube(DVec3::new(0.0, 0.1, 0.0), DVec3::ZERO);
+        body.collision_groups =
+            InteractionGroups::new(Group::GROUP_1, filter, InteractionTestMode::And);
+        let integrator = SymplecticEuler::default();
+        let frame = 1.0 / 60.0;
+        for _ in 0..12 {
+            body.detect_contacts(
+                &colliders,
+                &RigidBodySet::new(),
+                frame,
+                GRAVITY,
+                &ContactSettings::default(),
+            )
+            .unwrap();
+            integrator.step(&mut body, frame, GRAVITY).unwrap();
+        }
+        println!(
+            "filter {filter:?}: lowest node at {:.1} mm",
+            lowest(&body) * 1e3
+        );
+        if lands {
+            assert!(lowest(&body) > -2e-3, "the ground should hold it");
+        } else {
+            assert!(lowest(&body) < -0.1, "it should have fallen through");
+        }
+    }
+}

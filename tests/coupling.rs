@@ -216,7 +216,8 @@ fn a_rigid_plate_on_a_soft_block_sinks_by_m_g_h_over_e_a() {
     let (side, young) = (0.2, 1e6);
     let area = side * side;
     let plate_mass = 1e-3 * young * area / 9.81;
-    let settled_top = |with_plate: bool| {
+    // The top face's height and the force the block exerts on the plate (N), both averaged.
+    let settled = |with_plate: bool| {
         let mut world = FvmWorld::default();
         world.physics.insert_collider(
             ColliderBuilder::new(SharedShape::halfspace(Vec3::Y)).friction(0.0),
@@ -226,36 +227,51 @@ fn a_rigid_plate_on_a_soft_block_sinks_by_m_g_h_over_e_a() {
             world
                 .soft_bodies
                 .insert(soft_cube(side, 4, DVec3::new(0.0, side / 2.0, 0.0), young));
-        if with_plate {
+        let plate = with_plate.then(|| {
             // 30 x 2 x 30 cm, overhanging the block on every side.
             let (half_width, half_thickness) = (0.15f32, 0.01f32);
             let volume = 8.0 * half_width * half_width * half_thickness;
-            world.physics.insert(
-                RigidBodyBuilder::dynamic().translation(Vec3::new(
-                    0.0,
-                    side as f32 + half_thickness,
-                    0.0,
-                )),
-                ColliderBuilder::cuboid(half_width, half_thickness, half_width)
-                    .density(plate_mass as f32 / volume)
-                    .friction(0.0),
-            );
-        }
+            world
+                .physics
+                .insert(
+                    RigidBodyBuilder::dynamic().translation(Vec3::new(
+                        0.0,
+                        side as f32 + half_thickness,
+                        0.0,
+                    )),
+                    ColliderBuilder::cuboid(half_width, half_thickness, half_width)
+                        .density(plate_mass as f32 / volume)
+                        .friction(0.0),
+                )
+                .0
+        });
         let top = world.soft_bodies[block]
             .mesh()
             .nodes_where(|p| p.y >= side / 2.0 - 1e-9);
-        let (mut sum, mut samples) = (0.0, 0);
+        let (mut height, mut support, mut samples) = (0.0, DVec3::ZERO, 0);
         for frame in 0..120 {
             step(&mut world);
             if frame >= 90 {
                 let positions = world.soft_bodies[block].positions();
-                sum += top.iter().map(|&n| positions[n as usize].y).sum::<f64>() / top.len() as f64;
+                height +=
+                    top.iter().map(|&n| positions[n as usize].y).sum::<f64>() / top.len() as f64;
+                if let Some(plate) = plate {
+                    support += world.load_on(block, plate).0;
+                }
                 samples += 1;
             }
         }
-        sum / f64::from(samples)
+        let samples = f64::from(samples);
+        (height / samples, support / samples)
     };
-    let sink = settled_top(false) - settled_top(true);
+    let ((free_top, _), (loaded_top, support)) = (settled(false), settled(true));
+    // The block carries the plate: the force on it balances its weight (within 1 %, as the
+    // ground's reaction in the support test).
+    let weight = plate_mass * 9.81;
+    println!("support of the plate {support:?} N vs its weight {weight:.3} N");
+    assert!((support.y / weight - 1.0).abs() < 0.01);
+    assert!(support.x.abs().max(support.z.abs()) < 1e-3 * weight);
+    let sink = free_top - loaded_top;
     let expected = plate_mass * 9.81 * side / (young * area);
     println!(
         "sink {:.4} mm vs m g H / (E A) = {:.4} mm ({:+.2} %)",

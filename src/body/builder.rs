@@ -7,6 +7,7 @@ use crate::damping::RayleighDamping;
 use crate::fvm::{FvmMesh, NodalAveraging, VolumetricTreatment};
 use crate::material::Material;
 use crate::mesh::TetMesh;
+use rapier3d::geometry::InteractionGroups;
 use rapier3d::glamx::{DQuat, DVec3};
 
 /// Describes a soft body: its mesh and material, placement, initial velocity, damping and pinned
@@ -39,6 +40,7 @@ pub struct SoftBodyBuilder {
     pinned: Vec<u32>,
     user_data: u128,
     min_quality: f64,
+    collision_groups: InteractionGroups,
 }
 
 /// Default [`SoftBodyBuilder::min_element_quality`]: a tetrahedron whose smallest altitude is a
@@ -60,6 +62,7 @@ impl SoftBodyBuilder {
             pinned: Vec::new(),
             user_data: 0,
             min_quality: DEFAULT_MIN_ELEMENT_QUALITY,
+            collision_groups: InteractionGroups::all(),
         }
     }
 
@@ -113,6 +116,13 @@ impl SoftBodyBuilder {
     /// every valid mesh.
     pub fn min_element_quality(mut self, quality: f64) -> Self {
         self.min_quality = quality;
+        self
+    }
+
+    /// The collision groups of the body's surface, tested against each collider's as rapier
+    /// tests two colliders' (`InteractionGroups::test`); default: every group.
+    pub fn collision_groups(mut self, groups: InteractionGroups) -> Self {
+        self.collision_groups = groups;
         self
     }
 
@@ -216,6 +226,7 @@ impl SoftBodyBuilder {
             saved_anchors: Vec::new(),
             saved_planes: Vec::new(),
             contact_settings: ContactSettings::default(),
+            collision_groups: self.collision_groups,
             user_data: self.user_data,
         })
     }

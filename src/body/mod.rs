@@ -14,6 +14,7 @@ use crate::damping::RayleighDamping;
 use crate::fvm::{FvmMesh, NodalAveraging, VolumetricTreatment};
 use crate::material::{Material, with_hyperelastic_model};
 use crate::mesh::TetMesh;
+use rapier3d::geometry::InteractionGroups;
 use rapier3d::glamx::DVec3;
 
 /// A deformable body discretized by linear tetrahedra and simulated by finite volumes.
@@ -58,6 +59,9 @@ pub struct SoftBody {
     pub(crate) saved_planes: Vec<(DVec3, DVec3)>,
     /// The settings of the last contact detection.
     pub(crate) contact_settings: ContactSettings,
+    /// The collision groups of the surface: the body touches only the colliders whose groups
+    /// pass `InteractionGroups::test` with these, as rapier's colliders do.
+    pub collision_groups: InteractionGroups,
     /// Arbitrary user data, as on rapier's bodies.
     pub user_data: u128,
 }

@@ -32,7 +32,7 @@ pub(crate) use rigid::{RigidProxy, coming_velocity};
 
 use crate::Error;
 use crate::body::SoftBody;
-use rapier3d::dynamics::RigidBodySet;
+use rapier3d::dynamics::{RigidBodyHandle, RigidBodySet};
 use rapier3d::geometry::{ColliderHandle, ColliderSet, Shape, SharedShape};
 use rapier3d::glamx::{DMat3, DVec3};
 use rapier3d::math::Pose;
@@ -223,7 +223,8 @@ impl ContactSettings {
 impl SoftBody {
     /// Finds the contacts of the body's surface nodes with `colliders` for a frame of `frame_dt`
     /// (s) under `gravity` (m/s²), replacing the previous ones: a node gets a contact with each
-    /// non-sensor collider it is within `margin` of, plus twice the distance the body's fastest
+    /// non-sensor collider its [`SoftBody::collision_groups`] interact with and it is within
+    /// `margin` of, plus twice the distance the body's fastest
     /// node can travel in the frame (`2 (|v|max + |g| dt) dt`), plus twice the collider's own
     /// travel (at most 1 m), except the colliders of a rigid body the node is attached to. The
     /// integrators enforce them until
@@ -254,7 +255,7 @@ impl SoftBody {
             .fold(0.0, f64::max);
         let reach = settings.margin + 2.0 * (fastest + gravity.length() * frame_dt) * frame_dt;
         for (handle, collider) in colliders.iter() {
-            if collider.is_sensor() {
+            if collider.is_sensor() || !self.collision_groups.test(collider.collision_groups()) {
                 continue;
             }
             let aabb = collider.compute_aabb();
@@ -332,6 +333,15 @@ impl SoftBody {
     pub fn clear_contacts(&mut self) {
         self.contacts.clear();
         self.rigid_proxies.clear();
+    }
+
+    /// The impulse (N s) and angular impulse about the centre of mass (N m s) the body gave each
+    /// rigid body it touches or is attached to over the last step, not yet handed to rapier (see
+    /// [`SoftBody::transfer_contact_impulses`]).
+    pub fn rigid_impulses(&self) -> impl Iterator<Item = (RigidBodyHandle, DVec3, DVec3)> + '_ {
+        self.rigid_proxies
+            .iter()
+            .map(|proxy| (proxy.handle, proxy.impulse, proxy.angular_impulse))
     }
 
     /// Hands the impulses the contacts of the last step gave rigid bodies to rapier's set (the
