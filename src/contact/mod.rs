@@ -8,8 +8,11 @@
 //!
 //! - [`SymplecticEuler`](crate::integrate::SymplecticEuler), at every substep, as velocity
 //!   constraints: a node's normal velocity is raised so that it does not cross its plane within
-//!   the substep (an inelastic, speculative contact), and its tangential velocity is reduced by at
-//!   most the collider's friction coefficient times that change (Coulomb friction).
+//!   the substep (an inelastic, speculative contact), and its tangential velocity is reduced by a
+//!   friction impulse of at most the collider's friction coefficient times the normal impulse
+//!   (Coulomb friction). The impulses are accumulated and clamped over
+//!   [`ContactSettings::velocity_iterations`] sweeps when dynamic rigid bodies couple the
+//!   contacts (sequential impulses, as rapier's own solver).
 //! - [`ImplicitIntegrator`](crate::integrate::ImplicitIntegrator), as a stiff penalty in the
 //!   incremental potential, `k/2 min(0, g)²` per contact with `g` the signed distance to the plane
 //!   and `k` [`ContactSettings::penalty_factor`] times the node's `m/h²`: the resting penetration
