@@ -9,9 +9,15 @@
 //! - (c) `box_on_soft_block`: `examples/rigid_on_soft.rs`'s scene, a 2 kg rigid box (10 cm)
 //!   resting 4 cm off-centre on a 20 cm soft block (E = 1e6 Pa, 4 x 4 x 4 cells) on the ground,
 //!   in an [`FvmWorld`]: two-way contact with a dynamic rigid body.
+//! - (d) `d_grasp`: `examples/grasp.rs`'s scene, a 5 cm soft cube (E = 1e5 Pa, 4 x 4 x 4 cells)
+//!   squeezed by 2 mm a side between two position-based kinematic fingers (friction 1.0) and held
+//!   10 cm above the ground: friction contacts carrying a soft body's weight. Its settling,
+//!   closing and lifting (1.75 s) run outside the timing; the timed frames hold the fingers still
+//!   at their final pose. Beside it, `d_grasp_cube_alone`: the same cube falling freely, stepped
+//!   as in (a), for the ratio.
 //!
-//! Every scene first runs 1 s of frames outside the timing, so that (b) and (c) measure steady
-//! contact. Times are per frame.
+//! Every other scene first runs 1 s of frames outside the timing, so that (b) and (c) measure
+//! steady contact. Times are per frame.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use rapier_fvm::glamx::Vec3;
@@ -59,6 +65,50 @@ fn step(world: &mut FvmWorld) {
     }
 }
 
+/// `examples/grasp.rs`'s cube (5 cm) with its centre at height `y` (m).
+fn grasp_cube(y: f64) -> SoftBody {
+    soft_cube(0.05, 4, 1e5, DVec3::new(0.0, y, 0.0))
+}
+
+/// `examples/grasp.rs`'s scene after its settling (0.25 s), closing (0.5 s, the fingers moving
+/// in from 2 mm off the cube's faces to 2 mm into them) and lifting (10 cm over 1 s): the cube
+/// held in the air by the still fingers.
+fn held_grasp() -> FvmWorld {
+    let mut world = world_on_ground(0.5);
+    let (half, finger_half, gap, squeeze) = (0.025, 0.005, 2e-3, 2e-3);
+    world.soft_bodies.insert(grasp_cube(half));
+    let sides = [-1.0, 1.0];
+    let fingers = sides.map(|side: f64| {
+        let x = side * (half + finger_half + gap);
+        world
+            .physics
+            .insert(
+                RigidBodyBuilder::kinematic_position_based().translation(Vec3::new(
+                    x as f32,
+                    half as f32,
+                    0.0,
+                )),
+                ColliderBuilder::cuboid(finger_half as f32, 0.02, 0.02).friction(1.0),
+            )
+            .0
+    });
+    let dt = f64::from(world.physics.integration_parameters.dt);
+    let (settle, close, lift) = (0.25, 0.5, 1.0);
+    for frame in 1..=((settle + close + lift) / dt).round() as usize {
+        let t = frame as f64 * dt - settle;
+        let closing = (t / close).clamp(0.0, 1.0);
+        let lifting = ((t - close) / lift).clamp(0.0, 1.0);
+        for (finger, side) in fingers.iter().zip(sides) {
+            let x = side * (half + finger_half + gap - (gap + squeeze) * closing);
+            let y = half + 0.1 * lifting;
+            world.physics.bodies[*finger]
+                .set_next_kinematic_translation(Vec3::new(x as f32, y as f32, 0.0));
+        }
+        step(&mut world);
+    }
+    world
+}
+
 fn coupling_frame(c: &mut Criterion) {
     // (b) The cube resting on the ground.
     let mut on_ground = world_on_ground(0.5);
@@ -74,8 +124,11 @@ fn coupling_frame(c: &mut Criterion) {
             .density(2000.0)
             .friction(0.8),
     );
-    // (a) The cube alone, stepped as the world steps its soft bodies.
+    // (d) The grasp, held.
+    let mut grasp = held_grasp();
+    // (a) The cube alone, stepped as the world steps its soft bodies; and the grasp's cube.
     let mut alone = drop_cube(0.55);
+    let mut grasp_alone = grasp_cube(0.5);
     let integrator = on_ground.integrator;
     let substeps = on_ground.coupling_substeps;
     let h = f64::from(on_ground.physics.integration_parameters.dt) / f64::from(substeps);
@@ -87,6 +140,7 @@ fn coupling_frame(c: &mut Criterion) {
     };
     for _ in 0..SETTLING_FRAMES {
         frame_alone(&mut alone);
+        frame_alone(&mut grasp_alone);
         step(&mut on_ground);
         step(&mut box_on_block);
     }
@@ -100,6 +154,10 @@ fn coupling_frame(c: &mut Criterion) {
     group.bench_function("b_soft_cube_on_ground", |b| b.iter(|| step(&mut on_ground)));
     group.bench_function("c_box_on_soft_block", |b| {
         b.iter(|| step(&mut box_on_block))
+    });
+    group.bench_function("d_grasp", |b| b.iter(|| step(&mut grasp)));
+    group.bench_function("d_grasp_cube_alone", |b| {
+        b.iter(|| frame_alone(&mut grasp_alone))
     });
     group.finish();
 }
