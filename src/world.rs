@@ -205,6 +205,7 @@ impl FvmWorld {
     ) -> Vec<(SoftBodyHandle, Result<AutomaticReport, Error>)> {
         let substeps = self.coupling_substeps.max(1);
         let frame = self.physics.integration_parameters;
+        self.loads.clear();
         if frame.dt <= 0.0 {
             self.physics.step_with_events(hooks, events);
             return Vec::new();
@@ -222,7 +223,6 @@ impl FvmWorld {
             .div_ceil(substeps as usize)
             .max(1);
         let paths = KinematicPath::all(&self.physics.bodies);
-        self.loads.clear();
         for substep in 1..=substeps {
             for path in &paths {
                 path.advance(&mut self.physics.bodies, substep as f32 / substeps as f32);
