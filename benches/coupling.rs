@@ -67,7 +67,9 @@ fn step(world: &mut FvmWorld) {
 
 /// `examples/grasp.rs`'s cube (5 cm) with its centre at height `y` (m).
 fn grasp_cube(y: f64) -> SoftBody {
-    soft_cube(0.05, 4, 1e5, DVec3::new(0.0, y, 0.0))
+    let mut cube = soft_cube(0.05, 4, 1e5, DVec3::new(0.0, y, 0.0));
+    cube.friction = 1.0;
+    cube
 }
 
 /// `examples/grasp.rs`'s scene after its settling (0.25 s), closing (0.5 s, the fingers moving
@@ -115,9 +117,9 @@ fn coupling_frame(c: &mut Criterion) {
     on_ground.soft_bodies.insert(drop_cube(0.05));
     // (c) The box on the soft block.
     let mut box_on_block = world_on_ground(0.8);
-    box_on_block
-        .soft_bodies
-        .insert(soft_cube(0.2, 4, 1e6, DVec3::new(0.0, 0.1, 0.0)));
+    let mut block = soft_cube(0.2, 4, 1e6, DVec3::new(0.0, 0.1, 0.0));
+    block.friction = 0.8;
+    box_on_block.soft_bodies.insert(block);
     box_on_block.physics.insert(
         RigidBodyBuilder::dynamic().translation(Vec3::new(0.04, 0.2505, 0.0)),
         ColliderBuilder::cuboid(0.05, 0.05, 0.05)

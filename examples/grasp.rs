@@ -108,6 +108,7 @@ fn main() -> Result<(), Error> {
             rubber.lame(),
         )?)
         .translation(DVec3::new(0.0, HALF, 0.0))
+        .friction(1.0)
         .build()?;
     let cube = world.soft_bodies.insert(cube);
     // Left (x < 0) then right.

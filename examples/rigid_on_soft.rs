@@ -54,6 +54,7 @@ fn main() -> Result<(), Error> {
         rubber.lame(),
     )?)
     .translation(DVec3::new(0.0, BLOCK_SIDE / 2.0, 0.0))
+    .friction(0.8)
     .build()?;
     let block = world.soft_bodies.insert(block);
     // Placed 0.5 mm above the block's top.

@@ -72,7 +72,7 @@ pub use rapier3d::glamx;
 pub mod prelude {
     pub use crate::Error;
     pub use crate::body::{SoftBody, SoftBodyBuilder, SoftBodyHandle, SoftBodySet};
-    pub use crate::contact::{ContactSettings, NodeContact};
+    pub use crate::contact::{ContactSettings, ContactTarget, NodeContact};
     pub use crate::damping::RayleighDamping;
     pub use crate::fvm::VolumetricTreatment;
     pub use crate::integrate::{

@@ -141,6 +141,7 @@ fn a_block_on_a_slope_sticks_or_slides_as_coulomb_says() {
         };
         // The cube resting on the slope, tilted with it.
         let mut body = rubber_cube(normal * 0.0505, DVec3::new(0.0, 0.0, angle));
+        body.friction = friction;
         let frame = 1.0 / 240.0;
         let mut history = Vec::new();
         for _ in 0..240 {

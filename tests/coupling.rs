@@ -10,6 +10,12 @@ fn rubber(young: f64) -> Material {
     Material::new(MaterialModel::StableNeoHookean, young, 0.3, 1000.0).unwrap()
 }
 
+/// `body` with surface friction coefficient `friction`.
+fn with_friction(mut body: SoftBody, friction: f64) -> SoftBody {
+    body.friction = friction;
+    body
+}
+
 /// A soft cube of side `side` (m) centred at `centre`, with damping time 2e-3 s.
 fn soft_cube(side: f64, cells: usize, centre: DVec3, young: f64) -> SoftBody {
     let material = rubber(young);
@@ -98,9 +104,10 @@ fn a_box_resting_on_a_soft_block_is_supported_without_jitter_or_creep() {
         ColliderBuilder::new(SharedShape::halfspace(Vec3::Y)).friction(0.8),
         None,
     );
-    let block = world
-        .soft_bodies
-        .insert(soft_cube(0.2, 4, DVec3::new(0.0, 0.1, 0.0), 1e6));
+    let block = world.soft_bodies.insert(with_friction(
+        soft_cube(0.2, 4, DVec3::new(0.0, 0.1, 0.0), 1e6),
+        0.8,
+    ));
     let (rigid_box, _) = world.physics.insert(
         RigidBodyBuilder::dynamic().translation(Vec3::new(0.04, 0.2505, 0.0)),
         ColliderBuilder::cuboid(0.05, 0.05, 0.05)
@@ -223,10 +230,10 @@ fn a_rigid_plate_on_a_soft_block_sinks_by_m_g_h_over_e_a() {
             ColliderBuilder::new(SharedShape::halfspace(Vec3::Y)).friction(0.0),
             None,
         );
-        let block =
-            world
-                .soft_bodies
-                .insert(soft_cube(side, 4, DVec3::new(0.0, side / 2.0, 0.0), young));
+        let block = world.soft_bodies.insert(with_friction(
+            soft_cube(side, 4, DVec3::new(0.0, side / 2.0, 0.0), young),
+            0.0,
+        ));
         let plate = with_plate.then(|| {
             // 30 x 2 x 30 cm, overhanging the block on every side.
             let (half_width, half_thickness) = (0.15f32, 0.01f32);
@@ -295,9 +302,10 @@ fn grasp(squeeze: f64, integrator: Option<IntegratorKind>) -> (f64, f64, f64) {
         None,
     );
     let (half, finger_half) = (0.025, 0.005);
-    let cube = world
-        .soft_bodies
-        .insert(soft_cube(2.0 * half, 4, DVec3::new(0.0, half, 0.0), 1e5));
+    let cube = world.soft_bodies.insert(with_friction(
+        soft_cube(2.0 * half, 4, DVec3::new(0.0, half, 0.0), 1e5),
+        1.0,
+    ));
     let fingers: Vec<_> = [-1.0, 1.0]
         .map(|side: f64| {
             let x = side * (half + finger_half + 2e-3);

@@ -7,6 +7,7 @@ use crate::damping::RayleighDamping;
 use crate::fvm::{FvmMesh, NodalAveraging, VolumetricTreatment};
 use crate::material::Material;
 use crate::mesh::TetMesh;
+use rapier3d::dynamics::CoefficientCombineRule;
 use rapier3d::geometry::InteractionGroups;
 use rapier3d::glamx::{DQuat, DVec3};
 
@@ -41,7 +42,13 @@ pub struct SoftBodyBuilder {
     user_data: u128,
     min_quality: f64,
     collision_groups: InteractionGroups,
+    friction: f64,
+    friction_combine_rule: CoefficientCombineRule,
+    self_contact: bool,
 }
+
+/// Default [`SoftBodyBuilder::friction`]: rapier's default collider friction.
+pub const DEFAULT_FRICTION: f64 = 0.5;
 
 /// Default [`SoftBodyBuilder::min_element_quality`]: a tetrahedron whose smallest altitude is a
 /// thousandth of its longest edge is refused.
@@ -63,6 +70,9 @@ impl SoftBodyBuilder {
             user_data: 0,
             min_quality: DEFAULT_MIN_ELEMENT_QUALITY,
             collision_groups: InteractionGroups::all(),
+            friction: DEFAULT_FRICTION,
+            friction_combine_rule: CoefficientCombineRule::Average,
+            self_contact: false,
         }
     }
 
@@ -126,6 +136,28 @@ impl SoftBodyBuilder {
         self
     }
 
+    /// The surface's Coulomb friction coefficient (non-negative, finite); default
+    /// [`DEFAULT_FRICTION`]. A contact's coefficient combines it with the collider's or the other
+    /// soft body's by the stronger of the two combine rules, as rapier combines two colliders'.
+    pub fn friction(mut self, friction: f64) -> Self {
+        self.friction = friction;
+        self
+    }
+
+    /// How the body's friction combines with the other side's; default
+    /// [`CoefficientCombineRule::Average`], as rapier's colliders.
+    pub fn friction_combine_rule(mut self, rule: CoefficientCombineRule) -> Self {
+        self.friction_combine_rule = rule;
+        self
+    }
+
+    /// Whether the surface collides with itself where the motion brings together parts far apart
+    /// in the rest shape; default off (see [`SoftBody::self_contact`]).
+    pub fn self_contact(mut self, enabled: bool) -> Self {
+        self.self_contact = enabled;
+        self
+    }
+
     /// User data stored on the body.
     pub fn user_data(mut self, user_data: u128) -> Self {
         self.user_data = user_data;
@@ -140,8 +172,16 @@ impl SoftBodyBuilder {
     /// [`Error::NodeOutOfRange`] for a pinned node that does not exist;
     /// [`Error::NonFiniteInput`] for a non-finite velocity or translation or a zero rotation;
     /// [`Error::SliverTet`] for a tetrahedron below the minimum quality;
-    /// [`Error::InvalidSetting`] for a minimum quality outside `[0, 1)`.
+    /// [`Error::InvalidSetting`] for a minimum quality outside `[0, 1)` or a negative or
+    /// non-finite friction.
     pub fn build(self) -> Result<SoftBody, Error> {
+        if !(self.friction.is_finite() && self.friction >= 0.0) {
+            return Err(Error::InvalidSetting {
+                parameter: "friction",
+                value: self.friction,
+                reason: "must be non-negative and finite",
+            });
+        }
         if !(0.0..1.0).contains(&self.min_quality) {
             return Err(Error::InvalidSetting {
                 parameter: "min_element_quality",
@@ -189,12 +229,18 @@ impl SoftBodyBuilder {
             .map(|n| if pinned[n] { DVec3::ZERO } else { self.linvel })
             .collect();
         let fvm = FvmMesh::new(&self.mesh);
-        let mut surface_nodes: Vec<u32> = self
-            .mesh
-            .surface_triangles()
-            .into_iter()
-            .flatten()
-            .collect();
+        let surface_triangles = self.mesh.surface_triangles();
+        let mut surface_rings = vec![Vec::new(); node_count];
+        for triangle in &surface_triangles {
+            for &n in triangle {
+                surface_rings[n as usize].extend(triangle);
+            }
+        }
+        for ring in &mut surface_rings {
+            ring.sort_unstable();
+            ring.dedup();
+        }
+        let mut surface_nodes: Vec<u32> = surface_triangles.iter().flatten().copied().collect();
         surface_nodes.sort_unstable();
         surface_nodes.dedup();
         let nodal_averaging = match self.volumetric {
@@ -219,6 +265,8 @@ impl SoftBodyBuilder {
             velocities,
             pinned,
             surface_nodes,
+            surface_triangles,
+            surface_rings,
             contacts: Vec::new(),
             attachments: Vec::new(),
             rigid_proxies: Vec::new(),
@@ -227,6 +275,9 @@ impl SoftBodyBuilder {
             saved_planes: Vec::new(),
             contact_settings: ContactSettings::default(),
             collision_groups: self.collision_groups,
+            friction: self.friction,
+            friction_combine_rule: self.friction_combine_rule,
+            self_contact: self.self_contact,
             user_data: self.user_data,
         })
     }

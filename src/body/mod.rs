@@ -4,7 +4,7 @@
 mod builder;
 mod set;
 
-pub use builder::{DEFAULT_MIN_ELEMENT_QUALITY, SoftBodyBuilder};
+pub use builder::{DEFAULT_FRICTION, DEFAULT_MIN_ELEMENT_QUALITY, SoftBodyBuilder};
 pub use set::{SoftBodyHandle, SoftBodySet};
 
 use crate::assembly::Stiffness;
@@ -14,6 +14,7 @@ use crate::damping::RayleighDamping;
 use crate::fvm::{FvmMesh, NodalAveraging, VolumetricTreatment};
 use crate::material::{Material, with_hyperelastic_model};
 use crate::mesh::TetMesh;
+use rapier3d::dynamics::CoefficientCombineRule;
 use rapier3d::geometry::InteractionGroups;
 use rapier3d::glamx::DVec3;
 
@@ -46,6 +47,11 @@ pub struct SoftBody {
     pub(crate) tangent: Option<Stiffness>,
     /// The nodes on the mesh's boundary, which contacts are detected for.
     pub(crate) surface_nodes: Vec<u32>,
+    /// The mesh's boundary triangles, outward-oriented, which self-contact pushes against.
+    pub(crate) surface_triangles: Vec<[u32; 3]>,
+    /// Per node, the boundary nodes sharing a boundary triangle with it, itself included, sorted
+    /// (empty for interior nodes): self-contact's neighbourhood.
+    pub(crate) surface_rings: Vec<Vec<u32>>,
     /// The contacts the integrators enforce, from the last detection.
     pub(crate) contacts: Vec<NodeContact>,
     /// The nodes glued to rigid bodies.
@@ -62,6 +68,17 @@ pub struct SoftBody {
     /// The collision groups of the surface: the body touches only the colliders whose groups
     /// pass `InteractionGroups::test` with these, as rapier's colliders do.
     pub collision_groups: InteractionGroups,
+    /// The surface's Coulomb friction coefficient, combined with a collider's or another soft
+    /// body's by the stronger of their combine rules, as rapier combines two colliders'.
+    pub friction: f64,
+    /// How [`SoftBody::friction`] combines with the other side's.
+    pub friction_combine_rule: CoefficientCombineRule,
+    /// Whether the body's surface collides with itself (a body folding over itself, or made of
+    /// separate parts): off by default, as it costs a bounding-volume query per surface node and
+    /// detection. Self-contacts are solved by the explicit integrator
+    /// ([`SymplecticEuler`](crate::integrate::SymplecticEuler)); the automatic integrator picks
+    /// it while there are some, and a forced implicit step ignores them.
+    pub self_contact: bool,
     /// Arbitrary user data, as on rapier's bodies.
     pub user_data: u128,
 }

@@ -30,12 +30,13 @@
 //! impulses; the total is handed to rapier when the step is accepted.
 
 mod rigid;
+mod self_contact;
 
 pub(crate) use rigid::{RigidProxy, coming_velocity};
 
 use crate::Error;
 use crate::body::SoftBody;
-use rapier3d::dynamics::{RigidBodyHandle, RigidBodySet};
+use rapier3d::dynamics::{CoefficientCombineRule, RigidBodyHandle, RigidBodySet};
 use rapier3d::geometry::{ColliderHandle, ColliderSet, Shape, SharedShape};
 use rapier3d::glamx::{DMat3, DVec3};
 use rapier3d::math::Pose;
@@ -75,26 +76,40 @@ impl Default for ContactSettings {
     }
 }
 
-/// A surface node's contact with a collider for the coming frame: the plane through `point` with
-/// outward normal `normal` that the node must not cross. The explicit integrator re-projects the
-/// node onto the collider's shape (at its pose when detected) every substep to update the plane.
+/// What a node's contact pushes against.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ContactTarget {
+    /// A rapier collider.
+    Collider(ColliderHandle),
+    /// A triangle of the body's own boundary, far from the node in the rest shape
+    /// (self-contact; see [`SoftBody::self_contact`]).
+    OwnSurface {
+        /// The triangle's nodes.
+        triangle: [u32; 3],
+    },
+}
+
+/// A surface node's contact for the coming frame: the plane through `point` with outward normal
+/// `normal` that the node must not cross. Against a collider, the explicit integrator re-projects
+/// the node onto the collider's shape (at its pose when detected) every substep to update the
+/// plane; against a triangle of the body's own surface the plane follows the triangle.
 #[derive(Clone)]
 pub struct NodeContact {
     /// The soft body's node.
     pub node: u32,
-    /// The collider touched.
-    pub collider: ColliderHandle,
-    /// The nearest point of the collider's surface to the node when detected (m).
+    /// What it touches.
+    pub target: ContactTarget,
+    /// The nearest point of the target's surface to the node when detected (m).
     pub point: DVec3,
-    /// The collider's outward unit normal there.
+    /// The target's outward unit normal there.
     pub normal: DVec3,
-    /// Coulomb friction coefficient (the collider's).
+    /// Coulomb friction coefficient: the body's and the target's, combined by their rules.
     pub friction: f64,
     /// The impulse (N s) the contact gave the node over the last step.
     pub impulse: DVec3,
-    /// Index of the collider's rigid body among the body's proxies, if it has one.
-    proxy: Option<usize>,
-    /// Within an explicit substep: the lowest normal velocity (m/s) relative to the collider the
+    /// The far side of the contact, as the velocity constraints see it.
+    obstacle: Obstacle,
+    /// Within an explicit substep: the lowest normal velocity (m/s) relative to the target the
     /// node may keep, and the normal (N s) and friction impulses accumulated so far.
     lowest_speed: f64,
     normal_impulse: f64,
@@ -104,15 +119,28 @@ pub struct NodeContact {
     lagged_normal_force: f64,
     slip_origin: DVec3,
     surface_velocity: DVec3,
-    shape: SharedShape,
-    pose: Pose,
+}
+
+/// The far side of a contact.
+#[derive(Clone)]
+enum Obstacle {
+    /// A collider's shape at its pose, and its rigid body's index among the body's proxies, if it
+    /// has one.
+    Collider {
+        shape: SharedShape,
+        pose: Pose,
+        proxy: Option<usize>,
+    },
+    /// A triangle of the body's own surface: its nodes, and the barycentric weights of the
+    /// contact point.
+    OwnTriangle { nodes: [u32; 3], weights: [f64; 3] },
 }
 
 impl std::fmt::Debug for NodeContact {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("NodeContact")
             .field("node", &self.node)
-            .field("collider", &self.collider)
+            .field("target", &self.target)
             .field("point", &self.point)
             .field("normal", &self.normal)
             .field("friction", &self.friction)
@@ -122,6 +150,33 @@ impl std::fmt::Debug for NodeContact {
 }
 
 impl NodeContact {
+    /// A contact of `node` with `target` through the plane at `point` (m) with outward unit
+    /// `normal`, with friction coefficient `friction`, enforced against `obstacle`.
+    fn new(
+        node: u32,
+        target: ContactTarget,
+        point: DVec3,
+        normal: DVec3,
+        friction: f64,
+        obstacle: Obstacle,
+    ) -> Self {
+        Self {
+            node,
+            target,
+            point,
+            normal,
+            friction,
+            impulse: DVec3::ZERO,
+            obstacle,
+            lowest_speed: 0.0,
+            normal_impulse: 0.0,
+            friction_impulse: DVec3::ZERO,
+            lagged_normal_force: 0.0,
+            slip_origin: DVec3::ZERO,
+            surface_velocity: DVec3::ZERO,
+        }
+    }
+
     /// Signed distance (m) of position `x` from the contact plane, negative inside.
     pub fn gap(&self, x: DVec3) -> f64 {
         (x - self.point).dot(self.normal)
@@ -174,11 +229,24 @@ impl NodeContact {
         })
     }
 
-    /// Moves the plane to the collider's surface point nearest to `x` (m), if defined there.
-    fn refresh(&mut self, x: DVec3) {
-        if let Some((point, normal, _)) = nearest_surface_point(&*self.shape, &self.pose, x) {
-            self.point = point;
-            self.normal = normal;
+    /// Moves the plane to the collider's surface point nearest to `x` (m), if defined there, or
+    /// to an own triangle's contact point where its nodes are now (`positions`, m).
+    fn refresh(&mut self, x: DVec3, positions: &[DVec3]) {
+        match &self.obstacle {
+            Obstacle::Collider { shape, pose, .. } => {
+                if let Some((point, normal, _)) = nearest_surface_point(&**shape, pose, x) {
+                    self.point = point;
+                    self.normal = normal;
+                }
+            }
+            Obstacle::OwnTriangle { nodes, weights } => {
+                let at = nodes.map(|c| positions[c as usize]);
+                let normal = (at[1] - at[0]).cross(at[2] - at[0]).normalize_or_zero();
+                if normal != DVec3::ZERO {
+                    self.point = at[0] * weights[0] + at[1] * weights[1] + at[2] * weights[2];
+                    self.normal = normal;
+                }
+            }
         }
     }
 }
@@ -280,6 +348,12 @@ impl SoftBody {
                 .filter(|a| Some(a.body) == collider.parent())
                 .map(|a| a.node)
                 .collect();
+            let friction = f64::from(CoefficientCombineRule::combine(
+                self.friction as f32,
+                collider.friction(),
+                self.friction_combine_rule,
+                collider.friction_combine_rule(),
+            ));
             let mut proxy = None;
             for &node in &self.surface_nodes {
                 let n = node as usize;
@@ -300,29 +374,27 @@ impl SoftBody {
                     {
                         proxy = Some(RigidProxy::index_in(&mut proxies, handle, body, frame_dt));
                     }
-                    contacts.push(NodeContact {
+                    contacts.push(NodeContact::new(
                         node,
-                        collider: handle,
+                        ContactTarget::Collider(handle),
                         point,
                         normal,
-                        friction: f64::from(collider.friction()),
-                        impulse: DVec3::ZERO,
-                        proxy,
-                        lowest_speed: 0.0,
-                        normal_impulse: 0.0,
-                        friction_impulse: DVec3::ZERO,
-                        lagged_normal_force: 0.0,
-                        slip_origin: DVec3::ZERO,
-                        surface_velocity: DVec3::ZERO,
-                        shape: shape.clone(),
-                        pose: *pose,
-                    });
+                        friction,
+                        Obstacle::Collider {
+                            shape: shape.clone(),
+                            pose: *pose,
+                            proxy,
+                        },
+                    ));
                 }
             }
         }
         crate::attachment::ready(&mut self.attachments, &mut proxies, bodies, frame_dt);
         self.contacts = contacts;
         self.rigid_proxies = proxies;
+        if self.self_contact {
+            self.detect_self_contacts(reach);
+        }
         self.contact_settings = *settings;
         Ok(&self.contacts)
     }
@@ -379,7 +451,7 @@ impl SoftBody {
         Ok(self
             .contacts
             .iter()
-            .filter(|c| c.collider == collider)
+            .filter(|c| c.target == ContactTarget::Collider(collider))
             .fold((DVec3::ZERO, DVec3::ZERO), |(force, torque), c| {
                 let on_collider = -c.impulse / dt;
                 (
@@ -434,6 +506,110 @@ fn nearest_surface_point(shape: &dyn Shape, pose: &Pose, x: DVec3) -> Option<(DV
     Some((point, normal, sign * offset.length()))
 }
 
+/// What a body's contacts push against, as the sweeps see it: the rigid bodies' proxies and the
+/// body's own nodes (the contacts' nodes and self-contact triangles).
+struct Partners<'a> {
+    rigid: &'a mut [RigidProxy],
+    velocities: &'a mut [DVec3],
+    masses: &'a [f64],
+    pinned: &'a [bool],
+}
+
+impl Partners<'_> {
+    /// The inverse mass (1/kg) of the body's node `n`: zero when pinned.
+    fn own_inverse_mass(&self, n: usize) -> f64 {
+        if self.pinned[n] {
+            0.0
+        } else {
+            1.0 / self.masses[n]
+        }
+    }
+
+    /// Velocity (m/s) of the obstacle's material point at `x` (m): zero for a fixed collider.
+    fn velocity_at(&self, obstacle: &Obstacle, x: DVec3) -> DVec3 {
+        match obstacle {
+            Obstacle::Collider { proxy, .. } => {
+                proxy.map_or(DVec3::ZERO, |p| self.rigid[p].velocity_at(x))
+            }
+            Obstacle::OwnTriangle { nodes, weights } => nodes
+                .iter()
+                .zip(weights)
+                .map(|(&c, w)| self.velocities[c as usize] * *w)
+                .sum(),
+        }
+    }
+
+    /// The obstacle's inverse effective mass (1/kg) at `x` (m) along unit `direction`.
+    fn inverse_mass_along(&self, obstacle: &Obstacle, x: DVec3, direction: DVec3) -> f64 {
+        match obstacle {
+            Obstacle::Collider { proxy, .. } => {
+                proxy.map_or(0.0, |p| self.rigid[p].inverse_mass_along(x, direction))
+            }
+            Obstacle::OwnTriangle { nodes, weights } => nodes
+                .iter()
+                .zip(weights)
+                .map(|(&c, w)| w * w * self.own_inverse_mass(c as usize))
+                .sum(),
+        }
+    }
+
+    /// Gives the obstacle `impulse` (N s) at `x` (m): the opposite of what its node received.
+    fn apply(&mut self, obstacle: &Obstacle, impulse: DVec3, x: DVec3) {
+        match obstacle {
+            Obstacle::Collider { proxy, .. } => {
+                if let Some(p) = *proxy {
+                    self.rigid[p].apply(impulse, x);
+                }
+            }
+            Obstacle::OwnTriangle { nodes, weights } => {
+                for (&c, w) in nodes.iter().zip(weights) {
+                    let c = c as usize;
+                    self.velocities[c] += impulse * (w * self.own_inverse_mass(c));
+                }
+            }
+        }
+    }
+}
+
+/// Splits `body` into its contacts, its positions and what the contacts push against.
+fn contacts_and_partners(body: &mut SoftBody) -> (&mut [NodeContact], &[DVec3], Partners<'_>) {
+    let SoftBody {
+        contacts,
+        rigid_proxies,
+        positions,
+        velocities,
+        masses,
+        pinned,
+        ..
+    } = body;
+    (
+        contacts,
+        positions,
+        Partners {
+            rigid: rigid_proxies,
+            velocities,
+            masses,
+            pinned,
+        },
+    )
+}
+
+/// Whether the body's contact constraints are coupled to each other (through a dynamic rigid
+/// body's velocity or the nodes of a self-contact triangle), so that one sweep does not solve
+/// them.
+pub(crate) fn constraints_coupled(body: &SoftBody) -> bool {
+    body.rigid_proxies.iter().any(RigidProxy::is_dynamic) || body.has_self_contacts()
+}
+
+impl SoftBody {
+    /// Whether the last detection found self-contacts, which only the explicit integrator solves.
+    pub(crate) fn has_self_contacts(&self) -> bool {
+        self.contacts
+            .iter()
+            .any(|c| matches!(c.obstacle, Obstacle::OwnTriangle { .. }))
+    }
+}
+
 /// Readies the contacts' velocity constraints for an explicit substep of `h` (s), before the
 /// sweeps of [`solve_velocities`]: each plane moves to the collider's surface point nearest to its
 /// node, and the lowest normal velocity is set so that the node arrives at the plane but does not
@@ -442,7 +618,7 @@ pub(crate) fn prepare_velocities(body: &mut SoftBody, h: f64) {
     let depenetration_speed = body.contact_settings.depenetration_speed;
     for contact in &mut body.contacts {
         let x = body.positions[contact.node as usize];
-        contact.refresh(x);
+        contact.refresh(x, &body.positions);
         let gap = contact.gap(x);
         contact.lowest_speed = if gap >= 0.0 {
             -gap / h
@@ -456,62 +632,46 @@ pub(crate) fn prepare_velocities(body: &mut SoftBody, h: f64) {
 
 /// One sweep over the contacts' velocity constraints (called after the velocity update, before
 /// positions move): each contact's accumulated normal impulse is corrected toward the one that
-/// brings its node's normal velocity relative to the collider to the lowest allowed, kept
+/// brings its node's normal velocity relative to the obstacle to the lowest allowed, kept
 /// pushing, and its friction impulse toward the one that stops the sliding, kept within the
-/// collider's friction coefficient times the normal impulse (Coulomb). Against a rigid body the
-/// velocities are relative, the body's effective mass counts, and the body receives the opposite
-/// impulse at the node; the sweeps converge to the contacts' joint solution.
+/// contact's friction coefficient times the normal impulse (Coulomb). Against a rigid body or an
+/// own triangle the velocities are relative, the obstacle's effective mass counts, and the
+/// obstacle receives the opposite impulse; the sweeps converge to the contacts' joint solution.
 pub(crate) fn solve_velocities(body: &mut SoftBody) {
-    let SoftBody {
-        contacts,
-        rigid_proxies,
-        positions,
-        velocities,
-        masses,
-        ..
-    } = body;
+    let (contacts, positions, mut partners) = contacts_and_partners(body);
     for contact in contacts.iter_mut() {
         let n = contact.node as usize;
         let x = positions[n];
-        let mut proxy = contact.proxy.map(|p| &mut rigid_proxies[p]);
-        let inverse_mass = |proxy: &Option<&mut RigidProxy>, direction: DVec3| {
-            1.0 / masses[n]
-                + proxy
-                    .as_ref()
-                    .map_or(0.0, |p| p.inverse_mass_along(x, direction))
+        let obstacle = &contact.obstacle;
+        let inverse_mass_n = partners.own_inverse_mass(n);
+        let inverse_mass = |partners: &Partners, direction: DVec3| {
+            inverse_mass_n + partners.inverse_mass_along(obstacle, x, direction)
         };
-        let relative = |proxy: &Option<&mut RigidProxy>, v: DVec3| {
-            v - proxy.as_ref().map_or(DVec3::ZERO, |p| p.velocity_at(x))
-        };
+        let relative =
+            |partners: &Partners| partners.velocities[n] - partners.velocity_at(obstacle, x);
 
-        let normal_speed = relative(&proxy, velocities[n]).dot(contact.normal);
+        let normal_speed = relative(&partners).dot(contact.normal);
         let normal_impulse = (contact.normal_impulse
-            + (contact.lowest_speed - normal_speed) / inverse_mass(&proxy, contact.normal))
+            + (contact.lowest_speed - normal_speed) / inverse_mass(&partners, contact.normal))
         .max(0.0);
-        let push = |impulse: DVec3,
-                    velocity: &mut DVec3,
-                    recorded: &mut DVec3,
-                    proxy: &mut Option<&mut RigidProxy>| {
-            *velocity += impulse / masses[n];
+        let push = |impulse: DVec3, recorded: &mut DVec3, partners: &mut Partners| {
+            partners.velocities[n] += impulse * inverse_mass_n;
             *recorded += impulse;
-            if let Some(proxy) = proxy.as_mut() {
-                proxy.apply(-impulse, x);
-            }
+            partners.apply(obstacle, -impulse, x);
         };
         push(
             contact.normal * (normal_impulse - contact.normal_impulse),
-            &mut velocities[n],
             &mut contact.impulse,
-            &mut proxy,
+            &mut partners,
         );
         contact.normal_impulse = normal_impulse;
 
-        let v = relative(&proxy, velocities[n]);
+        let v = relative(&partners);
         let sliding = v - contact.normal * v.dot(contact.normal);
         let slip = sliding.length();
         let mut friction = contact.friction_impulse;
         if slip > 0.0 {
-            friction -= sliding / inverse_mass(&proxy, sliding / slip);
+            friction -= sliding / inverse_mass(&partners, sliding / slip);
         }
         let limit = contact.friction * normal_impulse;
         if friction.length() > limit {
@@ -519,63 +679,56 @@ pub(crate) fn solve_velocities(body: &mut SoftBody) {
         }
         push(
             friction - contact.friction_impulse,
-            &mut velocities[n],
             &mut contact.impulse,
-            &mut proxy,
+            &mut partners,
         );
         contact.friction_impulse = friction;
     }
 }
 
+/// The contacts the implicit integrator enforces: those with colliders (it leaves self-contact
+/// to the explicit integrator).
+fn implicit_contacts(contacts: &mut [NodeContact]) -> impl Iterator<Item = &mut NodeContact> {
+    contacts
+        .iter_mut()
+        .filter(|c| matches!(c.obstacle, Obstacle::Collider { .. }))
+}
+
 /// Records the impulses (N s) the implicit penalty and friction gave the nodes over a substep of
 /// length `h` (s), at the positions that ended it, and hands their opposite to the rigid bodies.
 pub(crate) fn record_penalty_impulses(body: &mut SoftBody, effective_h: f64, h: f64) {
-    let SoftBody {
-        contacts,
-        rigid_proxies,
-        positions,
-        masses,
-        contact_settings,
-        ..
-    } = body;
-    for contact in contacts.iter_mut() {
+    let settings = body.contact_settings;
+    let (contacts, positions, mut partners) = contacts_and_partners(body);
+    for contact in implicit_contacts(contacts) {
         let n = contact.node as usize;
+        let x = positions[n];
         let mut force = contact
-            .friction_term(positions[n], contact_settings, effective_h)
+            .friction_term(x, &settings, effective_h)
             .map_or(DVec3::ZERO, |(_, force, _)| force);
         if let Some((stiffness, gap)) =
-            contact.penalty(positions[n], masses[n], contact_settings, effective_h)
+            contact.penalty(x, partners.masses[n], &settings, effective_h)
         {
             force -= contact.normal * (stiffness * gap);
         }
         let impulse = force * h;
         contact.impulse += impulse;
-        if let Some(p) = contact.proxy {
-            rigid_proxies[p].apply(-impulse, positions[n]);
-        }
+        partners.apply(&contact.obstacle, -impulse, x);
     }
 }
 
 /// Readies implicit friction for a step of effective length `h` (s) from the body's positions:
 /// each contact's friction limit is its penalty force there, and slip is measured from there.
 pub(crate) fn lag_friction(body: &mut SoftBody, h: f64) {
-    let SoftBody {
-        contacts,
-        rigid_proxies,
-        positions,
-        masses,
-        contact_settings,
-        ..
-    } = body;
-    for contact in contacts.iter_mut() {
-        let x = positions[contact.node as usize];
+    let settings = body.contact_settings;
+    let (contacts, positions, partners) = contacts_and_partners(body);
+    for contact in implicit_contacts(contacts) {
+        let n = contact.node as usize;
+        let x = positions[n];
         contact.lagged_normal_force = contact
-            .penalty(x, masses[contact.node as usize], contact_settings, h)
+            .penalty(x, partners.masses[n], &settings, h)
             .map_or(0.0, |(stiffness, gap)| -stiffness * gap);
         contact.slip_origin = x;
-        contact.surface_velocity = contact
-            .proxy
-            .map_or(DVec3::ZERO, |p| rigid_proxies[p].velocity_at(x));
+        contact.surface_velocity = partners.velocity_at(&contact.obstacle, x);
     }
 }
 
@@ -587,7 +740,11 @@ pub(crate) fn for_each_friction(
     h: f64,
     mut each: impl FnMut(usize, f64, DVec3, DMat3),
 ) {
-    for contact in &body.contacts {
+    for contact in body
+        .contacts
+        .iter()
+        .filter(|c| matches!(c.obstacle, Obstacle::Collider { .. }))
+    {
         let n = contact.node as usize;
         if let Some((energy, force, tangent)) =
             contact.friction_term(body.positions[n], &body.contact_settings, h)
@@ -606,7 +763,11 @@ pub(crate) fn for_each_active_penalty(
     h: f64,
     mut each: impl FnMut(usize, f64, f64, DVec3),
 ) {
-    for contact in &body.contacts {
+    for contact in body
+        .contacts
+        .iter()
+        .filter(|c| matches!(c.obstacle, Obstacle::Collider { .. }))
+    {
         let n = contact.node as usize;
         if let Some((stiffness, gap)) =
             contact.penalty(body.positions[n], body.masses[n], &body.contact_settings, h)

@@ -135,7 +135,7 @@ impl AutomaticIntegrator {
     }
 
     /// Advances `body` by `frame_dt` (s) under gravity (m/s²) with the cheaper integrator (or the
-    /// forced one).
+    /// forced one); explicit while the body has self-contacts.
     ///
     /// # Errors
     /// [`Error::InvalidTimeStep`] for a non-positive or non-finite `frame_dt`, [`Error::NonFiniteInput`]
@@ -152,7 +152,14 @@ impl AutomaticIntegrator {
         // The stability limit is evaluated once and serves both the prediction and the step.
         let needed = self.explicit.needed_substeps(body, frame_dt)?;
         let prediction = self.prediction(body, needed);
-        let choice = self.force.unwrap_or_else(|| prediction.cheaper());
+        // Self-contact is solved by the explicit integrator only.
+        let choice = self.force.unwrap_or_else(|| {
+            if body.has_self_contacts() {
+                IntegratorKind::Explicit
+            } else {
+                prediction.cheaper()
+            }
+        });
         let explicit = match choice {
             IntegratorKind::Explicit => {
                 Some(self.explicit.advance(body, frame_dt, gravity, needed))

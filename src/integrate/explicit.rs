@@ -14,7 +14,6 @@
 use super::check_step;
 use crate::Error;
 use crate::body::SoftBody;
-use crate::contact::RigidProxy;
 use crate::{attachment, contact};
 use rapier3d::glamx::DVec3;
 
@@ -231,8 +230,7 @@ fn substep(body: &mut SoftBody, h: f64, gravity: DVec3) {
     }
     contact::prepare_velocities(body, h);
     attachment::prepare_velocities(body, h);
-    // Constraints are coupled only through the velocities of dynamic rigid bodies.
-    let sweeps = if body.rigid_proxies.iter().any(RigidProxy::is_dynamic) {
+    let sweeps = if contact::constraints_coupled(body) {
         body.contact_settings.velocity_iterations.max(1)
     } else {
         1
