@@ -13,10 +13,15 @@
 //! position-based kinematic body told where to be at the end of the frame
 //! (`set_next_kinematic_position`) gets there along the straight path (rotation by slerp), a
 //! part per substep, rather than in the first substep.
+//!
+//! Soft bodies whose surfaces touch (their collision groups interacting) are stepped together by
+//! the explicit integrator, in the substeps the least stable of them needs, whatever the
+//! automatic choice: their contacts are solved in the same sweeps with both bodies' nodes, so
+//! that momentum passes exactly from one to the other and a stack rests without creeping in.
 
 use crate::Error;
-use crate::body::{SoftBodyHandle, SoftBodySet};
-use crate::contact::ContactSettings;
+use crate::body::{SoftBody, SoftBodyHandle, SoftBodySet};
+use crate::contact::{self, BetweenContact, ContactSettings};
 use crate::integrate::{AutomaticIntegrator, AutomaticReport};
 use rapier3d::dynamics::{RigidBodyHandle, RigidBodySet, RigidBodyType};
 use rapier3d::glamx::DVec3;
@@ -109,6 +114,50 @@ fn hold_supported_bodies(body: &mut crate::body::SoftBody, physics: &PhysicsWorl
             proxy.hold();
         }
     }
+}
+
+/// The groups of `count` bodies that the contacts `between` them link (directly or through
+/// others), each with its contacts re-indexed to positions in the group: bodies that must step
+/// together. A body touching no other is a group of its own.
+fn touching_groups(
+    count: usize,
+    between: Vec<BetweenContact>,
+) -> Vec<(Vec<usize>, Vec<BetweenContact>)> {
+    let mut root: Vec<usize> = (0..count).collect();
+    fn find(root: &mut [usize], mut i: usize) -> usize {
+        while root[i] != i {
+            root[i] = root[root[i]];
+            i = root[i];
+        }
+        i
+    }
+    for contact in &between {
+        let (a, b) = (
+            find(&mut root, contact.node_body),
+            find(&mut root, contact.triangle_body),
+        );
+        root[a.max(b)] = a.min(b);
+    }
+    let mut groups: Vec<(Vec<usize>, Vec<BetweenContact>)> = Vec::new();
+    let mut group_of = vec![usize::MAX; count];
+    let mut slot_of = vec![0; count];
+    for (i, slot) in slot_of.iter_mut().enumerate() {
+        let r = find(&mut root, i);
+        if group_of[r] == usize::MAX {
+            group_of[r] = groups.len();
+            groups.push((Vec::new(), Vec::new()));
+        }
+        let group = &mut groups[group_of[r]].0;
+        *slot = group.len();
+        group.push(i);
+    }
+    for mut contact in between {
+        let g = group_of[find(&mut root, contact.node_body)];
+        contact.node_body = slot_of[contact.node_body];
+        contact.triangle_body = slot_of[contact.triangle_body];
+        groups[g].1.push(contact);
+    }
+    groups
 }
 
 /// Adds a substep's impulse (N s) and angular impulse about the centre of mass (N m s) to the
@@ -227,37 +276,65 @@ impl FvmWorld {
             for path in &paths {
                 path.advance(&mut self.physics.bodies, substep as f32 / substeps as f32);
             }
-            for ((handle, body), (_, outcome)) in self.soft_bodies.iter_mut().zip(&mut outcomes) {
+            for (handle, outcome) in &mut outcomes {
                 if matches!(outcome, Some(Err(_))) {
                     continue;
                 }
-                let physics = &mut self.physics;
-                let detected = body
-                    .detect_contacts(
-                        &physics.colliders,
-                        &physics.bodies,
-                        h,
-                        gravity,
-                        &self.contact,
-                    )
-                    .map(|_| ());
-                let stepped = detected.and_then(|()| {
-                    hold_supported_bodies(body, physics);
-                    self.integrator.step(body, h, gravity)
-                });
-                if stepped.is_ok() {
-                    for (rigid_body, impulse, angular_impulse) in body.rigid_impulses() {
-                        add_load(
-                            &mut self.loads,
-                            handle,
-                            rigid_body,
-                            impulse,
-                            angular_impulse,
-                        );
-                    }
-                    body.transfer_contact_impulses(&mut physics.bodies);
+                let physics = &self.physics;
+                if let Err(error) = self.soft_bodies[*handle].detect_contacts(
+                    &physics.colliders,
+                    &physics.bodies,
+                    h,
+                    gravity,
+                    &self.contact,
+                ) {
+                    *outcome = Some(Err(error));
                 }
-                *outcome = Some(stepped);
+            }
+            let live: Vec<SoftBodyHandle> = outcomes
+                .iter()
+                .filter(|(_, outcome)| !matches!(outcome, Some(Err(_))))
+                .map(|(handle, _)| *handle)
+                .collect();
+            let between = {
+                let bodies: Vec<&SoftBody> = live.iter().map(|&h| &self.soft_bodies[h]).collect();
+                contact::detect_between(&bodies, &self.contact, h, gravity)
+            };
+            for (group, mut contacts) in touching_groups(live.len(), between) {
+                let handles: Vec<SoftBodyHandle> = group.iter().map(|&i| live[i]).collect();
+                let physics = &mut self.physics;
+                let mut bodies = self.soft_bodies.get_many_mut(&handles);
+                for body in bodies.iter_mut() {
+                    hold_supported_bodies(body, physics);
+                }
+                let stepped: Vec<Result<AutomaticReport, Error>> = if let [body] = &mut bodies[..] {
+                    vec![self.integrator.step(body, h, gravity)]
+                } else {
+                    match self
+                        .integrator
+                        .step_together(&mut bodies, &mut contacts, h, gravity)
+                    {
+                        Ok(reports) => reports.into_iter().map(Ok).collect(),
+                        Err(error) => vec![Err(error); bodies.len()],
+                    }
+                };
+                for ((handle, body), result) in handles.iter().zip(bodies).zip(stepped) {
+                    if result.is_ok() {
+                        for (rigid_body, impulse, angular_impulse) in body.rigid_impulses() {
+                            add_load(
+                                &mut self.loads,
+                                *handle,
+                                rigid_body,
+                                impulse,
+                                angular_impulse,
+                            );
+                        }
+                        body.transfer_contact_impulses(&mut physics.bodies);
+                    }
+                    if let Some((_, outcome)) = outcomes.iter_mut().find(|(h, _)| h == handle) {
+                        *outcome = Some(result);
+                    }
+                }
             }
             self.physics.step_with_events(hooks, events);
         }

@@ -110,6 +110,18 @@ impl SoftBodySet {
         slot.body.as_mut()
     }
 
+    /// The bodies of distinct `handles`, mutably, in the order given; handles not in the set
+    /// are skipped.
+    pub(crate) fn get_many_mut(&mut self, handles: &[SoftBodyHandle]) -> Vec<&mut SoftBody> {
+        let mut found: Vec<Option<&mut SoftBody>> = handles.iter().map(|_| None).collect();
+        for (handle, body) in self.iter_mut() {
+            if let Some(i) = handles.iter().position(|h| *h == handle) {
+                found[i] = Some(body);
+            }
+        }
+        found.into_iter().flatten().collect()
+    }
+
     /// Whether `handle` refers to a body of the set.
     pub fn contains(&self, handle: SoftBodyHandle) -> bool {
         self.get(handle).is_some()

@@ -1,4 +1,5 @@
-//! Contact of soft bodies with rapier colliders.
+//! Contact of soft bodies with rapier colliders, with themselves (self-contact) and with each
+//! other.
 //!
 //! Detection ([`SoftBody::detect_contacts`]) projects every surface node onto every collider
 //! (parry's point projection, which covers all of rapier's shapes) that the node can reach within
@@ -29,10 +30,22 @@
 //! Within a soft step the rigid bodies are frozen in pose and their velocities follow the
 //! impulses; the total is handed to rapier when the step is accepted.
 
+//!
+//! A body with [`SoftBody::self_contact`] on also gets contacts of its surface nodes with its own
+//! boundary triangles away from their neighbourhood, and an [`FvmWorld`](crate::world::FvmWorld)
+//! finds the contacts of each soft body's surface nodes with the boundary triangles of the
+//! others. Both are solved by the explicit sweeps with the triangle's nodes taking their share of
+//! the opposite impulse; soft bodies that touch are stepped together for that.
+
+mod between;
 mod rigid;
 mod self_contact;
+mod surface_tree;
+mod velocity_constraint;
 
+pub(crate) use between::{BetweenContact, detect_between, prepare_between, solve_between};
 pub(crate) use rigid::{RigidProxy, coming_velocity};
+pub(crate) use velocity_constraint::{ContactSides, VelocityConstraint};
 
 use crate::Error;
 use crate::body::SoftBody;
@@ -109,11 +122,8 @@ pub struct NodeContact {
     pub impulse: DVec3,
     /// The far side of the contact, as the velocity constraints see it.
     obstacle: Obstacle,
-    /// Within an explicit substep: the lowest normal velocity (m/s) relative to the target the
-    /// node may keep, and the normal (N s) and friction impulses accumulated so far.
-    lowest_speed: f64,
-    normal_impulse: f64,
-    friction_impulse: DVec3,
+    /// Within an explicit substep: the velocity constraint.
+    constraint: VelocityConstraint,
     /// Within an implicit step: the normal force (N) friction is limited by, and the node's
     /// position and the surface's velocity there at the start of the step (m, m/s).
     lagged_normal_force: f64,
@@ -168,9 +178,7 @@ impl NodeContact {
             friction,
             impulse: DVec3::ZERO,
             obstacle,
-            lowest_speed: 0.0,
-            normal_impulse: 0.0,
-            friction_impulse: DVec3::ZERO,
+            constraint: VelocityConstraint::default(),
             lagged_normal_force: 0.0,
             slip_origin: DVec3::ZERO,
             surface_velocity: DVec3::ZERO,
@@ -619,70 +627,53 @@ pub(crate) fn prepare_velocities(body: &mut SoftBody, h: f64) {
     for contact in &mut body.contacts {
         let x = body.positions[contact.node as usize];
         contact.refresh(x, &body.positions);
-        let gap = contact.gap(x);
-        contact.lowest_speed = if gap >= 0.0 {
-            -gap / h
-        } else {
-            (-gap / h).min(depenetration_speed)
-        };
-        contact.normal_impulse = 0.0;
-        contact.friction_impulse = DVec3::ZERO;
+        contact.constraint = VelocityConstraint::new(contact.gap(x), h, depenetration_speed);
     }
 }
 
 /// One sweep over the contacts' velocity constraints (called after the velocity update, before
-/// positions move): each contact's accumulated normal impulse is corrected toward the one that
-/// brings its node's normal velocity relative to the obstacle to the lowest allowed, kept
-/// pushing, and its friction impulse toward the one that stops the sliding, kept within the
-/// contact's friction coefficient times the normal impulse (Coulomb). Against a rigid body or an
-/// own triangle the velocities are relative, the obstacle's effective mass counts, and the
-/// obstacle receives the opposite impulse; the sweeps converge to the contacts' joint solution.
+/// positions move; see [`VelocityConstraint`]). Against a rigid body or an own triangle the
+/// velocities are relative, the obstacle's effective mass counts, and the obstacle receives the
+/// opposite impulse.
 pub(crate) fn solve_velocities(body: &mut SoftBody) {
     let (contacts, positions, mut partners) = contacts_and_partners(body);
     for contact in contacts.iter_mut() {
         let n = contact.node as usize;
-        let x = positions[n];
-        let obstacle = &contact.obstacle;
-        let inverse_mass_n = partners.own_inverse_mass(n);
-        let inverse_mass = |partners: &Partners, direction: DVec3| {
-            inverse_mass_n + partners.inverse_mass_along(obstacle, x, direction)
+        let mut sides = WithinBody {
+            partners: &mut partners,
+            obstacle: &contact.obstacle,
+            node: n,
+            x: positions[n],
         };
-        let relative =
-            |partners: &Partners| partners.velocities[n] - partners.velocity_at(obstacle, x);
+        contact.impulse += contact
+            .constraint
+            .correct(contact.normal, contact.friction, &mut sides);
+    }
+}
 
-        let normal_speed = relative(&partners).dot(contact.normal);
-        let normal_impulse = (contact.normal_impulse
-            + (contact.lowest_speed - normal_speed) / inverse_mass(&partners, contact.normal))
-        .max(0.0);
-        let push = |impulse: DVec3, recorded: &mut DVec3, partners: &mut Partners| {
-            partners.velocities[n] += impulse * inverse_mass_n;
-            *recorded += impulse;
-            partners.apply(obstacle, -impulse, x);
-        };
-        push(
-            contact.normal * (normal_impulse - contact.normal_impulse),
-            &mut contact.impulse,
-            &mut partners,
-        );
-        contact.normal_impulse = normal_impulse;
+/// A contact's node and obstacle within one body's sweep.
+struct WithinBody<'a, 'b> {
+    partners: &'a mut Partners<'b>,
+    obstacle: &'a Obstacle,
+    node: usize,
+    x: DVec3,
+}
 
-        let v = relative(&partners);
-        let sliding = v - contact.normal * v.dot(contact.normal);
-        let slip = sliding.length();
-        let mut friction = contact.friction_impulse;
-        if slip > 0.0 {
-            friction -= sliding / inverse_mass(&partners, sliding / slip);
-        }
-        let limit = contact.friction * normal_impulse;
-        if friction.length() > limit {
-            friction *= limit / friction.length();
-        }
-        push(
-            friction - contact.friction_impulse,
-            &mut contact.impulse,
-            &mut partners,
-        );
-        contact.friction_impulse = friction;
+impl ContactSides for WithinBody<'_, '_> {
+    fn relative_velocity(&self) -> DVec3 {
+        self.partners.velocities[self.node] - self.partners.velocity_at(self.obstacle, self.x)
+    }
+
+    fn inverse_mass_along(&self, direction: DVec3) -> f64 {
+        self.partners.own_inverse_mass(self.node)
+            + self
+                .partners
+                .inverse_mass_along(self.obstacle, self.x, direction)
+    }
+
+    fn exchange(&mut self, impulse: DVec3) {
+        self.partners.velocities[self.node] += impulse * self.partners.own_inverse_mass(self.node);
+        self.partners.apply(self.obstacle, -impulse, self.x);
     }
 }
 

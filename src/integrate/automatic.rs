@@ -12,6 +12,7 @@
 use super::{ImplicitIntegrator, ImplicitReport, StepReport, SymplecticEuler};
 use crate::Error;
 use crate::body::{SoftBody, SoftBodyHandle, SoftBodySet};
+use crate::contact::BetweenContact;
 use crate::material::MaterialModel;
 use rapier3d::glamx::DVec3;
 
@@ -192,5 +193,39 @@ impl AutomaticIntegrator {
             implicit,
             fell_back,
         })
+    }
+
+    /// Advances soft `bodies` touching each other through `between` (indices into `bodies`)
+    /// by `frame_dt` (s) together, explicitly, whatever the choice or the forced integrator:
+    /// their contacts are solved in the explicit sweeps with both bodies' nodes. A report per
+    /// body, in order.
+    ///
+    /// # Errors
+    /// Those of [`SymplecticEuler::step`]; every body is then left as it was.
+    pub(crate) fn step_together(
+        &self,
+        bodies: &mut [&mut SoftBody],
+        between: &mut [BetweenContact],
+        frame_dt: f64,
+        gravity: DVec3,
+    ) -> Result<Vec<AutomaticReport>, Error> {
+        let predictions: Vec<CostPrediction> = bodies
+            .iter()
+            .map(|body| self.predict(body, frame_dt))
+            .collect();
+        let reports = self
+            .explicit
+            .step_together(bodies, between, frame_dt, gravity)?;
+        Ok(reports
+            .into_iter()
+            .zip(predictions)
+            .map(|(report, prediction)| AutomaticReport {
+                choice: IntegratorKind::Explicit,
+                prediction,
+                explicit: Some(report),
+                implicit: None,
+                fell_back: false,
+            })
+            .collect())
     }
 }

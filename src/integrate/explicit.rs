@@ -14,6 +14,7 @@
 use super::check_step;
 use crate::Error;
 use crate::body::SoftBody;
+use crate::contact::BetweenContact;
 use crate::{attachment, contact};
 use rapier3d::glamx::DVec3;
 
@@ -124,6 +125,41 @@ impl SymplecticEuler {
         gravity: DVec3,
         needed: f64,
     ) -> Result<StepReport, Error> {
+        let reports = self.advance_together(&mut [body], &mut [], frame_dt, gravity, needed)?;
+        Ok(reports[0])
+    }
+
+    /// Advances soft `bodies` in contact with each other through `between` (indices into
+    /// `bodies`) by `frame_dt` (s) together, in the same substeps: as many as the least stable of
+    /// them needs. A report per body, in order.
+    ///
+    /// # Errors
+    /// Those of [`SymplecticEuler::step`], for the first body at fault; every body is then left
+    /// as it was.
+    pub(crate) fn step_together(
+        &self,
+        bodies: &mut [&mut SoftBody],
+        between: &mut [BetweenContact],
+        frame_dt: f64,
+        gravity: DVec3,
+    ) -> Result<Vec<StepReport>, Error> {
+        check_step(frame_dt, gravity)?;
+        let mut needed: f64 = 1.0;
+        for body in bodies.iter() {
+            needed = needed.max(self.needed_substeps(body, frame_dt)?);
+        }
+        self.advance_together(bodies, between, frame_dt, gravity, needed)
+    }
+
+    /// [`SymplecticEuler::step_together`] in `needed` substeps.
+    fn advance_together(
+        &self,
+        bodies: &mut [&mut SoftBody],
+        between: &mut [BetweenContact],
+        frame_dt: f64,
+        gravity: DVec3,
+        needed: f64,
+    ) -> Result<Vec<StepReport>, Error> {
         let automatic = self.substeps == Substeps::Automatic;
         if automatic && (needed.is_nan() || needed > f64::from(self.max_substeps)) {
             return Err(Error::TooManySubsteps {
@@ -135,22 +171,30 @@ impl SymplecticEuler {
         let mut h = frame_dt / needed;
         let mut left = needed as u32;
         let (mut taken, mut elapsed, mut smallest) = (0u32, 0.0, h);
-        body.save_state();
-        let history = body.previous_step.take();
-        let fail = |body: &mut SoftBody, history, error| {
-            body.restore_state();
-            body.previous_step = history;
+        let mut histories = Vec::with_capacity(bodies.len());
+        for body in bodies.iter_mut() {
+            body.save_state();
+            histories.push(body.previous_step.take());
+        }
+        let fail = |bodies: &mut [&mut SoftBody], histories: Vec<_>, error| {
+            for (body, history) in bodies.iter_mut().zip(histories) {
+                body.restore_state();
+                body.previous_step = history;
+            }
             Err(error)
         };
         while left > 0 {
-            substep(body, h, gravity);
+            substep(bodies, between, h, gravity);
             left -= 1;
             taken += 1;
             elapsed += h;
             // Crushing elements lowers the limit within a frame (an impact flattens a soft
             // body in a few substeps): re-evaluate it now and then and shorten the rest.
             if automatic && left > 0 && taken % RECHECK_INTERVAL == 0 {
-                let stable = self.stable_time_step(body);
+                let stable = bodies
+                    .iter()
+                    .map(|body| self.stable_time_step(body))
+                    .fold(f64::INFINITY, f64::min);
                 if stable < h {
                     let remaining = frame_dt - elapsed;
                     let more = (remaining / stable).ceil();
@@ -158,8 +202,8 @@ impl SymplecticEuler {
                         let needed = f64::from(taken) + more;
                         let max = self.max_substeps;
                         return fail(
-                            body,
-                            history,
+                            bodies,
+                            histories,
                             Error::TooManySubsteps {
                                 frame_dt,
                                 needed,
@@ -173,14 +217,17 @@ impl SymplecticEuler {
                 }
             }
         }
-        if let Some(node) = body.first_non_finite_node() {
-            return fail(body, history, Error::NonFiniteState { node });
+        if let Some(node) = bodies.iter().find_map(|body| body.first_non_finite_node()) {
+            return fail(bodies, histories, Error::NonFiniteState { node });
         }
-        Ok(StepReport {
-            substeps: taken,
-            substep_dt: smallest,
-            inverted_tets: body.inverted_tet_count(),
-        })
+        Ok(bodies
+            .iter()
+            .map(|body| StepReport {
+                substeps: taken,
+                substep_dt: smallest,
+                inverted_tets: body.inverted_tet_count(),
+            })
+            .collect())
     }
 
     /// The substeps a frame of `frame_dt` (s) takes: the fixed count, or as many as the
@@ -208,8 +255,37 @@ impl SymplecticEuler {
     }
 }
 
-/// One symplectic Euler substep of length `h` (s).
-fn substep(body: &mut SoftBody, h: f64, gravity: DVec3) {
+/// One symplectic Euler substep of length `h` (s) of `bodies` and the contacts `between` them.
+fn substep(bodies: &mut [&mut SoftBody], between: &mut [BetweenContact], h: f64, gravity: DVec3) {
+    for body in bodies.iter_mut() {
+        update_velocities(body, h, gravity);
+    }
+    contact::prepare_between(between, bodies, h);
+    let sweeps = if !between.is_empty() || bodies.iter().any(|b| contact::constraints_coupled(b)) {
+        bodies
+            .iter()
+            .map(|body| body.contact_settings.velocity_iterations)
+            .max()
+            .unwrap_or(1)
+            .max(1)
+    } else {
+        1
+    };
+    for _ in 0..sweeps {
+        for body in bodies.iter_mut() {
+            contact::solve_velocities(body);
+            attachment::solve_velocities(body);
+        }
+        contact::solve_between(between, bodies);
+    }
+    for body in bodies.iter_mut() {
+        update_positions(body, h);
+    }
+}
+
+/// The substep's velocity update `v ← v + h (f/m + g)`, then the constraints readied for the
+/// sweeps.
+fn update_velocities(body: &mut SoftBody, h: f64, gravity: DVec3) {
     body.compute_internal_forces();
     let SoftBody {
         velocities,
@@ -230,15 +306,10 @@ fn substep(body: &mut SoftBody, h: f64, gravity: DVec3) {
     }
     contact::prepare_velocities(body, h);
     attachment::prepare_velocities(body, h);
-    let sweeps = if contact::constraints_coupled(body) {
-        body.contact_settings.velocity_iterations.max(1)
-    } else {
-        1
-    };
-    for _ in 0..sweeps {
-        contact::solve_velocities(body);
-        attachment::solve_velocities(body);
-    }
+}
+
+/// The substep's position update `x ← x + h v`, after the sweeps.
+fn update_positions(body: &mut SoftBody, h: f64) {
     attachment::advance_anchors(body, h);
     let SoftBody {
         positions,
