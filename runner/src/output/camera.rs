@@ -1,5 +1,6 @@
 //! A fixed oblique orthographic camera: looks down at the scene from the front right, about 27°
-//! above the horizon (y is up), and frames a given box with a margin.
+//! above the horizon (y is up), and frames a given box with a margin in the left part of the
+//! picture, leaving a column on the right for the legend or colour bar.
 
 use rapier_fvm::glamx::DVec3;
 
@@ -7,6 +8,8 @@ use rapier_fvm::glamx::DVec3;
 const VIEW_FROM: DVec3 = DVec3::new(0.9, 0.9, 1.6);
 /// Fraction of the picture left free on each side of the framed box.
 const MARGIN: f64 = 0.08;
+/// Fraction of the picture's width kept free on the right for the legend.
+const LEGEND_SHARE: f64 = 0.2;
 
 /// Maps world points (m) to pixels of a `width` × `height` picture.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -20,6 +23,8 @@ pub struct Camera {
     center: DVec3,
     /// Pixels per metre.
     scale: f64,
+    /// The pixel the centre is drawn at.
+    center_pixel: (f64, f64),
     /// Picture size (pixels).
     width: u32,
     height: u32,
@@ -51,8 +56,8 @@ impl Camera {
         );
         let extent = (hi - lo).max(DVec3::splat(1e-6));
         let usable = 1.0 - 2.0 * MARGIN;
-        let scale =
-            (f64::from(width) * usable / extent.x).min(f64::from(height) * usable / extent.y);
+        let scene_width = f64::from(width) * (1.0 - LEGEND_SHARE);
+        let scale = (scene_width * usable / extent.x).min(f64::from(height) * usable / extent.y);
         let mid = (lo + hi) * 0.5;
         Self {
             toward_eye,
@@ -60,6 +65,7 @@ impl Camera {
             up,
             center: right * mid.x + up * mid.y + toward_eye * (min + max).dot(toward_eye) * 0.5,
             scale,
+            center_pixel: (0.5 * scene_width, 0.5 * f64::from(height)),
             width,
             height,
         }
@@ -80,8 +86,8 @@ impl Camera {
     pub fn project(&self, p: DVec3) -> DVec3 {
         let d = p - self.center;
         DVec3::new(
-            0.5 * f64::from(self.width) + d.dot(self.right) * self.scale,
-            0.5 * f64::from(self.height) - d.dot(self.up) * self.scale,
+            self.center_pixel.0 + d.dot(self.right) * self.scale,
+            self.center_pixel.1 - d.dot(self.up) * self.scale,
             -d.dot(self.toward_eye),
         )
     }
