@@ -54,7 +54,6 @@ fn main() -> Result<(), Box<dyn Error>> {
         )],
         rigid_bodies: RigidBodySnapshot::all_of(&world.physics, GROUND_PATCH),
     };
-    let mut series = ParaViewSeries::new(out, "render_drop")?;
     let mut saved = vec![capture(&world, 0.0)];
     let mut height = TimeSeries {
         name: String::from("cube centre height"),
@@ -74,15 +73,21 @@ fn main() -> Result<(), Box<dyn Error>> {
         }
     }
 
-    let bounds = saved
-        .iter()
-        .filter_map(Snapshot::bounds)
-        .reduce(|a, b| (a.0.min(b.0), a.1.max(b.1)));
-    let (min, max) = bounds.ok_or("nothing to frame")?;
-    let camera = Camera::oblique(min, max, 800, 600);
-    // The colour scale ends at the largest 95th percentile of any frame, so that a few peak
-    // nodes at a contact corner do not leave the rest of the body in the bottom colour.
-    let max_stress = saved.iter().map(upper_stress).fold(1.0, f64::max);
+    write_series(out, &saved)?;
+    let max_stress = write_pictures(out, &saved)?;
+    plot_series(&out.join("cube_centre_height.png"), &height, (800, 500))?;
+    println!(
+        "{} frames saved to {} (colour scale to {:.0} Pa)",
+        saved.len(),
+        out.display(),
+        max_stress
+    );
+    Ok(())
+}
+
+/// Writes the ParaView series and the OBJ surfaces of every saved frame, printing a table.
+fn write_series(out: &Path, saved: &[Snapshot]) -> Result<(), Box<dyn Error>> {
+    let mut series = ParaViewSeries::new(out, "render_drop")?;
     println!(
         "{:>6} {:>12} {:>16}",
         "t (s)", "centre (mm)", "von Mises (kPa)"
@@ -100,6 +105,21 @@ fn main() -> Result<(), Box<dyn Error>> {
         series.write_frame(snapshot)?;
         write_obj(&out.join(format!("surface_{i:05}.obj")), snapshot)?;
     }
+    Ok(())
+}
+
+/// Renders a few saved frames coloured by material and by stress from one camera framing them
+/// all; returns the top of the stress colour scale (Pa).
+fn write_pictures(out: &Path, saved: &[Snapshot]) -> Result<f64, Box<dyn Error>> {
+    let bounds = saved
+        .iter()
+        .filter_map(Snapshot::bounds)
+        .reduce(|a, b| (a.0.min(b.0), a.1.max(b.1)));
+    let (min, max) = bounds.ok_or("nothing to frame")?;
+    let camera = Camera::oblique(min, max, 800, 600);
+    // The colour scale ends at the largest 95th percentile of any frame, so that a few peak
+    // nodes at a contact corner do not leave the rest of the body in the bottom colour.
+    let max_stress = saved.iter().map(upper_stress).fold(1.0, f64::max);
     // The start, the most stressed frame, and a few instants between.
     let peak = (0..saved.len())
         .max_by(|&a, &b| peak_stress(&saved[a]).total_cmp(&peak_stress(&saved[b])))
@@ -123,15 +143,7 @@ fn main() -> Result<(), Box<dyn Error>> {
             stress,
         )?;
     }
-    plot_series(&out.join("cube_centre_height.png"), &height, (800, 500))?;
-    println!(
-        "{} frames saved to {}: {} (colour scale to {:.0} Pa)",
-        saved.len(),
-        out.display(),
-        series.pvd_path().display(),
-        max_stress
-    );
-    Ok(())
+    Ok(max_stress)
 }
 
 /// The largest nodal von Mises stress (Pa) of a snapshot's soft bodies.
