@@ -3,6 +3,7 @@
 
 mod builder;
 mod set;
+mod stress;
 
 pub use builder::{DEFAULT_FRICTION, DEFAULT_MIN_ELEMENT_QUALITY, SoftBodyBuilder};
 pub use set::{SoftBodyHandle, SoftBodySet};

@@ -1,0 +1,64 @@
+//! Per-tetrahedron stress at the current positions, for output and post-processing: the Cauchy
+//! (true) stress `σ = P Fᵀ / det F` (Pa), force per unit deformed area in world axes, from the
+//! first Piola–Kirchhoff stress `P` of the body's material, and its von Mises equivalent
+//! `σ_vm = sqrt(3/2 s:s)`, `s = σ - tr(σ)/3 I`.
+
+use super::SoftBody;
+use crate::fvm::gather;
+use crate::material::{HyperelasticModel, VolumetricTerm, with_hyperelastic_model};
+use rapier3d::glamx::DMat3;
+
+impl SoftBody {
+    /// The Cauchy stress `σ = P Fᵀ / det F` (Pa) of every tetrahedron at the current positions,
+    /// in mesh order and world axes; symmetric for every model.
+    ///
+    /// It is the elastic stress the internal forces come from: with
+    /// [`VolumetricTreatment::NodalAverage`](crate::fvm::VolumetricTreatment::NodalAverage) it
+    /// includes the element's share of the averaged volumetric term. The viscous stress of the
+    /// Rayleigh damping is not included.
+    ///
+    /// An inverted or flattened tetrahedron (`det F <= 0`) has no Cauchy stress; for it the
+    /// Kirchhoff stress `τ = P Fᵀ` (Pa) is returned instead, the Cauchy stress it would have at
+    /// its rest volume: finite and of the right sign, never NaN for finite positions. Count those
+    /// elements with [`SoftBody::inverted_tet_count`].
+    pub fn cauchy_stresses(&self) -> Vec<DMat3> {
+        with_hyperelastic_model!(self.material, |model| {
+            let measures = self
+                .nodal_averaging
+                .as_ref()
+                .map(|averaging| averaging.measures(&model, &self.fvm, &self.positions));
+            let bulk = model.volumetric_modulus();
+            self.fvm
+                .tets()
+                .iter()
+                .enumerate()
+                .map(|(t, tet)| {
+                    let f = self.fvm.tet_rest(t).gradient(&gather(tet, &self.positions));
+                    let mut piola = model.first_piola(&f);
+                    if let Some(measures) = &measures {
+                        piola +=
+                            model.volume_measure_gradient(&f) * (bulk * measures.excess(tet, t));
+                    }
+                    let kirchhoff = piola * f.transpose();
+                    let volume_ratio = f.determinant();
+                    if volume_ratio > 0.0 {
+                        kirchhoff * volume_ratio.recip()
+                    } else {
+                        kirchhoff
+                    }
+                })
+                .collect()
+        })
+    }
+
+    /// The von Mises equivalent stress `sqrt(3/2 s:s)` (Pa) of a stress tensor `stress` (Pa),
+    /// with `s` its deviatoric part: the uniaxial stress of the same distortion energy.
+    pub fn von_mises(stress: &DMat3) -> f64 {
+        let mean = (stress.x_axis.x + stress.y_axis.y + stress.z_axis.z) / 3.0;
+        let deviator = *stress - DMat3::IDENTITY * mean;
+        let squared = deviator.x_axis.length_squared()
+            + deviator.y_axis.length_squared()
+            + deviator.z_axis.length_squared();
+        (1.5 * squared).sqrt()
+    }
+}
