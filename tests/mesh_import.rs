@@ -42,11 +42,17 @@ fn the_cube_reads_the_same_from_every_format() {
         assert_eq!(mesh.tet_count(), 1140, "{name}");
         assert_eq!(mesh.node_count(), 341, "{name}");
         // Side 1: volume 1 to rounding.
-        assert!((mesh.volume() - 1.0).abs() < 1e-12, "{name}: {}", mesh.volume());
-        let (lo, hi) = mesh.positions().iter().fold(
-            (DVec3::INFINITY, DVec3::NEG_INFINITY),
-            |(lo, hi), &p| (lo.min(p), hi.max(p)),
+        assert!(
+            (mesh.volume() - 1.0).abs() < 1e-12,
+            "{name}: {}",
+            mesh.volume()
         );
+        let (lo, hi) = mesh
+            .positions()
+            .iter()
+            .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &p| {
+                (lo.min(p), hi.max(p))
+            });
         assert_eq!((lo, hi), (DVec3::ZERO, DVec3::ONE), "{name}");
         // Same node order in every file (meshio renumbered the used nodes in order).
         // (ASCII files round coordinates: gmsh to 16 digits, meshio's VTU to about 12.)
@@ -75,18 +81,36 @@ fn gmsh_geometry_points_and_boundary_elements_are_dropped() {
 
 #[test]
 fn scale_converts_to_metres() {
-    let mm = import::load(asset("cube_v22_ascii.msh"), 0.001, &SurfaceOptions::default()).unwrap();
+    let mm = import::load(
+        asset("cube_v22_ascii.msh"),
+        0.001,
+        &SurfaceOptions::default(),
+    )
+    .unwrap();
     assert!((mm.volume() - 1e-9).abs() < 1e-21);
     for scale in [0.0, -1.0, f64::NAN, f64::INFINITY] {
-        let e = import::load(asset("cube_v22_ascii.msh"), scale, &SurfaceOptions::default());
-        assert!(matches!(e, Err(Error::InvalidSetting { parameter: "scale", .. })));
+        let e = import::load(
+            asset("cube_v22_ascii.msh"),
+            scale,
+            &SurfaceOptions::default(),
+        );
+        assert!(matches!(
+            e,
+            Err(Error::InvalidSetting {
+                parameter: "scale",
+                ..
+            })
+        ));
     }
 }
 
 #[test]
 fn a_missing_file_is_an_io_error() {
     let e = import::load("no/such/mesh.msh", 1.0, &SurfaceOptions::default()).unwrap_err();
-    assert!(matches!(&e, Error::Io { path, .. } if path == "no/such/mesh.msh"), "{e}");
+    assert!(
+        matches!(&e, Error::Io { path, .. } if path == "no/such/mesh.msh"),
+        "{e}"
+    );
     let e = import::load("mesh.xyz", 1.0, &SurfaceOptions::default()).unwrap_err();
     assert!(matches!(
         e,
@@ -115,33 +139,59 @@ fn malformed_gmsh_files_name_the_line_and_the_defect() {
     let parse = |s: &str| gmsh::parse(s.as_bytes(), "bad.msh", 1.0);
     // Unknown version on line 2.
     let (kind, at, _) = kind_and_location(parse(&text.replacen("2.2 0 8", "3.0 0 8", 1)));
-    assert_eq!((kind, at), (ImportErrorKind::UnknownVersion, FileLocation::Line(2)));
+    assert_eq!(
+        (kind, at),
+        (ImportErrorKind::UnknownVersion, FileLocation::Line(2))
+    );
     // Truncated in the middle of the nodes.
     let cut = &text[..text.find("\n100 ").unwrap()];
     let (kind, _, _) = kind_and_location(parse(cut));
     assert_eq!(kind, ImportErrorKind::Truncated);
     // A non-finite coordinate on node 1's line (line 6).
     let (kind, at, _) = kind_and_location(parse(&text.replacen("\n1 0 0 1\n", "\n1 0 nan 1\n", 1)));
-    assert_eq!((kind, at), (ImportErrorKind::NonFinite, FileLocation::Line(6)));
+    assert_eq!(
+        (kind, at),
+        (ImportErrorKind::NonFinite, FileLocation::Line(6))
+    );
     // A tetrahedron referring to a node that does not exist.
-    let line = text.lines().position(|l| l.split(' ').nth(1) == Some("4")).unwrap();
+    let line = text
+        .lines()
+        .position(|l| l.split(' ').nth(1) == Some("4"))
+        .unwrap();
     let mut lines: Vec<String> = text.lines().map(str::to_owned).collect();
     let mut words: Vec<&str> = lines[line].split(' ').collect();
     let last = words.len() - 1;
     words[last] = "99999";
     lines[line] = words.join(" ");
     let (kind, at, _) = kind_and_location(parse(&lines.join("\n")));
-    assert_eq!((kind, at), (ImportErrorKind::IndexOutOfRange, FileLocation::Line(line + 1)));
+    assert_eq!(
+        (kind, at),
+        (
+            ImportErrorKind::IndexOutOfRange,
+            FileLocation::Line(line + 1)
+        )
+    );
     // A quadratic tetrahedron: element type 11 with 10 nodes.
     let mut quadratic = lines.clone();
     let fields: Vec<&str> = text.lines().nth(line).unwrap().split(' ').collect();
     quadratic[line] = format!(
         "{} 11 {}",
         fields[0],
-        fields[2..].iter().chain(&["1", "2", "3", "4", "5", "6"]).copied().collect::<Vec<_>>().join(" ")
+        fields[2..]
+            .iter()
+            .chain(&["1", "2", "3", "4", "5", "6"])
+            .copied()
+            .collect::<Vec<_>>()
+            .join(" ")
     );
     let (kind, at, _) = kind_and_location(parse(&quadratic.join("\n")));
-    assert_eq!((kind, at), (ImportErrorKind::UnsupportedElement, FileLocation::Line(line + 1)));
+    assert_eq!(
+        (kind, at),
+        (
+            ImportErrorKind::UnsupportedElement,
+            FileLocation::Line(line + 1)
+        )
+    );
     // A hexahedron among the tetrahedra.
     let mut hex = lines.clone();
     hex[line] = format!("{} 5 2 1 1 1 2 3 4 5 6 7 8", fields[0]);
@@ -157,7 +207,10 @@ fn malformed_gmsh_files_name_the_line_and_the_defect() {
     // No tetrahedra at all.
     let only_nodes = &text[..text.find("$Elements").unwrap()];
     let (kind, at, _) = kind_and_location(parse(only_nodes));
-    assert_eq!((kind, at), (ImportErrorKind::NoTetrahedra, FileLocation::Whole));
+    assert_eq!(
+        (kind, at),
+        (ImportErrorKind::NoTetrahedra, FileLocation::Whole)
+    );
 }
 
 #[test]
@@ -180,7 +233,10 @@ fn tetgen_reads_one_based_indices_attributes_and_comments() {
     assert!((mesh.volume() - 8.0 / 6.0).abs() < 1e-15);
     let bad = b"1 4 1\n1 1 3 2 5 5\n";
     let (kind, at, _) = kind_and_location(tetgen::parse(node, "t.node", bad, "t.ele", 1.0));
-    assert_eq!((kind, at), (ImportErrorKind::IndexOutOfRange, FileLocation::Line(2)));
+    assert_eq!(
+        (kind, at),
+        (ImportErrorKind::IndexOutOfRange, FileLocation::Line(2))
+    );
     let quadratic = b"1 10 0\n";
     let (kind, _, _) = kind_and_location(tetgen::parse(node, "t.node", quadratic, "t.ele", 1.0));
     assert_eq!(kind, ImportErrorKind::UnsupportedElement);
@@ -228,11 +284,19 @@ fn the_sphere_obj_fills_with_good_tetrahedra_close_to_its_volume() {
         );
         assert_eq!(report.inverted + report.degenerate + report.invalid, 0);
         assert!(error.abs() < 0.05, "{cells_across}: {error}");
-        assert!(report.min_dihedral_angle > 5.0, "{}", report.min_dihedral_angle);
+        assert!(
+            report.min_dihedral_angle > 5.0,
+            "{}",
+            report.min_dihedral_angle
+        );
         // The boundary nodes are moved onto the surface, some only part of the way when the
         // full move would flatten an element: none lies further out than half a cell.
         let h = 2.0 / cells_across as f64;
-        let radius = mesh.positions().iter().map(|p| p.length()).fold(0.0, f64::max);
+        let radius = mesh
+            .positions()
+            .iter()
+            .map(|p| p.length())
+            .fold(0.0, f64::max);
         println!("  farthest node from the centre: {radius:.4} (cell size {h:.4})");
         assert!(radius < 1.0 + 0.5 * h && radius > 0.99, "{radius}");
     }
@@ -250,11 +314,19 @@ fn the_stl_cube_fills_to_its_volume() {
     // The lattice's boundary nodes snap onto the flat faces; the cube's edges are rounded off
     // by less than one cell.
     let error = mesh.volume() - 1.0;
-    println!("cube.stl, 8 cells across: {} tets, volume error {:+.3} %", mesh.tet_count(), 100.0 * error);
+    println!(
+        "cube.stl, 8 cells across: {} tets, volume error {:+.3} %",
+        mesh.tet_count(),
+        100.0 * error
+    );
     assert!(error.abs() < 0.02, "{error}");
     let ascii = import::load(asset("sphere_ascii.stl"), 2.0, &SurfaceOptions::default()).unwrap();
     let exact = 4.0 / 3.0 * std::f64::consts::PI * 8.0;
-    assert!((ascii.volume() / exact - 1.0).abs() < 0.12, "{}", ascii.volume());
+    assert!(
+        (ascii.volume() / exact - 1.0).abs() < 0.12,
+        "{}",
+        ascii.volume()
+    );
 }
 
 #[test]
@@ -262,23 +334,50 @@ fn an_open_surface_is_rejected() {
     let obj = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\n";
     let open = surface::parse_obj(obj, "open.obj", 1.0).unwrap();
     let e = surface::fill(&open, &SurfaceOptions::default()).unwrap_err();
-    assert!(matches!(e, Error::MeshImport { kind: ImportErrorKind::InvalidSurface, .. }), "{e}");
+    assert!(
+        matches!(
+            e,
+            Error::MeshImport {
+                kind: ImportErrorKind::InvalidSurface,
+                ..
+            }
+        ),
+        "{e}"
+    );
 }
 
 #[test]
 fn check_counts_inverted_and_degenerate_elements() {
-    let p = vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z, DVec3::new(1.0, 1.0, 0.0), DVec3::splat(5.0)];
+    let p = vec![
+        DVec3::ZERO,
+        DVec3::X,
+        DVec3::Y,
+        DVec3::Z,
+        DVec3::new(1.0, 1.0, 0.0),
+        DVec3::splat(5.0),
+    ];
     let tets = [[0, 1, 2, 3], [0, 2, 1, 3], [0, 1, 4, 2], [0, 1, 2, 9]];
     let steel = Material::new(MaterialModel::Corotated, 200e9, 0.3, 7850.0).unwrap();
     let report = import::check(&p, &tets, &steel);
     assert_eq!(
-        (report.tets, report.nodes, report.unused_nodes, report.inverted, report.degenerate, report.invalid),
+        (
+            report.tets,
+            report.nodes,
+            report.unused_nodes,
+            report.inverted,
+            report.degenerate,
+            report.invalid
+        ),
         (4, 6, 1, 1, 1, 1)
     );
     assert_eq!(report.min_dihedral_angle, 0.0);
     assert_eq!(report.critical_time_step, None);
     let good = import::check(&p, &tets[..1], &steel);
-    assert!((good.min_dihedral_angle - 54.7356).abs() < 1e-3, "{}", good.min_dihedral_angle);
+    assert!(
+        (good.min_dihedral_angle - 54.7356).abs() < 1e-3,
+        "{}",
+        good.min_dihedral_angle
+    );
     assert!((good.max_dihedral_angle - 90.0).abs() < 1e-9);
     // Corner tetrahedron: 3 r_in / r_circ = 3 (3 - sqrt 3) / (3 + sqrt 3) / (sqrt 3 / 2) ... as
     // computed in closed form: r_in = 1 / (3 + sqrt 3), r_circ = sqrt 3 / 2.
@@ -363,8 +462,22 @@ fn mutation() -> impl Strategy<Value = Mutation> {
         (
             any::<prop::sample::Index>(),
             prop::sample::select(vec![
-                "0", "-1", "1", "2", "4000000000", "18446744073709551615", "99999999999999999999",
-                "nan", "inf", "-1e308", "1e308", "11", "5", "10", "24", "3",
+                "0",
+                "-1",
+                "1",
+                "2",
+                "4000000000",
+                "18446744073709551615",
+                "99999999999999999999",
+                "nan",
+                "inf",
+                "-1e308",
+                "1e308",
+                "11",
+                "5",
+                "10",
+                "24",
+                "3",
             ])
         )
             .prop_map(|(i, n)| Mutation::Number(i, n)),
@@ -429,7 +542,7 @@ proptest! {
     }
 }
 
-/// Truncation at every length of the Gmsh and VTK cube files' first 4 kB and of the TetGen
+/// Truncation at every length of the Gmsh and VTK cube files' first 4 kB and of the `TetGen`
 /// files: every prefix must give a typed error (or, for a prefix that is a whole file, a mesh).
 #[test]
 fn fuzz_every_truncation_of_the_headers() {

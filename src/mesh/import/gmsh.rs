@@ -122,7 +122,10 @@ pub fn parse(data: &[u8], path: &str, scale: f64) -> Result<RawMesh, Error> {
             _ => {
                 return Err(source.error(
                     ImportErrorKind::Syntax,
-                    format!("expected a section such as `$Nodes`, found `{}`", shorten(line)),
+                    format!(
+                        "expected a section such as `$Nodes`, found `{}`",
+                        shorten(line)
+                    ),
                 ));
             }
         }

@@ -4,7 +4,7 @@
 //! | format | extension | reader |
 //! |---|---|---|
 //! | Gmsh MSH 2.2 and 4.1, ASCII and binary | `.msh` | [`gmsh`] |
-//! | TetGen | `.node` + `.ele` | [`tetgen`] |
+//! | `TetGen` | `.node` + `.ele` | [`tetgen`] |
 //! | VTK XML unstructured grid (ASCII, base64, appended; not compressed) | `.vtu` | [`vtk`] |
 //! | VTK legacy unstructured grid (ASCII and binary, 2.0 to 5.1) | `.vtk` | [`vtk`] |
 //! | surface: Wavefront OBJ, STL (ASCII and binary) | `.obj`, `.stl` | [`surface`] |
@@ -140,7 +140,7 @@ impl RawMesh {
 pub enum Format {
     /// Gmsh `.msh`, versions 2.2 and 4.1, ASCII or binary.
     Gmsh,
-    /// TetGen `.node` with its `.ele` beside it (either may be named).
+    /// `TetGen` `.node` with its `.ele` beside it (either may be named).
     TetGen,
     /// VTK XML unstructured grid `.vtu`.
     Vtu,

@@ -91,7 +91,12 @@ pub fn check(positions: &[DVec3], tets: &[[u32; 4]], material: &Material) -> Qua
         let volume = signed_volume(positions, tet);
         report.volume += volume;
         let longest = longest_edge(&p);
-        if !(volume.abs() > DEGENERATE_RELATIVE_VOLUME * longest.powi(3)) {
+        // A NaN volume counts as degenerate.
+        if volume
+            .abs()
+            .partial_cmp(&(DEGENERATE_RELATIVE_VOLUME * longest.powi(3)))
+            != Some(std::cmp::Ordering::Greater)
+        {
             report.degenerate += 1;
         } else if volume < 0.0 {
             report.inverted += 1;

@@ -20,7 +20,7 @@
 //! `tests/mesh_import.rs` on a 642-vertex icosphere: -2.2 % at 8 cells across, -0.41 % at 16,
 //! -0.24 % at 32, with minimum dihedral angles of 10.0°, 9.0° and 8.7° and no inverted
 //! element; boundary nodes whose full move would flatten an element stay up to 0.24 cell
-//! outside the surface). Conforming tetrahedralizers (TetGen through `tritet`) are AGPL-licensed, and
+//! outside the surface). Conforming tetrahedralizers (`TetGen` through `tritet`) are AGPL-licensed, and
 //! `parry3d`'s own `volume_mesh` encloses the shape (1.26 times its volume on the same sphere),
 //! hence this lattice approach.
 
@@ -127,10 +127,7 @@ pub fn parse_obj(data: &[u8], path: &str, scale: f64) -> Result<Surface, Error> 
                     return Err(source.error_at(
                         FileLocation::Whole,
                         ImportErrorKind::IndexOutOfRange,
-                        format!(
-                            "object `{}` refers to vertex {i} of {count}",
-                            model.name
-                        ),
+                        format!("object `{}` refers to vertex {i} of {count}", model.name),
                     ));
                 }
                 *corner = (first + i as usize) as u32;
@@ -229,10 +226,8 @@ pub fn fill(surface: &Surface, options: &SurfaceOptions) -> Result<RawMesh, Erro
             (lo.min(p), hi.max(p))
         });
     let extent = (hi - lo).max_element();
-    if !(volume.abs() > 1e-9 * extent.powi(3)) {
-        return Err(surface.error(format!(
-            "the surface encloses no volume ({volume:e} m^3)"
-        )));
+    if volume.abs().partial_cmp(&(1e-9 * extent.powi(3))) != Some(std::cmp::Ordering::Greater) {
+        return Err(surface.error(format!("the surface encloses no volume ({volume:e} m^3)")));
     }
     let triangles: Vec<[u32; 3]> = if volume < 0.0 {
         triangles.iter().map(|&[a, b, c]| [a, c, b]).collect()
@@ -257,7 +252,11 @@ pub fn fill(surface: &Surface, options: &SurfaceOptions) -> Result<RawMesh, Erro
     // 1. The BCC lattice over the bounding box grown by one cell.
     let h = extent / options.cells_across as f64;
     let origin = lo - DVec3::splat(h);
-    let cells = ((hi - lo) / h).ceil().as_uvec3().to_array().map(|n| n as usize + 2);
+    let cells = ((hi - lo) / h)
+        .ceil()
+        .as_uvec3()
+        .to_array()
+        .map(|n| n as usize + 2);
     let [nx, ny, nz] = cells;
     let corner_count = (nx + 1) * (ny + 1) * (nz + 1);
     let corner = |i: usize, j: usize, k: usize| (i + (nx + 1) * (j + (ny + 1) * k)) as u32;
@@ -360,15 +359,22 @@ pub fn fill(surface: &Surface, options: &SurfaceOptions) -> Result<RawMesh, Erro
     for _sweep in 0..3 {
         for &n in &boundary {
             let target = projector.closest_point(positions[n]);
-            move_node(&mut positions, &tets, &incident[n], n, target, &[1.0, 0.75, 0.5, 0.25]);
+            move_node(
+                &mut positions,
+                &tets,
+                &incident[n],
+                n,
+                target,
+                &[1.0, 0.75, 0.5, 0.25],
+            );
         }
     }
     let near_boundary: Vec<usize> = (0..positions.len())
         .filter(|&n| {
             !on_boundary[n]
-                && incident[n].iter().any(|&t| {
-                    tets[t as usize].iter().any(|&m| on_boundary[m as usize])
-                })
+                && incident[n]
+                    .iter()
+                    .any(|&t| tets[t as usize].iter().any(|&m| on_boundary[m as usize]))
         })
         .collect();
     for _sweep in 0..2 {

@@ -1,4 +1,4 @@
-//! TetGen's `.node` and `.ele` files.
+//! `TetGen`'s `.node` and `.ele` files.
 //!
 //! `.node`: a header `<points> 3 <attributes> <boundary markers 0|1>`, then one line per point,
 //! `<index> <x> <y> <z> [attributes] [marker]`. `.ele`: a header `<tetrahedra> <4|10> <region
@@ -13,7 +13,7 @@ use crate::Error;
 use crate::error::ImportErrorKind;
 use rapier3d::glamx::DVec3;
 
-/// Reads a TetGen mesh from the contents of its `.node` and `.ele` files (named `node_path`
+/// Reads a `TetGen` mesh from the contents of its `.node` and `.ele` files (named `node_path`
 /// and `ele_path` in errors), coordinates times `scale` (m per file unit).
 ///
 /// # Errors
@@ -58,7 +58,10 @@ pub fn parse(
         ));
     }
     if count == 0 {
-        return Err(source.error(ImportErrorKind::NoTetrahedra, "the file holds no tetrahedra"));
+        return Err(source.error(
+            ImportErrorKind::NoTetrahedra,
+            "the file holds no tetrahedra",
+        ));
     }
     let capacity = source.capacity(count, 10);
     let mut tets = Vec::with_capacity(capacity);
@@ -127,9 +130,9 @@ fn parse_node(data: &[u8], path: &str, scale: f64) -> Result<(Vec<DVec3>, u64), 
     let attributes: usize = tokens
         .next()
         .map_or(Ok(0), |t| parse_token(&source, Some(t), "attribute count"))?;
-    let markers: u32 = tokens
-        .next()
-        .map_or(Ok(0), |t| parse_token(&source, Some(t), "boundary marker flag"))?;
+    let markers: u32 = tokens.next().map_or(Ok(0), |t| {
+        parse_token(&source, Some(t), "boundary marker flag")
+    })?;
     if dimension != 3 {
         return Err(source.error(
             ImportErrorKind::Syntax,

@@ -217,7 +217,10 @@ pub fn parse_vtu(data: &[u8], path: &str, scale: f64) -> Result<RawMesh, Error> 
                 while i < vertices.len() {
                     let n = vertices[i] as usize;
                     let cell = vertices.get(i + 1..i + 1 + n).ok_or_else(|| {
-                        whole(ImportErrorKind::Truncated, "a cell list is cut short".into())
+                        whole(
+                            ImportErrorKind::Truncated,
+                            "a cell list is cut short".into(),
+                        )
                     })?;
                     connectivity.extend(cell.iter().map(|&v| u64::from(v)));
                     offsets.push(connectivity.len() as u64);
@@ -416,7 +419,9 @@ impl<'a> Legacy<'a> {
 /// A big-endian binary value of type `ty` (`bytes.len()` is its size) as `f64`.
 fn binary_value(bytes: &[u8], ty: DataType) -> f64 {
     match ty {
-        DataType::Float(4) => f64::from(f32::from_be_bytes([bytes[0], bytes[1], bytes[2], bytes[3]])),
+        DataType::Float(4) => {
+            f64::from(f32::from_be_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]))
+        }
         DataType::Float(_) => {
             let mut b = [0u8; 8];
             b.copy_from_slice(&bytes[..8]);
@@ -464,7 +469,10 @@ pub fn parse_legacy(data: &[u8], path: &str, scale: f64) -> Result<RawMesh, Erro
         _ => {
             return Err(source.error(
                 ImportErrorKind::UnknownVersion,
-                format!("version `{}` is not supported (2.0 to 5.1 are)", shorten(version)),
+                format!(
+                    "version `{}` is not supported (2.0 to 5.1 are)",
+                    shorten(version)
+                ),
             ));
         }
     };
@@ -479,7 +487,10 @@ pub fn parse_legacy(data: &[u8], path: &str, scale: f64) -> Result<RawMesh, Erro
         _ => {
             return Err(source.error(
                 ImportErrorKind::Syntax,
-                format!("expected `ASCII` or `BINARY`, found `{}`", shorten(encoding)),
+                format!(
+                    "expected `ASCII` or `BINARY`, found `{}`",
+                    shorten(encoding)
+                ),
             ));
         }
     };
@@ -514,8 +525,7 @@ pub fn parse_legacy(data: &[u8], path: &str, scale: f64) -> Result<RawMesh, Erro
             "POINTS" => {
                 let count: usize = parse_token(&file.source, words.next(), "point count")?;
                 let ty = data_type(&file.source, words.next())?;
-                let coordinates =
-                    file.floats(count.saturating_mul(3), ty, "point coordinates")?;
+                let coordinates = file.floats(count.saturating_mul(3), ty, "point coordinates")?;
                 let mut points = Vec::with_capacity(count.min(coordinates.len() / 3));
                 for p in coordinates.chunks_exact(3) {
                     points.push(scaled(&file.source, DVec3::new(p[0], p[1], p[2]), scale)?);
@@ -524,15 +534,14 @@ pub fn parse_legacy(data: &[u8], path: &str, scale: f64) -> Result<RawMesh, Erro
             }
             "CELLS" if major >= 5 => {
                 let location = file.source.location();
-                let offset_count: usize =
-                    parse_token(&file.source, words.next(), "offset count")?;
+                let offset_count: usize = parse_token(&file.source, words.next(), "offset count")?;
                 let connectivity_count: usize =
                     parse_token(&file.source, words.next(), "connectivity size")?;
                 let mut arrays = [Vec::new(), Vec::new()];
-                for (array, (name, count)) in arrays
-                    .iter_mut()
-                    .zip([("OFFSETS", offset_count), ("CONNECTIVITY", connectivity_count)])
-                {
+                for (array, (name, count)) in arrays.iter_mut().zip([
+                    ("OFFSETS", offset_count),
+                    ("CONNECTIVITY", connectivity_count),
+                ]) {
                     let line = file.keyword_line()?.unwrap_or("");
                     let mut words = line.split_ascii_whitespace();
                     if words.next() != Some(name) {
