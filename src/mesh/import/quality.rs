@@ -114,8 +114,9 @@ pub fn check(positions: &[DVec3], tets: &[[u32; 4]], material: &Material) -> Qua
             tets: tets.to_vec(),
             tet_locations: Vec::new(),
         };
-        if let Ok(mesh) = raw.into_mesh()
-            && let Ok(body) = SoftBodyBuilder::new(mesh, *material).build()
+        if let Ok(body) = raw
+            .into_mesh()
+            .and_then(|mesh| SoftBodyBuilder::new(mesh, *material).build())
         {
             report.critical_time_step = Some(SymplecticEuler::critical_time_step(&body));
             report.stable_time_step = Some(SymplecticEuler::default().stable_time_step(&body));
