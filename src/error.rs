@@ -2,7 +2,61 @@
 //! turned NaN) is reported with the element, node or parameter at fault, never as a panic. Asking
 //! for a node or tetrahedron index that does not exist panics, as slice indexing does.
 
+use std::fmt;
 use thiserror::Error;
+
+/// Where in a mesh file an import error was found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FileLocation {
+    /// A line of a text file (1-based).
+    Line(usize),
+    /// A byte offset into the file (0-based), for binary data.
+    Byte(usize),
+    /// The file as a whole: the defect has no single place (no tetrahedra at all, an error of a
+    /// parser that does not say where).
+    Whole,
+}
+
+impl fmt::Display for FileLocation {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Line(line) => write!(f, "line {line}"),
+            Self::Byte(offset) => write!(f, "byte {offset}"),
+            Self::Whole => write!(f, "file"),
+        }
+    }
+}
+
+/// What is wrong with a mesh file, see [`Error::MeshImport`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum ImportErrorKind {
+    /// The file ends before the data it announces.
+    Truncated,
+    /// A token is not what the format requires there (a number, a keyword, a section marker).
+    Syntax,
+    /// A count disagrees with the data or with another count.
+    BadCount,
+    /// Two nodes (or elements) carry the same identifier.
+    DuplicateId,
+    /// An element refers to a node that does not exist.
+    IndexOutOfRange,
+    /// A number is NaN or infinite, or becomes infinite once scaled.
+    NonFinite,
+    /// An element type that cannot be used: quadratic tetrahedra, or volume elements other than
+    /// tetrahedra (hexahedra, prisms, pyramids) mixed in.
+    UnsupportedElement,
+    /// A format version or variant this reader does not know (MSH 4.0, compressed data, ...).
+    UnknownVersion,
+    /// The file holds no tetrahedra.
+    NoTetrahedra,
+    /// A surface mesh that cannot be filled: empty, open or enclosing no volume.
+    InvalidSurface,
+    /// The file's extension names no format this crate reads.
+    UnknownFormat,
+    /// The file was read, but its tetrahedra do not make a valid mesh (a degenerate element).
+    InvalidMesh,
+}
 
 /// Everything that can go wrong when building or stepping a soft body.
 #[derive(Debug, Clone, PartialEq, Error)]
@@ -167,6 +221,26 @@ pub enum Error {
     IndefiniteStiffness {
         /// Newton iteration (0-based) at which factorization failed.
         iteration: usize,
+    },
+    /// A mesh file is malformed or holds what this crate cannot use.
+    #[error("{path}: {location}: {message}")]
+    MeshImport {
+        /// The file, as given.
+        path: String,
+        /// Where in the file.
+        location: FileLocation,
+        /// What kind of defect.
+        kind: ImportErrorKind,
+        /// What is wrong, in words.
+        message: String,
+    },
+    /// A file could not be read (missing, unreadable).
+    #[error("{path}: {message}")]
+    Io {
+        /// The file, as given.
+        path: String,
+        /// The operating system's message.
+        message: String,
     },
     /// The static solver did not reach its tolerance.
     #[error(

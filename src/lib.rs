@@ -57,7 +57,7 @@ mod newton;
 pub mod statics;
 pub mod world;
 
-pub use error::Error;
+pub use error::{Error, FileLocation, ImportErrorKind};
 
 /// The README's examples, compiled and run as doctests.
 #[doc = include_str!("../README.md")]

@@ -1,11 +1,13 @@
 //! Tetrahedral meshes: a validated [`TetMesh`] of rest positions (m) and positively oriented
-//! tetrahedra, its boundary surface, and generators for boxes, cylinders and spheres.
+//! tetrahedra, its boundary surface, generators for boxes, cylinders and spheres, and readers for
+//! the files of other meshing tools ([`import`]).
 //!
 //! A tetrahedron `[a, b, c, d]` is positively oriented when `((b - a) x (c - a)) . (d - a) > 0`,
 //! i.e. its signed volume is positive.
 
 mod generators;
 mod hex_mesher;
+pub mod import;
 mod surface;
 
 pub use generators::{cuboid, cylinder, sphere};
@@ -15,7 +17,7 @@ use rapier3d::glamx::DVec3;
 
 /// Relative volume below which a tetrahedron counts as degenerate: `|V| <= 1e-12 * l^3`, with `l`
 /// the tetrahedron's longest edge.
-const DEGENERATE_RELATIVE_VOLUME: f64 = 1e-12;
+pub(crate) const DEGENERATE_RELATIVE_VOLUME: f64 = 1e-12;
 
 /// A validated tetrahedral mesh in its rest configuration.
 ///

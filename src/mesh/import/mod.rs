@@ -1,0 +1,261 @@
+//! Reading tetrahedral meshes written by other tools, and filling closed surfaces with
+//! tetrahedra.
+//!
+//! | format | extension | reader |
+//! |---|---|---|
+//! | Gmsh MSH 2.2 and 4.1, ASCII and binary | `.msh` | [`gmsh`] |
+//! | `TetGen` | `.node` + `.ele` | [`tetgen`] |
+//! | VTK XML unstructured grid (ASCII, base64, appended; not compressed) | `.vtu` | [`vtk`] |
+//! | VTK legacy unstructured grid (ASCII and binary, 2.0 to 5.1) | `.vtk` | [`vtk`] |
+//! | surface: Wavefront OBJ, STL (ASCII and binary) | `.obj`, `.stl` | [`surface`] |
+//!
+//! Every reader takes a `scale` in metres per file unit (1 for files in metres, 0.001 for
+//! millimetres) and first returns a [`RawMesh`]: positions and tetrahedra as the file has them,
+//! lower-dimensional elements (points, lines, boundary triangles) skipped. [`check`] reports a raw
+//! mesh's quality, defects included; [`RawMesh::into_mesh`] drops the nodes no tetrahedron uses
+//! (geometry points of Gmsh files), fixes the orientation of inverted tetrahedra and validates
+//! the result into a [`TetMesh`]. [`load`] does both, choosing the reader by extension.
+//!
+//! Malformed files give [`Error::MeshImport`] with the file, the line (text) or byte offset
+//! (binary) and the [`ImportErrorKind`]; files that cannot be opened give [`Error::Io`]. No
+//! reader panics or allocates more than its input can fill, whatever the bytes (fuzzed in
+//! `tests/mesh_import.rs`).
+//!
+//! # Example
+//! ```
+//! use rapier_fvm::mesh::import;
+//!
+//! // A tetrahedron in TetGen's format, in millimetres.
+//! let node = b"# corners\n4 3 0 0\n1 0 0 0\n2 10 0 0\n3 0 10 0\n4 0 0 10\n";
+//! let ele = b"1 4 0\n1 1 2 3 4\n";
+//! let raw = import::tetgen::parse(node, "tet.node", ele, "tet.ele", 0.001)?;
+//! let mesh = raw.into_mesh()?;
+//! assert_eq!(mesh.tet_count(), 1);
+//! assert!((mesh.volume() - 1e-6 / 6.0).abs() < 1e-18); // (1 cm)^3 / 6
+//! # Ok::<(), rapier_fvm::Error>(())
+//! ```
+
+pub mod gmsh;
+pub mod quality;
+pub mod surface;
+pub mod tetgen;
+mod text;
+pub mod vtk;
+
+pub use crate::error::{FileLocation, ImportErrorKind};
+pub use quality::{QualityReport, check};
+pub use surface::SurfaceOptions;
+
+use crate::Error;
+use crate::mesh::TetMesh;
+use rapier3d::glamx::DVec3;
+use std::path::Path;
+
+/// A tetrahedral mesh as read from a file, before validation: positions already scaled to
+/// metres, tetrahedra as node indices into `positions` (in range, but possibly inverted,
+/// degenerate, or leaving nodes unused).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RawMesh {
+    /// The file it was read from, as given (for error messages).
+    pub path: String,
+    /// Node positions (m).
+    pub positions: Vec<DVec3>,
+    /// Tetrahedra, four indices into `positions` each, in file order.
+    pub tets: Vec<[u32; 4]>,
+    /// Where each tetrahedron was defined in the file (same length as `tets`).
+    pub tet_locations: Vec<FileLocation>,
+}
+
+impl RawMesh {
+    /// The validated mesh: nodes that no tetrahedron uses are dropped and the others renumbered
+    /// in their order of first use, inverted tetrahedra are re-oriented.
+    ///
+    /// # Errors
+    /// [`Error::MeshImport`] of kind [`ImportErrorKind::NoTetrahedra`] for a mesh without
+    /// tetrahedra, [`ImportErrorKind::IndexOutOfRange`] for an index past `positions`, and
+    /// [`ImportErrorKind::InvalidMesh`] naming the element's place in the file when
+    /// [`TetMesh::new_reoriented`] rejects it (a degenerate or repeated-node tetrahedron).
+    pub fn into_mesh(self) -> Result<TetMesh, Error> {
+        let error = |location, kind, message: String| Error::MeshImport {
+            path: self.path.clone(),
+            location,
+            kind,
+            message,
+        };
+        if self.tets.is_empty() {
+            return Err(error(
+                FileLocation::Whole,
+                ImportErrorKind::NoTetrahedra,
+                "the file holds no tetrahedra".into(),
+            ));
+        }
+        let location = |tet: usize| {
+            self.tet_locations
+                .get(tet)
+                .copied()
+                .unwrap_or(FileLocation::Whole)
+        };
+        const UNUSED: u32 = u32::MAX;
+        let mut new_index = vec![UNUSED; self.positions.len()];
+        let mut positions = Vec::new();
+        let mut tets = Vec::with_capacity(self.tets.len());
+        for (t, tet) in self.tets.iter().enumerate() {
+            let mut renumbered = [0; 4];
+            for (corner, &node) in tet.iter().enumerate() {
+                let Some(slot) = new_index.get_mut(node as usize) else {
+                    return Err(error(
+                        location(t),
+                        ImportErrorKind::IndexOutOfRange,
+                        format!(
+                            "tetrahedron {t} refers to node {node}, but there are {} nodes",
+                            self.positions.len()
+                        ),
+                    ));
+                };
+                if *slot == UNUSED {
+                    *slot = positions.len() as u32;
+                    positions.push(self.positions[node as usize]);
+                }
+                renumbered[corner] = *slot;
+            }
+            tets.push(renumbered);
+        }
+        match TetMesh::new_reoriented(positions, tets) {
+            Ok((mesh, _flipped)) => Ok(mesh),
+            Err(e) => {
+                let at = match e {
+                    Error::DegenerateTet { tet, .. } | Error::RepeatedNode { tet, .. } => {
+                        location(tet)
+                    }
+                    _ => FileLocation::Whole,
+                };
+                Err(error(at, ImportErrorKind::InvalidMesh, e.to_string()))
+            }
+        }
+    }
+}
+
+/// The file formats [`load`] recognises by extension.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Format {
+    /// Gmsh `.msh`, versions 2.2 and 4.1, ASCII or binary.
+    Gmsh,
+    /// `TetGen` `.node` with its `.ele` beside it (either may be named).
+    TetGen,
+    /// VTK XML unstructured grid `.vtu`.
+    Vtu,
+    /// VTK legacy `.vtk` unstructured grid.
+    LegacyVtk,
+    /// Wavefront `.obj` surface, filled with tetrahedra.
+    Obj,
+    /// `.stl` surface (ASCII or binary), filled with tetrahedra.
+    Stl,
+}
+
+impl Format {
+    /// The format of `path` from its extension (case-insensitive), if known.
+    pub fn from_path(path: &Path) -> Option<Self> {
+        let extension = path.extension()?.to_str()?.to_ascii_lowercase();
+        Some(match extension.as_str() {
+            "msh" => Self::Gmsh,
+            "node" | "ele" => Self::TetGen,
+            "vtu" => Self::Vtu,
+            "vtk" => Self::LegacyVtk,
+            "obj" => Self::Obj,
+            "stl" => Self::Stl,
+            _ => return None,
+        })
+    }
+}
+
+/// Reads the mesh file at `path` (format by extension, see [`Format`]) into a [`RawMesh`] with
+/// positions in metres: `scale` metres per file unit. Surfaces are filled with tetrahedra
+/// following `surface_options`.
+///
+/// # Errors
+/// [`Error::InvalidSetting`] for a `scale` that is not finite and positive, [`Error::Io`] when
+/// a file cannot be read, and [`Error::MeshImport`] for an unknown extension or malformed
+/// content.
+pub fn load_raw(
+    path: impl AsRef<Path>,
+    scale: f64,
+    surface_options: &SurfaceOptions,
+) -> Result<RawMesh, Error> {
+    let path = path.as_ref();
+    let name = path.display().to_string();
+    let Some(format) = Format::from_path(path) else {
+        return Err(Error::MeshImport {
+            path: name,
+            location: FileLocation::Whole,
+            kind: ImportErrorKind::UnknownFormat,
+            message: "unknown mesh file extension (expected .msh, .node, .ele, .vtu, .vtk, \
+                      .obj or .stl)"
+                .into(),
+        });
+    };
+    match format {
+        Format::Gmsh => gmsh::parse(&read_file(path)?, &name, scale),
+        Format::TetGen => {
+            let node = path.with_extension("node");
+            let ele = path.with_extension("ele");
+            tetgen::parse(
+                &read_file(&node)?,
+                &node.display().to_string(),
+                &read_file(&ele)?,
+                &ele.display().to_string(),
+                scale,
+            )
+        }
+        Format::Vtu => vtk::parse_vtu(&read_file(path)?, &name, scale),
+        Format::LegacyVtk => vtk::parse_legacy(&read_file(path)?, &name, scale),
+        Format::Obj => surface::fill(
+            &surface::parse_obj(&read_file(path)?, &name, scale)?,
+            surface_options,
+        ),
+        Format::Stl => surface::fill(
+            &surface::parse_stl(&read_file(path)?, &name, scale)?,
+            surface_options,
+        ),
+    }
+}
+
+/// Reads and validates the mesh file at `path`: [`load_raw`] then [`RawMesh::into_mesh`].
+///
+/// # Errors
+/// Those of [`load_raw`] and [`RawMesh::into_mesh`].
+///
+/// # Example
+/// ```no_run
+/// use rapier_fvm::mesh::import::{self, SurfaceOptions};
+/// // A part drawn in millimetres.
+/// let mesh = import::load("part.msh", 0.001, &SurfaceOptions::default())?;
+/// # Ok::<(), rapier_fvm::Error>(())
+/// ```
+pub fn load(
+    path: impl AsRef<Path>,
+    scale: f64,
+    surface_options: &SurfaceOptions,
+) -> Result<TetMesh, Error> {
+    load_raw(path, scale, surface_options)?.into_mesh()
+}
+
+/// The whole file at `path`, or [`Error::Io`].
+fn read_file(path: &Path) -> Result<Vec<u8>, Error> {
+    std::fs::read(path).map_err(|e| Error::Io {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    })
+}
+
+/// [`Error::InvalidSetting`] unless `scale` (m per file unit) is finite and positive.
+fn check_scale(scale: f64) -> Result<(), Error> {
+    if scale.is_finite() && scale > 0.0 {
+        Ok(())
+    } else {
+        Err(Error::InvalidSetting {
+            parameter: "scale",
+            value: scale,
+            reason: "must be finite and positive (m per file unit)",
+        })
+    }
+}
