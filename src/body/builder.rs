@@ -268,6 +268,7 @@ impl SoftBodyBuilder {
             surface_triangles,
             surface_rings,
             contacts: Vec::new(),
+            corner_contacts: Vec::new(),
             attachments: Vec::new(),
             rigid_proxies: Vec::new(),
             saved_proxies: Vec::new(),

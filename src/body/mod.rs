@@ -10,7 +10,7 @@ pub use set::{SoftBodyHandle, SoftBodySet};
 
 use crate::assembly::Stiffness;
 use crate::attachment::Attachment;
-use crate::contact::{ContactSettings, NodeContact, RigidProxy};
+use crate::contact::{ContactSettings, CornerContact, NodeContact, RigidProxy};
 use crate::damping::RayleighDamping;
 use crate::fvm::{FvmMesh, NodalAveraging, VolumetricTreatment};
 use crate::material::{Material, with_hyperelastic_model};
@@ -55,6 +55,8 @@ pub struct SoftBody {
     pub(crate) surface_rings: Vec<Vec<u32>>,
     /// The contacts the integrators enforce, from the last detection.
     pub(crate) contacts: Vec<NodeContact>,
+    /// Rigid vertices against the body's boundary triangles, from the last detection.
+    pub(crate) corner_contacts: Vec<CornerContact>,
     /// The nodes glued to rigid bodies.
     pub(crate) attachments: Vec<Attachment>,
     /// The rigid bodies the contacts and attachments touch, as the soft step sees them.
@@ -175,6 +177,9 @@ impl SoftBody {
         for contact in &mut self.contacts {
             contact.impulse = DVec3::ZERO;
         }
+        for contact in &mut self.corner_contacts {
+            contact.impulse = DVec3::ZERO;
+        }
         self.saved_proxies.clone_from(&self.rigid_proxies);
         self.saved_anchors.clear();
         self.saved_anchors
@@ -189,6 +194,9 @@ impl SoftBody {
         self.positions.clone_from(&self.saved_state.0);
         self.velocities.clone_from(&self.saved_state.1);
         for contact in &mut self.contacts {
+            contact.impulse = DVec3::ZERO;
+        }
+        for contact in &mut self.corner_contacts {
             contact.impulse = DVec3::ZERO;
         }
         self.rigid_proxies.clone_from(&self.saved_proxies);

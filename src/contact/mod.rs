@@ -38,12 +38,14 @@
 //! the opposite impulse; soft bodies that touch are stepped together for that.
 
 mod between;
+mod corner;
 mod rigid;
 mod self_contact;
 mod surface_tree;
 mod velocity_constraint;
 
 pub(crate) use between::{BetweenContact, detect_between, prepare_between, solve_between};
+pub(crate) use corner::{CornerContact, advance_corners, prepare_corners, solve_corners};
 pub(crate) use rigid::{RigidProxy, coming_velocity};
 pub(crate) use velocity_constraint::{ContactSides, VelocityConstraint};
 
@@ -333,6 +335,12 @@ impl SoftBody {
             .map(|v| v.length())
             .fold(0.0, f64::max);
         let reach = settings.margin + 2.0 * (fastest + gravity.length() * frame_dt) * frame_dt;
+        let (body_lo, body_hi) = self.positions.iter().fold(
+            (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+            |(lo, hi), x| (lo.min(*x), hi.max(*x)),
+        );
+        let mut tree = None;
+        let mut corners = Vec::new();
         for (handle, collider) in colliders.iter() {
             if collider.is_sensor() || !self.collision_groups.test(collider.collision_groups()) {
                 continue;
@@ -396,7 +404,26 @@ impl SoftBody {
                     ));
                 }
             }
+            let near_body = !((hi + DVec3::splat(reach)).cmplt(body_lo).any()
+                || (lo - DVec3::splat(reach)).cmpgt(body_hi).any());
+            if near_body && corner::has_vertices(&**shape) {
+                let tree = tree.get_or_insert_with(|| surface_tree::SurfaceTree::of(self));
+                let mut found = self
+                    .find_corner_contacts(tree, handle, &**shape, pose, friction, reach, &glued);
+                if !found.is_empty()
+                    && let Some((handle, body)) = parent
+                {
+                    let proxy = proxy.unwrap_or_else(|| {
+                        RigidProxy::index_in(&mut proxies, handle, body, frame_dt)
+                    });
+                    for contact in &mut found {
+                        contact.proxy = Some(proxy);
+                    }
+                }
+                corners.extend(found);
+            }
         }
+        self.corner_contacts = corners;
         crate::attachment::ready(&mut self.attachments, &mut proxies, bodies, frame_dt);
         self.contacts = contacts;
         self.rigid_proxies = proxies;
@@ -415,6 +442,7 @@ impl SoftBody {
     /// Removes every contact.
     pub fn clear_contacts(&mut self) {
         self.contacts.clear();
+        self.corner_contacts.clear();
         self.rigid_proxies.clear();
     }
 
@@ -439,7 +467,8 @@ impl SoftBody {
 
     /// The mean force (N) and torque about the world origin (N m) the soft body's contacts
     /// exerted on `collider` over the last step, of length `dt` (s): their impulses over `dt`
-    /// (the torque taken at the nodes' end-of-step positions). In an
+    /// (the torque taken at the nodes' end-of-step positions, and at the collider's vertices for
+    /// its corners pressing on the surface). In an
     /// [`FvmWorld`](crate::world::FvmWorld) the last step is the frame's last coupling substep.
     ///
     /// # Errors
@@ -456,17 +485,22 @@ impl SoftBody {
             });
         }
         let positions = &self.positions;
-        Ok(self
+        let from_nodes = self
             .contacts
             .iter()
             .filter(|c| c.target == ContactTarget::Collider(collider))
-            .fold((DVec3::ZERO, DVec3::ZERO), |(force, torque), c| {
-                let on_collider = -c.impulse / dt;
-                (
-                    force + on_collider,
-                    torque + positions[c.node as usize].cross(on_collider),
-                )
-            }))
+            .map(|c| (positions[c.node as usize], -c.impulse / dt));
+        let from_corners = self
+            .corner_contacts
+            .iter()
+            .filter(|c| c.collider == collider)
+            .map(|c| c.force_on_collider(dt));
+        Ok(from_nodes.chain(from_corners).fold(
+            (DVec3::ZERO, DVec3::ZERO),
+            |(force, torque), (at, on_collider)| {
+                (force + on_collider, torque + at.cross(on_collider))
+            },
+        ))
     }
 }
 
@@ -606,15 +640,18 @@ fn contacts_and_partners(body: &mut SoftBody) -> (&mut [NodeContact], &[DVec3], 
 /// body's velocity or the nodes of a self-contact triangle), so that one sweep does not solve
 /// them.
 pub(crate) fn constraints_coupled(body: &SoftBody) -> bool {
-    body.rigid_proxies.iter().any(RigidProxy::is_dynamic) || body.has_self_contacts()
+    body.rigid_proxies.iter().any(RigidProxy::is_dynamic) || body.needs_explicit_contacts()
 }
 
 impl SoftBody {
-    /// Whether the last detection found self-contacts, which only the explicit integrator solves.
-    pub(crate) fn has_self_contacts(&self) -> bool {
-        self.contacts
-            .iter()
-            .any(|c| matches!(c.obstacle, Obstacle::OwnTriangle { .. }))
+    /// Whether the last detection found self-contacts or rigid corners against the surface,
+    /// which only the explicit integrator solves.
+    pub(crate) fn needs_explicit_contacts(&self) -> bool {
+        !self.corner_contacts.is_empty()
+            || self
+                .contacts
+                .iter()
+                .any(|c| matches!(c.obstacle, Obstacle::OwnTriangle { .. }))
     }
 }
 

@@ -136,7 +136,7 @@ impl AutomaticIntegrator {
     }
 
     /// Advances `body` by `frame_dt` (s) under gravity (m/s²) with the cheaper integrator (or the
-    /// forced one); explicit while the body has self-contacts.
+    /// forced one); explicit while the body has self-contacts or rigid corners against its surface.
     ///
     /// # Errors
     /// [`Error::InvalidTimeStep`] for a non-positive or non-finite `frame_dt`, [`Error::NonFiniteInput`]
@@ -153,9 +153,9 @@ impl AutomaticIntegrator {
         // The stability limit is evaluated once and serves both the prediction and the step.
         let needed = self.explicit.needed_substeps(body, frame_dt)?;
         let prediction = self.prediction(body, needed);
-        // Self-contact is solved by the explicit integrator only.
+        // Self-contacts and rigid corners are solved by the explicit integrator only.
         let choice = self.force.unwrap_or_else(|| {
-            if body.has_self_contacts() {
+            if body.needs_explicit_contacts() {
                 IntegratorKind::Explicit
             } else {
                 prediction.cheaper()

@@ -274,6 +274,7 @@ fn substep(bodies: &mut [&mut SoftBody], between: &mut [BetweenContact], h: f64,
     for _ in 0..sweeps {
         for body in bodies.iter_mut() {
             contact::solve_velocities(body);
+            contact::solve_corners(body);
             attachment::solve_velocities(body);
         }
         contact::solve_between(between, bodies);
@@ -305,12 +306,14 @@ fn update_velocities(body: &mut SoftBody, h: f64, gravity: DVec3) {
         proxy.fall(gravity, h);
     }
     contact::prepare_velocities(body, h);
+    contact::prepare_corners(body, h);
     attachment::prepare_velocities(body, h);
 }
 
 /// The substep's position update `x ← x + h v`, after the sweeps.
 fn update_positions(body: &mut SoftBody, h: f64) {
     attachment::advance_anchors(body, h);
+    contact::advance_corners(body, h);
     let SoftBody {
         positions,
         velocities,
