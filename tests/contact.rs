@@ -226,3 +226,55 @@ fn collision_groups_decide_which_colliders_a_soft_body_touches() {
         }
     }
 }
+
+#[test]
+fn an_elastic_bar_striking_a_wall_end_on_rebounds_at_its_impact_speed() {
+    // Saint-Venant's bar: an undamped elastic bar (0.5 m, E = 1e6 Pa, ν = 0, 1000 kg/m³, so
+    // c = sqrt(E/ρ) = 31.6 m/s) moving end-on at 1 m/s into a rigid frictionless wall, in zero
+    // gravity, with the default inelastic contacts. A compression wave runs to the far end and
+    // back; after 2L/c = 31.6 ms the bar leaves the wall at its impact speed, all its energy
+    // elastic in between. Tolerance 5 % on the rebound speed and the contact time: the lumped
+    // masses and the explicit step disperse the wave front over a few cells.
+    let mut colliders = ColliderSet::new();
+    let wall = colliders.insert(
+        ColliderBuilder::new(SharedShape::halfspace(rapier_fvm::glamx::Vec3::X))
+            .friction(0.0)
+            .build(),
+    );
+    let material = Material::new(MaterialModel::StableNeoHookean, 1e6, 0.0, 1000.0).unwrap();
+    let length = 0.5;
+    let mesh = mesh::cuboid(DVec3::new(length / 2.0, 0.025, 0.025), [20, 2, 2]).unwrap();
+    let mut bar = SoftBodyBuilder::new(mesh, material)
+        .translation(DVec3::new(length / 2.0 + 1e-3, 0.0, 0.0))
+        .linvel(DVec3::new(-1.0, 0.0, 0.0))
+        .friction(0.0)
+        .build()
+        .unwrap();
+    let integrator = SymplecticEuler::default();
+    let (dt, mut time) = (1e-3, 0.0);
+    let (mut first_touch, mut last_touch) = (None, None);
+    let bodies = RigidBodySet::new();
+    let settings = ContactSettings::default();
+    while time < 0.1 {
+        bar.detect_contacts(&colliders, &bodies, dt, DVec3::ZERO, &settings)
+            .unwrap();
+        integrator.step(&mut bar, dt, DVec3::ZERO).unwrap();
+        time += dt;
+        let (force, _) = bar.contact_force_on(wall, dt).unwrap();
+        if force.x.abs() > 0.0 {
+            first_touch.get_or_insert(time - dt);
+            last_touch = Some(time);
+        }
+    }
+    let speed = bar.linear_momentum().x / bar.total_mass();
+    let contact_time = last_touch.unwrap() - first_touch.unwrap();
+    let expected_time = 2.0 * length / (1e6f64 / 1000.0).sqrt();
+    println!(
+        "rebound {speed:.4} m/s for 1 m/s in ({:+.2} %); contact {:.2} ms vs 2L/c = {:.2} ms",
+        100.0 * (speed - 1.0),
+        contact_time * 1e3,
+        expected_time * 1e3
+    );
+    assert!((speed - 1.0).abs() < 0.05);
+    assert!((contact_time / expected_time - 1.0).abs() < 0.05);
+}

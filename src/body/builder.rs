@@ -44,6 +44,8 @@ pub struct SoftBodyBuilder {
     collision_groups: InteractionGroups,
     friction: f64,
     friction_combine_rule: CoefficientCombineRule,
+    restitution: f64,
+    restitution_combine_rule: CoefficientCombineRule,
     self_contact: bool,
 }
 
@@ -72,6 +74,8 @@ impl SoftBodyBuilder {
             collision_groups: InteractionGroups::all(),
             friction: DEFAULT_FRICTION,
             friction_combine_rule: CoefficientCombineRule::Average,
+            restitution: 0.0,
+            restitution_combine_rule: CoefficientCombineRule::Average,
             self_contact: false,
         }
     }
@@ -151,6 +155,20 @@ impl SoftBodyBuilder {
         self
     }
 
+    /// The surface's restitution coefficient (non-negative, finite); default 0, as rapier's
+    /// colliders (see [`SoftBody::restitution`]).
+    pub fn restitution(mut self, restitution: f64) -> Self {
+        self.restitution = restitution;
+        self
+    }
+
+    /// How the body's restitution combines with the other side's; default
+    /// [`CoefficientCombineRule::Average`], as rapier's colliders.
+    pub fn restitution_combine_rule(mut self, rule: CoefficientCombineRule) -> Self {
+        self.restitution_combine_rule = rule;
+        self
+    }
+
     /// Whether the surface collides with itself where the motion brings together parts far apart
     /// in the rest shape; default off (see [`SoftBody::self_contact`]).
     pub fn self_contact(mut self, enabled: bool) -> Self {
@@ -173,14 +191,19 @@ impl SoftBodyBuilder {
     /// [`Error::NonFiniteInput`] for a non-finite velocity or translation or a zero rotation;
     /// [`Error::SliverTet`] for a tetrahedron below the minimum quality;
     /// [`Error::InvalidSetting`] for a minimum quality outside `[0, 1)` or a negative or
-    /// non-finite friction.
+    /// non-finite friction or restitution.
     pub fn build(self) -> Result<SoftBody, Error> {
-        if !(self.friction.is_finite() && self.friction >= 0.0) {
-            return Err(Error::InvalidSetting {
-                parameter: "friction",
-                value: self.friction,
-                reason: "must be non-negative and finite",
-            });
+        for (parameter, value) in [
+            ("friction", self.friction),
+            ("restitution", self.restitution),
+        ] {
+            if !(value.is_finite() && value >= 0.0) {
+                return Err(Error::InvalidSetting {
+                    parameter,
+                    value,
+                    reason: "must be non-negative and finite",
+                });
+            }
         }
         if !(0.0..1.0).contains(&self.min_quality) {
             return Err(Error::InvalidSetting {
@@ -278,6 +301,8 @@ impl SoftBodyBuilder {
             collision_groups: self.collision_groups,
             friction: self.friction,
             friction_combine_rule: self.friction_combine_rule,
+            restitution: self.restitution,
+            restitution_combine_rule: self.restitution_combine_rule,
             self_contact: self.self_contact,
             user_data: self.user_data,
         })

@@ -76,6 +76,14 @@ pub struct SoftBody {
     pub friction: f64,
     /// How [`SoftBody::friction`] combines with the other side's.
     pub friction_combine_rule: CoefficientCombineRule,
+    /// The surface's restitution coefficient, combined with the other side's as
+    /// [`SoftBody::friction`] is: a node striking a surface faster than
+    /// [`RESTITUTION_THRESHOLD`](crate::contact::RESTITUTION_THRESHOLD) leaves it at this fraction
+    /// of its approach speed (explicit integration). The body's own elasticity makes it rebound
+    /// too; with the default 0 that is the only rebound.
+    pub restitution: f64,
+    /// How [`SoftBody::restitution`] combines with the other side's.
+    pub restitution_combine_rule: CoefficientCombineRule,
     /// Whether the body's surface collides with itself (a body folding over itself, or made of
     /// separate parts): off by default, as it costs a bounding-volume query per surface node and
     /// detection. Self-contacts are solved by the explicit integrator

@@ -9,9 +9,8 @@
 //! so momentum is exchanged exactly, and the plane follows the triangle through the step.
 
 use super::surface_tree::SurfaceTree;
-use super::{ContactSettings, ContactSides, VelocityConstraint};
+use super::{Coefficients, ContactSettings, ContactSides, SurfaceCoefficients, VelocityConstraint};
 use crate::body::SoftBody;
-use rapier3d::dynamics::CoefficientCombineRule;
 use rapier3d::glamx::DVec3;
 use rapier3d::parry::bounding_volume::BoundingVolume;
 
@@ -28,8 +27,8 @@ pub(crate) struct BetweenContact {
     /// The contact plane: a point (m) and the triangle's outward unit normal.
     point: DVec3,
     normal: DVec3,
-    /// Coulomb coefficient, the two bodies' combined.
-    friction: f64,
+    /// The two bodies' coefficients, combined.
+    coefficients: Coefficients,
     constraint: VelocityConstraint,
 }
 
@@ -67,12 +66,8 @@ pub(crate) fn detect_between(
                 continue;
             }
             let normals = normals.get_or_insert_with(|| body.surface_node_normals());
-            let friction = f64::from(CoefficientCombineRule::combine(
-                body.friction as f32,
-                other.friction as f32,
-                body.friction_combine_rule,
-                other.friction_combine_rule,
-            ));
+            let coefficients =
+                SurfaceCoefficients::of_body(body).combine(SurfaceCoefficients::of_body(other));
             for &node in &body.surface_nodes {
                 let n = node as usize;
                 if body.pinned[n] {
@@ -89,7 +84,7 @@ pub(crate) fn detect_between(
                         weights: hit.weights,
                         point: hit.point,
                         normal: hit.normal,
-                        friction,
+                        coefficients,
                         constraint: VelocityConstraint::default(),
                     });
                 }
@@ -131,9 +126,21 @@ pub(crate) fn prepare_between(contacts: &mut [BetweenContact], bodies: &[&mut So
             contact.normal = normal;
         }
         let node_body = &bodies[contact.node_body];
-        let gap = (node_body.positions[contact.node as usize] - contact.point).dot(contact.normal);
-        contact.constraint =
-            VelocityConstraint::new(gap, h, node_body.contact_settings.depenetration_speed);
+        let n = contact.node as usize;
+        let gap = (node_body.positions[n] - contact.point).dot(contact.normal);
+        let face_velocity: DVec3 = contact
+            .triangle
+            .iter()
+            .zip(contact.weights)
+            .map(|(&c, w)| triangle_body.velocities[c as usize] * w)
+            .sum();
+        let normal_speed = (node_body.velocities[n] - face_velocity).dot(contact.normal);
+        contact.constraint = VelocityConstraint::new(
+            gap,
+            h,
+            node_body.contact_settings.depenetration_speed,
+        )
+        .bounce(gap, h, normal_speed, contact.coefficients.restitution);
     }
 }
 
@@ -151,7 +158,7 @@ pub(crate) fn solve_between(contacts: &mut [BetweenContact], bodies: &mut [&mut 
         };
         contact
             .constraint
-            .correct(contact.normal, contact.friction, &mut sides);
+            .correct(contact.normal, contact.coefficients.friction, &mut sides);
     }
 }
 

@@ -10,7 +10,7 @@
 //! and the plane follows the triangle through the step.
 
 use super::surface_tree::SurfaceTree;
-use super::{ContactSides, RigidProxy, VelocityConstraint};
+use super::{Coefficients, ContactSides, RigidProxy, VelocityConstraint};
 use crate::body::SoftBody;
 use rapier3d::geometry::{ColliderHandle, Shape};
 use rapier3d::glamx::DVec3;
@@ -31,8 +31,8 @@ pub(crate) struct CornerContact {
     /// The contact plane: a point (m) and the triangle's outward unit normal.
     point: DVec3,
     normal: DVec3,
-    /// Coulomb coefficient.
-    friction: f64,
+    /// The soft body's and the collider's coefficients, combined.
+    coefficients: Coefficients,
     constraint: VelocityConstraint,
     /// The impulse (N s) the triangle gave the collider over the last step.
     pub(crate) impulse: DVec3,
@@ -85,8 +85,8 @@ fn for_each_vertex(shape: &dyn Shape, pose: &Pose, each: &mut impl FnMut(DVec3, 
 }
 
 impl SoftBody {
-    /// The contacts of the vertices of `shape` at `pose` (collider `collider`, friction
-    /// `friction`) within `reach` (m) of the body's boundary triangles in `tree`, skipping
+    /// The contacts of the vertices of `shape` at `pose` (collider `collider`, contact
+    /// `coefficients`) within `reach` (m) of the body's boundary triangles in `tree`, skipping
     /// triangles with a node in `glued` (nodes attached to the collider's rigid body); their
     /// proxy is left for the caller to set.
     #[allow(clippy::too_many_arguments)]
@@ -96,7 +96,7 @@ impl SoftBody {
         collider: ColliderHandle,
         shape: &dyn Shape,
         pose: &Pose,
-        friction: f64,
+        coefficients: Coefficients,
         reach: f64,
         glued: &[u32],
     ) -> Vec<CornerContact> {
@@ -116,7 +116,7 @@ impl SoftBody {
                     weights: hit.weights,
                     point: hit.point,
                     normal: hit.normal,
-                    friction,
+                    coefficients,
                     constraint: VelocityConstraint::default(),
                     impulse: DVec3::ZERO,
                 });
@@ -139,7 +139,22 @@ pub(crate) fn prepare_corners(body: &mut SoftBody, h: f64) {
             contact.normal = normal;
         }
         let gap = (contact.vertex - contact.point).dot(contact.normal);
-        contact.constraint = VelocityConstraint::new(gap, h, depenetration_speed);
+        let vertex_velocity = contact.proxy.map_or(DVec3::ZERO, |p| {
+            body.rigid_proxies[p].velocity_at(contact.vertex)
+        });
+        let face_velocity: DVec3 = contact
+            .triangle
+            .iter()
+            .zip(contact.weights)
+            .map(|(&n, w)| body.velocities[n as usize] * w)
+            .sum();
+        let normal_speed = (vertex_velocity - face_velocity).dot(contact.normal);
+        contact.constraint = VelocityConstraint::new(gap, h, depenetration_speed).bounce(
+            gap,
+            h,
+            normal_speed,
+            contact.coefficients.restitution,
+        );
     }
 }
 
@@ -173,9 +188,10 @@ pub(crate) fn solve_corners(body: &mut SoftBody) {
             triangle: contact.triangle,
             weights: contact.weights,
         };
-        contact.impulse += contact
-            .constraint
-            .correct(contact.normal, contact.friction, &mut sides);
+        contact.impulse +=
+            contact
+                .constraint
+                .correct(contact.normal, contact.coefficients.friction, &mut sides);
     }
 }
 

@@ -47,6 +47,7 @@ mod velocity_constraint;
 pub(crate) use between::{BetweenContact, detect_between, prepare_between, solve_between};
 pub(crate) use corner::{CornerContact, advance_corners, prepare_corners, solve_corners};
 pub(crate) use rigid::{RigidProxy, coming_velocity};
+pub use velocity_constraint::RESTITUTION_THRESHOLD;
 pub(crate) use velocity_constraint::{ContactSides, VelocityConstraint};
 
 use crate::Error;
@@ -91,6 +92,65 @@ impl Default for ContactSettings {
     }
 }
 
+/// A surface's friction and restitution coefficients and how each combines with another's.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct SurfaceCoefficients {
+    friction: f32,
+    friction_rule: CoefficientCombineRule,
+    restitution: f32,
+    restitution_rule: CoefficientCombineRule,
+}
+
+impl SurfaceCoefficients {
+    /// A soft body's.
+    pub(crate) fn of_body(body: &SoftBody) -> Self {
+        Self {
+            friction: body.friction as f32,
+            friction_rule: body.friction_combine_rule,
+            restitution: body.restitution as f32,
+            restitution_rule: body.restitution_combine_rule,
+        }
+    }
+
+    /// A collider's.
+    pub(crate) fn of_collider(collider: &rapier3d::geometry::Collider) -> Self {
+        Self {
+            friction: collider.friction(),
+            friction_rule: collider.friction_combine_rule(),
+            restitution: collider.restitution(),
+            restitution_rule: collider.restitution_combine_rule(),
+        }
+    }
+
+    /// The coefficients of a contact between the two surfaces: each pair combined by the
+    /// stronger of the two rules, as rapier combines two colliders'.
+    pub(crate) fn combine(self, other: Self) -> Coefficients {
+        let combine =
+            |a, b, rule_a, rule_b| f64::from(CoefficientCombineRule::combine(a, b, rule_a, rule_b));
+        Coefficients {
+            friction: combine(
+                self.friction,
+                other.friction,
+                self.friction_rule,
+                other.friction_rule,
+            ),
+            restitution: combine(
+                self.restitution,
+                other.restitution,
+                self.restitution_rule,
+                other.restitution_rule,
+            ),
+        }
+    }
+}
+
+/// A contact's Coulomb friction and restitution coefficients.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Coefficients {
+    pub(crate) friction: f64,
+    pub(crate) restitution: f64,
+}
+
 /// What a node's contact pushes against.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ContactTarget {
@@ -120,6 +180,9 @@ pub struct NodeContact {
     pub normal: DVec3,
     /// Coulomb friction coefficient: the body's and the target's, combined by their rules.
     pub friction: f64,
+    /// Restitution coefficient: the body's and the target's, combined by their rules (see
+    /// [`RESTITUTION_THRESHOLD`]).
+    pub restitution: f64,
     /// The impulse (N s) the contact gave the node over the last step.
     pub impulse: DVec3,
     /// The far side of the contact, as the velocity constraints see it.
@@ -163,13 +226,13 @@ impl std::fmt::Debug for NodeContact {
 
 impl NodeContact {
     /// A contact of `node` with `target` through the plane at `point` (m) with outward unit
-    /// `normal`, with friction coefficient `friction`, enforced against `obstacle`.
+    /// `normal`, with `coefficients`, enforced against `obstacle`.
     fn new(
         node: u32,
         target: ContactTarget,
         point: DVec3,
         normal: DVec3,
-        friction: f64,
+        coefficients: Coefficients,
         obstacle: Obstacle,
     ) -> Self {
         Self {
@@ -177,7 +240,8 @@ impl NodeContact {
             target,
             point,
             normal,
-            friction,
+            friction: coefficients.friction,
+            restitution: coefficients.restitution,
             impulse: DVec3::ZERO,
             obstacle,
             constraint: VelocityConstraint::default(),
@@ -364,12 +428,8 @@ impl SoftBody {
                 .filter(|a| Some(a.body) == collider.parent())
                 .map(|a| a.node)
                 .collect();
-            let friction = f64::from(CoefficientCombineRule::combine(
-                self.friction as f32,
-                collider.friction(),
-                self.friction_combine_rule,
-                collider.friction_combine_rule(),
-            ));
+            let coefficients = SurfaceCoefficients::of_body(self)
+                .combine(SurfaceCoefficients::of_collider(collider));
             let mut proxy = None;
             for &node in &self.surface_nodes {
                 let n = node as usize;
@@ -395,7 +455,7 @@ impl SoftBody {
                         ContactTarget::Collider(handle),
                         point,
                         normal,
-                        friction,
+                        coefficients,
                         Obstacle::Collider {
                             shape: shape.clone(),
                             pose: *pose,
@@ -408,8 +468,15 @@ impl SoftBody {
                 || (lo - DVec3::splat(reach)).cmpgt(body_hi).any());
             if near_body && corner::has_vertices(&**shape) {
                 let tree = tree.get_or_insert_with(|| surface_tree::SurfaceTree::of(self));
-                let mut found = self
-                    .find_corner_contacts(tree, handle, &**shape, pose, friction, reach, &glued);
+                let mut found = self.find_corner_contacts(
+                    tree,
+                    handle,
+                    &**shape,
+                    pose,
+                    coefficients,
+                    reach,
+                    &glued,
+                );
                 if !found.is_empty()
                     && let Some((handle, body)) = parent
                 {
@@ -661,10 +728,25 @@ impl SoftBody {
 /// cross it within the substep, or, found inside, leaves at most at the depenetration speed.
 pub(crate) fn prepare_velocities(body: &mut SoftBody, h: f64) {
     let depenetration_speed = body.contact_settings.depenetration_speed;
-    for contact in &mut body.contacts {
-        let x = body.positions[contact.node as usize];
-        contact.refresh(x, &body.positions);
-        contact.constraint = VelocityConstraint::new(contact.gap(x), h, depenetration_speed);
+    let (contacts, positions, mut partners) = contacts_and_partners(body);
+    for contact in contacts.iter_mut() {
+        let n = contact.node as usize;
+        let x = positions[n];
+        contact.refresh(x, positions);
+        let gap = contact.gap(x);
+        let sides = WithinBody {
+            partners: &mut partners,
+            obstacle: &contact.obstacle,
+            node: n,
+            x,
+        };
+        let normal_speed = sides.relative_velocity().dot(contact.normal);
+        contact.constraint = VelocityConstraint::new(gap, h, depenetration_speed).bounce(
+            gap,
+            h,
+            normal_speed,
+            contact.restitution,
+        );
     }
 }
 

@@ -13,9 +13,8 @@
 //! conserved within the body.
 
 use super::surface_tree::SurfaceTree;
-use super::{ContactTarget, NodeContact, Obstacle};
+use super::{ContactTarget, NodeContact, Obstacle, SurfaceCoefficients};
 use crate::body::SoftBody;
-use rapier3d::dynamics::CoefficientCombineRule;
 
 impl SoftBody {
     /// Adds the self-contacts of the body's surface nodes within `reach` (m) of its own
@@ -23,12 +22,8 @@ impl SoftBody {
     pub(crate) fn detect_self_contacts(&mut self, reach: f64) {
         let tree = SurfaceTree::of(self);
         let node_normals = self.surface_node_normals();
-        let friction = f64::from(CoefficientCombineRule::combine(
-            self.friction as f32,
-            self.friction as f32,
-            self.friction_combine_rule,
-            self.friction_combine_rule,
-        ));
+        let own = SurfaceCoefficients::of_body(self);
+        let coefficients = own.combine(own);
         let mut found = Vec::new();
         for &node in &self.surface_nodes {
             let n = node as usize;
@@ -47,7 +42,7 @@ impl SoftBody {
                     },
                     hit.point,
                     hit.normal,
-                    friction,
+                    coefficients,
                     Obstacle::OwnTriangle {
                         nodes: hit.triangle,
                         weights: hit.weights,

@@ -12,6 +12,10 @@
 
 use rapier3d::glamx::DVec3;
 
+/// Approach speed (m/s) below which a contact does not bounce, whatever its restitution, so that
+/// bodies can come to rest (as `Box2D`'s restitution threshold).
+pub const RESTITUTION_THRESHOLD: f64 = 1.0;
+
 /// The two sides of a contact, as a sweep sees them.
 pub(crate) trait ContactSides {
     /// Velocity (m/s) of the node relative to the obstacle's material point it touches.
@@ -47,6 +51,21 @@ impl VelocityConstraint {
         }
     }
 
+    /// Makes the contact bounce: a node that approaches the plane at normal velocity
+    /// `normal_speed` (m/s, negative toward it) faster than [`RESTITUTION_THRESHOLD`] and reaches
+    /// it within the substep of `h` (s) from `gap` (m) leaves it at `restitution` times its
+    /// approach speed (a new contact, as rapier bounces only those).
+    pub(crate) fn bounce(mut self, gap: f64, h: f64, normal_speed: f64, restitution: f64) -> Self {
+        if restitution > 0.0
+            && gap >= 0.0
+            && normal_speed < -RESTITUTION_THRESHOLD
+            && normal_speed * h <= -gap
+        {
+            self.lowest_speed = self.lowest_speed.max(-restitution * normal_speed);
+        }
+        self
+    }
+
     /// One sweep's correction along the plane's unit `normal` with Coulomb coefficient
     /// `friction`; returns the impulse (N s) it gave the node.
     pub(crate) fn correct(
@@ -78,5 +97,69 @@ impl VelocityConstraint {
         sides.exchange(rubbed);
         self.friction_impulse = friction_impulse;
         pushed + rubbed
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A node of mass `m` against a fixed plane of normal +y.
+    struct AgainstFixedPlane {
+        velocity: DVec3,
+        mass: f64,
+    }
+
+    impl ContactSides for AgainstFixedPlane {
+        fn relative_velocity(&self) -> DVec3 {
+            self.velocity
+        }
+
+        fn inverse_mass_along(&self, _direction: DVec3) -> f64 {
+            1.0 / self.mass
+        }
+
+        fn exchange(&mut self, impulse: DVec3) {
+            self.velocity += impulse / self.mass;
+        }
+    }
+
+    #[test]
+    fn a_node_hitting_a_fixed_plane_leaves_at_restitution_times_its_approach_speed() {
+        // A 0.1 kg node 1 mm above the plane at -3 m/s (it reaches the plane within a substep
+        // of 1 ms), frictionless: one sweep against a fixed plane is exact, so the normal
+        // velocity after is e times 3 m/s to round-off, and the tangential one is untouched.
+        for restitution in [0.0, 0.5, 1.0] {
+            let (gap, h) = (1e-3, 1e-3);
+            let mut node = AgainstFixedPlane {
+                velocity: DVec3::new(0.2, -3.0, 0.0),
+                mass: 0.1,
+            };
+            let mut constraint =
+                VelocityConstraint::new(gap, h, 0.1).bounce(gap, h, -3.0, restitution);
+            constraint.correct(DVec3::Y, 0.0, &mut node);
+            let expected = if restitution > 0.0 {
+                3.0 * restitution
+            } else {
+                // Inelastic: it arrives at the plane by the end of the substep.
+                -gap / h
+            };
+            assert!(
+                (node.velocity.y - expected).abs() < 1e-12,
+                "{restitution}: {node:?}",
+                node = node.velocity
+            );
+            assert!((node.velocity.x - 0.2).abs() < 1e-15);
+        }
+    }
+
+    #[test]
+    fn slow_or_resting_contacts_do_not_bounce() {
+        // Below the threshold (resting nodes pressed by gravity), or not reaching the plane
+        // within the substep, the constraint is the inelastic one.
+        let inelastic = VelocityConstraint::new(1e-3, 1e-3, 0.1);
+        assert_eq!(inelastic.bounce(1e-3, 1e-3, -0.5, 1.0), inelastic);
+        let far = VelocityConstraint::new(1e-2, 1e-3, 0.1);
+        assert_eq!(far.bounce(1e-2, 1e-3, -3.0, 1.0), far);
     }
 }
