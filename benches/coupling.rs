@@ -15,6 +15,10 @@
 //!   closing and lifting (1.75 s) run outside the timing; the timed frames hold the fingers still
 //!   at their final pose. Beside it, `d_grasp_cube_alone`: the same cube falling freely, stepped
 //!   as in (a), for the ratio.
+//! - (e) `e_soft_stack`: `examples/soft_stack.rs`'s kind of scene, two 10 cm soft cubes
+//!   (E = 1e5 Pa, 4 x 4 x 4 cells) stacked on the ground: soft-soft contact, the two cubes
+//!   stepped together. Beside it, `e_two_cubes_alone`: the same two cubes falling freely, each
+//!   stepped as in (a).
 //!
 //! Every other scene first runs 1 s of frames outside the timing, so that (b) and (c) measure
 //! steady contact. Times are per frame.
@@ -128,6 +132,18 @@ fn coupling_frame(c: &mut Criterion) {
     );
     // (d) The grasp, held.
     let mut grasp = held_grasp();
+    // (e) Two soft cubes stacked on the ground, and the same two falling freely.
+    let mut stack = world_on_ground(0.5);
+    stack
+        .soft_bodies
+        .insert(soft_cube(0.1, 4, 1e5, DVec3::new(0.0, 0.05, 0.0)));
+    stack
+        .soft_bodies
+        .insert(soft_cube(0.1, 4, 1e5, DVec3::new(0.0, 0.151, 0.0)));
+    let mut pair_alone = [
+        soft_cube(0.1, 4, 1e5, DVec3::new(0.0, 0.5, 0.0)),
+        soft_cube(0.1, 4, 1e5, DVec3::new(0.0, 0.7, 0.0)),
+    ];
     // (a) The cube alone, stepped as the world steps its soft bodies; and the grasp's cube.
     let mut alone = drop_cube(0.55);
     let mut grasp_alone = grasp_cube(0.5);
@@ -145,6 +161,7 @@ fn coupling_frame(c: &mut Criterion) {
         frame_alone(&mut grasp_alone);
         step(&mut on_ground);
         step(&mut box_on_block);
+        step(&mut stack);
     }
 
     let mut group = c.benchmark_group("coupling_frame_1_60");
@@ -160,6 +177,10 @@ fn coupling_frame(c: &mut Criterion) {
     group.bench_function("d_grasp", |b| b.iter(|| step(&mut grasp)));
     group.bench_function("d_grasp_cube_alone", |b| {
         b.iter(|| frame_alone(&mut grasp_alone))
+    });
+    group.bench_function("e_soft_stack", |b| b.iter(|| step(&mut stack)));
+    group.bench_function("e_two_cubes_alone", |b| {
+        b.iter(|| pair_alone.iter_mut().for_each(frame_alone))
     });
     group.finish();
 }
