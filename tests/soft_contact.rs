@@ -194,19 +194,15 @@ fn mean_height_of_layer(body: &SoftBody, rest_y: f64) -> f64 {
         / layer.len() as f64
 }
 
-/// Two cubes of side `SIDE`, 4 cells a side, one on top of the other with a gap `gap` (m), as one
-/// mesh; the lower one's centre at the origin.
-fn two_cubes_one_mesh(gap: f64) -> TetMesh {
+/// Two cubes of side `SIDE`, 4 cells a side, as one mesh: one centred at the origin, the other
+/// at `offset` (m).
+fn two_cubes_one_mesh(offset: DVec3) -> TetMesh {
     let cube = mesh::cuboid(DVec3::splat(SIDE / 2.0), [4; 3]).unwrap();
-    let offset = cube.node_count() as u32;
+    let count = cube.node_count() as u32;
     let mut positions = cube.positions().to_vec();
-    positions.extend(
-        cube.positions()
-            .iter()
-            .map(|p| *p + DVec3::new(0.0, SIDE + gap, 0.0)),
-    );
+    positions.extend(cube.positions().iter().map(|p| *p + offset));
     let mut tets = cube.tets().to_vec();
-    tets.extend(cube.tets().iter().map(|t| t.map(|n| n + offset)));
+    tets.extend(cube.tets().iter().map(|t| t.map(|n| n + count)));
     TetMesh::new(positions, tets).unwrap()
 }
 
@@ -222,13 +218,16 @@ fn a_body_of_two_separate_cubes_lands_on_itself_only_with_self_contact() {
     let material = rubber(young);
     for self_contact in [true, false] {
         let (mut world, ground) = world_on_ground(0.5);
-        let body = SoftBodyBuilder::new(two_cubes_one_mesh(2e-3), material)
-            .damping(RayleighDamping::stiffness_proportional(2e-3, material.lame()).unwrap())
-            .translation(DVec3::new(0.0, SIDE / 2.0, 0.0))
-            .friction(0.5)
-            .self_contact(self_contact)
-            .build()
-            .unwrap();
+        let body = SoftBodyBuilder::new(
+            two_cubes_one_mesh(DVec3::new(0.0, SIDE + 2e-3, 0.0)),
+            material,
+        )
+        .damping(RayleighDamping::stiffness_proportional(2e-3, material.lame()).unwrap())
+        .translation(DVec3::new(0.0, SIDE / 2.0, 0.0))
+        .friction(0.5)
+        .self_contact(self_contact)
+        .build()
+        .unwrap();
         let handle = world.soft_bodies.insert(body);
         let frame = f64::from(world.physics.integration_parameters.dt);
         let frames = (2.0 / frame).round() as usize;
@@ -281,25 +280,16 @@ fn the_halves_of_a_body_colliding_in_zero_gravity_conserve_its_momentum() {
     // bounded by the margin times the impulse exchanged (the right cube's final momentum).
     let mut world = FvmWorld::default();
     world.physics.gravity = Vector::ZERO;
-    let cube = mesh::cuboid(DVec3::splat(SIDE / 2.0), [4; 3]).unwrap();
-    let offset = cube.node_count() as u32;
-    let mut positions = cube.positions().to_vec();
-    positions.extend(
-        cube.positions()
-            .iter()
-            .map(|p| *p + DVec3::new(SIDE + 2e-3, 0.03, 0.0)),
-    );
-    let mut tets = cube.tets().to_vec();
-    tets.extend(cube.tets().iter().map(|t| t.map(|n| n + offset)));
+    let mesh = two_cubes_one_mesh(DVec3::new(SIDE + 2e-3, 0.03, 0.0));
     let material = rubber(1e5);
     let handle = world.soft_bodies.insert(
-        SoftBodyBuilder::new(TetMesh::new(positions, tets).unwrap(), material)
+        SoftBodyBuilder::new(mesh, material)
             .damping(RayleighDamping::stiffness_proportional(2e-3, material.lame()).unwrap())
             .self_contact(true)
             .build()
             .unwrap(),
     );
-    let left = offset as usize;
+    let left = world.soft_bodies[handle].node_count() / 2;
     for v in &mut world.soft_bodies[handle].velocities_mut()[..left] {
         *v = DVec3::new(1.0, 0.0, 0.3);
     }

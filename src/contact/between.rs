@@ -9,7 +9,10 @@
 //! so momentum is exchanged exactly, and the plane follows the triangle through the step.
 
 use super::surface_tree::SurfaceTree;
-use super::{Coefficients, ContactSettings, ContactSides, SurfaceCoefficients, VelocityConstraint};
+use super::{
+    Coefficients, ContactSettings, ContactSides, SoftPoint, SurfaceCoefficients,
+    VelocityConstraint, node_inverse_mass,
+};
 use crate::body::SoftBody;
 use rapier3d::glamx::DVec3;
 use rapier3d::parry::bounding_volume::BoundingVolume;
@@ -20,10 +23,9 @@ pub(crate) struct BetweenContact {
     /// The node's body (an index into the bodies stepped together) and the node.
     pub(crate) node_body: usize,
     pub(crate) node: u32,
-    /// The triangle's body and nodes, and the contact point's barycentric weights.
+    /// The triangle's body and the contact point on the triangle.
     pub(crate) triangle_body: usize,
-    triangle: [u32; 3],
-    weights: [f64; 3],
+    on_triangle: SoftPoint,
     /// The contact plane: a point (m) and the triangle's outward unit normal.
     point: DVec3,
     normal: DVec3,
@@ -80,8 +82,7 @@ pub(crate) fn detect_between(
                         node_body: a,
                         node,
                         triangle_body: b,
-                        triangle: hit.triangle,
-                        weights: hit.weights,
+                        on_triangle: hit.soft_point(),
                         point: hit.point,
                         normal: hit.normal,
                         coefficients,
@@ -115,26 +116,16 @@ fn two_bodies<'a>(
 pub(crate) fn prepare_between(contacts: &mut [BetweenContact], bodies: &[&mut SoftBody], h: f64) {
     for contact in contacts {
         let triangle_body = &bodies[contact.triangle_body];
-        let at = contact
-            .triangle
-            .map(|c| triangle_body.positions[c as usize]);
-        let normal = (at[1] - at[0]).cross(at[2] - at[0]).normalize_or_zero();
-        if normal != DVec3::ZERO {
-            contact.point = at[0] * contact.weights[0]
-                + at[1] * contact.weights[1]
-                + at[2] * contact.weights[2];
+        if let Some((point, normal)) = contact.on_triangle.plane(&triangle_body.positions) {
+            contact.point = point;
             contact.normal = normal;
         }
         let node_body = &bodies[contact.node_body];
         let n = contact.node as usize;
         let gap = (node_body.positions[n] - contact.point).dot(contact.normal);
-        let face_velocity: DVec3 = contact
-            .triangle
-            .iter()
-            .zip(contact.weights)
-            .map(|(&c, w)| triangle_body.velocities[c as usize] * w)
-            .sum();
-        let normal_speed = (node_body.velocities[n] - face_velocity).dot(contact.normal);
+        let normal_speed = (node_body.velocities[n]
+            - contact.on_triangle.velocity(&triangle_body.velocities))
+        .dot(contact.normal);
         contact.constraint = VelocityConstraint::new(
             gap,
             h,
@@ -153,8 +144,7 @@ pub(crate) fn solve_between(contacts: &mut [BetweenContact], bodies: &mut [&mut 
             node_body,
             node: contact.node as usize,
             triangle_body,
-            triangle: contact.triangle,
-            weights: contact.weights,
+            on_triangle: contact.on_triangle,
         };
         contact
             .constraint
@@ -167,47 +157,33 @@ struct Between<'a> {
     node_body: &'a mut SoftBody,
     node: usize,
     triangle_body: &'a mut SoftBody,
-    triangle: [u32; 3],
-    weights: [f64; 3],
-}
-
-/// The inverse mass (1/kg) of `body`'s node `n`: zero when pinned.
-fn inverse_mass(body: &SoftBody, n: usize) -> f64 {
-    if body.pinned[n] {
-        0.0
-    } else {
-        1.0 / body.masses[n]
-    }
+    on_triangle: SoftPoint,
 }
 
 impl ContactSides for Between<'_> {
     fn relative_velocity(&self) -> DVec3 {
-        let triangle: DVec3 = self
-            .triangle
-            .iter()
-            .zip(self.weights)
-            .map(|(&c, w)| self.triangle_body.velocities[c as usize] * w)
-            .sum();
-        self.node_body.velocities[self.node] - triangle
+        self.node_body.velocities[self.node]
+            - self.on_triangle.velocity(&self.triangle_body.velocities)
     }
 
     fn inverse_mass_along(&self, _direction: DVec3) -> f64 {
-        inverse_mass(self.node_body, self.node)
+        let (node, triangle) = (&self.node_body, &self.triangle_body);
+        node_inverse_mass(node.masses[self.node], node.pinned[self.node])
             + self
-                .triangle
-                .iter()
-                .zip(self.weights)
-                .map(|(&c, w)| w * w * inverse_mass(self.triangle_body, c as usize))
-                .sum::<f64>()
+                .on_triangle
+                .inverse_mass(&triangle.masses, &triangle.pinned)
     }
 
     fn exchange(&mut self, impulse: DVec3) {
-        let own = inverse_mass(self.node_body, self.node);
-        self.node_body.velocities[self.node] += impulse * own;
-        for (&c, w) in self.triangle.iter().zip(self.weights) {
-            let c = c as usize;
-            let corner = inverse_mass(self.triangle_body, c);
-            self.triangle_body.velocities[c] -= impulse * (w * corner);
-        }
+        let node = &mut self.node_body;
+        node.velocities[self.node] +=
+            impulse * node_inverse_mass(node.masses[self.node], node.pinned[self.node]);
+        let triangle = &mut self.triangle_body;
+        self.on_triangle.apply(
+            -impulse,
+            &mut triangle.velocities,
+            &triangle.masses,
+            &triangle.pinned,
+        );
     }
 }

@@ -10,7 +10,7 @@
 //! and the plane follows the triangle through the step.
 
 use super::surface_tree::SurfaceTree;
-use super::{Coefficients, ContactSides, RigidProxy, VelocityConstraint};
+use super::{Coefficients, ContactSides, RigidProxy, SoftPoint, VelocityConstraint};
 use crate::body::SoftBody;
 use rapier3d::geometry::{ColliderHandle, Shape};
 use rapier3d::glamx::DVec3;
@@ -25,9 +25,8 @@ pub(crate) struct CornerContact {
     pub(crate) proxy: Option<usize>,
     /// The vertex in the world (m), moved at its rigid body's velocity through the soft step.
     vertex: DVec3,
-    /// The triangle's nodes and the contact point's barycentric weights.
-    triangle: [u32; 3],
-    weights: [f64; 3],
+    /// The contact point on the soft triangle.
+    on_triangle: SoftPoint,
     /// The contact plane: a point (m) and the triangle's outward unit normal.
     point: DVec3,
     normal: DVec3,
@@ -112,8 +111,7 @@ impl SoftBody {
                     collider,
                     proxy: None,
                     vertex,
-                    triangle: hit.triangle,
-                    weights: hit.weights,
+                    on_triangle: hit.soft_point(),
                     point: hit.point,
                     normal: hit.normal,
                     coefficients,
@@ -131,24 +129,16 @@ impl SoftBody {
 pub(crate) fn prepare_corners(body: &mut SoftBody, h: f64) {
     let depenetration_speed = body.contact_settings.depenetration_speed;
     for contact in &mut body.corner_contacts {
-        let at = contact.triangle.map(|n| body.positions[n as usize]);
-        let normal = (at[1] - at[0]).cross(at[2] - at[0]).normalize_or_zero();
-        if normal != DVec3::ZERO {
-            let [a, b, c] = contact.weights;
-            contact.point = at[0] * a + at[1] * b + at[2] * c;
+        if let Some((point, normal)) = contact.on_triangle.plane(&body.positions) {
+            contact.point = point;
             contact.normal = normal;
         }
         let gap = (contact.vertex - contact.point).dot(contact.normal);
         let vertex_velocity = contact.proxy.map_or(DVec3::ZERO, |p| {
             body.rigid_proxies[p].velocity_at(contact.vertex)
         });
-        let face_velocity: DVec3 = contact
-            .triangle
-            .iter()
-            .zip(contact.weights)
-            .map(|(&n, w)| body.velocities[n as usize] * w)
-            .sum();
-        let normal_speed = (vertex_velocity - face_velocity).dot(contact.normal);
+        let normal_speed =
+            (vertex_velocity - contact.on_triangle.velocity(&body.velocities)).dot(contact.normal);
         contact.constraint = VelocityConstraint::new(gap, h, depenetration_speed).bounce(
             gap,
             h,
@@ -185,8 +175,7 @@ pub(crate) fn solve_corners(body: &mut SoftBody) {
             velocities,
             masses,
             pinned,
-            triangle: contact.triangle,
-            weights: contact.weights,
+            on_triangle: contact.on_triangle,
         };
         contact.impulse +=
             contact
@@ -202,19 +191,7 @@ struct Corner<'a> {
     velocities: &'a mut [DVec3],
     masses: &'a [f64],
     pinned: &'a [bool],
-    triangle: [u32; 3],
-    weights: [f64; 3],
-}
-
-impl Corner<'_> {
-    /// The inverse mass (1/kg) of node `n`: zero when pinned.
-    fn inverse_mass(&self, n: usize) -> f64 {
-        if self.pinned[n] {
-            0.0
-        } else {
-            1.0 / self.masses[n]
-        }
-    }
+    on_triangle: SoftPoint,
 }
 
 impl ContactSides for Corner<'_> {
@@ -223,35 +200,21 @@ impl ContactSides for Corner<'_> {
             .rigid
             .as_ref()
             .map_or(DVec3::ZERO, |r| r.velocity_at(self.vertex));
-        let face: DVec3 = self
-            .triangle
-            .iter()
-            .zip(self.weights)
-            .map(|(&n, w)| self.velocities[n as usize] * w)
-            .sum();
-        vertex - face
+        vertex - self.on_triangle.velocity(self.velocities)
     }
 
     fn inverse_mass_along(&self, direction: DVec3) -> f64 {
         self.rigid
             .as_ref()
             .map_or(0.0, |r| r.inverse_mass_along(self.vertex, direction))
-            + self
-                .triangle
-                .iter()
-                .zip(self.weights)
-                .map(|(&n, w)| w * w * self.inverse_mass(n as usize))
-                .sum::<f64>()
+            + self.on_triangle.inverse_mass(self.masses, self.pinned)
     }
 
     fn exchange(&mut self, impulse: DVec3) {
         if let Some(rigid) = self.rigid.as_mut() {
             rigid.apply(impulse, self.vertex);
         }
-        for (&n, w) in self.triangle.iter().zip(self.weights) {
-            let n = n as usize;
-            let share = w * self.inverse_mass(n);
-            self.velocities[n] -= impulse * share;
-        }
+        self.on_triangle
+            .apply(-impulse, self.velocities, self.masses, self.pinned);
     }
 }

@@ -41,12 +41,14 @@ mod between;
 mod corner;
 mod rigid;
 mod self_contact;
+mod soft_point;
 mod surface_tree;
 mod velocity_constraint;
 
 pub(crate) use between::{BetweenContact, detect_between, prepare_between, solve_between};
 pub(crate) use corner::{CornerContact, advance_corners, prepare_corners, solve_corners};
 pub(crate) use rigid::{RigidProxy, coming_velocity};
+use soft_point::{SoftPoint, node_inverse_mass};
 pub use velocity_constraint::RESTITUTION_THRESHOLD;
 pub(crate) use velocity_constraint::{ContactSides, VelocityConstraint};
 
@@ -206,9 +208,8 @@ enum Obstacle {
         pose: Pose,
         proxy: Option<usize>,
     },
-    /// A triangle of the body's own surface: its nodes, and the barycentric weights of the
-    /// contact point.
-    OwnTriangle { nodes: [u32; 3], weights: [f64; 3] },
+    /// The contact point of a triangle of the body's own surface.
+    OwnTriangle(SoftPoint),
 }
 
 impl std::fmt::Debug for NodeContact {
@@ -313,11 +314,9 @@ impl NodeContact {
                     self.normal = normal;
                 }
             }
-            Obstacle::OwnTriangle { nodes, weights } => {
-                let at = nodes.map(|c| positions[c as usize]);
-                let normal = (at[1] - at[0]).cross(at[2] - at[0]).normalize_or_zero();
-                if normal != DVec3::ZERO {
-                    self.point = at[0] * weights[0] + at[1] * weights[1] + at[2] * weights[2];
+            Obstacle::OwnTriangle(point) => {
+                if let Some((point, normal)) = point.plane(positions) {
+                    self.point = point;
                     self.normal = normal;
                 }
             }
@@ -627,11 +626,7 @@ struct Partners<'a> {
 impl Partners<'_> {
     /// The inverse mass (1/kg) of the body's node `n`: zero when pinned.
     fn own_inverse_mass(&self, n: usize) -> f64 {
-        if self.pinned[n] {
-            0.0
-        } else {
-            1.0 / self.masses[n]
-        }
+        node_inverse_mass(self.masses[n], self.pinned[n])
     }
 
     /// Velocity (m/s) of the obstacle's material point at `x` (m): zero for a fixed collider.
@@ -640,11 +635,7 @@ impl Partners<'_> {
             Obstacle::Collider { proxy, .. } => {
                 proxy.map_or(DVec3::ZERO, |p| self.rigid[p].velocity_at(x))
             }
-            Obstacle::OwnTriangle { nodes, weights } => nodes
-                .iter()
-                .zip(weights)
-                .map(|(&c, w)| self.velocities[c as usize] * *w)
-                .sum(),
+            Obstacle::OwnTriangle(point) => point.velocity(self.velocities),
         }
     }
 
@@ -654,11 +645,7 @@ impl Partners<'_> {
             Obstacle::Collider { proxy, .. } => {
                 proxy.map_or(0.0, |p| self.rigid[p].inverse_mass_along(x, direction))
             }
-            Obstacle::OwnTriangle { nodes, weights } => nodes
-                .iter()
-                .zip(weights)
-                .map(|(&c, w)| w * w * self.own_inverse_mass(c as usize))
-                .sum(),
+            Obstacle::OwnTriangle(point) => point.inverse_mass(self.masses, self.pinned),
         }
     }
 
@@ -670,11 +657,8 @@ impl Partners<'_> {
                     self.rigid[p].apply(impulse, x);
                 }
             }
-            Obstacle::OwnTriangle { nodes, weights } => {
-                for (&c, w) in nodes.iter().zip(weights) {
-                    let c = c as usize;
-                    self.velocities[c] += impulse * (w * self.own_inverse_mass(c));
-                }
+            Obstacle::OwnTriangle(point) => {
+                point.apply(impulse, self.velocities, self.masses, self.pinned);
             }
         }
     }
@@ -718,7 +702,7 @@ impl SoftBody {
             || self
                 .contacts
                 .iter()
-                .any(|c| matches!(c.obstacle, Obstacle::OwnTriangle { .. }))
+                .any(|c| matches!(c.obstacle, Obstacle::OwnTriangle(_)))
     }
 }
 

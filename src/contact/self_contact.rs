@@ -43,10 +43,7 @@ impl SoftBody {
                     hit.point,
                     hit.normal,
                     coefficients,
-                    Obstacle::OwnTriangle {
-                        nodes: hit.triangle,
-                        weights: hit.weights,
-                    },
+                    Obstacle::OwnTriangle(hit.soft_point()),
                 ));
             }
         }

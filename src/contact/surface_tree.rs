@@ -1,6 +1,7 @@
 //! A soft body's boundary triangles, where they are now, in a parry bounding-volume hierarchy:
 //! the nearest triangle facing a point, for self-contact and contact between soft bodies.
 
+use super::SoftPoint;
 use crate::body::SoftBody;
 use rapier3d::glamx::{DVec3, Vec3};
 use rapier3d::parry::bounding_volume::{Aabb, BoundingVolume};
@@ -29,6 +30,16 @@ pub(crate) struct SurfaceTree {
     bvh: Bvh,
     /// The hierarchy's bounds (m).
     pub(crate) bounds: Aabb,
+}
+
+impl TrianglePoint {
+    /// The point as a side of a contact.
+    pub(crate) fn soft_point(&self) -> SoftPoint {
+        SoftPoint {
+            nodes: self.triangle,
+            weights: self.weights,
+        }
+    }
 }
 
 impl SurfaceTree {
