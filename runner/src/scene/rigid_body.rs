@@ -30,8 +30,8 @@
 //! only; the plane passes through the translation), `trimesh = { file, scale }` (an `.obj` or
 //! `.stl` surface relative to the scene file, `scale` in m per file unit, default 1; fixed or
 //! kinematic bodies only). A kinematic body's translation is interpolated linearly between
-//! its keyframes (times in s, increasing) and held before the first and after the last; its
-//! rotation stays as given.
+//! its keyframes (times in s, increasing) and held before the first and after the last (so it
+//! starts at the first keyframe's translation); its rotation stays as given.
 
 use super::check::Checker;
 use serde::Deserialize;
@@ -185,6 +185,12 @@ impl RigidBodySpec {
             c.fail(
                 &format!("{key}.linvel"),
                 "only a `dynamic` body starts with a velocity (a kinematic one follows its keyframes)",
+            );
+        }
+        if !self.keyframes.is_empty() && self.translation != [0.0; 3] {
+            c.fail(
+                &format!("{key}.translation"),
+                "a keyframed body takes its translation from its keyframes: leave it out",
             );
         }
         let mut previous = f64::NEG_INFINITY;
