@@ -60,9 +60,14 @@ pub fn run(scene: &Scene, options: &RunOptions) -> Result<Report, RunError> {
     }
     let mut sim = Simulation::build(scene)?;
     let out = &options.out;
-    let create = |dir: &Path| std::fs::create_dir_all(dir).map_err(OutputError::io(dir));
-    for dir in ["obj", "pictures", "plots"] {
-        create(&out.join(dir))?;
+    for (dir, extension) in [
+        ("paraview", "vtu"),
+        ("paraview", "pvd"),
+        ("obj", "obj"),
+        ("pictures", "png"),
+        ("plots", "png"),
+    ] {
+        clear(&out.join(dir), extension)?;
     }
     let name = scene.display_name();
     let mut series = ParaViewSeries::new(out.join("paraview"), &name)?;
@@ -221,11 +226,9 @@ fn render_pictures(
     dt: f64,
 ) -> Result<Vec<(f64, String)>, OutputError> {
     let camera = Camera::oblique(lo, hi, width, height);
-    // The colour scale ends at the largest 95th percentile of any pictured frame, so that a
-    // few peak nodes at a contact corner do not leave the rest in the bottom colour.
     let max_stress = pictured
         .iter()
-        .map(|(_, s)| upper_stress(s))
+        .map(|(_, s)| stress_scale(s))
         .fold(1.0, f64::max);
     let mut written = Vec::new();
     for (frame, snapshot) in pictured {
@@ -244,14 +247,23 @@ fn render_pictures(
     Ok(written)
 }
 
-/// The 95th percentile of the nodal von Mises stresses (Pa) of a snapshot's soft bodies.
-fn upper_stress(snapshot: &Snapshot) -> f64 {
-    let mut values: Vec<f64> = (snapshot.soft_bodies.iter())
-        .flat_map(SoftBodySnapshot::nodal_von_mises)
-        .filter(|v| v.is_finite())
+/// The top of the stress colour scale (Pa) for a snapshot: each soft body's 95th percentile of
+/// nodal von Mises stress (so that a few peak nodes at a contact corner do not leave the rest in
+/// the bottom colour), and the median of these over the bodies (so that one body far more
+/// stressed than the others, a taut rope, does not leave them all in the bottom colour: it shows
+/// in the top colour instead).
+fn stress_scale(snapshot: &Snapshot) -> f64 {
+    let mut per_body: Vec<f64> = (snapshot.soft_bodies.iter())
+        .map(|body| {
+            let mut values: Vec<f64> = (body.nodal_von_mises().into_iter())
+                .filter(|v| v.is_finite())
+                .collect();
+            values.sort_by(f64::total_cmp);
+            values.get(values.len() * 95 / 100).copied().unwrap_or(0.0)
+        })
         .collect();
-    values.sort_by(f64::total_cmp);
-    values.get(values.len() * 95 / 100).copied().unwrap_or(0.0)
+    per_body.sort_by(f64::total_cmp);
+    per_body.get(per_body.len() / 2).copied().unwrap_or(0.0)
 }
 
 /// A progress bar over `frames`, drawn on stderr only when it is a terminal and `show` is set.
@@ -267,6 +279,20 @@ fn progress_bar(frames: usize, show: bool) -> ProgressBar {
         bar.set_style(style);
     }
     bar
+}
+
+/// Creates the folder `dir` if needed and removes the files with `extension` an earlier run
+/// left in it, so that the folder holds only this run's output.
+fn clear(dir: &Path, extension: &str) -> Result<(), OutputError> {
+    std::fs::create_dir_all(dir).map_err(OutputError::io(dir))?;
+    let entries = std::fs::read_dir(dir).map_err(OutputError::io(dir))?;
+    for entry in entries.flatten() {
+        let path = entry.path();
+        if path.is_file() && path.extension().is_some_and(|e| e == extension) {
+            std::fs::remove_file(&path).map_err(OutputError::io(&path))?;
+        }
+    }
+    Ok(())
 }
 
 /// `path` relative to `out`, with `/` separators.
