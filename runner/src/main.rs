@@ -1,4 +1,4 @@
-//! `rapier-fvm`: runs rapier_fvm scenes headless and checks meshes.
+//! `rapier-fvm`: runs `rapier_fvm` scenes headless and checks meshes.
 //!
 //! See `rapier-fvm --help`, and `assets/scenes/README.md` for the scene format.
 
@@ -11,7 +11,8 @@ use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-/// Runs rapier_fvm scenes (soft and rigid bodies described in TOML) headless, and checks meshes.
+/// Runs scenes of finite-volume soft bodies and rapier rigid bodies (described in TOML)
+/// headless, and checks meshes.
 ///
 /// Errors (a missing file, a malformed scene or mesh) print one line on stderr and exit with
 /// status 1; wrong command-line arguments exit with status 2.

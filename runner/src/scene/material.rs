@@ -80,7 +80,7 @@ impl MaterialSpec {
     /// The library's material.
     ///
     /// # Errors
-    /// The library's message for constants it refuses (after [`MaterialSpec::check`], none).
+    /// The library's message for constants it refuses (none once the scene is checked).
     pub fn material(&self) -> Result<Material, rapier_fvm::Error> {
         Material::new(self.model.model(), self.young, self.poisson, self.density)
     }

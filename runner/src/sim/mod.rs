@@ -13,6 +13,7 @@ mod build;
 mod probe;
 mod report;
 mod run;
+mod writer;
 
 pub use build::{RigidEntry, Simulation, SoftEntry};
 pub use probe::Probe;
