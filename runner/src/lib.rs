@@ -1,7 +1,13 @@
 //! # `rapier_fvm_runner`
 //!
-//! The output side of the headless runner for [`rapier_fvm`] scenes, in its own crate so that
-//! users of the library do not build the plotting and file-format dependencies.
+//! The headless runner for [`rapier_fvm`] scenes, in its own crate so that users of the library
+//! do not build the command line, the scene format and the plotting and file-format
+//! dependencies. The binary `rapier-fvm` (`src/main.rs`) is a thin layer over three modules:
+//! - [`scene`]: the TOML scene format, read and checked with errors that name the file, the
+//!   line and the key;
+//! - [`sim`]: a scene built into an [`rapier_fvm::world::FvmWorld`] and run frame by frame,
+//!   with its probes sampled and its output written;
+//! - [`output`]: the writers.
 //!
 //! Each saved frame, the runner fills a [`output::Snapshot`] (plain data: positions, velocities,
 //! tetrahedra, surfaces and stresses of the soft bodies, world-space triangle meshes of the rigid
@@ -15,3 +21,5 @@
 //! All lengths are in m, times in s, velocities in m/s and stresses in Pa.
 
 pub mod output;
+pub mod scene;
+pub mod sim;

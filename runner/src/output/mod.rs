@@ -22,7 +22,7 @@ pub use snapshot::{RigidBodySnapshot, Snapshot, SoftBodySnapshot};
 
 /// `name` made safe as a file name and an OBJ object name: ASCII letters, digits, `-` and `_`
 /// kept, anything else replaced by `_`; `body` if nothing is left.
-fn file_stem(name: &str) -> String {
+pub(crate) fn file_stem(name: &str) -> String {
     let stem: String = name
         .chars()
         .map(|c| {

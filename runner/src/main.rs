@@ -1,0 +1,200 @@
+//! `rapier-fvm`: runs `rapier_fvm` scenes headless and checks meshes.
+//!
+//! See `rapier-fvm --help`, and `assets/scenes/README.md` for the scene format.
+
+use clap::{Parser, Subcommand};
+use rapier_fvm::material::{Material, MaterialModel};
+use rapier_fvm::mesh::import::{self, SurfaceOptions};
+use rapier_fvm_runner::scene::Scene;
+use rapier_fvm_runner::sim::{self, RunOptions};
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// Runs scenes of finite-volume soft bodies and rapier rigid bodies (described in TOML)
+/// headless, and checks meshes.
+///
+/// Errors (a missing file, a malformed scene or mesh) print one line on stderr and exit with
+/// status 1; wrong command-line arguments exit with status 2.
+#[derive(Debug, Parser)]
+#[command(name = "rapier-fvm", version, about, long_about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Runs a scene and writes its results into a folder.
+    ///
+    /// Steps the scene frame by frame (progress bar on stderr when it is a terminal), then
+    /// writes into the output folder: report.json (settings used, tets and nodes per body,
+    /// integrator choices, wall time and ms per frame, stability flags, every probe as a time
+    /// series with its final value); paraview/<scene>.pvd with a .vtu per soft body per saved
+    /// frame (displacement, velocity, Cauchy and von Mises stress); obj/surface_<frame>.obj
+    /// (every body's surface, for Blender); pictures/view_<frame>.png and
+    /// pictures/stress_<frame>.png (rendered views coloured by material and by von Mises
+    /// stress); plots/<probe>.png (each probe against time). Prints a summary on stdout.
+    Run {
+        /// The scene file (TOML; format in assets/scenes/README.md).
+        scene: PathBuf,
+        /// The output folder (created if needed; files in it are overwritten).
+        #[arg(long, short)]
+        out: PathBuf,
+        /// Runs this long (s) instead of the scene's duration.
+        #[arg(long)]
+        duration: Option<f64>,
+        /// Hides the progress bar.
+        #[arg(long)]
+        quiet: bool,
+    },
+    /// Reports a mesh file's size, volume, quality and stable explicit time step.
+    ///
+    /// Reads Gmsh .msh (2.2, 4.1, ASCII or binary), TetGen .node/.ele, VTK .vtu/.vtk, or a
+    /// closed .obj/.stl surface (filled with tetrahedra), and prints the element and node
+    /// counts, the volume, the smallest dihedral angle and radius ratio, the inverted and
+    /// degenerate elements, and the explicit integrator's critical and stable time steps for
+    /// the material given.
+    Check {
+        /// The mesh file.
+        mesh: PathBuf,
+        /// Metres per file unit (0.001 for a file in millimetres).
+        #[arg(long, default_value_t = 1.0)]
+        scale: f64,
+        /// Young's modulus (Pa) for the time step.
+        #[arg(long, default_value_t = 1e6)]
+        young: f64,
+        /// Poisson's ratio for the time step.
+        #[arg(long, default_value_t = 0.3)]
+        poisson: f64,
+        /// Density (kg/m³) for the time step.
+        #[arg(long, default_value_t = 1000.0)]
+        density: f64,
+        /// Lattice cells across a surface's largest extent when it is filled (2 to 128).
+        #[arg(long, default_value_t = 16)]
+        cells_across: usize,
+    },
+}
+
+fn main() -> ExitCode {
+    // A bug must still end in one line, not a backtrace.
+    std::panic::set_hook(Box::new(|info| {
+        let message = info
+            .payload()
+            .downcast_ref::<&str>()
+            .map(|s| (*s).to_owned())
+            .or_else(|| info.payload().downcast_ref::<String>().cloned())
+            .unwrap_or_default();
+        eprintln!("error: internal error: {message}");
+    }));
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Run {
+            scene,
+            out,
+            duration,
+            quiet,
+        } => run(scene, out, duration, !quiet),
+        Command::Check {
+            mesh,
+            scale,
+            young,
+            poisson,
+            density,
+            cells_across,
+        } => check(mesh, scale, [young, poisson, density], cells_across),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(message) => {
+            eprintln!("error: {message}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// `run`: runs the scene and prints a summary.
+fn run(scene: PathBuf, out: PathBuf, duration: Option<f64>, progress: bool) -> Result<(), String> {
+    let scene = Scene::load(&scene).map_err(|e| e.to_string())?;
+    let options = RunOptions {
+        out: out.clone(),
+        duration,
+        progress: progress && std::io::stderr().is_terminal(),
+    };
+    let report = sim::run(&scene, &options).map_err(|e| e.to_string())?;
+    println!(
+        "{}: {} frames, {:.3} s simulated in {:.2} s ({:.2} s stepping, {:.2} ms per frame, {:.2}x real time)",
+        report.scene,
+        report.frames,
+        report.simulated_time,
+        report.wall_time_s,
+        report.stepping_time_s,
+        report.ms_per_frame,
+        report.speed_vs_real_time
+    );
+    for body in &report.soft_bodies {
+        println!(
+            "  soft {:<16} {:>6} tets {:>5} nodes; {} explicit / {} implicit frames; {} failed; max inverted {}",
+            body.name,
+            body.tets,
+            body.nodes,
+            body.explicit_frames,
+            body.implicit_frames,
+            body.failed_frames,
+            body.max_inverted_tets
+        );
+    }
+    for probe in &report.probes {
+        println!(
+            "  probe {:<28} final {:>12.5e} {}",
+            probe.name, probe.final_value, probe.unit
+        );
+    }
+    let s = &report.stability;
+    println!(
+        "  stability: non-finite {}, errors {}, inverted elements {}, final state finite {}",
+        s.non_finite, s.any_error, s.inverted_elements, s.final_state_finite
+    );
+    println!("  written to {}", out.display());
+    Ok(())
+}
+
+/// `check`: prints the mesh's quality report.
+fn check(
+    mesh: PathBuf,
+    scale: f64,
+    [young, poisson, density]: [f64; 3],
+    cells_across: usize,
+) -> Result<(), String> {
+    let material = Material::new(MaterialModel::StableNeoHookean, young, poisson, density)
+        .map_err(|e| e.to_string())?;
+    if !(2..=128).contains(&cells_across) {
+        return Err(format!(
+            "--cells-across must lie in 2 to 128, got {cells_across}"
+        ));
+    }
+    let raw = import::load_raw(&mesh, scale, &SurfaceOptions { cells_across })
+        .map_err(|e| e.to_string())?;
+    let r = import::check(&raw.positions, &raw.tets, &material);
+    let step =
+        |s: Option<f64>| s.map_or_else(|| "- (mesh unusable)".to_owned(), |s| format!("{s:.4e} s"));
+    println!("{}", mesh.display());
+    println!("  tetrahedra          {}", r.tets);
+    println!(
+        "  nodes               {} ({} unused)",
+        r.nodes, r.unused_nodes
+    );
+    println!("  volume              {:.6e} m³", r.volume);
+    println!(
+        "  dihedral angles     {:.2}° to {:.2}°",
+        r.min_dihedral_angle, r.max_dihedral_angle
+    );
+    println!("  min radius ratio    {:.4}", r.min_radius_ratio);
+    println!("  inverted            {}", r.inverted);
+    println!("  degenerate          {}", r.degenerate);
+    println!("  invalid             {}", r.invalid);
+    println!("  material            E = {young:e} Pa, nu = {poisson}, rho = {density} kg/m³");
+    println!("  critical time step  {}", step(r.critical_time_step));
+    println!("  stable time step    {}", step(r.stable_time_step));
+    Ok(())
+}

@@ -1,0 +1,60 @@
+//! The checks after parsing: values a type cannot rule out (a negative Young's modulus, ν at
+//! 0.5, a zero time step) and references between entries (an attachment to a rigid body that
+//! does not exist). The first failure is kept, with its key path, and located in the file.
+
+use super::error::{SceneError, SceneSource};
+
+/// Collects the first failed check.
+pub(crate) struct Checker<'a> {
+    source: &'a SceneSource,
+    first: Option<SceneError>,
+}
+
+impl<'a> Checker<'a> {
+    /// A checker for the scene in `source`.
+    pub(crate) fn new(source: &'a SceneSource) -> Self {
+        Self {
+            source,
+            first: None,
+        }
+    }
+
+    /// Records that the value at `key` is wrong (only the first failure is kept).
+    pub(crate) fn fail(&mut self, key: &str, message: impl Into<String>) {
+        if self.first.is_none() {
+            self.first = Some(self.source.error(key, message));
+        }
+    }
+
+    /// Fails unless `value` is finite and positive.
+    pub(crate) fn positive(&mut self, key: &str, value: f64, unit: &str) {
+        if !(value.is_finite() && value > 0.0) {
+            self.fail(
+                key,
+                format!("must be positive and finite ({unit}), got {value}"),
+            );
+        }
+    }
+
+    /// Fails unless `value` is finite and not negative.
+    pub(crate) fn non_negative(&mut self, key: &str, value: f64, unit: &str) {
+        if !(value.is_finite() && value >= 0.0) {
+            self.fail(
+                key,
+                format!("must be zero or positive and finite ({unit}), got {value}"),
+            );
+        }
+    }
+
+    /// Fails unless every component is finite.
+    pub(crate) fn finite_vector(&mut self, key: &str, value: [f64; 3]) {
+        if value.iter().any(|v| !v.is_finite()) {
+            self.fail(key, format!("must be finite, got {value:?}"));
+        }
+    }
+
+    /// The first failure, if any.
+    pub(crate) fn finish(self) -> Result<(), SceneError> {
+        self.first.map_or(Ok(()), Err)
+    }
+}

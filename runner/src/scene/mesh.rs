@@ -1,0 +1,159 @@
+//! `mesh`: a soft body's tetrahedral mesh, from a generator or a file. Exactly one of
+//! `cuboid`, `cylinder`, `sphere` or `file` is given.
+//!
+//! ```toml
+//! mesh = { cuboid = { half_extents = [0.05, 0.05, 0.05], cells = [6, 6, 6] } }
+//! mesh = { cylinder = { radius = 0.05, half_height = 0.1, cells_across = 6, cells_along = 8 } }
+//! mesh = { sphere = { radius = 0.05, cells_across = 6 } }
+//! mesh = { file = "../meshes/sphere.obj", scale = 0.05, cells_across = 8 }
+//! ```
+//! Lengths in m; a file's `scale` is metres per file unit (default 1), and its path is relative
+//! to the scene file. Surfaces (`.obj`, `.stl`) are filled with tetrahedra, `cells_across`
+//! lattice cells over their largest extent (default 16).
+
+use super::check::Checker;
+use super::error::{SceneError, SceneSource};
+use rapier_fvm::glamx::DVec3;
+use rapier_fvm::mesh::{self, TetMesh, import};
+use serde::Deserialize;
+
+/// Where a soft body's mesh comes from.
+#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeshSpec {
+    /// A box centred at the origin.
+    pub cuboid: Option<CuboidSpec>,
+    /// A cylinder along y centred at the origin.
+    pub cylinder: Option<CylinderSpec>,
+    /// A ball centred at the origin.
+    pub sphere: Option<SphereSpec>,
+    /// A mesh file (`.msh`, `.node`/`.ele`, `.vtu`, `.vtk`, `.obj`, `.stl`), relative to the
+    /// scene file.
+    pub file: Option<String>,
+    /// Metres per file unit (only with `file`); default 1.
+    pub scale: Option<f64>,
+    /// Lattice cells across a surface file's largest extent when it is filled with tetrahedra
+    /// (only with an `.obj` or `.stl` file), 2 to 128; default 16.
+    pub cells_across: Option<usize>,
+}
+
+/// `cuboid = { half_extents, cells }`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CuboidSpec {
+    /// Half extents (m).
+    pub half_extents: [f64; 3],
+    /// Cubes along each axis (each split into five tetrahedra).
+    pub cells: [usize; 3],
+}
+
+/// `cylinder = { radius, half_height, cells_across, cells_along }`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CylinderSpec {
+    /// Radius (m).
+    pub radius: f64,
+    /// Half height (m), along y.
+    pub half_height: f64,
+    /// Cells over the diameter (at least 2).
+    pub cells_across: usize,
+    /// Cells over the height (at least 1).
+    pub cells_along: usize,
+}
+
+/// `sphere = { radius, cells_across }`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SphereSpec {
+    /// Radius (m).
+    pub radius: f64,
+    /// Cells over the diameter (at least 2).
+    pub cells_across: usize,
+}
+
+impl MeshSpec {
+    /// Checks that exactly one source is given and that the sizes are physical; `key` is the
+    /// mesh's key path.
+    pub(crate) fn check(&self, key: &str, c: &mut Checker<'_>) {
+        let given = [
+            self.cuboid.is_some(),
+            self.cylinder.is_some(),
+            self.sphere.is_some(),
+            self.file.is_some(),
+        ];
+        if given.iter().filter(|&&g| g).count() != 1 {
+            c.fail(
+                key,
+                "give exactly one of `cuboid`, `cylinder`, `sphere` or `file`",
+            );
+            return;
+        }
+        if self.file.is_none() {
+            for (name, set) in [
+                ("scale", self.scale.is_some()),
+                ("cells_across", self.cells_across.is_some()),
+            ] {
+                if set {
+                    c.fail(&format!("{key}.{name}"), "only applies to a mesh `file`");
+                }
+            }
+        }
+        if let Some(scale) = self.scale {
+            c.positive(&format!("{key}.scale"), scale, "m per file unit");
+        }
+        if let Some(cuboid) = &self.cuboid {
+            for (i, h) in cuboid.half_extents.iter().enumerate() {
+                c.positive(&format!("{key}.cuboid.half_extents[{i}]"), *h, "m");
+            }
+            if cuboid.cells.contains(&0) {
+                c.fail(
+                    &format!("{key}.cuboid.cells"),
+                    "every count must be at least 1",
+                );
+            }
+        }
+        if let Some(cylinder) = &self.cylinder {
+            c.positive(&format!("{key}.cylinder.radius"), cylinder.radius, "m");
+            c.positive(
+                &format!("{key}.cylinder.half_height"),
+                cylinder.half_height,
+                "m",
+            );
+        }
+        if let Some(sphere) = &self.sphere {
+            c.positive(&format!("{key}.sphere.radius"), sphere.radius, "m");
+        }
+    }
+
+    /// Builds the mesh (rest positions in m); files are resolved from the scene's folder.
+    ///
+    /// # Errors
+    /// A [`SceneError`] at `key` naming the generator's or the file's problem.
+    pub fn build(&self, key: &str, source: &SceneSource) -> Result<TetMesh, SceneError> {
+        let result = if let Some(c) = &self.cuboid {
+            mesh::cuboid(DVec3::from_array(c.half_extents), c.cells)
+                .map_err(|e| (format!("{key}.cuboid"), e.to_string()))
+        } else if let Some(c) = &self.cylinder {
+            mesh::cylinder(c.radius, c.half_height, c.cells_across, c.cells_along)
+                .map_err(|e| (format!("{key}.cylinder"), e.to_string()))
+        } else if let Some(s) = &self.sphere {
+            mesh::sphere(s.radius, s.cells_across)
+                .map_err(|e| (format!("{key}.sphere"), e.to_string()))
+        } else if let Some(file) = &self.file {
+            let options = import::SurfaceOptions {
+                cells_across: self
+                    .cells_across
+                    .unwrap_or(import::SurfaceOptions::default().cells_across),
+            };
+            import::load(
+                source.folder().join(file),
+                self.scale.unwrap_or(1.0),
+                &options,
+            )
+            .map_err(|e| (format!("{key}.file"), e.to_string()))
+        } else {
+            Err((key.to_owned(), "no mesh source".to_owned()))
+        };
+        result.map_err(|(key, message)| source.error(&key, message))
+    }
+}

@@ -1,0 +1,176 @@
+//! Scene files: a mixed rigid/soft world described in TOML, in SI units.
+//!
+//! A scene has a `name` (default: the file's stem) and these tables, each in its own module:
+//! - [`world`]: `[world]` gravity (m/s²), frame step `dt` (s), `duration` (s), coupling
+//!   substeps;
+//! - [`soft_body`]: `[[soft_body]]` entries, with their [`mesh`] (generator or file) and
+//!   [`material`] (model, E in Pa, ν, ρ in kg/m³, Rayleigh damping), placement, friction,
+//!   pinned regions and attachments;
+//! - [`rigid_body`]: `[[rigid_body]]` entries: shape, pose, density or mass, velocity, and
+//!   fixed / dynamic / kinematic (keyframed) motion;
+//! - [`settings`]: `[contact]`, `[integrator]` and `[output]`;
+//! - [`probe`]: `[[probe]]` entries sampled every frame.
+//!
+//! `assets/scenes/README.md` lists every key with its unit and default.
+//!
+//! Reading a scene ([`Scene::load`]) fails with a [`SceneError`] naming the file, the line and
+//! the key path for TOML syntax errors, unknown keys, missing keys, wrong types, non-physical
+//! values and references to bodies that do not exist. Keys left out take the documented
+//! defaults; a key given a wrong value is never replaced by one.
+
+mod check;
+mod error;
+pub mod material;
+pub mod mesh;
+pub mod probe;
+pub mod rigid_body;
+pub mod settings;
+pub mod soft_body;
+pub mod world;
+
+pub use error::{SceneError, SceneSource};
+
+use check::Checker;
+use probe::ProbeSpec;
+use rigid_body::RigidBodySpec;
+use serde::Deserialize;
+use settings::{ContactSpec, IntegratorSpec, OutputSpec};
+use soft_body::SoftBodySpec;
+use std::path::Path;
+use world::WorldSpec;
+
+/// A scene as written in its file.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    /// The scene's name (report and file names); default the file's stem.
+    pub name: Option<String>,
+    /// World settings.
+    pub world: WorldSpec,
+    /// The soft bodies.
+    #[serde(default)]
+    pub soft_body: Vec<SoftBodySpec>,
+    /// The rigid bodies.
+    #[serde(default)]
+    pub rigid_body: Vec<RigidBodySpec>,
+    /// Contact settings.
+    #[serde(default)]
+    pub contact: ContactSpec,
+    /// Integrator settings.
+    #[serde(default)]
+    pub integrator: IntegratorSpec,
+    /// Output settings.
+    #[serde(default)]
+    pub output: OutputSpec,
+    /// The probes.
+    #[serde(default)]
+    pub probe: Vec<ProbeSpec>,
+    /// The file and its text, to place later errors (a mesh file that cannot be read).
+    #[serde(skip)]
+    pub source: SceneSource,
+}
+
+impl Scene {
+    /// Reads, parses and checks the scene file at `path`.
+    ///
+    /// # Errors
+    /// A [`SceneError`] if the file cannot be read or the scene is malformed.
+    pub fn load(path: impl AsRef<Path>) -> Result<Self, SceneError> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path).map_err(|e| SceneError {
+            file: path.to_path_buf(),
+            line: None,
+            key: None,
+            message: format!("cannot read the scene: {e}"),
+        })?;
+        Self::parse(path, text)
+    }
+
+    /// Parses and checks `text`, the content of the scene file `path` (used for messages and to
+    /// resolve the mesh files it names).
+    ///
+    /// # Errors
+    /// A [`SceneError`] if the scene is malformed.
+    pub fn parse(path: impl AsRef<Path>, text: String) -> Result<Self, SceneError> {
+        let source = SceneSource {
+            path: path.as_ref().to_path_buf(),
+            text,
+        };
+        let syntax_error = |error: toml::de::Error| SceneError {
+            file: source.path.clone(),
+            line: error.span().map(|span| source.line_of(span.start)),
+            key: None,
+            message: error.message().trim().to_owned(),
+        };
+        let table = toml::de::DeTable::parse(&source.text).map_err(syntax_error)?;
+        let deserializer = toml::de::Deserializer::from(table);
+        let mut scene: Self = serde_path_to_error::deserialize(deserializer).map_err(|error| {
+            let key = error.path().to_string();
+            let inner = error.into_inner();
+            let line = inner.span().map(|span| source.line_of(span.start));
+            SceneError {
+                file: source.path.clone(),
+                line,
+                key: (key != ".").then_some(key),
+                message: inner.message().trim().to_owned(),
+            }
+        })?;
+        scene.source = source;
+        scene.check()?;
+        Ok(scene)
+    }
+
+    /// The scene's name: `name`, or the file's stem.
+    pub fn display_name(&self) -> String {
+        self.name.clone().unwrap_or_else(|| {
+            self.source
+                .path
+                .file_stem()
+                .map_or_else(|| "scene".to_owned(), |s| s.to_string_lossy().into_owned())
+        })
+    }
+
+    /// The values and references a type cannot check.
+    fn check(&self) -> Result<(), SceneError> {
+        let mut c = Checker::new(&self.source);
+        self.world.check(&mut c);
+        let soft: Vec<&str> = self.soft_body.iter().map(|b| b.name.as_str()).collect();
+        let rigid: Vec<&str> = self.rigid_body.iter().map(|b| b.name.as_str()).collect();
+        let mut seen: Vec<&str> = Vec::new();
+        let names = (self.soft_body.iter().enumerate())
+            .map(|(i, b)| (format!("soft_body[{i}].name"), b.name.as_str()))
+            .chain(
+                (self.rigid_body.iter().enumerate())
+                    .map(|(i, b)| (format!("rigid_body[{i}].name"), b.name.as_str())),
+            );
+        for (key, name) in names {
+            if name.trim().is_empty() {
+                c.fail(&key, "must not be empty");
+            } else if seen.contains(&name) {
+                c.fail(&key, format!("another body is already named {name:?}"));
+            }
+            seen.push(name);
+        }
+        for (i, body) in self.soft_body.iter().enumerate() {
+            body.check(&format!("soft_body[{i}]"), &rigid, &mut c);
+        }
+        for (i, body) in self.rigid_body.iter().enumerate() {
+            body.check(&format!("rigid_body[{i}]"), &mut c);
+        }
+        self.contact.check(&mut c);
+        self.integrator.check(&mut c);
+        self.output.check(self.world.duration, &mut c);
+        let mut probe_names: Vec<&str> = Vec::new();
+        for (i, probe) in self.probe.iter().enumerate() {
+            if probe_names.contains(&probe.name.as_str()) {
+                c.fail(
+                    &format!("probe[{i}].name"),
+                    format!("another probe is already named {:?}", probe.name),
+                );
+            }
+            probe_names.push(&probe.name);
+            probe.check(&format!("probe[{i}]"), &soft, &rigid, &mut c);
+        }
+        c.finish()
+    }
+}

@@ -1,0 +1,248 @@
+//! `[contact]`, `[integrator]` and `[output]`: how contacts are enforced, which integrator
+//! steps the soft bodies, and what the runner writes. Every key is optional.
+//!
+//! ```toml
+//! [contact]
+//! margin = 1e-3              # m
+//! penalty_factor = 1e3       # implicit penalty stiffness in units of m/h²
+//! depenetration_speed = 0.1  # m/s
+//! velocity_iterations = 4
+//! stiction_speed = 1e-4      # m/s
+//!
+//! [integrator]
+//! kind = "automatic"         # "automatic" (cheaper per frame), "explicit" or "implicit"
+//! safety_factor = 0.5        # explicit: fraction of the critical step
+//! max_substeps = 100000      # explicit: most substeps per frame
+//! implicit_substeps = 1      # implicit: Newton solves per frame
+//! scheme = "backward_euler"  # implicit: or "bdf2"
+//! tolerance = 1e-6           # implicit: Newton's relative tolerance
+//! max_newton_iterations = 20
+//!
+//! [output]
+//! save_every = 3             # frames between saved ParaView/OBJ frames (frame 0 always saved)
+//! pictures = [0.0, 1.0, 2.0] # times (s) of the rendered views; default: start, 1/3, 2/3, end
+//! picture_size = [1000, 700] # pixels
+//! ground_patch = 0.5         # half size of the drawn square of a half-space (m)
+//! ```
+
+use super::check::Checker;
+use rapier_fvm::contact::ContactSettings;
+use rapier_fvm::integrate::{
+    AutomaticIntegrator, ImplicitIntegrator, ImplicitScheme, IntegratorKind, SymplecticEuler,
+};
+use serde::Deserialize;
+
+/// Contact settings; unset keys keep [`ContactSettings::default`].
+#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactSpec {
+    /// Detection margin (m).
+    pub margin: Option<f64>,
+    /// Implicit penalty stiffness in units of a node's `m/h²`.
+    pub penalty_factor: Option<f64>,
+    /// Speed at which nodes found inside a collider are pushed out (m/s).
+    pub depenetration_speed: Option<f64>,
+    /// Sweeps per explicit substep over contacts with dynamic bodies.
+    pub velocity_iterations: Option<u32>,
+    /// Implicit stiction speed (m/s).
+    pub stiction_speed: Option<f64>,
+}
+
+impl ContactSpec {
+    /// The library's settings.
+    pub fn settings(&self) -> ContactSettings {
+        let d = ContactSettings::default();
+        ContactSettings {
+            margin: self.margin.unwrap_or(d.margin),
+            penalty_factor: self.penalty_factor.unwrap_or(d.penalty_factor),
+            depenetration_speed: self.depenetration_speed.unwrap_or(d.depenetration_speed),
+            velocity_iterations: self.velocity_iterations.unwrap_or(d.velocity_iterations),
+            stiction_speed: self.stiction_speed.unwrap_or(d.stiction_speed),
+        }
+    }
+
+    pub(crate) fn check(&self, c: &mut Checker<'_>) {
+        for (name, value, unit) in [
+            ("margin", self.margin, "m"),
+            ("depenetration_speed", self.depenetration_speed, "m/s"),
+            ("stiction_speed", self.stiction_speed, "m/s"),
+        ] {
+            if let Some(value) = value {
+                c.non_negative(&format!("contact.{name}"), value, unit);
+            }
+        }
+        if let Some(value) = self.penalty_factor {
+            c.positive("contact.penalty_factor", value, "dimensionless");
+        }
+        if self.velocity_iterations == Some(0) {
+            c.fail("contact.velocity_iterations", "must be at least 1");
+        }
+    }
+}
+
+/// Which integrator steps the soft bodies.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum IntegratorChoice {
+    /// The cheaper of explicit and implicit, per body per frame.
+    #[default]
+    Automatic,
+    /// Always symplectic Euler with automatic substeps.
+    Explicit,
+    /// Always the implicit integrator.
+    Implicit,
+}
+
+/// The implicit time discretisation.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SchemeSpec {
+    /// Backward Euler.
+    #[default]
+    BackwardEuler,
+    /// Second-order backward differentiation.
+    Bdf2,
+}
+
+/// Integrator settings; unset keys keep the library's defaults.
+#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct IntegratorSpec {
+    /// Which integrator; default automatic.
+    #[serde(default)]
+    pub kind: IntegratorChoice,
+    /// Explicit: fraction of the critical step, in (0, 1].
+    pub safety_factor: Option<f64>,
+    /// Explicit: most substeps per frame.
+    pub max_substeps: Option<u32>,
+    /// Implicit: equal substeps (Newton solves) per frame.
+    pub implicit_substeps: Option<u32>,
+    /// Implicit: the scheme.
+    pub scheme: Option<SchemeSpec>,
+    /// Implicit: Newton's relative tolerance.
+    pub tolerance: Option<f64>,
+    /// Implicit: Newton iterations per substep at most.
+    pub max_newton_iterations: Option<usize>,
+}
+
+impl IntegratorSpec {
+    /// The library's integrator.
+    pub fn integrator(&self) -> AutomaticIntegrator {
+        let explicit = SymplecticEuler::default();
+        let implicit = ImplicitIntegrator::default();
+        AutomaticIntegrator {
+            explicit: SymplecticEuler {
+                safety_factor: self.safety_factor.unwrap_or(explicit.safety_factor),
+                max_substeps: self.max_substeps.unwrap_or(explicit.max_substeps),
+                ..explicit
+            },
+            implicit: ImplicitIntegrator {
+                scheme: match self.scheme.unwrap_or_default() {
+                    SchemeSpec::BackwardEuler => ImplicitScheme::BackwardEuler,
+                    SchemeSpec::Bdf2 => ImplicitScheme::Bdf2,
+                },
+                tolerance: self.tolerance.unwrap_or(implicit.tolerance),
+                max_newton_iterations: self
+                    .max_newton_iterations
+                    .unwrap_or(implicit.max_newton_iterations),
+                substeps: self.implicit_substeps.unwrap_or(implicit.substeps),
+                ..implicit
+            },
+            force: match self.kind {
+                IntegratorChoice::Automatic => None,
+                IntegratorChoice::Explicit => Some(IntegratorKind::Explicit),
+                IntegratorChoice::Implicit => Some(IntegratorKind::Implicit),
+            },
+        }
+    }
+
+    pub(crate) fn check(&self, c: &mut Checker<'_>) {
+        if let Some(f) = self.safety_factor
+            && !(f > 0.0 && f <= 1.0)
+        {
+            c.fail(
+                "integrator.safety_factor",
+                format!("must lie in (0, 1], got {f}"),
+            );
+        }
+        if let Some(t) = self.tolerance {
+            c.positive("integrator.tolerance", t, "dimensionless");
+        }
+        for (name, value) in [
+            ("max_substeps", self.max_substeps.map(|v| v as usize)),
+            (
+                "implicit_substeps",
+                self.implicit_substeps.map(|v| v as usize),
+            ),
+            ("max_newton_iterations", self.max_newton_iterations),
+        ] {
+            if value == Some(0) {
+                c.fail(&format!("integrator.{name}"), "must be at least 1");
+            }
+        }
+    }
+}
+
+/// What the runner writes.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSpec {
+    /// Frames between saved ParaView and OBJ frames; default 3.
+    #[serde(default = "default_save_every")]
+    pub save_every: usize,
+    /// Times (s) of the rendered views; default: start, a third, two thirds and end.
+    pub pictures: Option<Vec<f64>>,
+    /// Size of the rendered views (pixels); default 1000 x 700.
+    #[serde(default = "default_picture_size")]
+    pub picture_size: [u32; 2],
+    /// Half size of the drawn square standing for a half-space (m); default 0.5.
+    #[serde(default = "default_ground_patch")]
+    pub ground_patch: f64,
+}
+
+impl Default for OutputSpec {
+    fn default() -> Self {
+        Self {
+            save_every: default_save_every(),
+            pictures: None,
+            picture_size: default_picture_size(),
+            ground_patch: default_ground_patch(),
+        }
+    }
+}
+
+fn default_save_every() -> usize {
+    3
+}
+
+fn default_picture_size() -> [u32; 2] {
+    [1000, 700]
+}
+
+fn default_ground_patch() -> f64 {
+    0.5
+}
+
+impl OutputSpec {
+    pub(crate) fn check(&self, duration: f64, c: &mut Checker<'_>) {
+        if self.save_every == 0 {
+            c.fail("output.save_every", "must be at least 1");
+        }
+        for (i, &t) in self.pictures.iter().flatten().enumerate() {
+            if !(t.is_finite() && (0.0..=duration + 1e-9).contains(&t)) {
+                c.fail(
+                    &format!("output.pictures[{i}]"),
+                    format!("must lie between 0 and the duration {duration} s, got {t}"),
+                );
+            }
+        }
+        let [w, h] = self.picture_size;
+        if !(64..=8192).contains(&w) || !(64..=8192).contains(&h) {
+            c.fail(
+                "output.picture_size",
+                "each side must lie in 64 to 8192 pixels",
+            );
+        }
+        c.positive("output.ground_patch", self.ground_patch, "m");
+    }
+}

@@ -1,0 +1,161 @@
+//! `[[soft_body]]`: a finite-volume soft body: its mesh, material, placement, contact
+//! properties, pinned regions and attachments to rigid bodies.
+//!
+//! ```toml
+//! [[soft_body]]
+//! name = "beam"
+//! mesh = { cuboid = { half_extents = [0.5, 0.05, 0.05], cells = [20, 2, 2] } }
+//! material = { model = "st_venant_kirchhoff", young = 1e8, poisson = 0.3, density = 1000.0 }
+//! damping = { stiffness_time = 1e-3 }
+//! translation = [0.5, 0.0, 0.0]   # m, default 0
+//! rotation = [0.0, 0.0, 0.0]      # scaled axis (rad), default 0
+//! linvel = [0.0, 0.0, 0.0]        # m/s, default 0
+//! friction = 0.5                  # default 0.5
+//! self_contact = false            # default false
+//! volumetric = "per_element"      # or "nodal_average" (nearly incompressible), default per_element
+//! pinned = [{ min = [-0.51, -1, -1], max = [-0.49, 1, 1] }]         # boxes in rest coordinates
+//! attach = [{ rigid = "ball", min = [-1, -0.26, -1], max = [1, -0.24, 1] }]
+//! ```
+//! Regions are boxes `min`..`max` (m) in the mesh's rest coordinates, before the translation and
+//! rotation; each must hold at least one node.
+
+use super::check::Checker;
+use super::material::{DampingSpec, MaterialSpec};
+use super::mesh::MeshSpec;
+use rapier_fvm::glamx::DVec3;
+use rapier_fvm::mesh::TetMesh;
+use serde::Deserialize;
+
+/// A soft body.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SoftBodySpec {
+    /// Its name, unique among all bodies (probes and file names use it).
+    pub name: String,
+    /// The mesh.
+    pub mesh: MeshSpec,
+    /// The material.
+    pub material: MaterialSpec,
+    /// Rayleigh damping; default none.
+    pub damping: Option<DampingSpec>,
+    /// Translation of the rest mesh (m); default 0.
+    #[serde(default)]
+    pub translation: [f64; 3],
+    /// Rotation of the rest mesh about its origin, as a scaled axis (rad); default 0.
+    #[serde(default)]
+    pub rotation: [f64; 3],
+    /// Initial velocity of every node (m/s); default 0.
+    #[serde(default)]
+    pub linvel: [f64; 3],
+    /// Coulomb friction coefficient of the surface; default 0.5.
+    #[serde(default = "default_friction")]
+    pub friction: f64,
+    /// Whether the surface collides with itself; default false.
+    #[serde(default)]
+    pub self_contact: bool,
+    /// How the volumetric energy is evaluated; default per element.
+    #[serde(default)]
+    pub volumetric: VolumetricSpec,
+    /// Regions whose nodes are held fixed.
+    #[serde(default)]
+    pub pinned: Vec<RegionSpec>,
+    /// Regions whose nodes are glued to rigid bodies.
+    #[serde(default)]
+    pub attach: Vec<AttachmentSpec>,
+}
+
+fn default_friction() -> f64 {
+    rapier_fvm::body::DEFAULT_FRICTION
+}
+
+/// How a soft body's volumetric energy is evaluated.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum VolumetricSpec {
+    /// Per tetrahedron.
+    #[default]
+    PerElement,
+    /// Averaged over each node's tetrahedra (against locking at ν near 0.5).
+    NodalAverage,
+}
+
+/// A box of rest coordinates (m).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RegionSpec {
+    /// Lower corner (m).
+    pub min: [f64; 3],
+    /// Upper corner (m).
+    pub max: [f64; 3],
+}
+
+/// Nodes of a region glued to a rigid body.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AttachmentSpec {
+    /// The rigid body's name.
+    pub rigid: String,
+    /// Lower corner of the region (m, rest coordinates).
+    pub min: [f64; 3],
+    /// Upper corner of the region (m, rest coordinates).
+    pub max: [f64; 3],
+}
+
+impl RegionSpec {
+    /// The nodes of `mesh` inside the box (bounds included).
+    pub fn nodes(&self, mesh: &TetMesh) -> Vec<u32> {
+        nodes_in(mesh, self.min, self.max)
+    }
+}
+
+impl AttachmentSpec {
+    /// The nodes of `mesh` inside the box (bounds included).
+    pub fn nodes(&self, mesh: &TetMesh) -> Vec<u32> {
+        nodes_in(mesh, self.min, self.max)
+    }
+}
+
+fn nodes_in(mesh: &TetMesh, min: [f64; 3], max: [f64; 3]) -> Vec<u32> {
+    let (min, max) = (DVec3::from_array(min), DVec3::from_array(max));
+    mesh.nodes_where(|p| p.cmpge(min).all() && p.cmple(max).all())
+}
+
+/// Checks a box's corners.
+fn check_box(key: &str, min: [f64; 3], max: [f64; 3], c: &mut Checker<'_>) {
+    c.finite_vector(&format!("{key}.min"), min);
+    c.finite_vector(&format!("{key}.max"), max);
+    if min.iter().zip(&max).any(|(a, b)| a > b) {
+        c.fail(
+            &format!("{key}.max"),
+            format!("{max:?} is below min {min:?}"),
+        );
+    }
+}
+
+impl SoftBodySpec {
+    /// Checks the values; `key` is the body's key path, `rigid_names` the scene's rigid bodies.
+    pub(crate) fn check(&self, key: &str, rigid_names: &[&str], c: &mut Checker<'_>) {
+        self.mesh.check(&format!("{key}.mesh"), c);
+        self.material.check(&format!("{key}.material"), c);
+        if let Some(damping) = &self.damping {
+            damping.check(&format!("{key}.damping"), c);
+        }
+        c.finite_vector(&format!("{key}.translation"), self.translation);
+        c.finite_vector(&format!("{key}.rotation"), self.rotation);
+        c.finite_vector(&format!("{key}.linvel"), self.linvel);
+        c.non_negative(&format!("{key}.friction"), self.friction, "dimensionless");
+        for (i, region) in self.pinned.iter().enumerate() {
+            check_box(&format!("{key}.pinned[{i}]"), region.min, region.max, c);
+        }
+        for (i, attachment) in self.attach.iter().enumerate() {
+            let key = format!("{key}.attach[{i}]");
+            check_box(&key, attachment.min, attachment.max, c);
+            if !rigid_names.contains(&attachment.rigid.as_str()) {
+                c.fail(
+                    &format!("{key}.rigid"),
+                    format!("no rigid body is named {:?}", attachment.rigid),
+                );
+            }
+        }
+    }
+}

@@ -1,0 +1,70 @@
+//! `[world]`: gravity, the frame step and how long the scene runs.
+//!
+//! ```toml
+//! [world]
+//! gravity = [0.0, -9.81, 0.0] # m/s², default
+//! dt = 0.016666666666666666   # frame step (s), default 1/60
+//! duration = 2.0              # simulated time (s), required
+//! coupling_substeps = 4       # rapier steps per frame, soft bodies stepped between, default 4
+//! ```
+
+use super::check::Checker;
+use serde::Deserialize;
+
+/// The most frames a scene may run (about 46 hours at 60 frames per second).
+pub const MAX_FRAMES: f64 = 1e7;
+
+/// The world's settings.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WorldSpec {
+    /// Gravity (m/s²); default `[0, -9.81, 0]`.
+    #[serde(default = "default_gravity")]
+    pub gravity: [f64; 3],
+    /// Frame step (s); default 1/60.
+    #[serde(default = "default_dt")]
+    pub dt: f64,
+    /// Simulated time (s), required.
+    pub duration: f64,
+    /// Rapier steps per frame with the soft bodies stepped between them; default 4.
+    #[serde(default = "default_coupling_substeps")]
+    pub coupling_substeps: u32,
+}
+
+fn default_gravity() -> [f64; 3] {
+    [0.0, -9.81, 0.0]
+}
+
+fn default_dt() -> f64 {
+    1.0 / 60.0
+}
+
+fn default_coupling_substeps() -> u32 {
+    4
+}
+
+impl WorldSpec {
+    /// The number of frames: the duration over the frame step, rounded to the nearest.
+    pub fn frames(&self) -> usize {
+        (self.duration / self.dt).round().max(1.0) as usize
+    }
+
+    /// Checks the values.
+    pub(crate) fn check(&self, c: &mut Checker<'_>) {
+        c.finite_vector("world.gravity", self.gravity);
+        c.positive("world.dt", self.dt, "s");
+        c.positive("world.duration", self.duration, "s");
+        if self.dt > 0.0 && self.duration / self.dt > MAX_FRAMES {
+            c.fail(
+                "world.duration",
+                format!(
+                    "{} s at dt = {} s is more than {MAX_FRAMES:e} frames",
+                    self.duration, self.dt
+                ),
+            );
+        }
+        if self.coupling_substeps == 0 {
+            c.fail("world.coupling_substeps", "must be at least 1");
+        }
+    }
+}

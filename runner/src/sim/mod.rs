@@ -1,0 +1,23 @@
+//! Running a scene: [`Simulation::build`] makes its world, [`run`] steps it frame by frame,
+//! samples the probes after every frame, and writes the output folder:
+//!
+//! | file | what |
+//! |---|---|
+//! | `report.json` | the [`Report`]: settings used, sizes, timings, stability flags, probes |
+//! | `paraview/<scene>.pvd`, `paraview/<body>_<n>.vtu` | ParaView series of the saved frames |
+//! | `obj/surface_<n>.obj` | every body's surface per saved frame (Blender) |
+//! | `pictures/view_<frame>.png`, `pictures/stress_<frame>.png` | rendered views by material and by von Mises stress |
+//! | `plots/<probe>.png` | each probe against time |
+
+mod build;
+mod probe;
+mod report;
+mod run;
+mod writer;
+
+pub use build::{RigidEntry, Simulation, SoftEntry};
+pub use probe::Probe;
+pub use report::{
+    Files, ProbeReport, Report, RigidBodyReport, Settings, SoftBodyReport, Stability,
+};
+pub use run::{RunError, RunOptions, run};

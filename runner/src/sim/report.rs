@@ -1,0 +1,214 @@
+//! `report.json`: what a run did, for scripts to read. Times in s, lengths in m, forces in N,
+//! energies in J.
+
+use rapier_fvm::Error;
+use rapier_fvm::integrate::{AutomaticReport, IntegratorKind};
+use serde::Serialize;
+
+/// The whole report.
+#[derive(Debug, Clone, Serialize)]
+pub struct Report {
+    /// The scene's name.
+    pub scene: String,
+    /// The scene file.
+    pub scene_file: String,
+    /// The settings the run used.
+    pub settings: Settings,
+    /// Per soft body: size, material and how it was stepped.
+    pub soft_bodies: Vec<SoftBodyReport>,
+    /// Per rigid body: its name and kind.
+    pub rigid_bodies: Vec<RigidBodyReport>,
+    /// Frames stepped.
+    pub frames: usize,
+    /// Simulated time reached (s).
+    pub simulated_time: f64,
+    /// Wall time of the whole run, output included (s).
+    pub wall_time_s: f64,
+    /// Wall time spent stepping the world (s).
+    pub stepping_time_s: f64,
+    /// Stepping wall time per frame (ms).
+    pub ms_per_frame: f64,
+    /// Simulated time over stepping wall time (above 1: faster than real time).
+    pub speed_vs_real_time: f64,
+    /// Whether anything went wrong numerically.
+    pub stability: Stability,
+    /// Every probe's samples and final value.
+    pub probes: Vec<ProbeReport>,
+    /// The files written, relative to the output folder.
+    pub files: Files,
+}
+
+/// The settings a run used, defaults filled in.
+#[derive(Debug, Clone, Serialize)]
+pub struct Settings {
+    /// Frame step (s).
+    pub dt: f64,
+    /// Simulated duration asked for (s).
+    pub duration: f64,
+    /// Gravity (m/s²).
+    pub gravity: [f64; 3],
+    /// Rapier steps per frame.
+    pub coupling_substeps: u32,
+    /// `automatic`, `explicit` or `implicit`.
+    pub integrator: String,
+    /// Explicit safety factor.
+    pub explicit_safety_factor: f64,
+    /// Implicit substeps per frame.
+    pub implicit_substeps: u32,
+    /// Contact margin (m).
+    pub contact_margin: f64,
+    /// Contact velocity iterations.
+    pub contact_velocity_iterations: u32,
+    /// Frames between saved frames.
+    pub save_every: usize,
+}
+
+/// A soft body's size, material and stepping record.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct SoftBodyReport {
+    /// Its name.
+    pub name: String,
+    /// Its material label.
+    pub material: String,
+    /// Tetrahedra.
+    pub tets: usize,
+    /// Nodes.
+    pub nodes: usize,
+    /// Mass (kg).
+    pub mass: f64,
+    /// Frames its last substep stepped explicitly.
+    pub explicit_frames: usize,
+    /// Frames its last substep stepped implicitly.
+    pub implicit_frames: usize,
+    /// Frames chosen explicit but redone implicitly.
+    pub fell_back_frames: usize,
+    /// Mean explicit substeps per explicit coupling substep.
+    pub mean_explicit_substeps: f64,
+    /// Most explicit substeps in a coupling substep.
+    pub max_explicit_substeps: u32,
+    /// Implicit frames whose Newton solve missed the tolerance.
+    pub unconverged_frames: usize,
+    /// Frames whose step failed (the state before it kept).
+    pub failed_frames: usize,
+    /// The first failure's message.
+    pub first_error: Option<String>,
+    /// Most inverted tetrahedra at the end of a frame.
+    pub max_inverted_tets: usize,
+    #[serde(skip)]
+    explicit_substeps_sum: u64,
+}
+
+/// A rigid body's name and kind.
+#[derive(Debug, Clone, Serialize)]
+pub struct RigidBodyReport {
+    /// Its name.
+    pub name: String,
+    /// `fixed`, `dynamic` or `kinematic`.
+    pub kind: String,
+    /// Mass (kg; 0 for fixed and kinematic bodies).
+    pub mass: f64,
+}
+
+/// Numerical trouble over the run.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct Stability {
+    /// A step produced a NaN or infinite state (rejected, the state before it kept).
+    pub non_finite: bool,
+    /// A step failed for any reason.
+    pub any_error: bool,
+    /// A frame ended with inverted tetrahedra.
+    pub inverted_elements: bool,
+    /// The final state is finite everywhere.
+    pub final_state_finite: bool,
+}
+
+/// A probe's samples.
+#[derive(Debug, Clone, Serialize)]
+pub struct ProbeReport {
+    /// Its name.
+    pub name: String,
+    /// Its kind.
+    pub kind: String,
+    /// The unit of its values.
+    pub unit: String,
+    /// The last sample.
+    pub final_value: f64,
+    /// Sample times (s), one per frame from 0.
+    pub times: Vec<f64>,
+    /// Sample values.
+    pub values: Vec<f64>,
+}
+
+/// The files written, relative to the output folder.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct Files {
+    /// The ParaView index.
+    pub pvd: String,
+    /// `.vtu` files written.
+    pub vtu_count: usize,
+    /// OBJ surfaces, one per saved frame.
+    pub obj: Vec<String>,
+    /// Rendered views `(time (s), file)`.
+    pub pictures: Vec<(f64, String)>,
+    /// Probe plots.
+    pub plots: Vec<String>,
+}
+
+impl SoftBodyReport {
+    /// An empty record for a body.
+    pub(crate) fn new(
+        name: String,
+        material: String,
+        tets: usize,
+        nodes: usize,
+        mass: f64,
+    ) -> Self {
+        Self {
+            name,
+            material,
+            tets,
+            nodes,
+            mass,
+            ..Self::default()
+        }
+    }
+
+    /// Records a frame's outcome.
+    pub(crate) fn record(
+        &mut self,
+        outcome: &Result<AutomaticReport, Error>,
+        stability: &mut Stability,
+    ) {
+        match outcome {
+            Ok(report) => {
+                match report.choice {
+                    IntegratorKind::Explicit => self.explicit_frames += 1,
+                    IntegratorKind::Implicit => self.implicit_frames += 1,
+                }
+                self.fell_back_frames += usize::from(report.fell_back);
+                if let Some(explicit) = report.explicit {
+                    self.explicit_substeps_sum += u64::from(explicit.substeps);
+                    self.max_explicit_substeps = self.max_explicit_substeps.max(explicit.substeps);
+                    self.max_inverted_tets = self.max_inverted_tets.max(explicit.inverted_tets);
+                }
+                if let Some(implicit) = report.implicit {
+                    self.unconverged_frames += usize::from(!implicit.converged);
+                    self.max_inverted_tets = self.max_inverted_tets.max(implicit.inverted_tets);
+                }
+                stability.inverted_elements |= self.max_inverted_tets > 0;
+                if self.explicit_frames > 0 {
+                    self.mean_explicit_substeps =
+                        self.explicit_substeps_sum as f64 / self.explicit_frames as f64;
+                }
+            }
+            Err(error) => {
+                self.failed_frames += 1;
+                if self.first_error.is_none() {
+                    self.first_error = Some(error.to_string());
+                }
+                stability.any_error = true;
+                stability.non_finite |= matches!(error, Error::NonFiniteState { .. });
+            }
+        }
+    }
+}

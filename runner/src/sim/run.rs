@@ -1,0 +1,193 @@
+//! The frame loop: drive the kinematic bodies, step, record each body's outcome, sample the
+//! probes, save frames, then render the pictures and plots and write the report.
+
+use super::build::Simulation;
+use super::report::{ProbeReport, Report, RigidBodyReport, Settings, SoftBodyReport, Stability};
+use super::writer::Writer;
+use crate::output::OutputError;
+use crate::scene::rigid_body::RigidKind;
+use crate::scene::world::WorldSpec;
+use crate::scene::{Scene, SceneError};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+/// How to run a scene.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunOptions {
+    /// The output folder (created if needed).
+    pub out: PathBuf,
+    /// Runs this long (s) instead of the scene's duration.
+    pub duration: Option<f64>,
+    /// Shows a progress bar on stderr (only when it is a terminal).
+    pub progress: bool,
+}
+
+/// A run that could not be done.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// The scene could not be built.
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    /// An output file could not be written.
+    #[error(transparent)]
+    Output(#[from] OutputError),
+    /// The duration override is not positive.
+    #[error("the duration must be positive and finite (s), got {0}")]
+    Duration(f64),
+}
+
+/// Runs `scene` and writes its output into `options.out`; returns the report (also written as
+/// `report.json`).
+///
+/// # Errors
+/// [`RunError`] if the scene cannot be built or a file cannot be written. A body whose step
+/// fails does not stop the run: it keeps its state, and the report records the failure.
+pub fn run(scene: &Scene, options: &RunOptions) -> Result<Report, RunError> {
+    let started = Instant::now();
+    let mut world_spec = scene.world.clone();
+    if let Some(duration) = options.duration {
+        if !(duration.is_finite() && duration > 0.0) {
+            return Err(RunError::Duration(duration));
+        }
+        world_spec.duration = duration;
+    }
+    let mut sim = Simulation::build(scene)?;
+    let frames = world_spec.frames();
+    let dt = world_spec.dt;
+    let mut writer = Writer::new(scene, &options.out, frames, dt)?;
+    let mut bodies: Vec<SoftBodyReport> = (sim.soft.iter())
+        .map(|entry| {
+            let body = &sim.world.soft_bodies[entry.handle];
+            SoftBodyReport::new(
+                entry.name.clone(),
+                entry.label.clone(),
+                body.mesh().tet_count(),
+                body.node_count(),
+                body.total_mass(),
+            )
+        })
+        .collect();
+    let mut stability = Stability::default();
+    sim.sample_probes(0.0);
+    writer.frame(&sim, 0)?;
+    let progress = progress_bar(frames, options.progress);
+    let mut stepping = Duration::ZERO;
+    for frame in 1..=frames {
+        let t = frame as f64 * dt;
+        let step_start = Instant::now();
+        sim.drive_kinematic(t);
+        let outcomes = sim.world.step();
+        stepping += step_start.elapsed();
+        for (handle, outcome) in &outcomes {
+            if let Some(i) = sim.soft.iter().position(|e| e.handle == *handle) {
+                bodies[i].record(outcome, &mut stability);
+            }
+        }
+        sim.sample_probes(t);
+        writer.frame(&sim, frame)?;
+        progress.set_position(frame as u64);
+        let speed = t / stepping.as_secs_f64().max(1e-9);
+        progress.set_message(format!("t = {t:.3} s, {speed:.2}x real time"));
+    }
+    progress.finish_and_clear();
+    let files = writer.finish(&sim)?;
+    stability.final_state_finite = sim.soft.iter().all(|entry| {
+        let body = &sim.world.soft_bodies[entry.handle];
+        body.positions()
+            .iter()
+            .chain(body.velocities())
+            .all(|v| v.is_finite())
+    });
+    let stepping_s = stepping.as_secs_f64();
+    let simulated = frames as f64 * dt;
+    let report = Report {
+        scene: scene.display_name(),
+        scene_file: scene.source.path.display().to_string(),
+        settings: settings(scene, &world_spec, &sim),
+        soft_bodies: bodies,
+        rigid_bodies: rigid_reports(&sim),
+        frames,
+        simulated_time: simulated,
+        wall_time_s: started.elapsed().as_secs_f64(),
+        stepping_time_s: stepping_s,
+        ms_per_frame: stepping_s * 1e3 / frames as f64,
+        speed_vs_real_time: simulated / stepping_s.max(1e-9),
+        stability,
+        probes: sim.probes.iter().map(probe_report).collect(),
+        files,
+    };
+    let path = options.out.join("report.json");
+    let json = serde_json::to_string_pretty(&report).map_err(|e| OutputError::Io {
+        path: path.clone(),
+        source: std::io::Error::other(e),
+    })?;
+    std::fs::write(&path, json).map_err(OutputError::io(&path))?;
+    Ok(report)
+}
+
+/// A progress bar over `frames`, drawn on stderr only when it is a terminal and `show` is set.
+fn progress_bar(frames: usize, show: bool) -> ProgressBar {
+    let target = if show {
+        ProgressDrawTarget::stderr()
+    } else {
+        ProgressDrawTarget::hidden()
+    };
+    let bar = ProgressBar::with_draw_target(Some(frames as u64), target);
+    if let Ok(style) = ProgressStyle::with_template("{bar:30} frame {pos}/{len} {msg} (eta {eta})")
+    {
+        bar.set_style(style);
+    }
+    bar
+}
+
+/// The settings used.
+fn settings(scene: &Scene, world: &WorldSpec, sim: &Simulation) -> Settings {
+    let integrator = &sim.world.integrator;
+    Settings {
+        dt: world.dt,
+        duration: world.duration,
+        gravity: world.gravity,
+        coupling_substeps: sim.world.coupling_substeps,
+        integrator: format!("{:?}", scene.integrator.kind).to_lowercase(),
+        explicit_safety_factor: integrator.explicit.safety_factor,
+        implicit_substeps: integrator.implicit.substeps,
+        contact_margin: sim.world.contact.margin,
+        contact_velocity_iterations: sim.world.contact.velocity_iterations,
+        save_every: scene.output.save_every,
+    }
+}
+
+/// The rigid bodies' names, kinds and masses.
+fn rigid_reports(sim: &Simulation) -> Vec<RigidBodyReport> {
+    (sim.rigid.iter())
+        .map(|entry| RigidBodyReport {
+            name: entry.name.clone(),
+            kind: match entry.spec.kind {
+                RigidKind::Fixed => "fixed",
+                RigidKind::Dynamic => "dynamic",
+                RigidKind::Kinematic => "kinematic",
+            }
+            .to_owned(),
+            mass: sim
+                .world
+                .physics
+                .bodies
+                .get(entry.handle)
+                .map_or(0.0, |b| f64::from(b.mass())),
+        })
+        .collect()
+}
+
+/// A probe's report.
+fn probe_report(probe: &super::Probe) -> ProbeReport {
+    let (times, values): (Vec<f64>, Vec<f64>) = probe.series.samples.iter().copied().unzip();
+    ProbeReport {
+        name: probe.series.name.clone(),
+        kind: probe.kind.name().to_owned(),
+        unit: probe.series.unit.clone(),
+        final_value: values.last().copied().unwrap_or(f64::NAN),
+        times,
+        values,
+    }
+}

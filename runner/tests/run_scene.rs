@@ -1,0 +1,139 @@
+//! Running shipped scenes: every one parses and builds; a short run writes the report, the
+//! ParaView series, the surfaces, the pictures and the plots; the `.vtu` read back matches the
+//! body's state.
+
+use rapier_fvm::glamx::DVec3;
+use rapier_fvm_runner::scene::Scene;
+use rapier_fvm_runner::sim::{self, RunOptions, Simulation};
+use std::path::{Path, PathBuf};
+use vtkio::model::{Attribute, DataSet, IOBuffer, Piece, Vtk};
+
+/// The shipped scene `name`.
+fn scene_path(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../assets/scenes")
+        .join(name)
+}
+
+/// A fresh output folder for `test`.
+fn out_dir(test: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(test);
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+#[test]
+fn every_shipped_scene_parses_and_builds() {
+    let names = [
+        "cantilever.toml",
+        "drop.toml",
+        "rigid_on_soft.toml",
+        "grasp.toml",
+        "soft_stack.toml",
+        "hanging_rope.toml",
+        "showcase.toml",
+    ];
+    let folder = scene_path("");
+    let mut found: Vec<String> = std::fs::read_dir(&folder)
+        .unwrap()
+        .filter_map(|e| e.ok()?.file_name().into_string().ok())
+        .filter(|n| n.ends_with(".toml"))
+        .collect();
+    found.sort();
+    let mut expected: Vec<String> = names.iter().map(|n| (*n).to_owned()).collect();
+    expected.sort();
+    assert_eq!(found, expected, "the scenes shipped");
+    for name in names {
+        let scene = Scene::load(scene_path(name)).unwrap_or_else(|e| panic!("{e}"));
+        let simulation = Simulation::build(&scene).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(simulation.soft.len(), scene.soft_body.len(), "{name}");
+        assert_eq!(simulation.probes.len(), scene.probe.len(), "{name}");
+    }
+}
+
+/// The points and a named point field of a `.vtu` file.
+fn read_vtu(path: &Path, field: &str) -> (Vec<f64>, Vec<f64>) {
+    let vtk = Vtk::import(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let DataSet::UnstructuredGrid { pieces, .. } = vtk.data else {
+        panic!("not an unstructured grid");
+    };
+    let Piece::Inline(piece) = &pieces[0] else {
+        panic!("not an inline piece");
+    };
+    let numbers = |buffer: &IOBuffer| buffer.clone().cast_into::<f64>().expect("f64 data");
+    let points = numbers(&piece.points);
+    let values = piece
+        .data
+        .point
+        .iter()
+        .find_map(|attribute| match attribute {
+            Attribute::DataArray(array) if array.name == field => Some(numbers(&array.data)),
+            _ => None,
+        })
+        .unwrap_or_else(|| panic!("no point field {field}"));
+    (points, values)
+}
+
+#[test]
+fn a_short_drop_writes_every_output_and_the_vtu_matches_the_body() {
+    let scene = Scene::load(scene_path("drop.toml")).unwrap();
+    let out = out_dir("short_drop");
+    let options = RunOptions {
+        out: out.clone(),
+        duration: Some(0.1),
+        progress: false,
+    };
+    let report = sim::run(&scene, &options).unwrap();
+    assert_eq!(report.frames, 6);
+    assert_eq!(report.soft_bodies[0].tets, 1080);
+    assert_eq!(report.soft_bodies[0].nodes, 343);
+    assert!(!report.stability.any_error && report.stability.final_state_finite);
+    // report.json holds the same.
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    assert_eq!(json["scene"], "drop");
+    assert_eq!(json["frames"], 6);
+    assert_eq!(json["probes"][0]["values"].as_array().unwrap().len(), 7);
+    assert!(json["ms_per_frame"].as_f64().unwrap() > 0.0);
+    // Saved frames 0, 3, 6: one .vtu each, an OBJ each, the index.
+    let pvd = std::fs::read_to_string(out.join("paraview/drop.pvd")).unwrap();
+    assert_eq!(pvd.matches("<DataSet").count(), 3);
+    for frame in 0..3 {
+        assert!(out.join(format!("paraview/cube_{frame:05}.vtu")).is_file());
+    }
+    for frame in [0, 3, 6] {
+        assert!(out.join(format!("obj/surface_{frame:05}.obj")).is_file());
+    }
+    // Pictures at the frames nearest 0, 0.3, 0.5 and 1.5 s, clamped to the 6 frames run.
+    for file in [
+        "view_00000.png",
+        "stress_00000.png",
+        "view_00006.png",
+        "stress_00006.png",
+    ] {
+        let png = std::fs::read(out.join("pictures").join(file)).unwrap();
+        assert_eq!(&png[1..4], b"PNG", "{file}");
+    }
+    for file in ["cube_centre_height_change.png", "ground_reaction.png"] {
+        assert!(out.join("plots").join(file).is_file(), "{file}");
+    }
+
+    // The last .vtu: one point per node, and the displacement of the node the probe follows
+    // equals the probe's final value (read from the body's state after the last frame).
+    let (points, displacement) = read_vtu(&out.join("paraview/cube_00002.vtu"), "displacement");
+    assert_eq!(points.len(), 3 * 343);
+    assert_eq!(displacement.len(), 3 * 343);
+    let simulation = Simulation::build(&scene).unwrap();
+    let body = &simulation.world.soft_bodies[simulation.soft[0].handle];
+    let node = body.mesh().nearest_node(DVec3::ZERO) as usize;
+    let probe = report.probes[0].final_value;
+    assert!(probe < -0.04, "the cube fell: {probe}");
+    assert!((displacement[3 * node + 1] - probe).abs() < 1e-12);
+    // Displacements are the points less the rest positions.
+    for (n, rest) in simulation.soft[0].rest.iter().enumerate() {
+        for axis in 0..3 {
+            let i = 3 * n + axis;
+            assert!((points[i] - rest[axis] - displacement[i]).abs() < 1e-12);
+        }
+    }
+}

@@ -1,0 +1,171 @@
+//! Every kind of scene error names the file, the key path and the line.
+
+use rapier_fvm_runner::scene::{Scene, SceneError};
+
+/// A valid scene; each test breaks one line of it.
+const VALID: &str = r#"name = "test"
+
+[world]
+duration = 0.1
+dt = 0.01
+
+[[rigid_body]]
+name = "ground"
+kind = "fixed"
+shape = { half_space = { normal = [0.0, 1.0, 0.0] } }
+
+[[soft_body]]
+name = "cube"
+mesh = { cuboid = { half_extents = [0.05, 0.05, 0.05], cells = [2, 2, 2] } }
+translation = [0.0, 0.1, 0.0]
+
+[soft_body.material]
+model = "stable_neo_hookean"
+young = 1e5
+poisson = 0.3
+density = 1000.0
+
+[[probe]]
+name = "reaction"
+kind = "contact_force"
+rigid = "ground"
+"#;
+
+/// `VALID` with `from` replaced by `to` (which must occur once).
+fn broken(from: &str, to: &str) -> String {
+    assert_eq!(VALID.matches(from).count(), 1, "{from:?} must occur once");
+    VALID.replace(from, to)
+}
+
+/// The error of parsing `text` as `scenes/bad.toml`.
+fn error(text: String) -> SceneError {
+    match Scene::parse("scenes/bad.toml", text) {
+        Ok(_) => panic!("the scene should be refused"),
+        Err(error) => error,
+    }
+}
+
+/// Asserts the message names the file, the line and the key, and mentions `words`.
+fn assert_names(error: &SceneError, line: usize, key: &str, words: &str) {
+    let message = error.to_string();
+    assert!(
+        message.starts_with(&format!("scenes/bad.toml:{line}: ")),
+        "file and line {line} in {message:?}"
+    );
+    assert!(message.contains(key), "key {key} in {message:?}");
+    assert!(message.contains(words), "{words:?} in {message:?}");
+    assert_eq!(error.line, Some(line));
+    assert!(!message.contains('\n'), "one line: {message:?}");
+}
+
+#[test]
+fn the_valid_scene_parses() {
+    let scene = Scene::parse("scenes/ok.toml", VALID.to_owned()).unwrap();
+    assert_eq!(scene.soft_body[0].material.young, 1e5);
+    assert_eq!(scene.world.frames(), 10);
+}
+
+#[test]
+fn an_unknown_key_is_named_with_its_line() {
+    let e = error(broken("young = 1e5", "yuong = 1e5"));
+    assert_names(
+        &e,
+        19,
+        "soft_body[0].material.yuong",
+        "unknown field `yuong`",
+    );
+}
+
+#[test]
+fn a_missing_key_is_named_at_its_table() {
+    let e = error(broken("density = 1000.0\n", ""));
+    assert_names(&e, 17, "soft_body[0].material", "missing field `density`");
+}
+
+#[test]
+fn a_wrong_type_is_named_with_its_line() {
+    let e = error(broken("young = 1e5", "young = \"stiff\""));
+    assert_names(&e, 19, "soft_body[0].material.young", "invalid type");
+}
+
+#[test]
+fn an_unknown_model_is_named_with_the_models_known() {
+    let e = error(broken("\"stable_neo_hookean\"", "\"neo_hookean\""));
+    assert_names(&e, 18, "soft_body[0].material.model", "stable_neo_hookean");
+}
+
+#[test]
+fn a_negative_young_modulus_is_refused() {
+    let e = error(broken("young = 1e5", "young = -1e5"));
+    assert_names(&e, 19, "soft_body[0].material.young", "positive");
+}
+
+#[test]
+fn a_poisson_ratio_of_one_half_is_refused() {
+    let e = error(broken("poisson = 0.3", "poisson = 0.5"));
+    assert_names(&e, 20, "soft_body[0].material.poisson", "(-1, 0.5)");
+}
+
+#[test]
+fn a_zero_time_step_is_refused() {
+    let e = error(broken("dt = 0.01", "dt = 0.0"));
+    assert_names(&e, 5, "world.dt", "positive");
+}
+
+#[test]
+fn a_probe_on_a_missing_body_is_refused() {
+    let e = error(broken("rigid = \"ground\"", "rigid = \"floor\""));
+    assert_names(&e, 26, "probe[0].rigid", "no rigid body is named \"floor\"");
+}
+
+#[test]
+fn an_attachment_to_a_missing_body_is_refused() {
+    let e = error(broken(
+        "translation = [0.0, 0.1, 0.0]",
+        "translation = [0.0, 0.1, 0.0]\nattach = [{ rigid = \"hook\", min = [-1, -1, -1], max = [1, 1, 1] }]",
+    ));
+    assert_names(&e, 16, "soft_body[0].attach[0].rigid", "\"hook\"");
+}
+
+#[test]
+fn two_mesh_sources_are_refused() {
+    let e = error(broken(
+        "cells = [2, 2, 2] } }",
+        "cells = [2, 2, 2] }, sphere = { radius = 0.1, cells_across = 4 } }",
+    ));
+    assert_names(&e, 14, "soft_body[0].mesh", "exactly one");
+}
+
+#[test]
+fn a_toml_syntax_error_gives_its_line() {
+    let e = error(broken("duration = 0.1", "duration = "));
+    assert_eq!(e.line, Some(4), "{e}");
+    assert!(e.to_string().starts_with("scenes/bad.toml:4: "), "{e}");
+}
+
+#[test]
+fn a_missing_mesh_file_is_named_at_its_key() {
+    let scene = Scene::parse(
+        "scenes/bad.toml",
+        broken(
+            "{ cuboid = { half_extents = [0.05, 0.05, 0.05], cells = [2, 2, 2] } }",
+            "{ file = \"missing.msh\" }",
+        ),
+    )
+    .unwrap();
+    let e = match rapier_fvm_runner::sim::Simulation::build(&scene) {
+        Ok(_) => panic!("the missing mesh should be refused"),
+        Err(e) => e,
+    };
+    assert_names(&e, 14, "soft_body[0].mesh.file", "missing.msh");
+}
+
+#[test]
+fn a_missing_scene_file_names_the_file() {
+    let e = Scene::load("scenes/no_such_scene.toml").unwrap_err();
+    assert!(
+        e.to_string()
+            .starts_with("scenes/no_such_scene.toml: cannot read"),
+        "{e}"
+    );
+}
