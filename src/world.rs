@@ -28,6 +28,10 @@ use rapier3d::glamx::DVec3;
 use rapier3d::math::Pose;
 use rapier3d::pipeline::{EventHandler, PhysicsHooks, PhysicsWorld};
 
+/// What stepping a soft body gave over a frame so far: nothing yet, its last report, or the
+/// error that stopped it.
+type Outcome = Option<Result<AutomaticReport, Error>>;
+
 /// Rigid and soft bodies in one world.
 ///
 /// # Example
@@ -237,6 +241,78 @@ impl FvmWorld {
             .map_or((DVec3::ZERO, DVec3::ZERO), |load| (load.force, load.torque))
     }
 
+    /// One coupling substep of `h` (s) of the soft bodies whose `outcomes` are not yet an error:
+    /// each finds its contacts with the colliders, bodies touching each other are grouped and
+    /// stepped together, the others alone, and the impulses they gave rigid bodies go to rapier
+    /// and to the frame's loads. Each body's outcome becomes its last report or its error.
+    fn step_soft_bodies(
+        &mut self,
+        outcomes: &mut [(SoftBodyHandle, Outcome)],
+        h: f64,
+        gravity: DVec3,
+    ) {
+        for (handle, outcome) in outcomes.iter_mut() {
+            if matches!(outcome, Some(Err(_))) {
+                continue;
+            }
+            let physics = &self.physics;
+            if let Err(error) = self.soft_bodies[*handle].detect_contacts(
+                &physics.colliders,
+                &physics.bodies,
+                h,
+                gravity,
+                &self.contact,
+            ) {
+                *outcome = Some(Err(error));
+            }
+        }
+        let live: Vec<SoftBodyHandle> = outcomes
+            .iter()
+            .filter(|(_, outcome)| !matches!(outcome, Some(Err(_))))
+            .map(|(handle, _)| *handle)
+            .collect();
+        let between = {
+            let bodies: Vec<&SoftBody> = live.iter().map(|&h| &self.soft_bodies[h]).collect();
+            contact::detect_between(&bodies, &self.contact, h, gravity)
+        };
+        for (group, mut contacts) in touching_groups(live.len(), between) {
+            let handles: Vec<SoftBodyHandle> = group.iter().map(|&i| live[i]).collect();
+            let physics = &mut self.physics;
+            let mut bodies = self.soft_bodies.get_many_mut(&handles);
+            for body in bodies.iter_mut() {
+                hold_supported_bodies(body, physics);
+            }
+            let stepped: Vec<Result<AutomaticReport, Error>> = if let [body] = &mut bodies[..] {
+                vec![self.integrator.step(body, h, gravity)]
+            } else {
+                match self
+                    .integrator
+                    .step_together(&mut bodies, &mut contacts, h, gravity)
+                {
+                    Ok(reports) => reports.into_iter().map(Ok).collect(),
+                    Err(error) => vec![Err(error); bodies.len()],
+                }
+            };
+            for ((handle, body), result) in handles.iter().zip(bodies).zip(stepped) {
+                if result.is_ok() {
+                    for (rigid_body, impulse, angular_impulse) in body.rigid_impulses() {
+                        add_load(
+                            &mut self.loads,
+                            *handle,
+                            rigid_body,
+                            impulse,
+                            angular_impulse,
+                        );
+                    }
+                    body.transfer_contact_impulses(&mut physics.bodies);
+                }
+                if let Some((_, outcome)) = outcomes.iter_mut().find(|(h, _)| h == handle) {
+                    *outcome = Some(result);
+                }
+            }
+        }
+    }
+
     /// Advances the world by one frame (`physics.integration_parameters.dt`), without hooks or
     /// events; see [`FvmWorld::step_with_events`].
     pub fn step(&mut self) -> Vec<(SoftBodyHandle, Result<AutomaticReport, Error>)> {
@@ -261,7 +337,7 @@ impl FvmWorld {
         }
         let h = f64::from(frame.dt) / f64::from(substeps);
         let gravity = self.physics.gravity.as_dvec3();
-        let mut outcomes: Vec<(SoftBodyHandle, Option<Result<AutomaticReport, Error>>)> = self
+        let mut outcomes: Vec<(SoftBodyHandle, Outcome)> = self
             .soft_bodies
             .iter()
             .map(|(handle, _)| (handle, None))
@@ -276,66 +352,7 @@ impl FvmWorld {
             for path in &paths {
                 path.advance(&mut self.physics.bodies, substep as f32 / substeps as f32);
             }
-            for (handle, outcome) in &mut outcomes {
-                if matches!(outcome, Some(Err(_))) {
-                    continue;
-                }
-                let physics = &self.physics;
-                if let Err(error) = self.soft_bodies[*handle].detect_contacts(
-                    &physics.colliders,
-                    &physics.bodies,
-                    h,
-                    gravity,
-                    &self.contact,
-                ) {
-                    *outcome = Some(Err(error));
-                }
-            }
-            let live: Vec<SoftBodyHandle> = outcomes
-                .iter()
-                .filter(|(_, outcome)| !matches!(outcome, Some(Err(_))))
-                .map(|(handle, _)| *handle)
-                .collect();
-            let between = {
-                let bodies: Vec<&SoftBody> = live.iter().map(|&h| &self.soft_bodies[h]).collect();
-                contact::detect_between(&bodies, &self.contact, h, gravity)
-            };
-            for (group, mut contacts) in touching_groups(live.len(), between) {
-                let handles: Vec<SoftBodyHandle> = group.iter().map(|&i| live[i]).collect();
-                let physics = &mut self.physics;
-                let mut bodies = self.soft_bodies.get_many_mut(&handles);
-                for body in bodies.iter_mut() {
-                    hold_supported_bodies(body, physics);
-                }
-                let stepped: Vec<Result<AutomaticReport, Error>> = if let [body] = &mut bodies[..] {
-                    vec![self.integrator.step(body, h, gravity)]
-                } else {
-                    match self
-                        .integrator
-                        .step_together(&mut bodies, &mut contacts, h, gravity)
-                    {
-                        Ok(reports) => reports.into_iter().map(Ok).collect(),
-                        Err(error) => vec![Err(error); bodies.len()],
-                    }
-                };
-                for ((handle, body), result) in handles.iter().zip(bodies).zip(stepped) {
-                    if result.is_ok() {
-                        for (rigid_body, impulse, angular_impulse) in body.rigid_impulses() {
-                            add_load(
-                                &mut self.loads,
-                                *handle,
-                                rigid_body,
-                                impulse,
-                                angular_impulse,
-                            );
-                        }
-                        body.transfer_contact_impulses(&mut physics.bodies);
-                    }
-                    if let Some((_, outcome)) = outcomes.iter_mut().find(|(h, _)| h == handle) {
-                        *outcome = Some(result);
-                    }
-                }
-            }
+            self.step_soft_bodies(&mut outcomes, h, gravity);
             self.physics.step_with_events(hooks, events);
         }
         self.physics.integration_parameters = frame;

@@ -15,7 +15,6 @@ use super::{
 };
 use crate::body::SoftBody;
 use rapier3d::glamx::DVec3;
-use rapier3d::parry::bounding_volume::BoundingVolume;
 
 /// A surface node of one soft body touching a boundary triangle of another.
 #[derive(Debug, Clone)]
@@ -48,7 +47,9 @@ pub(crate) fn detect_between(
     if bodies.len() < 2 {
         return contacts;
     }
-    let trees: Vec<SurfaceTree> = bodies.iter().map(|body| SurfaceTree::of(body)).collect();
+    // The trees are built only for bodies another one comes near.
+    let mut trees: Vec<Option<SurfaceTree>> = bodies.iter().map(|_| None).collect();
+    let bounds: Vec<(DVec3, DVec3)> = bodies.iter().map(|body| body.position_bounds()).collect();
     let fastest: Vec<f64> = bodies
         .iter()
         .map(|body| body.fastest_node_speed())
@@ -58,15 +59,15 @@ pub(crate) fn detect_between(
         for (b, other) in bodies.iter().enumerate() {
             let reach =
                 settings.margin + 2.0 * (fastest[a] + fastest[b] + gravity.length() * dt) * dt;
+            let ((lo_a, hi_a), (lo_b, hi_b)) = (bounds[a], bounds[b]);
             if a == b
                 || !body.collision_groups.test(other.collision_groups)
-                || !trees[a]
-                    .bounds
-                    .loosened(reach as f32)
-                    .intersects(&trees[b].bounds)
+                || (hi_a + DVec3::splat(reach)).cmplt(lo_b).any()
+                || (lo_a - DVec3::splat(reach)).cmpgt(hi_b).any()
             {
                 continue;
             }
+            let tree = trees[b].get_or_insert_with(|| SurfaceTree::of(other));
             let normals = normals.get_or_insert_with(|| body.surface_node_normals());
             let coefficients =
                 SurfaceCoefficients::of_body(body).combine(SurfaceCoefficients::of_body(other));
@@ -76,7 +77,7 @@ pub(crate) fn detect_between(
                     continue;
                 }
                 if let Some(hit) =
-                    trees[b].nearest_facing(other, body.positions[n], normals[n], reach, |_| false)
+                    tree.nearest_facing(other, body.positions[n], normals[n], reach, |_| false)
                 {
                     contacts.push(BetweenContact {
                         node_body: a,

@@ -392,16 +392,9 @@ impl SoftBody {
         let mut proxies: Vec<RigidProxy> = Vec::new();
         // Elastic waves can speed a node up within the frame: reach as far as the body's fastest
         // node, twice over.
-        let fastest = self
-            .velocities
-            .iter()
-            .map(|v| v.length())
-            .fold(0.0, f64::max);
-        let reach = settings.margin + 2.0 * (fastest + gravity.length() * frame_dt) * frame_dt;
-        let (body_lo, body_hi) = self.positions.iter().fold(
-            (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-            |(lo, hi), x| (lo.min(*x), hi.max(*x)),
-        );
+        let reach = settings.margin
+            + 2.0 * (self.fastest_node_speed() + gravity.length() * frame_dt) * frame_dt;
+        let (body_lo, body_hi) = self.position_bounds();
         let mut tree = None;
         let mut corners = Vec::new();
         for (handle, collider) in colliders.iter() {
