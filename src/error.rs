@@ -12,8 +12,8 @@ pub enum FileLocation {
     Line(usize),
     /// A byte offset into the file (0-based), for binary data.
     Byte(usize),
-    /// The file as a whole: the defect has no single place (no tetrahedra at all, an error of a
-    /// parser that does not say where).
+    /// The file as a whole: the defect has no single place (no tetrahedra at all), or the
+    /// parser that found it does not say where and no scan of the file could place it.
     Whole,
 }
 

@@ -222,6 +222,226 @@ fn malformed_binary_gmsh_files_name_the_byte() {
     assert!(matches!(at, FileLocation::Byte(_)), "{at:?}");
 }
 
+/// The kind, location and message of an import error from a surface reader.
+fn surface_error(
+    result: Result<surface::Surface, Error>,
+) -> (ImportErrorKind, FileLocation, String) {
+    kind_and_location(result.map(|_| unreachable_mesh()))
+}
+
+/// Never called: gives `surface_error`'s `Ok` arm a `RawMesh` type.
+fn unreachable_mesh() -> RawMesh {
+    panic!("expected an import error, the surface was read")
+}
+
+/// Prints an import error as the user sees it (collected in the closing note of the change).
+fn shown(result: &Result<impl std::fmt::Debug, Error>) {
+    if let Err(e) = result {
+        println!("  {e}");
+    }
+}
+
+#[test]
+fn malformed_obj_files_name_the_line() {
+    // A tetrahedron: four vertices, four outward faces; a group splits the faces.
+    let tet = [
+        "# a tetrahedron",     // 1
+        "v 0 0 0",             // 2
+        "v 1 0 0",             // 3
+        "v 0 1 0",             // 4
+        "",                    // 5
+        "v 0 0 1",             // 6
+        "o bottom",            // 7
+        "f 1 3 2",             // 8
+        "g sides",             // 9
+        "f 1 2 4",             // 10
+        "f 2/1 3/1 4/1",       // 11 (texture indices are ignored without `vt`)
+        "f -4//1 -1//1 -2//1", // 12 (relative indices, empty texture slot)
+    ]
+    .join("\n");
+    let good = surface::parse_obj(tet.as_bytes(), "tet.obj", 1.0).unwrap();
+    assert_eq!(good.triangles.len(), 4);
+    let parse = |text: &str| {
+        let result = surface::parse_obj(text.as_bytes(), "bad.obj", 1.0);
+        shown(&result);
+        surface_error(result)
+    };
+    // A coordinate that is not a number on line 4.
+    let (kind, at, message) = parse(&tet.replace("v 0 1 0", "v 0 one 0"));
+    assert_eq!((kind, at), (ImportErrorKind::Syntax, FileLocation::Line(4)));
+    assert!(message.contains("position parse error"), "{message}");
+    // A face referring to vertex 9 of 4 on line 10: `tobj` checks indices when the object
+    // ends, the line is still that of the face.
+    let (kind, at, _) = parse(&tet.replace("f 1 2 4", "f 1 2 9"));
+    assert_eq!(
+        (kind, at),
+        (ImportErrorKind::IndexOutOfRange, FileLocation::Line(10))
+    );
+    // A relative index before the first vertex (-5 of 4) on line 12.
+    let (kind, at, _) = parse(&tet.replace("f -4//1", "f -5//1"));
+    assert_eq!(
+        (kind, at),
+        (ImportErrorKind::IndexOutOfRange, FileLocation::Line(12))
+    );
+    // Index 0 (OBJ counts from 1) in the first object, on line 8.
+    let (kind, at, _) = parse(&tet.replace("f 1 3 2", "f 0 3 2"));
+    assert_eq!(
+        (kind, at),
+        (ImportErrorKind::IndexOutOfRange, FileLocation::Line(8))
+    );
+    // A face vertex that is not an index, and an empty face.
+    let (kind, at, _) = parse(&tet.replace("f 2/1 3/1", "f 2/1 3/x"));
+    assert_eq!(
+        (kind, at),
+        (ImportErrorKind::Syntax, FileLocation::Line(11))
+    );
+    let (_, at, _) = parse(&tet.replace("f 1 2 4", "f"));
+    assert_eq!(at, FileLocation::Line(10));
+    // Text that is not UTF-8 on line 3.
+    let mut bytes = tet.clone().into_bytes();
+    let at = tet.find("v 1 0 0").unwrap() + 2;
+    bytes[at] = 0xff;
+    let (kind, at, _) = surface_error(surface::parse_obj(&bytes, "bad.obj", 1.0));
+    assert_eq!((kind, at), (ImportErrorKind::Syntax, FileLocation::Line(3)));
+    // A coordinate that overflows once scaled, on line 6.
+    let huge = tet.replace("v 0 0 1", "v 0 0 1e300");
+    let result = surface::parse_obj(huge.as_bytes(), "huge.obj", 1e10);
+    shown(&result);
+    let (kind, at, _) = surface_error(result);
+    assert_eq!(
+        (kind, at),
+        (ImportErrorKind::NonFinite, FileLocation::Line(6))
+    );
+}
+
+#[test]
+fn malformed_stl_files_name_the_line_or_the_byte() {
+    let text = String::from_utf8(bytes("sphere_ascii.stl")).unwrap();
+    let parse = |data: &[u8]| {
+        let result = surface::parse_stl(data, "bad.stl", 1.0);
+        shown(&result);
+        surface_error(result)
+    };
+    // The second facet's first vertex (line 10) loses a coordinate.
+    let lines: Vec<&str> = text.lines().collect();
+    let mut broken: Vec<String> = lines.iter().map(|l| l.to_string()).collect();
+    broken[9] = "      vertex -0.809016994 0.5".into();
+    let (kind, at, _) = parse(broken.join("\n").as_bytes());
+    assert_eq!(
+        (kind, at),
+        (ImportErrorKind::Syntax, FileLocation::Line(10))
+    );
+    // `endloop` misspelt on line 7.
+    let mut broken: Vec<String> = lines.iter().map(|l| l.to_string()).collect();
+    broken[6] = "    end loop".into();
+    let (_, at, _) = parse(broken.join("\n").as_bytes());
+    assert_eq!(at, FileLocation::Line(7));
+    // Cut inside the third facet (after line 20): the file ends where a statement is missing.
+    let (kind, at, _) = parse(lines[..20].join("\n").as_bytes());
+    assert_eq!(
+        (kind, at),
+        (ImportErrorKind::Truncated, FileLocation::Line(20))
+    );
+
+    // Binary: 80-byte header, triangle count, 50-byte records.
+    let binary = bytes("cube.stl");
+    assert_eq!(binary.len(), 84 + 12 * 50);
+    // Cut 20 bytes into record 5 (of 12): the record starts at byte 334.
+    let (kind, at, _) = parse(&binary[..84 + 5 * 50 + 20]);
+    assert_eq!(
+        (kind, at),
+        (ImportErrorKind::Truncated, FileLocation::Byte(334))
+    );
+    // Cut inside the header and inside the count.
+    assert_eq!(parse(&binary[..50]).1, FileLocation::Byte(0));
+    assert_eq!(parse(&binary[..82]).1, FileLocation::Byte(80));
+    // A NaN coordinate in record 3's second vertex (bytes 84 + 150 + 24 onwards).
+    let mut nan = binary.clone();
+    let vertex = 84 + 3 * 50 + 24;
+    nan[vertex + 4..vertex + 8].copy_from_slice(&f32::NAN.to_le_bytes());
+    let (kind, at, _) = parse(&nan);
+    assert_eq!(
+        (kind, at),
+        (ImportErrorKind::NonFinite, FileLocation::Byte(vertex))
+    );
+}
+
+#[test]
+fn malformed_vtu_files_name_the_line() {
+    let text = String::from_utf8(bytes("cube_ascii.vtu")).unwrap();
+    let line_of = |needle: &str| text.lines().position(|l| l.starts_with(needle)).unwrap() + 1;
+    let parse = |s: &str| {
+        let result = vtk::parse_vtu(s.as_bytes(), "bad.vtu", 1.0);
+        shown(&result);
+        kind_and_location(result)
+    };
+    // A mismatched end tag: `</Points>` on line 1033 closes `<Pointz>`.
+    let points_end = line_of("</Points>");
+    assert_eq!(points_end, 1033);
+    let (kind, at, _) = parse(&text.replacen("</Points>", "</Pointz>", 1));
+    assert_eq!(
+        (kind, at),
+        (ImportErrorKind::Syntax, FileLocation::Line(points_end))
+    );
+    // An attribute without its closing quote on the offsets' line.
+    let offsets = line_of("<DataArray type=\"Int64\" Name=\"offsets\"");
+    let (kind, at, _) = parse(&text.replacen("Name=\"offsets\"", "Name=\"offsets", 1));
+    assert_eq!(
+        (kind, at),
+        (ImportErrorKind::Syntax, FileLocation::Line(offsets))
+    );
+    // The file cut inside the cells: it ends inside open elements.
+    let cut = text.lines().take(2000).collect::<Vec<_>>().join("\n");
+    let (kind, at, _) = parse(&cut);
+    assert_eq!(
+        (kind, at),
+        (ImportErrorKind::Syntax, FileLocation::Line(2000))
+    );
+    // A connectivity entry past the 341 points: the connectivity's `<DataArray>` line.
+    let connectivity = line_of("<DataArray type=\"Int64\" Name=\"connectivity\"");
+    let mut lines: Vec<&str> = text.lines().collect();
+    lines[connectivity + 3] = "99999";
+    let (kind, at, message) = parse(&lines.join("\n"));
+    assert_eq!(
+        (kind, at),
+        (
+            ImportErrorKind::IndexOutOfRange,
+            FileLocation::Line(connectivity)
+        )
+    );
+    assert!(message.contains("99999"), "{message}");
+    // An unknown cell type (a hexahedron) and a non-finite coordinate: their arrays' lines.
+    let types = line_of("<DataArray type=\"Int64\" Name=\"types\"");
+    let mut lines: Vec<&str> = text.lines().collect();
+    lines[types] = "12";
+    let (kind, at, _) = parse(&lines.join("\n"));
+    assert_eq!(
+        (kind, at),
+        (
+            ImportErrorKind::UnsupportedElement,
+            FileLocation::Line(types)
+        )
+    );
+    let mut lines: Vec<&str> = text.lines().collect();
+    lines[7] = "nan";
+    let (kind, at, _) = parse(&lines.join("\n"));
+    assert_eq!(
+        (kind, at),
+        (ImportErrorKind::NonFinite, FileLocation::Line(7))
+    );
+    // One cell type too few: `vtkio` names the array, its line is given.
+    let mut lines: Vec<&str> = text.lines().collect();
+    lines.remove(types);
+    let (kind, at, _) = parse(&lines.join("\n"));
+    assert_eq!(
+        (kind, at),
+        (ImportErrorKind::BadCount, FileLocation::Line(types))
+    );
+    // Tetrahedra carry their connectivity's line.
+    let raw = vtk::parse_vtu(text.as_bytes(), "cube.vtu", 1.0).unwrap();
+    assert_eq!(raw.tet_locations[0], FileLocation::Line(connectivity));
+}
+
 #[test]
 fn tetgen_reads_one_based_indices_attributes_and_comments() {
     let node = b"# a tetrahedron\n4 3 1 1 # one attribute, markers\n\n1 0 0 0 7.5 1\n2 2 0 0 7.5 1\n3 0 2 0 7.5 0\n4 0 0 2 7.5 1\n";
@@ -401,9 +621,9 @@ fn run_reader(reader: usize, data: &[u8]) {
         2 => tetgen::parse(&bytes_cached_node(), "cube.node", data, "fuzz.ele", 1.0),
         3 => vtk::parse_vtu(data, "fuzz.vtu", 1.0),
         4 => vtk::parse_legacy(data, "fuzz.vtk", 1.0),
-        5 => surface::parse_obj(data, "fuzz.obj", 1.0)
+        5 => located(surface::parse_obj(data, "fuzz.obj", 1.0))
             .and_then(|s| surface::fill(&s, &SurfaceOptions { cells_across: 4 })),
-        _ => surface::parse_stl(data, "fuzz.stl", 1.0)
+        _ => located(surface::parse_stl(data, "fuzz.stl", 1.0))
             .and_then(|s| surface::fill(&s, &SurfaceOptions { cells_across: 4 })),
     };
     match result.and_then(RawMesh::into_mesh) {
@@ -411,6 +631,15 @@ fn run_reader(reader: usize, data: &[u8]) {
         Err(Error::MeshImport { .. } | Error::InvalidSetting { .. }) => {}
         Err(other) => panic!("untyped import error {other:?}"),
     }
+}
+
+/// `result`, after checking that an error of the OBJ or STL reader says where: their
+/// locators must find every statement `tobj` or `stl_io` rejects.
+fn located(result: Result<surface::Surface, Error>) -> Result<surface::Surface, Error> {
+    if let Err(e @ Error::MeshImport { location, .. }) = &result {
+        assert_ne!(*location, FileLocation::Whole, "unplaced error: {e}");
+    }
+    result
 }
 
 fn bytes_cached_node() -> Vec<u8> {
@@ -424,7 +653,7 @@ fn bytes_cached_ele() -> Vec<u8> {
 }
 
 /// (reader, valid file) pairs mutated by the fuzz properties.
-const SEEDS: [(usize, &str); 12] = [
+const SEEDS: [(usize, &str); 13] = [
     (0, "cube_v22_ascii.msh"),
     (0, "cube_v22_binary.msh"),
     (0, "cube_v41_ascii.msh"),
@@ -437,6 +666,7 @@ const SEEDS: [(usize, &str); 12] = [
     (4, "cube_binary.vtk"),
     (5, "sphere.obj"),
     (6, "cube.stl"),
+    (6, "sphere_ascii.stl"),
 ];
 
 fn seed(index: usize) -> (usize, Vec<u8>) {

@@ -17,8 +17,14 @@
 //! the result into a [`TetMesh`]. [`load`] does both, choosing the reader by extension.
 //!
 //! Malformed files give [`Error::MeshImport`] with the file, the line (text) or byte offset
-//! (binary) and the [`ImportErrorKind`]; files that cannot be opened give [`Error::Io`]. No
-//! reader panics or allocates more than its input can fill, whatever the bytes (fuzzed in
+//! (binary) and the [`ImportErrorKind`]; files that cannot be opened give [`Error::Io`]. Every
+//! reader reports lines: the Gmsh, `TetGen` and legacy VTK readers as they read; the OBJ, STL
+//! and VTU readers, whose crates (`tobj`, `stl_io`, `vtkio`) say what is wrong but not where,
+//! by scanning the file again once it has failed (the first statement the crate rejects, the
+//! line where the XML stops being well-formed, the `<DataArray>` an error is about; binary STL
+//! by the offset of the incomplete record). Only what no single place causes (no tetrahedra at
+//! all, a few `vtkio` errors that name no element) carries [`FileLocation::Whole`]. No reader
+//! panics or allocates more than its input can fill, whatever the bytes (fuzzed in
 //! `tests/mesh_import.rs`).
 //!
 //! # Example
@@ -36,6 +42,7 @@
 //! ```
 
 pub mod gmsh;
+mod locate;
 pub mod quality;
 pub mod surface;
 pub mod tetgen;

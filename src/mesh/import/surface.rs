@@ -24,6 +24,7 @@
 //! `parry3d`'s own `volume_mesh` encloses the shape (1.26 times its volume on the same sphere),
 //! hence this lattice approach.
 
+use super::locate;
 use super::text::Source;
 use super::{RawMesh, check_scale};
 use crate::Error;
@@ -93,7 +94,9 @@ impl Surface {
 ///
 /// # Errors
 /// [`Error::InvalidSetting`] for a bad `scale`; [`Error::MeshImport`] for a file `tobj`
-/// rejects (no location: `tobj` gives none), indices out of range or non-finite coordinates.
+/// rejects, with the line of the first statement at fault (`tobj` gives none: the file is
+/// scanned again to find it; [`FileLocation::Whole`] if that fails), indices out of range
+/// ([`ImportErrorKind::IndexOutOfRange`]) or non-finite coordinates (at the vertex's line).
 pub fn parse_obj(data: &[u8], path: &str, scale: f64) -> Result<Surface, Error> {
     check_scale(scale)?;
     let source = Source::new(path, data);
@@ -106,9 +109,18 @@ pub fn parse_obj(data: &[u8], path: &str, scale: f64) -> Result<Surface, Error> 
         Err(tobj::LoadError::OpenFileFailed)
     })
     .map_err(|e| {
+        use tobj::LoadError as E;
+        let kind = match e {
+            E::FaceVertexOutOfBounds
+            | E::FaceTexCoordOutOfBounds
+            | E::FaceNormalOutOfBounds
+            | E::FaceColorOutOfBounds => ImportErrorKind::IndexOutOfRange,
+            _ => ImportErrorKind::Syntax,
+        };
+        let line = locate::obj_error_line(data);
         source.error_at(
-            FileLocation::Whole,
-            ImportErrorKind::Syntax,
+            line.map_or(FileLocation::Whole, FileLocation::Line),
+            kind,
             format!("invalid OBJ file: {e}"),
         )
     })?;
@@ -117,7 +129,11 @@ pub fn parse_obj(data: &[u8], path: &str, scale: f64) -> Result<Surface, Error> 
     for model in models {
         let first = vertices.len();
         for p in model.mesh.positions.chunks_exact(3) {
-            vertices.push(scaled_vertex(&source, DVec3::new(p[0], p[1], p[2]), scale)?);
+            let p = DVec3::new(p[0], p[1], p[2]);
+            vertices.push(scaled_vertex(&source, p, scale, || {
+                locate::obj_non_finite_line(data, scale)
+                    .map_or(FileLocation::Whole, FileLocation::Line)
+            })?);
         }
         let count = vertices.len() - first;
         for t in model.mesh.indices.chunks_exact(3) {
@@ -147,14 +163,21 @@ pub fn parse_obj(data: &[u8], path: &str, scale: f64) -> Result<Surface, Error> 
 ///
 /// # Errors
 /// [`Error::InvalidSetting`] for a bad `scale`; [`Error::MeshImport`] for a file `stl_io`
-/// rejects (no location: `stl_io` gives none) or non-finite coordinates.
+/// rejects or non-finite coordinates, at the line of the first statement at fault (ASCII) or
+/// the byte offset of the incomplete or non-finite record (binary); `stl_io` gives no position,
+/// so the file is scanned again to find it.
 pub fn parse_stl(data: &[u8], path: &str, scale: f64) -> Result<Surface, Error> {
     check_scale(scale)?;
     let source = Source::new(path, data);
     let mesh = stl_io::read_stl(&mut std::io::Cursor::new(data)).map_err(|e| {
+        let kind = if e.kind() == std::io::ErrorKind::UnexpectedEof {
+            ImportErrorKind::Truncated
+        } else {
+            ImportErrorKind::Syntax
+        };
         source.error_at(
-            FileLocation::Whole,
-            ImportErrorKind::Syntax,
+            locate::stl_error_location(data).unwrap_or(FileLocation::Whole),
+            kind,
             format!("invalid STL file: {e}"),
         )
     })?;
@@ -163,7 +186,9 @@ pub fn parse_stl(data: &[u8], path: &str, scale: f64) -> Result<Surface, Error> 
         .iter()
         .map(|v| {
             let p = DVec3::new(f64::from(v[0]), f64::from(v[1]), f64::from(v[2]));
-            scaled_vertex(&source, p, scale)
+            scaled_vertex(&source, p, scale, || {
+                locate::stl_non_finite_location(data, scale).unwrap_or(FileLocation::Whole)
+            })
         })
         .collect::<Result<Vec<_>, _>>()?;
     let mut triangles = Vec::with_capacity(mesh.faces.len());
@@ -188,15 +213,25 @@ pub fn parse_stl(data: &[u8], path: &str, scale: f64) -> Result<Surface, Error> 
     })
 }
 
-fn scaled_vertex(source: &Source<'_>, p: DVec3, scale: f64) -> Result<DVec3, Error> {
+/// `p * scale` if finite, else a [`ImportErrorKind::NonFinite`] error at the place `locate`
+/// finds (called only then: it scans the file).
+fn scaled_vertex(
+    source: &Source<'_>,
+    p: DVec3,
+    scale: f64,
+    locate: impl FnOnce() -> FileLocation,
+) -> Result<DVec3, Error> {
     let scaled = p * scale;
     if scaled.is_finite() {
         Ok(scaled)
     } else {
         Err(source.error_at(
-            FileLocation::Whole,
+            locate(),
             ImportErrorKind::NonFinite,
-            format!("vertex {p} (times the scale {scale}) is not finite"),
+            format!(
+                "vertex [{:?}, {:?}, {:?}] times the scale {scale:?} is not finite",
+                p.x, p.y, p.z
+            ),
         ))
     }
 }

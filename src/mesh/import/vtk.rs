@@ -9,14 +9,19 @@
 //! `.vtu` files are parsed by the `vtkio` crate (ASCII, base64 `binary` and appended data;
 //! compressed data is an error since this crate builds `vtkio` without its decompressors,
 //! which also rules out decompression bombs). `vtkio`'s errors do not say where in the file
-//! they arise, so they carry [`FileLocation::Whole`]; the checks made here afterwards name the
-//! cell or the data array. Mutating valid files (tens of thousands of truncations, byte flips
+//! they arise: on an error the file is scanned again with `quick-xml` (the version `vtkio`
+//! uses) to report the line where the XML stops being well-formed, or the line of the
+//! `<DataArray>` a size mismatch or an unknown cell type is about; other `vtkio` errors carry
+//! [`FileLocation::Whole`]. The checks made here afterwards name the cell or the data array and
+//! report the line of that array's `<DataArray>` element (of the `<Piece>` for count
+//! mismatches); appended and binary data are placed at their element's line. Mutating valid files (tens of thousands of truncations, byte flips
 //! and huge counts) made `vtkio` neither panic nor allocate beyond its input.
 //!
 //! Legacy `.vtk` files (versions 2.0 to 5.1, ASCII or big-endian BINARY, `DATASET
 //! UNSTRUCTURED_GRID`) are read by hand: `vtkio`'s legacy parser reports only the nom error
 //! kind (`Parse(Digit)`), with no line, while the format is a few keywords and number lists.
 
+use super::locate::{self, PieceLines, VtuLines};
 use super::text::{Source, finite, parse_token, scaled, shorten};
 use super::{RawMesh, check_scale};
 use crate::Error;
@@ -38,7 +43,7 @@ fn is_lower_dimensional(cell_type: u64) -> bool {
 }
 
 /// Points (as `x y z` triples, scaled) and cells (offsets into `connectivity`, types) turned
-/// into a [`RawMesh`]; `at` gives the file location to report for a cell.
+/// into a [`RawMesh`] by [`build`].
 struct Cells<'c> {
     /// `offsets[i]..offsets[i + 1]` is cell `i`'s range in `connectivity`.
     offsets: &'c [u64],
@@ -46,16 +51,26 @@ struct Cells<'c> {
     types: &'c [u64],
 }
 
+/// Which of a cell's data an error is about, for the location of its data array.
+#[derive(Clone, Copy)]
+enum CellData {
+    Offsets,
+    Connectivity,
+    Types,
+}
+
+/// The [`RawMesh`] of `positions` and the tetrahedra of `cells`; `locate` gives the file
+/// location of a cell's data (that of its connectivity is each tetrahedron's location).
 fn build(
     source: &Source<'_>,
     positions: Vec<DVec3>,
     cells: &Cells<'_>,
-    location: FileLocation,
+    locate: &dyn Fn(usize, CellData) -> FileLocation,
 ) -> Result<RawMesh, Error> {
     let cell_count = cells.types.len();
     if cells.offsets.len() != cell_count + 1 {
         return Err(source.error_at(
-            location,
+            locate(0, CellData::Offsets),
             ImportErrorKind::BadCount,
             format!(
                 "{} cell types but {} cells",
@@ -65,11 +80,12 @@ fn build(
         ));
     }
     let mut tets = Vec::new();
+    let mut tet_locations = Vec::new();
     for (cell, &cell_type) in cells.types.iter().enumerate() {
         let (start, end) = (cells.offsets[cell], cells.offsets[cell + 1]);
         if start > end || end > cells.connectivity.len() as u64 {
             return Err(source.error_at(
-                location,
+                locate(cell, CellData::Offsets),
                 ImportErrorKind::BadCount,
                 format!(
                     "cell {cell} spans entries {start}..{end} of a connectivity of {}",
@@ -82,7 +98,7 @@ fn build(
             VTK_TETRA => {
                 if nodes.len() != 4 {
                     return Err(source.error_at(
-                        location,
+                        locate(cell, CellData::Offsets),
                         ImportErrorKind::BadCount,
                         format!("cell {cell} is a tetrahedron with {} nodes", nodes.len()),
                     ));
@@ -91,7 +107,7 @@ fn build(
                 for (corner, &node) in tet.iter_mut().zip(nodes) {
                     if node >= positions.len() as u64 {
                         return Err(source.error_at(
-                            location,
+                            locate(cell, CellData::Connectivity),
                             ImportErrorKind::IndexOutOfRange,
                             format!(
                                 "cell {cell} refers to point {node}, but there are {} points",
@@ -102,11 +118,12 @@ fn build(
                     *corner = node as u32;
                 }
                 tets.push(tet);
+                tet_locations.push(locate(cell, CellData::Connectivity));
             }
             _ if is_lower_dimensional(cell_type) => {}
             VTK_QUADRATIC_TETRA => {
                 return Err(source.error_at(
-                    location,
+                    locate(cell, CellData::Types),
                     ImportErrorKind::UnsupportedElement,
                     format!(
                         "cell {cell} is a quadratic tetrahedron (type 24): only linear \
@@ -116,7 +133,7 @@ fn build(
             }
             _ => {
                 return Err(source.error_at(
-                    location,
+                    locate(cell, CellData::Types),
                     ImportErrorKind::UnsupportedElement,
                     format!(
                         "cell {cell} has type {cell_type}, a volume cell other than a linear \
@@ -133,7 +150,6 @@ fn build(
             "the file holds no tetrahedra (cell type 10)",
         ));
     }
-    let tet_locations = vec![location; tets.len()];
     Ok(RawMesh {
         path: source.path().to_owned(),
         positions,
@@ -147,44 +163,62 @@ fn build(
 ///
 /// # Errors
 /// [`Error::InvalidSetting`] for a bad `scale`; [`Error::MeshImport`] for malformed XML or
-/// data (no location: `vtkio` gives none), pieces in other files, cells that are not linear
-/// tetrahedra or lower-dimensional, indices out of range, non-finite coordinates.
+/// data, pieces in other files, cells that are not linear tetrahedra or lower-dimensional,
+/// indices out of range, non-finite coordinates. Malformed XML is reported at the line where
+/// it stops being well-formed, errors about a data array at the line of its `<DataArray>`,
+/// count mismatches at the line of the `<Piece>`; `vtkio`'s errors that name no place carry
+/// [`FileLocation::Whole`].
 pub fn parse_vtu(data: &[u8], path: &str, scale: f64) -> Result<RawMesh, Error> {
     use vtkio::model::{DataSet, Piece, VertexNumbers};
     check_scale(scale)?;
     let source = Source::new(path, data);
-    let whole = |kind, message: String| source.error_at(FileLocation::Whole, kind, message);
-    let vtk = vtkio::Vtk::parse_xml(data)
-        .map_err(|e| whole(ImportErrorKind::Syntax, format!("invalid VTU file: {e}")))?;
+    let vtk = vtkio::Vtk::parse_xml(data).map_err(|e| vtkio_error(&source, data, &e))?;
+    let lines = VtuLines::scan(data);
+    // The location of piece `number`'s element chosen by `element`.
+    let at = |number: usize, element: fn(&PieceLines) -> Option<usize>| {
+        lines
+            .pieces
+            .get(number)
+            .and_then(element)
+            .map_or(FileLocation::Whole, FileLocation::Line)
+    };
+    let piece_line: fn(&PieceLines) -> Option<usize> = |p| Some(p.piece);
     let DataSet::UnstructuredGrid { pieces, .. } = vtk.data else {
-        return Err(whole(
+        return Err(source.error_at(
+            FileLocation::Whole,
             ImportErrorKind::Syntax,
-            "the file holds no UnstructuredGrid".into(),
+            "the file holds no UnstructuredGrid",
         ));
     };
     let mut positions = Vec::new();
     let mut offsets = vec![0u64];
     let mut connectivity = Vec::new();
     let mut types = Vec::new();
+    // The first cell of each piece, to find a cell's piece.
+    let mut first_cells = Vec::new();
     for (number, piece) in pieces.into_iter().enumerate() {
         let piece = match piece {
             Piece::Inline(piece) => piece,
             Piece::Source(..) | Piece::Loaded(_) => {
-                return Err(whole(
+                return Err(source.error_at(
+                    at(number, piece_line),
                     ImportErrorKind::UnknownVersion,
                     format!("piece {number} is stored in another file: not supported"),
                 ));
             }
         };
+        let points = at(number, |p| p.points);
         let first_point = positions.len() as u64;
         let coordinates = piece.points.cast_into::<f64>().ok_or_else(|| {
-            whole(
+            source.error_at(
+                points,
                 ImportErrorKind::Syntax,
                 format!("the points of piece {number} are not numbers"),
             )
         })?;
         if coordinates.len() % 3 != 0 {
-            return Err(whole(
+            return Err(source.error_at(
+                points,
                 ImportErrorKind::BadCount,
                 format!(
                     "piece {number} has {} point coordinates, not a multiple of 3",
@@ -194,16 +228,18 @@ pub fn parse_vtu(data: &[u8], path: &str, scale: f64) -> Result<RawMesh, Error> 
         }
         for p in coordinates.chunks_exact(3) {
             let p = DVec3::new(p[0], p[1], p[2]);
-            if !p.is_finite() {
-                return Err(whole(
+            let scaled = p * scale;
+            if !scaled.is_finite() {
+                return Err(source.error_at(
+                    points,
                     ImportErrorKind::NonFinite,
                     format!(
-                        "point {} of piece {number} is {p}, not finite",
+                        "point {} of piece {number} is {p}, not finite times the scale {scale}",
                         positions.len() as u64 - first_point
                     ),
                 ));
             }
-            positions.push(scaled(&source, p, scale)?);
+            positions.push(scaled);
         }
         let (piece_offsets, piece_connectivity) = match piece.cells.cell_verts {
             VertexNumbers::XML {
@@ -217,9 +253,10 @@ pub fn parse_vtu(data: &[u8], path: &str, scale: f64) -> Result<RawMesh, Error> 
                 while i < vertices.len() {
                     let n = vertices[i] as usize;
                     let cell = vertices.get(i + 1..i + 1 + n).ok_or_else(|| {
-                        whole(
+                        source.error_at(
+                            at(number, |p| p.connectivity),
                             ImportErrorKind::Truncated,
-                            "a cell list is cut short".into(),
+                            "a cell list is cut short",
                         )
                     })?;
                     connectivity.extend(cell.iter().map(|&v| u64::from(v)));
@@ -235,7 +272,8 @@ pub fn parse_vtu(data: &[u8], path: &str, scale: f64) -> Result<RawMesh, Error> 
             _ => &piece_offsets[..],
         };
         if ends.len() != piece.cells.types.len() {
-            return Err(whole(
+            return Err(source.error_at(
+                at(number, piece_line),
                 ImportErrorKind::BadCount,
                 format!(
                     "piece {number} has {} cell offsets but {} cell types",
@@ -244,10 +282,12 @@ pub fn parse_vtu(data: &[u8], path: &str, scale: f64) -> Result<RawMesh, Error> 
                 ),
             ));
         }
+        first_cells.push(types.len());
         let base = connectivity.len() as u64;
         for &end in ends {
             if end > piece_connectivity.len() as u64 {
-                return Err(whole(
+                return Err(source.error_at(
+                    at(number, |p| p.offsets),
                     ImportErrorKind::BadCount,
                     format!(
                         "piece {number}: cell offset {end} is past the connectivity's {} entries",
@@ -259,7 +299,8 @@ pub fn parse_vtu(data: &[u8], path: &str, scale: f64) -> Result<RawMesh, Error> 
         }
         for &node in &piece_connectivity {
             let global = node.checked_add(first_point).ok_or_else(|| {
-                whole(
+                source.error_at(
+                    at(number, |p| p.connectivity),
                     ImportErrorKind::IndexOutOfRange,
                     format!("piece {number} refers to point {node}"),
                 )
@@ -273,7 +314,47 @@ pub fn parse_vtu(data: &[u8], path: &str, scale: f64) -> Result<RawMesh, Error> 
         connectivity: &connectivity,
         types: &types,
     };
-    build(&source, positions, &cells, FileLocation::Whole)
+    let locate = |cell: usize, data: CellData| {
+        let number = first_cells.partition_point(|&first| first <= cell).max(1) - 1;
+        at(
+            number,
+            match data {
+                CellData::Offsets => |p| p.offsets,
+                CellData::Connectivity => |p| p.connectivity,
+                CellData::Types => |p| p.types,
+            },
+        )
+    };
+    build(&source, positions, &cells, &locate)
+}
+
+/// `vtkio`'s error `e` on `data`, placed: at the line where the XML stops being well-formed,
+/// else at the `<DataArray>` it names (a size mismatch, an unknown cell type), else nowhere.
+fn vtkio_error(source: &Source<'_>, data: &[u8], e: &vtkio::Error) -> Error {
+    use vtkio::xml::{Error as XmlError, ValidationError};
+    if let Some((line, syntax)) = locate::xml_error(data) {
+        return source.error_at(
+            FileLocation::Line(line),
+            ImportErrorKind::Syntax,
+            format!("invalid VTU file: malformed XML: {syntax}"),
+        );
+    }
+    let (kind, array) = match e {
+        vtkio::Error::XML(XmlError::Validation(ValidationError::DataArraySizeMismatch {
+            name,
+            ..
+        })) => (ImportErrorKind::BadCount, Some(name.as_str())),
+        vtkio::Error::XML(XmlError::Validation(ValidationError::InvalidCellType(_))) => {
+            (ImportErrorKind::UnsupportedElement, Some("types"))
+        }
+        _ => (ImportErrorKind::Syntax, None),
+    };
+    let line = array.and_then(|name| VtuLines::scan(data).array(name));
+    source.error_at(
+        line.map_or(FileLocation::Whole, FileLocation::Line),
+        kind,
+        format!("invalid VTU file: {e}"),
+    )
 }
 
 /// A legacy VTK data type: its size in binary files and whether it is a float.
@@ -628,5 +709,5 @@ pub fn parse_legacy(data: &[u8], path: &str, scale: f64) -> Result<RawMesh, Erro
         connectivity: &connectivity,
         types: &types,
     };
-    build(&file.source, positions, &cells, location)
+    build(&file.source, positions, &cells, &|_, _| location)
 }
