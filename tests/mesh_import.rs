@@ -792,3 +792,16 @@ fn fuzz_execution_count() {
     // 4 properties of CASES cases each, plus the truncations (printed by their test).
     println!("proptest fuzz executions: {}", 4 * CASES);
 }
+
+#[test]
+fn an_obj_surface_split_into_groups_stays_closed() {
+    // A unit right tetrahedron's four faces in two groups: the reader welds the vertices each
+    // group repeats, giving 4 vertices and 4 faces enclosing 1/6 m³ (exact in binary).
+    let obj = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n\
+                g bottom\nf 1 3 2\nf 1 2 4\n\
+                g top\nf 1 4 3\nf 2 3 4\n";
+    let surface = rapier_fvm::mesh::import::surface::parse_obj(obj, "tet.obj", 1.0).unwrap();
+    assert_eq!(surface.vertices.len(), 4);
+    assert_eq!(surface.triangles.len(), 4);
+    assert!((surface.enclosed_volume() - 1.0 / 6.0).abs() < 1e-15);
+}

@@ -124,29 +124,40 @@ pub fn parse_obj(data: &[u8], path: &str, scale: f64) -> Result<Surface, Error> 
             format!("invalid OBJ file: {e}"),
         )
     })?;
+    // tobj gives each object or group its own copy of the vertices it uses: vertices at the same
+    // coordinates are welded back into one, so that a closed surface split into groups stays
+    // closed.
     let mut vertices = Vec::new();
+    let mut welded: HashMap<[u64; 3], u32> = HashMap::new();
     let mut triangles = Vec::new();
     for model in models {
-        let first = vertices.len();
+        let mut global = Vec::with_capacity(model.mesh.positions.len() / 3);
         for p in model.mesh.positions.chunks_exact(3) {
             let p = DVec3::new(p[0], p[1], p[2]);
-            vertices.push(scaled_vertex(&source, p, scale, || {
+            let vertex = scaled_vertex(&source, p, scale, || {
                 locate::obj_non_finite_line(data, scale)
                     .map_or(FileLocation::Whole, FileLocation::Line)
-            })?);
+            })?;
+            let key = vertex.to_array().map(f64::to_bits);
+            global.push(*welded.entry(key).or_insert_with(|| {
+                vertices.push(vertex);
+                (vertices.len() - 1) as u32
+            }));
         }
-        let count = vertices.len() - first;
         for t in model.mesh.indices.chunks_exact(3) {
             let mut triangle = [0u32; 3];
             for (corner, &i) in triangle.iter_mut().zip(t) {
-                if i as usize >= count {
-                    return Err(source.error_at(
+                *corner = *global.get(i as usize).ok_or_else(|| {
+                    source.error_at(
                         FileLocation::Whole,
                         ImportErrorKind::IndexOutOfRange,
-                        format!("object `{}` refers to vertex {i} of {count}", model.name),
-                    ));
-                }
-                *corner = (first + i as usize) as u32;
+                        format!(
+                            "object `{}` refers to vertex {i} of {}",
+                            model.name,
+                            global.len()
+                        ),
+                    )
+                })?;
             }
             triangles.push(triangle);
         }
