@@ -124,9 +124,10 @@ pub(crate) fn prepare_between(contacts: &mut [BetweenContact], bodies: &[&mut So
         let node_body = &bodies[contact.node_body];
         let n = contact.node as usize;
         let gap = (node_body.positions[n] - contact.point).dot(contact.normal);
-        let normal_speed = (node_body.velocities[n]
-            - contact.on_triangle.velocity(&triangle_body.velocities))
-        .dot(contact.normal);
+        let normal_speed = || {
+            (node_body.velocities[n] - contact.on_triangle.velocity(&triangle_body.velocities))
+                .dot(contact.normal)
+        };
         contact.constraint = VelocityConstraint::new(
             gap,
             h,

@@ -134,11 +134,12 @@ pub(crate) fn prepare_corners(body: &mut SoftBody, h: f64) {
             contact.normal = normal;
         }
         let gap = (contact.vertex - contact.point).dot(contact.normal);
-        let vertex_velocity = contact.proxy.map_or(DVec3::ZERO, |p| {
-            body.rigid_proxies[p].velocity_at(contact.vertex)
-        });
-        let normal_speed =
-            (vertex_velocity - contact.on_triangle.velocity(&body.velocities)).dot(contact.normal);
+        let normal_speed = || {
+            let vertex_velocity = contact.proxy.map_or(DVec3::ZERO, |p| {
+                body.rigid_proxies[p].velocity_at(contact.vertex)
+            });
+            (vertex_velocity - contact.on_triangle.velocity(&body.velocities)).dot(contact.normal)
+        };
         contact.constraint = VelocityConstraint::new(gap, h, depenetration_speed).bounce(
             gap,
             h,

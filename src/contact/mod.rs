@@ -252,6 +252,12 @@ impl NodeContact {
         }
     }
 
+    /// Whether the implicit integrator enforces the contact: those with colliders (it leaves
+    /// self-contact to the explicit integrator).
+    fn is_implicit(&self) -> bool {
+        matches!(self.obstacle, Obstacle::Collider { .. })
+    }
+
     /// Signed distance (m) of position `x` from the contact plane, negative inside.
     pub fn gap(&self, x: DVec3) -> f64 {
         (x - self.point).dot(self.normal)
@@ -717,11 +723,11 @@ pub(crate) fn prepare_velocities(body: &mut SoftBody, h: f64) {
             node: n,
             x,
         };
-        let normal_speed = sides.relative_velocity().dot(contact.normal);
+        let normal = contact.normal;
         contact.constraint = VelocityConstraint::new(gap, h, depenetration_speed).bounce(
             gap,
             h,
-            normal_speed,
+            || sides.relative_velocity().dot(normal),
             contact.restitution,
         );
     }
@@ -776,9 +782,7 @@ impl ContactSides for WithinBody<'_, '_> {
 /// The contacts the implicit integrator enforces: those with colliders (it leaves self-contact
 /// to the explicit integrator).
 fn implicit_contacts(contacts: &mut [NodeContact]) -> impl Iterator<Item = &mut NodeContact> {
-    contacts
-        .iter_mut()
-        .filter(|c| matches!(c.obstacle, Obstacle::Collider { .. }))
+    contacts.iter_mut().filter(|c| c.is_implicit())
 }
 
 /// Records the impulses (N s) the implicit penalty and friction gave the nodes over a substep of
@@ -827,11 +831,7 @@ pub(crate) fn for_each_friction(
     h: f64,
     mut each: impl FnMut(usize, f64, DVec3, DMat3),
 ) {
-    for contact in body
-        .contacts
-        .iter()
-        .filter(|c| matches!(c.obstacle, Obstacle::Collider { .. }))
-    {
+    for contact in body.contacts.iter().filter(|c| c.is_implicit()) {
         let n = contact.node as usize;
         if let Some((energy, force, tangent)) =
             contact.friction_term(body.positions[n], &body.contact_settings, h)
@@ -850,11 +850,7 @@ pub(crate) fn for_each_active_penalty(
     h: f64,
     mut each: impl FnMut(usize, f64, f64, DVec3),
 ) {
-    for contact in body
-        .contacts
-        .iter()
-        .filter(|c| matches!(c.obstacle, Obstacle::Collider { .. }))
-    {
+    for contact in body.contacts.iter().filter(|c| c.is_implicit()) {
         let n = contact.node as usize;
         if let Some((stiffness, gap)) =
             contact.penalty(body.positions[n], body.masses[n], &body.contact_settings, h)

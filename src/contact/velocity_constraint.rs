@@ -52,16 +52,22 @@ impl VelocityConstraint {
     }
 
     /// Makes the contact bounce: a node that approaches the plane at normal velocity
-    /// `normal_speed` (m/s, negative toward it) faster than [`RESTITUTION_THRESHOLD`] and reaches
-    /// it within the substep of `h` (s) from `gap` (m) leaves it at `restitution` times its
-    /// approach speed (a new contact, as rapier bounces only those).
-    pub(crate) fn bounce(mut self, gap: f64, h: f64, normal_speed: f64, restitution: f64) -> Self {
-        if restitution > 0.0
-            && gap >= 0.0
-            && normal_speed < -RESTITUTION_THRESHOLD
-            && normal_speed * h <= -gap
-        {
-            self.lowest_speed = self.lowest_speed.max(-restitution * normal_speed);
+    /// `normal_speed()` (m/s, negative toward it, asked for only when `restitution > 0`) faster
+    /// than [`RESTITUTION_THRESHOLD`] and reaches it within the substep of `h` (s) from `gap` (m)
+    /// leaves it at `restitution` times its approach speed (a new contact, as rapier bounces only
+    /// those).
+    pub(crate) fn bounce(
+        mut self,
+        gap: f64,
+        h: f64,
+        normal_speed: impl FnOnce() -> f64,
+        restitution: f64,
+    ) -> Self {
+        if restitution > 0.0 && gap >= 0.0 {
+            let normal_speed = normal_speed();
+            if normal_speed < -RESTITUTION_THRESHOLD && normal_speed * h <= -gap {
+                self.lowest_speed = self.lowest_speed.max(-restitution * normal_speed);
+            }
         }
         self
     }
@@ -136,7 +142,7 @@ mod tests {
                 mass: 0.1,
             };
             let mut constraint =
-                VelocityConstraint::new(gap, h, 0.1).bounce(gap, h, -3.0, restitution);
+                VelocityConstraint::new(gap, h, 0.1).bounce(gap, h, || -3.0, restitution);
             constraint.correct(DVec3::Y, 0.0, &mut node);
             let expected = if restitution > 0.0 {
                 3.0 * restitution
@@ -158,8 +164,8 @@ mod tests {
         // Below the threshold (resting nodes pressed by gravity), or not reaching the plane
         // within the substep, the constraint is the inelastic one.
         let inelastic = VelocityConstraint::new(1e-3, 1e-3, 0.1);
-        assert_eq!(inelastic.bounce(1e-3, 1e-3, -0.5, 1.0), inelastic);
+        assert_eq!(inelastic.bounce(1e-3, 1e-3, || -0.5, 1.0), inelastic);
         let far = VelocityConstraint::new(1e-2, 1e-3, 0.1);
-        assert_eq!(far.bounce(1e-2, 1e-3, -3.0, 1.0), far);
+        assert_eq!(far.bounce(1e-2, 1e-3, || -3.0, 1.0), far);
     }
 }
