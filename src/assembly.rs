@@ -1,8 +1,9 @@
 //! Assembly of sparse symmetric tangent matrices (N/m) over a body's mesh: the lower triangle in
 //! compressed columns, pinned nodes' rows and columns replaced by the identity.
 //!
-//! An element contributes `K_e = V Gᵀ A G`, where `A = ∂P/∂F` is the 9 x 9 tangent of the stress
-//! with respect to the deformation gradient and `G` maps the four node displacements to `dF`.
+//! An integration point of weight `w` contributes `w Gᵀ A G`, where `A = ∂P/∂F` is the 9 x 9
+//! tangent of the stress with respect to the deformation gradient and `G` maps its element's node
+//! displacements to `dF` (4 nodes for linear tetrahedra, 10 for quadratic ones).
 //! On request `A` is first projected onto its positive semi-definite part, so that `K_e` has no
 //! negative eigenvalue and Newton steps always descend (the stress tangents of St.
 //! Venant–Kirchhoff and Neo-Hookean are indefinite under compression); the projection stiffens
@@ -10,7 +11,9 @@
 
 use crate::Error;
 use crate::body::SoftBody;
-use crate::fvm::{NodalAveraging, TetRest, gather};
+use crate::element::Elements;
+use crate::element::tet10::deformation_gradient;
+use crate::fvm::NodalAveraging;
 use crate::material::{HyperelasticModel, with_hyperelastic_model};
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
@@ -22,6 +25,9 @@ use rapier3d::na;
 /// A 9 x 9 stress tangent `A[(r, c), (s, d)] = ∂P_rc / ∂F_sd` (Pa), indices column-major
 /// (`3 c + r`).
 pub(crate) type StressTangent = na::SMatrix<f64, 9, 9>;
+
+/// The most nodes an element has (quadratic tetrahedra).
+const MAX_ELEMENT_NODES: usize = crate::element::tet10::NODES;
 
 /// The sparsity pattern of the lower triangle of the 3n x 3n tangent of a mesh, and its values.
 #[derive(Debug, Clone)]
@@ -44,10 +50,7 @@ impl Stiffness {
     pub(crate) fn new(body: &SoftBody) -> Self {
         let n = body.node_count();
         let mut lower_neighbours: Vec<Vec<u32>> = (0..n as u32).map(|b| vec![b]).collect();
-        couple_all_pairs(
-            &mut lower_neighbours,
-            body.mesh().tets().iter().map(|t| &t[..]),
-        );
+        couple_all_pairs(&mut lower_neighbours, body.elements.element_nodes());
         if body.nodal_averaging.is_some() {
             // A node's patch: itself and every node sharing a tetrahedron with it.
             let mut patches: Vec<Vec<u32>> = lower_neighbours.clone();
@@ -94,8 +97,9 @@ impl Stiffness {
     }
 
     /// Fills the values with the body's tangent stiffness at its current positions: for every
-    /// tetrahedron `V Gᵀ A G` with `A` the stress tangent of the elastic stress differential plus
-    /// `extra(t, F, dF)` (a further stress differential, Pa), projected to be positive
+    /// integration point (see [`crate::element`]) `w ∇N_aᵀ A ∇N_b` with `A` the stress tangent of
+    /// the elastic stress differential plus `extra(point, F, dF)` (a further stress differential,
+    /// Pa), projected to be positive
     /// semi-definite if `project`; the coupling of nodal averaging if the body uses it; and
     /// `diagonal[n] I` on each free node.
     pub(crate) fn assemble(
@@ -106,28 +110,33 @@ impl Stiffness {
         extra: impl Fn(usize, &DMat3, &DMat3) -> DMat3,
     ) {
         self.values.fill(0.0);
-        let fvm = &body.fvm;
+        let x = body.positions();
         with_hyperelastic_model!(body.material, |model| {
-            let averaging = body.nodal_averaging.as_ref();
-            let measures = averaging.map(|a| a.measures(&model, fvm, body.positions()));
-            for (t, tet) in fvm.tets().iter().enumerate() {
-                let rest = fvm.tet_rest(t);
-                let f = rest.gradient(&gather(tet, body.positions()));
-                let a = stress_tangent(|df| {
+            let averaging = match (&body.nodal_averaging, &body.elements) {
+                (Some(averaging), Elements::Linear(fvm)) => Some((averaging, fvm)),
+                _ => None,
+            };
+            let measures = averaging.map(|(a, fvm)| a.measures(&model, fvm, x));
+            body.elements
+                .for_each_point(|point, nodes, gradients, weight| {
+                    let f = deformation_gradient(nodes, gradients, x);
+                    let changes = unit_changes();
                     let elastic = match &measures {
-                        Some(m) => {
-                            NodalAveraging::element_differential(&model, &f, m.excess(tet, t), df)
-                        }
-                        None => model.first_piola_differential(&f, df),
+                        Some(m) => changes.map(|df| {
+                            let excess = m.excess(nodes, point);
+                            NodalAveraging::element_differential(&model, &f, excess, &df)
+                        }),
+                        None => model.first_piola_differentials(&f, &changes),
                     };
-                    elastic + extra(t, &f, df)
+                    let a = tangent_from_columns(std::array::from_fn(|c| {
+                        elastic[c] + extra(point, &f, &changes[c])
+                    }));
+                    let a = if project { project_positive(a) } else { a };
+                    self.add_point(nodes, gradients, weight, &a, &body.pinned);
                 });
-                let k = element_matrix(&rest, &if project { project_positive(a) } else { a });
-                self.add_element(tet, &k, &body.pinned);
-            }
             // The coupling is positive semi-definite (K > 0), so it needs no projection.
-            if let Some(averaging) = averaging {
-                averaging.for_each_coupling(&model, fvm, body.positions(), |gradient, weight| {
+            if let Some((averaging, fvm)) = averaging {
+                averaging.for_each_coupling(&model, fvm, x, |gradient, weight| {
                     self.add_outer(gradient, weight, &body.pinned)
                 });
             }
@@ -165,11 +174,29 @@ impl Stiffness {
         }
     }
 
-    fn add_element(&mut self, tet: &[u32; 4], k: &[[f64; 12]; 12], pinned: &[bool]) {
-        for (cb, &b) in tet.iter().enumerate() {
-            for (ca, &a) in tet.iter().enumerate() {
+    /// Adds one integration point's `w ∇N_aᵀ A ∇N_b` (N/m) for every pair of its nodes:
+    /// `K_ab[i][j] = w Σ_cd A[(i,c),(j,d)] g_a,c g_b,d`, with `g` the shape-function gradients
+    /// (1/m), `w` the point's rest volume (m³) and `A` the stress tangent (Pa).
+    fn add_point(
+        &mut self,
+        nodes: &[u32],
+        gradients: &[DVec3],
+        weight: f64,
+        tangent: &StressTangent,
+        pinned: &[bool],
+    ) {
+        // A g_b: per node, the 9 x 3 map from its displacement to dP.
+        let mut stress_maps = [na::SMatrix::<f64, 9, 3>::zeros(); MAX_ELEMENT_NODES];
+        for (map, g) in stress_maps.iter_mut().zip(gradients) {
+            *map = na::SMatrix::<f64, 9, 3>::from_fn(|row, j| {
+                (0..3).map(|d| tangent[(row, 3 * d + j)] * g[d]).sum()
+            });
+        }
+        for (cb, &b) in nodes.iter().enumerate() {
+            for (ca, &a) in nodes.iter().enumerate() {
+                let (ga, map) = (gradients[ca], &stress_maps[cb]);
                 self.add_pair_block(a as usize, b as usize, pinned, |i, j| {
-                    k[3 * ca + i][3 * cb + j]
+                    weight * (0..3).map(|c| ga[c] * map[(3 * c + i, j)]).sum::<f64>()
                 });
             }
         }
@@ -187,13 +214,23 @@ impl Stiffness {
         if a < b || pinned[a] || pinned[b] {
             return;
         }
-        for j in 0..3 {
-            for i in 0..3 {
-                if a == b && i < j {
-                    continue;
+        if a == b {
+            for j in 0..3 {
+                let start = self.col_ptr[3 * b + j];
+                for i in j..3 {
+                    self.values[start + i - j] += value(i, j);
                 }
-                let e = self.entry(a, i, b, j);
-                self.values[e] += value(i, j);
+            }
+            return;
+        }
+        // One search for the block; its nine entries follow arithmetically (see `entry`).
+        let k = self.lower_neighbours[b]
+            .binary_search(&(a as u32))
+            .expect("the pattern contains every pair of coupled nodes");
+        for j in 0..3 {
+            let first = self.col_ptr[3 * b + j] + (3 - j) + 3 * (k - 1);
+            for i in 0..3 {
+                self.values[first + i] += value(i, j);
             }
         }
     }
@@ -308,15 +345,21 @@ pub(crate) fn solve(factor: &Llt<usize, f64>, rhs: &[DVec3]) -> Vec<DVec3> {
         .collect()
 }
 
-/// The stress tangent `∂P/∂F` of `differential` (a stress differential `dF -> dP`) at one `F`,
-/// built column by column from the nine unit changes of `F`.
-pub(crate) fn stress_tangent(differential: impl Fn(&DMat3) -> DMat3) -> StressTangent {
-    let mut tangent = StressTangent::zeros();
-    for column in 0..9 {
+/// The nine unit changes of `F`, in the column-major order of a [`StressTangent`]'s columns.
+fn unit_changes() -> [DMat3; 9] {
+    std::array::from_fn(|column| {
         let mut df = [0.0; 9];
         df[column] = 1.0;
-        let dp = differential(&DMat3::from_cols_array(&df)).to_cols_array();
-        for (row, value) in dp.iter().enumerate() {
+        DMat3::from_cols_array(&df)
+    })
+}
+
+/// The stress tangent `∂P/∂F` whose columns are the stress differentials `dps` (Pa) of the nine
+/// [`unit_changes`].
+fn tangent_from_columns(dps: [DMat3; 9]) -> StressTangent {
+    let mut tangent = StressTangent::zeros();
+    for (column, dp) in dps.iter().enumerate() {
+        for (row, value) in dp.to_cols_array().iter().enumerate() {
             tangent[(row, column)] = *value;
         }
     }
@@ -333,21 +376,4 @@ pub(crate) fn project_positive(a: StressTangent) -> StressTangent {
     }
     let clamped = eigen.eigenvalues.map(|l| l.max(0.0));
     eigen.eigenvectors * StressTangent::from_diagonal(&clamped) * eigen.eigenvectors.transpose()
-}
-
-/// `K_e[3a+i][3b+j] = V Σ A[(i,c),(j,d)] g_a,c g_b,d` (N/m): the element matrix of a stress
-/// tangent, `g_a` the gradient of node `a`'s shape function.
-fn element_matrix(rest: &TetRest, tangent: &StressTangent) -> [[f64; 12]; 12] {
-    let gradients = rest.shape_gradients();
-    // G: 9 x 12, vec(dF) = G dx with dF_rc = Σ_b dx_b,r g_b,c at row 3c + r.
-    let mut map = na::SMatrix::<f64, 9, 12>::zeros();
-    for (b, gradient) in gradients.iter().enumerate() {
-        for r in 0..3 {
-            for c in 0..3 {
-                map[(3 * c + r, 3 * b + r)] = gradient[c];
-            }
-        }
-    }
-    let k = map.transpose() * tangent * map * rest.volume;
-    std::array::from_fn(|row| std::array::from_fn(|col| k[(row, col)]))
 }

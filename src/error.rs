@@ -96,6 +96,28 @@ pub enum Error {
         /// The repeated node.
         node: u32,
     },
+    /// Two quadratic tetrahedra share an edge but put different mid-edge nodes on it.
+    #[error(
+        "tetrahedron {tet} puts node {node} at the middle of edge {corners:?}, where an earlier tetrahedron put node {other}"
+    )]
+    NonConformingEdge {
+        /// Index of the offending element.
+        tet: usize,
+        /// The edge's corner nodes.
+        corners: [u32; 2],
+        /// The mid-edge node this element gives.
+        node: u32,
+        /// The mid-edge node an earlier element gave.
+        other: u32,
+    },
+    /// An option the body's other settings do not support.
+    #[error("{option} is not supported here: {reason}")]
+    UnsupportedOption {
+        /// The option.
+        option: &'static str,
+        /// Why it does not apply.
+        reason: &'static str,
+    },
     /// A node belongs to no tetrahedron: it would have no mass and no stiffness.
     #[error("node {node} belongs to no tetrahedron")]
     UnreferencedNode {

@@ -46,6 +46,7 @@ pub mod attachment;
 pub mod body;
 pub mod contact;
 pub mod damping;
+pub mod element;
 mod error;
 pub mod fvm;
 pub mod integrate;

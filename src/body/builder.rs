@@ -4,9 +4,11 @@ use super::{SoftBody, lumped_masses};
 use crate::Error;
 use crate::contact::ContactSettings;
 use crate::damping::RayleighDamping;
+use crate::element::Elements;
+use crate::element::tet10::{self, QuadraticElements};
 use crate::fvm::{FvmMesh, NodalAveraging, VolumetricTreatment};
 use crate::material::Material;
-use crate::mesh::TetMesh;
+use crate::mesh::{QuadraticTetMesh, TetMesh};
 use rapier3d::dynamics::CoefficientCombineRule;
 use rapier3d::geometry::InteractionGroups;
 use rapier3d::glamx::{DQuat, DVec3};
@@ -31,7 +33,10 @@ use rapier3d::glamx::{DQuat, DVec3};
 #[derive(Debug, Clone)]
 #[must_use = "a builder does nothing until `build` is called"]
 pub struct SoftBodyBuilder {
+    /// The linear tetrahedra: the body's elements, or the subdivision of its quadratic ones.
     mesh: TetMesh,
+    /// The quadratic elements, for a body of them.
+    quadratic: Option<Vec<[u32; tet10::NODES]>>,
     material: Material,
     damping: Option<RayleighDamping>,
     volumetric: VolumetricTreatment,
@@ -62,6 +67,7 @@ impl SoftBodyBuilder {
     pub fn new(mesh: TetMesh, material: Material) -> Self {
         Self {
             mesh,
+            quadratic: None,
             material,
             damping: None,
             volumetric: VolumetricTreatment::PerElement,
@@ -77,6 +83,34 @@ impl SoftBodyBuilder {
             restitution: 0.0,
             restitution_combine_rule: CoefficientCombineRule::Average,
             self_contact: false,
+        }
+    }
+
+    /// A body of quadratic (10-node) tetrahedra: far more accurate in bending per degree of
+    /// freedom than linear ones (see [`crate::element::tet10`]). The body's
+    /// [`SoftBody::mesh`] is then `mesh`'s [subdivision](QuadraticTetMesh::subdivided), on the
+    /// same nodes; node indices (pins, attachments, probes) are those of `mesh`.
+    ///
+    /// # Example
+    /// ```
+    /// use rapier_fvm::prelude::*;
+    ///
+    /// let linear = mesh::cuboid(DVec3::new(0.5, 0.05, 0.05), [5, 1, 1])?;
+    /// let mesh = mesh::QuadraticTetMesh::from_linear(&linear)?;
+    /// let clamped = mesh.nodes_where(|p| p.x <= -0.5 + 1e-9);
+    /// let material = Material::new(MaterialModel::Corotated, 1e8, 0.3, 1000.0)?;
+    /// let beam = SoftBodyBuilder::quadratic(mesh, material)
+    ///     .pinned_nodes(clamped)
+    ///     .build()?;
+    /// assert_eq!(beam.element_order(), rapier_fvm::element::ElementOrder::Quadratic);
+    /// assert!((beam.total_mass() - 10.0).abs() < 1e-12);
+    /// # Ok::<(), rapier_fvm::Error>(())
+    /// ```
+    pub fn quadratic(mesh: QuadraticTetMesh, material: Material) -> Self {
+        let elements = mesh.elements().to_vec();
+        Self {
+            quadratic: Some(elements),
+            ..Self::new(mesh.subdivided().clone(), material)
         }
     }
 
@@ -189,7 +223,9 @@ impl SoftBodyBuilder {
     /// # Errors
     /// [`Error::NodeOutOfRange`] for a pinned node that does not exist;
     /// [`Error::NonFiniteInput`] for a non-finite velocity or translation or a zero rotation;
-    /// [`Error::SliverTet`] for a tetrahedron below the minimum quality;
+    /// [`Error::SliverTet`] for a tetrahedron below the minimum quality (of the subdivision, for
+    /// quadratic elements); [`Error::InvertedTet`] for a quadratic element whose rest map folds;
+    /// [`Error::UnsupportedOption`] for nodal averaging on quadratic elements;
     /// [`Error::InvalidSetting`] for a minimum quality outside `[0, 1)` or a negative or
     /// non-finite friction or restitution.
     pub fn build(self) -> Result<SoftBody, Error> {
@@ -251,7 +287,21 @@ impl SoftBodyBuilder {
         let velocities = (0..node_count)
             .map(|n| if pinned[n] { DVec3::ZERO } else { self.linvel })
             .collect();
-        let fvm = FvmMesh::new(&self.mesh);
+        let (elements, masses) = match &self.quadratic {
+            None => (
+                Elements::Linear(FvmMesh::new(&self.mesh)),
+                lumped_masses(&self.mesh, self.material.density()),
+            ),
+            Some(quadratic) => {
+                let elements = QuadraticElements::new(self.mesh.positions(), quadratic)?;
+                let masses = elements
+                    .lumped_volumes(node_count)
+                    .into_iter()
+                    .map(|volume| volume * self.material.density())
+                    .collect();
+                (Elements::Quadratic(elements), masses)
+            }
+        };
         let surface_triangles = self.mesh.surface_triangles();
         let mut surface_rings = vec![Vec::new(); node_count];
         for triangle in &surface_triangles {
@@ -266,14 +316,22 @@ impl SoftBodyBuilder {
         let mut surface_nodes: Vec<u32> = surface_triangles.iter().flatten().copied().collect();
         surface_nodes.sort_unstable();
         surface_nodes.dedup();
-        let nodal_averaging = match self.volumetric {
-            VolumetricTreatment::PerElement => None,
-            VolumetricTreatment::NodalAverage => Some(NodalAveraging::new(&fvm)),
+        let nodal_averaging = match (self.volumetric, &elements) {
+            (VolumetricTreatment::PerElement, _) => None,
+            (VolumetricTreatment::NodalAverage, Elements::Linear(fvm)) => {
+                Some(NodalAveraging::new(fvm))
+            }
+            (VolumetricTreatment::NodalAverage, Elements::Quadratic(_)) => {
+                return Err(Error::UnsupportedOption {
+                    option: "VolumetricTreatment::NodalAverage",
+                    reason: "nodal averaging applies to linear tetrahedra",
+                });
+            }
         };
         Ok(SoftBody {
-            fvm,
+            elements,
             nodal_averaging,
-            masses: lumped_masses(&self.mesh, self.material.density()),
+            masses,
             forces: vec![DVec3::ZERO; node_count],
             saved_state: (
                 Vec::with_capacity(node_count),

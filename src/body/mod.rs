@@ -12,22 +12,25 @@ use crate::assembly::Stiffness;
 use crate::attachment::Attachment;
 use crate::contact::{ContactSettings, CornerContact, NodeContact, RigidProxy};
 use crate::damping::RayleighDamping;
-use crate::fvm::{FvmMesh, NodalAveraging, VolumetricTreatment};
+use crate::element::{ElementOrder, Elements};
+use crate::fvm::{NodalAveraging, VolumetricTreatment};
 use crate::material::{Material, with_hyperelastic_model};
 use crate::mesh::TetMesh;
 use rapier3d::dynamics::CoefficientCombineRule;
 use rapier3d::geometry::InteractionGroups;
 use rapier3d::glamx::DVec3;
 
-/// A deformable body discretized by linear tetrahedra and simulated by finite volumes.
+/// A deformable body discretized by tetrahedra, linear (simulated by finite volumes) or
+/// quadratic.
 ///
 /// Built with [`SoftBodyBuilder`]. Mass is lumped on the nodes from their control volumes (a
-/// quarter of each incident tetrahedron's rest volume times the density), so the nodal masses sum
-/// to density times rest volume.
+/// quarter of each incident linear tetrahedron's rest volume times the density; HRZ fractions
+/// for quadratic ones), so the nodal masses sum to density times rest volume.
 #[derive(Debug, Clone)]
 pub struct SoftBody {
+    /// The linear tetrahedra: the elements, or the subdivision of the quadratic ones.
     pub(crate) mesh: TetMesh,
-    pub(crate) fvm: FvmMesh,
+    pub(crate) elements: Elements,
     pub(crate) material: Material,
     pub(crate) damping: Option<RayleighDamping>,
     /// The incidence data of nodal averaging, when the body uses it.
@@ -95,9 +98,17 @@ pub struct SoftBody {
 }
 
 impl SoftBody {
-    /// The rest mesh (rest positions in the body's own frame, m).
+    /// The rest mesh (rest positions in the body's own frame, m): the elements for a body of
+    /// linear tetrahedra; for quadratic ones their subdivision into linear tetrahedra on the same
+    /// nodes (see [`QuadraticTetMesh::subdivided`](crate::mesh::QuadraticTetMesh::subdivided)),
+    /// which its surface, contacts and output use.
     pub fn mesh(&self) -> &TetMesh {
         &self.mesh
+    }
+
+    /// The order of the elements the body is simulated with.
+    pub fn element_order(&self) -> ElementOrder {
+        self.elements.order()
     }
 
     /// The material.
@@ -164,11 +175,17 @@ impl SoftBody {
     }
 
     /// The mesh's wave length scale (m) at the current positions, see
-    /// [`FvmMesh::wave_length_scale`]: the explicit critical step is about
-    /// [`COURANT_NUMBER`](crate::integrate::COURANT_NUMBER) times this over the pressure wave
-    /// speed.
+    /// [`FvmMesh::wave_length_scale`](crate::fvm::FvmMesh::wave_length_scale): the explicit
+    /// critical step is about [`COURANT_NUMBER`](crate::integrate::COURANT_NUMBER) times this over
+    /// the pressure wave speed.
     pub fn wave_length_scale(&self) -> f64 {
-        self.fvm.wave_length_scale(&self.positions)
+        let density = self.material.density();
+        let control_volumes: Vec<f64> = match self.elements.order() {
+            ElementOrder::Linear => Vec::new(),
+            ElementOrder::Quadratic => self.masses.iter().map(|m| m / density).collect(),
+        };
+        self.elements
+            .wave_length_scale(&self.positions, &control_volumes)
     }
 
     /// Internal forces (N per node): elastic plus damping, at the current positions and velocities.
@@ -234,7 +251,7 @@ impl SoftBody {
     /// Recomputes `self.forces`.
     pub(crate) fn compute_internal_forces(&mut self) {
         let Self {
-            fvm,
+            elements,
             material,
             damping,
             nodal_averaging,
@@ -244,8 +261,8 @@ impl SoftBody {
             ..
         } = self;
         with_hyperelastic_model!(material, |model| {
-            fvm.internal_forces(&model, damping.as_ref(), positions, velocities, forces);
-            if let Some(averaging) = nodal_averaging {
+            elements.internal_forces(&model, damping.as_ref(), positions, velocities, forces);
+            if let (Some(averaging), Elements::Linear(fvm)) = (nodal_averaging, elements) {
                 averaging.add_forces(&model, fvm, positions, forces);
             }
         });
@@ -253,9 +270,14 @@ impl SoftBody {
 
     /// Elastic strain energy (J) at the current positions.
     pub fn elastic_energy(&self) -> f64 {
-        with_hyperelastic_model!(self.material, |model| match &self.nodal_averaging {
-            Some(averaging) => averaging.elastic_energy(&model, &self.fvm, &self.positions),
-            None => self.fvm.elastic_energy(&model, &self.positions),
+        with_hyperelastic_model!(self.material, |model| match (
+            &self.nodal_averaging,
+            &self.elements
+        ) {
+            (Some(averaging), Elements::Linear(fvm)) => {
+                averaging.elastic_energy(&model, fvm, &self.positions)
+            }
+            _ => self.elements.elastic_energy(&model, &self.positions),
         })
     }
 

@@ -4,13 +4,30 @@
 //! `σ_vm = sqrt(3/2 s:s)`, `s = σ - tr(σ)/3 I`.
 
 use super::SoftBody;
+use crate::element::Elements;
 use crate::fvm::gather;
 use crate::material::{HyperelasticModel, VolumetricTerm, with_hyperelastic_model};
-use rapier3d::glamx::DMat3;
+use crate::mesh::SUB_TETS;
+use rapier3d::glamx::{DMat3, DVec3};
+
+/// The barycentric coordinates of `point` (m) in the tetrahedron of corners `corners` at rest
+/// positions `rest`.
+fn barycentric(corners: &[u32], rest: &[DVec3], point: DVec3) -> [f64; 4] {
+    let p0 = rest[corners[0] as usize];
+    let edges = DMat3::from_cols(
+        rest[corners[1] as usize] - p0,
+        rest[corners[2] as usize] - p0,
+        rest[corners[3] as usize] - p0,
+    );
+    let l = edges.inverse() * (point - p0);
+    [1.0 - l.x - l.y - l.z, l.x, l.y, l.z]
+}
 
 impl SoftBody {
-    /// The Cauchy stress `σ = P Fᵀ / det F` (Pa) of every tetrahedron at the current positions,
-    /// in mesh order and world axes; symmetric for every model.
+    /// The Cauchy stress `σ = P Fᵀ / det F` (Pa) of every tetrahedron of [`SoftBody::mesh`] at
+    /// the current positions, in mesh order and world axes; symmetric for every model. For
+    /// quadratic elements, whose stress varies inside the element, each tetrahedron of the
+    /// subdivision gets the stress at its centroid.
     ///
     /// It is the elastic stress the internal forces come from: with
     /// [`VolumetricTreatment::NodalAverage`](crate::fvm::VolumetricTreatment::NodalAverage) it
@@ -23,31 +40,54 @@ impl SoftBody {
     /// elements with [`SoftBody::inverted_tet_count`].
     pub fn cauchy_stresses(&self) -> Vec<DMat3> {
         with_hyperelastic_model!(self.material, |model| {
-            let measures = self
-                .nodal_averaging
-                .as_ref()
-                .map(|averaging| averaging.measures(&model, &self.fvm, &self.positions));
-            let bulk = model.volumetric_modulus();
-            self.fvm
-                .tets()
-                .iter()
-                .enumerate()
-                .map(|(t, tet)| {
-                    let f = self.fvm.tet_rest(t).gradient(&gather(tet, &self.positions));
-                    let mut piola = model.first_piola(&f);
-                    if let Some(measures) = &measures {
-                        piola +=
-                            model.volume_measure_gradient(&f) * (bulk * measures.excess(tet, t));
-                    }
-                    let kirchhoff = piola * f.transpose();
-                    let volume_ratio = f.determinant();
-                    if volume_ratio > 0.0 {
-                        kirchhoff * volume_ratio.recip()
-                    } else {
-                        kirchhoff
-                    }
-                })
-                .collect()
+            let stress = |f: &DMat3, piola: DMat3| {
+                let kirchhoff = piola * f.transpose();
+                let volume_ratio = f.determinant();
+                if volume_ratio > 0.0 {
+                    kirchhoff * volume_ratio.recip()
+                } else {
+                    kirchhoff
+                }
+            };
+            match &self.elements {
+                Elements::Linear(fvm) => {
+                    let measures = self
+                        .nodal_averaging
+                        .as_ref()
+                        .map(|averaging| averaging.measures(&model, fvm, &self.positions));
+                    let bulk = model.volumetric_modulus();
+                    fvm.tets()
+                        .iter()
+                        .enumerate()
+                        .map(|(t, tet)| {
+                            let f = fvm.tet_rest(t).gradient(&gather(tet, &self.positions));
+                            let mut piola = model.first_piola(&f);
+                            if let Some(measures) = &measures {
+                                piola += model.volume_measure_gradient(&f)
+                                    * (bulk * measures.excess(tet, t));
+                            }
+                            stress(&f, piola)
+                        })
+                        .collect()
+                }
+                Elements::Quadratic(quadratic) => {
+                    let rest = self.mesh.positions();
+                    self.mesh
+                        .tets()
+                        .iter()
+                        .enumerate()
+                        .map(|(t, sub_tet)| {
+                            let element = t / SUB_TETS;
+                            let corners = &quadratic.elements()[element][..4];
+                            let centroid =
+                                sub_tet.iter().map(|&n| rest[n as usize]).sum::<DVec3>() * 0.25;
+                            let l = barycentric(corners, rest, centroid);
+                            let f = quadratic.gradient_at(element, rest, &self.positions, l);
+                            stress(&f, model.first_piola(&f))
+                        })
+                        .collect()
+                }
+            }
         })
     }
 

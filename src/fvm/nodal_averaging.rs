@@ -55,7 +55,7 @@ pub(crate) struct VolumeMeasures {
 
 impl VolumeMeasures {
     /// `θ̄_e - m_e` for tetrahedron `t` of `tets`: the element's share of the averaging.
-    pub(crate) fn excess(&self, tet: &[u32; 4], t: usize) -> f64 {
+    pub(crate) fn excess(&self, tet: &[u32], t: usize) -> f64 {
         0.25 * tet.iter().map(|&n| self.nodal[n as usize]).sum::<f64>() - self.element[t]
     }
 }

@@ -22,7 +22,8 @@ use crate::Error;
 use crate::assembly::Stiffness;
 use crate::body::{PreviousStep, SoftBody};
 use crate::damping::RayleighDamping;
-use crate::fvm::{gather, stress_forces};
+use crate::element::add_point_forces;
+use crate::element::tet10::deformation_gradient;
 use crate::linear_solver::{LinearSolver, Method, solve_newton_system};
 use crate::material::green_strain;
 use crate::newton::{check_tolerance, descend, norm};
@@ -338,9 +339,10 @@ impl StepStart {
             ImplicitScheme::BackwardEuler => None,
         };
         let green_at = |x: &[DVec3]| -> Vec<DMat3> {
-            let tets = body.fvm.tets();
-            (0..tets.len())
-                .map(|t| green_strain(&body.fvm.tet_rest(t).gradient(&gather(&tets[t], x))))
+            body.elements
+                .gradients(x)
+                .iter()
+                .map(green_strain)
                 .collect()
         };
         let damped = body.damping.is_some();
@@ -431,14 +433,12 @@ impl StepStart {
     }
 
     fn add_damping_forces(&self, body: &SoftBody, damping: &RayleighDamping, out: &mut [DVec3]) {
-        for (t, tet) in body.fvm.tets().iter().enumerate() {
-            let rest = body.fvm.tet_rest(t);
-            let f = rest.gradient(&gather(tet, &body.positions));
-            let stress = damping.step_first_piola(&f, &self.green[t], self.h);
-            for (&n, force) in tet.iter().zip(stress_forces(&rest, &stress)) {
-                out[n as usize] += force;
-            }
-        }
+        body.elements
+            .for_each_point(|point, nodes, gradients, weight| {
+                let f = deformation_gradient(nodes, gradients, &body.positions);
+                let stress = damping.step_first_piola(&f, &self.green[point], self.h);
+                add_point_forces(nodes, gradients, &(stress * weight), out);
+            });
     }
 
     /// The force scale the tolerance is relative to (N): the largest of gravity, the inertial
@@ -467,13 +467,16 @@ impl StepStart {
             .map(|(f, (x, x0))| f.dot(*x - *x0))
             .sum();
         let dissipation = match body.damping {
-            Some(damping) => (0..body.fvm.tets().len())
-                .map(|t| {
-                    let rest = body.fvm.tet_rest(t);
-                    let f = rest.gradient(&gather(&body.fvm.tets()[t], &body.positions));
-                    rest.volume * damping.step_potential(&f, &self.green[t], self.h)
-                })
-                .sum(),
+            Some(damping) => {
+                let mut dissipation = 0.0;
+                body.elements
+                    .for_each_point(|point, nodes, gradients, weight| {
+                        let f = deformation_gradient(nodes, gradients, &body.positions);
+                        dissipation +=
+                            weight * damping.step_potential(&f, &self.green[point], self.h);
+                    });
+                dissipation
+            }
             None => 0.0,
         };
         let mut penalty = 0.0;

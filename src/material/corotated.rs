@@ -91,30 +91,57 @@ impl HyperelasticModel for Corotated {
         (*f - r) * (2.0 * mu) + r * (lambda * (stretch_trace - 3.0))
     }
 
-    /// Uses the rotation's differential, `rotation_differential`.
+    /// Uses the rotation's differential, [`RotationDifferential`].
     fn first_piola_differential(&self, f: &DMat3, df: &DMat3) -> DMat3 {
+        self.first_piola_differentials(f, &[*df])[0]
+    }
+
+    /// Decomposes `F` once for all the changes.
+    fn first_piola_differentials<const N: usize>(&self, f: &DMat3, dfs: &[DMat3; N]) -> [DMat3; N] {
         let r = polar_rotation(f);
         let LameParameters { lambda, mu } = self.0;
-        let stretch_trace = trace(&(r.transpose() * *f));
-        let dr = rotation_differential(f, &r, df);
-        (*df - dr) * (2.0 * mu)
-            + r * (lambda * trace(&(r.transpose() * *df)))
-            + dr * (lambda * (stretch_trace - 3.0))
+        let rotation = RotationDifferential::new(f, &r);
+        dfs.each_ref().map(|df| {
+            let dr = rotation.apply(df);
+            (*df - dr) * (2.0 * mu)
+                + r * (lambda * trace(&(r.transpose() * *df)))
+                + dr * (lambda * (rotation.stretch_trace - 3.0))
+        })
     }
 }
 
-/// The differential `dR` of the polar rotation `r` of `f` for a change `df`:
+/// The differential `dR` of the polar rotation `R` of `F` for a change `dF`:
 /// `dR = R [w]x` with `w = (tr(S) I - S)⁻¹ axial(Rᵀ dF - dFᵀ R)` (`McAdams` et al. 2011); zero
 /// where that system is singular (two stretches summing to zero: a flattened or inverted element).
-pub(crate) fn rotation_differential(f: &DMat3, r: &DMat3, df: &DMat3) -> DMat3 {
-    let s = r.transpose() * *f;
-    let stretch_trace = trace(&s);
-    let rt_df = r.transpose() * *df;
-    let system = DMat3::IDENTITY * stretch_trace - s;
-    let w = if system.determinant().abs() > 1e-12 * stretch_trace.abs().powi(3) {
-        system.inverse() * axial(&(rt_df - rt_df.transpose()))
-    } else {
-        DVec3::ZERO
-    };
-    *r * cross_matrix(w)
+pub(crate) struct RotationDifferential {
+    rotation: DMat3,
+    /// `tr(S)`, `S = Rᵀ F` the stretch.
+    stretch_trace: f64,
+    /// `(tr(S) I - S)⁻¹`, or `None` where it is singular.
+    system_inverse: Option<DMat3>,
+}
+
+impl RotationDifferential {
+    /// The differential at `f`, whose polar rotation is `r`.
+    pub(crate) fn new(f: &DMat3, r: &DMat3) -> Self {
+        let s = r.transpose() * *f;
+        let stretch_trace = trace(&s);
+        let system = DMat3::IDENTITY * stretch_trace - s;
+        let system_inverse = (system.determinant().abs() > 1e-12 * stretch_trace.abs().powi(3))
+            .then(|| system.inverse());
+        Self {
+            rotation: *r,
+            stretch_trace,
+            system_inverse,
+        }
+    }
+
+    /// `dR` for the change `df`.
+    pub(crate) fn apply(&self, df: &DMat3) -> DMat3 {
+        let Some(inverse) = self.system_inverse else {
+            return DMat3::ZERO;
+        };
+        let rt_df = self.rotation.transpose() * *df;
+        self.rotation * cross_matrix(inverse * axial(&(rt_df - rt_df.transpose())))
+    }
 }

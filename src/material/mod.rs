@@ -34,6 +34,14 @@ pub trait HyperelasticModel: Copy + Send + Sync {
     /// Differential of the stress, `dP = (∂P/∂F) : dF` (Pa), for a change `df` of `F`.
     fn first_piola_differential(&self, f: &DMat3, df: &DMat3) -> DMat3;
 
+    /// [`HyperelasticModel::first_piola_differential`] for several changes `dfs` at one `F` (the
+    /// columns of the stress tangent). The default evaluates them one by one; models whose
+    /// differential needs an expensive factorization of `F` override it to do that once.
+    fn first_piola_differentials<const N: usize>(&self, f: &DMat3, dfs: &[DMat3; N]) -> [DMat3; N] {
+        dfs.each_ref()
+            .map(|df| self.first_piola_differential(f, df))
+    }
+
     /// `P(F) + F S_extra` (Pa) in four lanes at once: the stress plus the first Piola–Kirchhoff
     /// form of an extra second Piola–Kirchhoff stress (the damping stress). The default evaluates
     /// the lanes one by one with the scalar methods; models with short branch-free formulas

@@ -22,7 +22,7 @@
 //! incompressible bodies with nodal averaging should be damped in shear only (`φ = 0`), or their
 //! bending modes are over-damped.
 
-use super::corotated::{polar_rotation, rotation_differential};
+use super::corotated::{RotationDifferential, polar_rotation};
 use super::neo_hookean::{cofactor, cofactor_differential};
 use super::{
     Corotated, HyperelasticModel, LameParameters, LinearElastic, StVenantKirchhoff,
@@ -103,7 +103,7 @@ impl VolumetricTerm for Corotated {
     }
 
     fn volume_measure_differential(&self, f: &DMat3, df: &DMat3) -> DMat3 {
-        rotation_differential(f, &polar_rotation(f), df)
+        RotationDifferential::new(f, &polar_rotation(f)).apply(df)
     }
 
     fn energy_density_without_volumetric(&self, f: &DMat3) -> f64 {

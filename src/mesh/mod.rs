@@ -8,9 +8,12 @@
 mod generators;
 mod hex_mesher;
 pub mod import;
+mod quadratic;
 mod surface;
 
 pub use generators::{cuboid, cylinder, sphere};
+pub use quadratic::QuadraticTetMesh;
+pub(crate) use quadratic::SUB_TETS;
 
 use crate::Error;
 use rapier3d::glamx::DVec3;
@@ -197,7 +200,9 @@ fn min_tet_altitude(positions: &[DVec3], tet: &[u32; 4]) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
-fn validate_topology(positions: &[DVec3], tets: &[[u32; 4]]) -> Result<(), Error> {
+/// Checks that the mesh is not empty, its coordinates finite, and every element of `N` nodes
+/// refers to existing, distinct nodes, with every node used.
+fn validate_topology<const N: usize>(positions: &[DVec3], tets: &[[u32; N]]) -> Result<(), Error> {
     if positions.is_empty() || tets.is_empty() {
         return Err(Error::EmptyMesh {
             nodes: positions.len(),
@@ -219,7 +224,7 @@ fn validate_topology(positions: &[DVec3], tets: &[[u32; 4]]) -> Result<(), Error
                 node_count: positions.len(),
             });
         }
-        for i in 0..4 {
+        for i in 0..N {
             if nodes[i + 1..].contains(&nodes[i]) {
                 return Err(Error::RepeatedNode {
                     tet,
