@@ -171,7 +171,8 @@ fn malformed_gmsh_files_name_the_line_and_the_defect() {
             FileLocation::Line(line + 1)
         )
     );
-    // A quadratic tetrahedron: element type 11 with 10 nodes.
+    // A quadratic tetrahedron (element type 11, 10 nodes) first, then linear ones: the first
+    // linear one is named.
     let mut quadratic = lines.clone();
     let fields: Vec<&str> = text.lines().nth(line).unwrap().split(' ').collect();
     quadratic[line] = format!(
@@ -184,14 +185,15 @@ fn malformed_gmsh_files_name_the_line_and_the_defect() {
             .collect::<Vec<_>>()
             .join(" ")
     );
-    let (kind, at, _) = kind_and_location(parse(&quadratic.join("\n")));
+    let (kind, at, message) = kind_and_location(parse(&quadratic.join("\n")));
     assert_eq!(
         (kind, at),
         (
             ImportErrorKind::UnsupportedElement,
-            FileLocation::Line(line + 1)
+            FileLocation::Line(line + 2)
         )
     );
+    assert!(message.contains("mixed"), "{message}");
     // A hexahedron among the tetrahedra.
     let mut hex = lines.clone();
     hex[line] = format!("{} 5 2 1 1 1 2 3 4 5 6 7 8", fields[0]);
@@ -804,4 +806,47 @@ fn an_obj_surface_split_into_groups_stays_closed() {
     assert_eq!(surface.vertices.len(), 4);
     assert_eq!(surface.triangles.len(), 4);
     assert!((surface.enclosed_volume() - 1.0 / 6.0).abs() < 1e-15);
+}
+
+/// A Gmsh 2.2 file of second-order tetrahedra (type 11, Gmsh's node order, in millimetres, one
+/// element written clockwise) loads as the quadratic mesh it was written from: same nodes, same
+/// elements in VTK order, the clockwise one re-oriented; `load` gives its subdivision.
+#[test]
+fn gmsh_quadratic_tetrahedra_load_as_quadratic_meshes() {
+    use rapier_fvm::mesh::QuadraticTetMesh;
+    let linear = rapier_fvm::mesh::cuboid(DVec3::new(0.2, 0.1, 0.1), [2, 1, 1]).unwrap();
+    let written = QuadraticTetMesh::from_linear(&linear).unwrap();
+    let mut text = String::from("$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n");
+    text += &format!("{}\n", written.node_count());
+    for (n, p) in written.positions().iter().enumerate() {
+        let mm = *p * 1000.0;
+        text += &format!("{} {} {} {}\n", n + 1, mm.x, mm.y, mm.z);
+    }
+    text += &format!("$EndNodes\n$Elements\n{}\n", written.element_count());
+    for (e, element) in written.elements().iter().enumerate() {
+        // VTK order to Gmsh's: the last two mid-edge nodes swap.
+        let mut gmsh = [0, 1, 2, 3, 4, 5, 6, 7, 9, 8].map(|k| element[k] + 1);
+        if e == 0 {
+            // Clockwise: corners 2 and 3 swapped, with their edges.
+            gmsh = [0, 1, 3, 2, 4, 9, 7, 6, 8, 5].map(|k| gmsh[k]);
+        }
+        let nodes: Vec<String> = gmsh.iter().map(u32::to_string).collect();
+        text += &format!("{} 11 2 1 1 {}\n", e + 1, nodes.join(" "));
+    }
+    text += "$EndElements\n";
+    let raw = gmsh::parse(text.as_bytes(), "quadratic.msh", 0.001).unwrap();
+    assert_eq!(raw.mid_edge_nodes.len(), written.element_count());
+    let read = raw.clone().into_quadratic_mesh().unwrap();
+    assert_eq!(read.node_count(), written.node_count());
+    // Nodes are renumbered in order of first use; the elements' node positions are the written
+    // ones, element 0 included (re-oriented back).
+    for (r, w) in read.elements().iter().zip(written.elements()) {
+        for (a, b) in r.iter().zip(w) {
+            let (pa, pb) = (read.positions()[*a as usize], written.positions()[*b as usize]);
+            assert!(pa.distance(pb) < 1e-15, "{pa} vs {pb}");
+        }
+    }
+    let subdivided = raw.into_mesh().unwrap();
+    assert_eq!(subdivided.tet_count(), 8 * written.element_count());
+    assert!((subdivided.volume() - 0.4 * 0.2 * 0.2).abs() < 1e-15);
 }

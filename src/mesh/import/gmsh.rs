@@ -1,8 +1,9 @@
 //! Gmsh `.msh` files, versions 2.2 and 4.1, ASCII and binary.
 //!
-//! Linear tetrahedra (element type 4) are read; points, lines, triangles and quadrangles
-//! (boundary and geometry elements Gmsh saves beside the volume) are skipped; other volume
-//! elements, quadratic tetrahedra (type 11) among them, are an
+//! Linear tetrahedra (element type 4) and quadratic ones (type 11, `gmsh -order 2`; their
+//! mid-edge nodes go to [`RawMesh::mid_edge_nodes`]) are read; points, lines, triangles and
+//! quadrangles (boundary and geometry elements Gmsh saves beside the volume) are skipped; other
+//! volume elements, and linear and quadratic tetrahedra mixed in one file, are an
 //! [`ImportErrorKind::UnsupportedElement`] error, since dropping them would silently lose
 //! material. Sections other than `$MeshFormat`, `$Nodes` and `$Elements` are skipped.
 //!
@@ -87,6 +88,7 @@ pub fn parse(data: &[u8], path: &str, scale: f64) -> Result<RawMesh, Error> {
         node_index: HashMap::new(),
         positions: Vec::new(),
         tets: Vec::new(),
+            mid_edge_tags: Vec::new(),
     };
     let mut saw_nodes = false;
     while let Some(line) = source.line()? {
@@ -241,6 +243,8 @@ struct Reader {
     positions: Vec<DVec3>,
     /// Tetrahedra as node tags, with where they were read.
     tets: Vec<([u64; 4], FileLocation)>,
+    /// The mid-edge node tags of quadratic tetrahedra, in Gmsh's order, one per tetrahedron.
+    mid_edge_tags: Vec<[u64; 6]>,
 }
 
 impl Reader {
@@ -269,18 +273,29 @@ impl Reader {
         element_type: u32,
         nodes: &[u64],
     ) -> Result<(), Error> {
-        match element_type {
-            TETRAHEDRON => {
-                self.tets
-                    .push(([nodes[0], nodes[1], nodes[2], nodes[3]], location));
-                Ok(())
-            }
-            QUADRATIC_TETRAHEDRON => Err(source.error_at(
+        let quadratic = element_type == QUADRATIC_TETRAHEDRON;
+        if matches!(element_type, TETRAHEDRON | QUADRATIC_TETRAHEDRON)
+            && !self.tets.is_empty()
+            && quadratic == self.mid_edge_tags.is_empty()
+        {
+            return Err(source.error_at(
                 location,
                 ImportErrorKind::UnsupportedElement,
-                "quadratic (10-node) tetrahedra, element type 11, are not supported: mesh with \
-                 first-order elements (gmsh -order 1)",
-            )),
+                "linear (type 4) and quadratic (type 11) tetrahedra mixed in one mesh",
+            ));
+        }
+        match element_type {
+            TETRAHEDRON | QUADRATIC_TETRAHEDRON => {
+                self.tets
+                    .push(([nodes[0], nodes[1], nodes[2], nodes[3]], location));
+                if quadratic {
+                    // Gmsh numbers the edges (0,1) (1,2) (0,2) (0,3) (2,3) (1,3); the last two
+                    // are swapped into VTK's order.
+                    self.mid_edge_tags
+                        .push([nodes[4], nodes[5], nodes[6], nodes[7], nodes[9], nodes[8]]);
+                }
+                Ok(())
+            }
             _ => match element_shape(element_type) {
                 Some((_, 3)) => Err(source.error_at(
                     location,
@@ -646,30 +661,41 @@ impl Reader {
             return Err(source.error_at(
                 FileLocation::Whole,
                 ImportErrorKind::NoTetrahedra,
-                "the file holds no tetrahedra (element type 4)",
+                "the file holds no tetrahedra (element type 4 or 11)",
             ));
         }
+        let index = |tag: &u64, location: FileLocation| {
+            self.node_index.get(tag).copied().ok_or_else(|| {
+                source.error_at(
+                    location,
+                    ImportErrorKind::IndexOutOfRange,
+                    format!("the tetrahedron refers to node {tag}, which is not defined"),
+                )
+            })
+        };
         let mut tets = Vec::with_capacity(self.tets.len());
         let mut tet_locations = Vec::with_capacity(self.tets.len());
-        for (tags, location) in self.tets {
+        for (tags, location) in &self.tets {
             let mut tet = [0u32; 4];
             for (corner, tag) in tags.iter().enumerate() {
-                let Some(&index) = self.node_index.get(tag) else {
-                    return Err(source.error_at(
-                        location,
-                        ImportErrorKind::IndexOutOfRange,
-                        format!("the tetrahedron refers to node {tag}, which is not defined"),
-                    ));
-                };
-                tet[corner] = index;
+                tet[corner] = index(tag, *location)?;
             }
             tets.push(tet);
-            tet_locations.push(location);
+            tet_locations.push(*location);
+        }
+        let mut mid_edge_nodes = Vec::with_capacity(self.mid_edge_tags.len());
+        for (tags, (_, location)) in self.mid_edge_tags.iter().zip(&self.tets) {
+            let mut mids = [0u32; 6];
+            for (k, tag) in tags.iter().enumerate() {
+                mids[k] = index(tag, *location)?;
+            }
+            mid_edge_nodes.push(mids);
         }
         Ok(RawMesh {
             path: source.path().to_owned(),
             positions: self.positions,
             tets,
+            mid_edge_nodes,
             tet_locations,
         })
     }

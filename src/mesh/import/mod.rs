@@ -54,7 +54,7 @@ pub use quality::{QualityReport, check};
 pub use surface::SurfaceOptions;
 
 use crate::Error;
-use crate::mesh::TetMesh;
+use crate::mesh::{QuadraticTetMesh, TetMesh};
 use rapier3d::glamx::DVec3;
 use std::path::Path;
 
@@ -67,15 +67,22 @@ pub struct RawMesh {
     pub path: String,
     /// Node positions (m).
     pub positions: Vec<DVec3>,
-    /// Tetrahedra, four indices into `positions` each, in file order.
+    /// Tetrahedra, four indices into `positions` each (the corners), in file order.
     pub tets: Vec<[u32; 4]>,
+    /// For a mesh of quadratic tetrahedra, the six mid-edge nodes of each (indices into
+    /// `positions`, VTK's edge order `(0,1) (1,2) (0,2) (0,3) (1,3) (2,3)`); empty for linear
+    /// ones.
+    pub mid_edge_nodes: Vec<[u32; 6]>,
     /// Where each tetrahedron was defined in the file (same length as `tets`).
     pub tet_locations: Vec<FileLocation>,
 }
 
 impl RawMesh {
     /// The validated mesh: nodes that no tetrahedron uses are dropped and the others renumbered
-    /// in their order of first use, inverted tetrahedra are re-oriented.
+    /// in their order of first use, inverted tetrahedra are re-oriented. A mesh of quadratic
+    /// tetrahedra becomes their [subdivision](QuadraticTetMesh::subdivided) into linear ones on
+    /// all its nodes, which keeps every node and the curved shape; read it with
+    /// [`RawMesh::into_quadratic_mesh`] to simulate the quadratic elements themselves.
     ///
     /// # Errors
     /// [`Error::MeshImport`] of kind [`ImportErrorKind::NoTetrahedra`] for a mesh without
@@ -83,35 +90,73 @@ impl RawMesh {
     /// [`ImportErrorKind::InvalidMesh`] naming the element's place in the file when
     /// [`TetMesh::new_reoriented`] rejects it (a degenerate or repeated-node tetrahedron).
     pub fn into_mesh(self) -> Result<TetMesh, Error> {
-        let error = |location, kind, message: String| Error::MeshImport {
-            path: self.path.clone(),
-            location,
-            kind,
-            message,
-        };
-        if self.tets.is_empty() {
-            return Err(error(
+        if !self.mid_edge_nodes.is_empty() {
+            return Ok(self.into_quadratic_mesh()?.subdivided().clone());
+        }
+        let (positions, tets) = self.renumbered(&self.tets)?;
+        match TetMesh::new_reoriented(positions, tets) {
+            Ok((mesh, _flipped)) => Ok(mesh),
+            Err(e) => Err(self.invalid(e)),
+        }
+    }
+
+    /// The validated mesh of quadratic tetrahedra: the file's own for a quadratic mesh (nodes
+    /// renumbered and inverted elements re-oriented as by [`RawMesh::into_mesh`]), or a linear
+    /// mesh elevated by [`QuadraticTetMesh::from_linear`].
+    ///
+    /// # Errors
+    /// Those of [`RawMesh::into_mesh`], and [`ImportErrorKind::InvalidMesh`] naming the
+    /// element's place in the file when [`QuadraticTetMesh::new`] rejects it (a mid-edge node
+    /// shared inconsistently, or an element folded by its mid-edge nodes).
+    pub fn into_quadratic_mesh(self) -> Result<QuadraticTetMesh, Error> {
+        if self.mid_edge_nodes.is_empty() {
+            return QuadraticTetMesh::from_linear(&self.into_mesh()?);
+        }
+        let elements: Vec<[u32; 10]> = self
+            .tets
+            .iter()
+            .zip(&self.mid_edge_nodes)
+            .map(|(corners, mids)| {
+                let mut element = [0; 10];
+                element[..4].copy_from_slice(corners);
+                element[4..].copy_from_slice(mids);
+                element
+            })
+            .collect();
+        let (positions, mut elements) = self.renumbered(&elements)?;
+        for element in &mut elements {
+            let corners = [element[0], element[1], element[2], element[3]];
+            if crate::mesh::signed_volume(&positions, &corners) < 0.0 {
+                // Swapping corners 2 and 3 exchanges the edges (1,2) <-> (1,3) and
+                // (0,2) <-> (0,3).
+                *element = [0, 1, 3, 2, 4, 8, 7, 6, 5, 9].map(|k| element[k]);
+            }
+        }
+        QuadraticTetMesh::new(positions, elements).map_err(|e| self.invalid(e))
+    }
+
+    /// The nodes `elements` use, in order of first use, and the elements renumbered to them.
+    fn renumbered<const N: usize>(
+        &self,
+        elements: &[[u32; N]],
+    ) -> Result<(Vec<DVec3>, Vec<[u32; N]>), Error> {
+        if elements.is_empty() {
+            return Err(self.error(
                 FileLocation::Whole,
                 ImportErrorKind::NoTetrahedra,
                 "the file holds no tetrahedra".into(),
             ));
         }
-        let location = |tet: usize| {
-            self.tet_locations
-                .get(tet)
-                .copied()
-                .unwrap_or(FileLocation::Whole)
-        };
         const UNUSED: u32 = u32::MAX;
         let mut new_index = vec![UNUSED; self.positions.len()];
         let mut positions = Vec::new();
-        let mut tets = Vec::with_capacity(self.tets.len());
-        for (t, tet) in self.tets.iter().enumerate() {
-            let mut renumbered = [0; 4];
-            for (corner, &node) in tet.iter().enumerate() {
+        let mut renumbered = Vec::with_capacity(elements.len());
+        for (t, element) in elements.iter().enumerate() {
+            let mut nodes = [0; N];
+            for (k, &node) in element.iter().enumerate() {
                 let Some(slot) = new_index.get_mut(node as usize) else {
-                    return Err(error(
-                        location(t),
+                    return Err(self.error(
+                        self.location(t),
                         ImportErrorKind::IndexOutOfRange,
                         format!(
                             "tetrahedron {t} refers to node {node}, but there are {} nodes",
@@ -123,22 +168,40 @@ impl RawMesh {
                     *slot = positions.len() as u32;
                     positions.push(self.positions[node as usize]);
                 }
-                renumbered[corner] = *slot;
+                nodes[k] = *slot;
             }
-            tets.push(renumbered);
+            renumbered.push(nodes);
         }
-        match TetMesh::new_reoriented(positions, tets) {
-            Ok((mesh, _flipped)) => Ok(mesh),
-            Err(e) => {
-                let at = match e {
-                    Error::DegenerateTet { tet, .. } | Error::RepeatedNode { tet, .. } => {
-                        location(tet)
-                    }
-                    _ => FileLocation::Whole,
-                };
-                Err(error(at, ImportErrorKind::InvalidMesh, e.to_string()))
-            }
+        Ok((positions, renumbered))
+    }
+
+    /// Where tetrahedron `tet` was defined in the file.
+    fn location(&self, tet: usize) -> FileLocation {
+        self.tet_locations
+            .get(tet)
+            .copied()
+            .unwrap_or(FileLocation::Whole)
+    }
+
+    fn error(&self, location: FileLocation, kind: ImportErrorKind, message: String) -> Error {
+        Error::MeshImport {
+            path: self.path.clone(),
+            location,
+            kind,
+            message,
         }
+    }
+
+    /// [`ImportErrorKind::InvalidMesh`] for a validation error, at the element it names.
+    fn invalid(&self, e: Error) -> Error {
+        let at = match e {
+            Error::DegenerateTet { tet, .. }
+            | Error::RepeatedNode { tet, .. }
+            | Error::InvertedTet { tet, .. }
+            | Error::NonConformingEdge { tet, .. } => self.location(tet),
+            _ => FileLocation::Whole,
+        };
+        self.error(at, ImportErrorKind::InvalidMesh, e.to_string())
     }
 }
 
@@ -244,6 +307,20 @@ pub fn load(
     surface_options: &SurfaceOptions,
 ) -> Result<TetMesh, Error> {
     load_raw(path, scale, surface_options)?.into_mesh()
+}
+
+/// Reads the mesh file at `path` as quadratic tetrahedra: [`load_raw`] then
+/// [`RawMesh::into_quadratic_mesh`] (a Gmsh file of second-order tetrahedra keeps its own
+/// mid-edge nodes; a linear mesh gets them at its edges' midpoints).
+///
+/// # Errors
+/// Those of [`load_raw`] and [`RawMesh::into_quadratic_mesh`].
+pub fn load_quadratic(
+    path: impl AsRef<Path>,
+    scale: f64,
+    surface_options: &SurfaceOptions,
+) -> Result<QuadraticTetMesh, Error> {
+    load_raw(path, scale, surface_options)?.into_quadratic_mesh()
 }
 
 /// The whole file at `path`, or [`Error::Io`].

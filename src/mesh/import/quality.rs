@@ -112,6 +112,7 @@ pub fn check(positions: &[DVec3], tets: &[[u32; 4]], material: &Material) -> Qua
             path: String::new(),
             positions: positions.to_vec(),
             tets: tets.to_vec(),
+            mid_edge_nodes: Vec::new(),
             tet_locations: Vec::new(),
         };
         if let Ok(body) = raw

@@ -460,6 +460,7 @@ pub fn fill(surface: &Surface, options: &SurfaceOptions) -> Result<RawMesh, Erro
     Ok(RawMesh {
         path: surface.path.clone(),
         positions: used,
+        mid_edge_nodes: Vec::new(),
         tet_locations: vec![FileLocation::Whole; tets.len()],
         tets,
     })

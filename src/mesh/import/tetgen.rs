@@ -113,6 +113,7 @@ pub fn parse(
         path: ele_path.to_owned(),
         positions,
         tets,
+        mid_edge_nodes: Vec::new(),
         tet_locations,
     })
 }

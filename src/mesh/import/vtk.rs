@@ -154,6 +154,7 @@ fn build(
         path: source.path().to_owned(),
         positions,
         tets,
+        mid_edge_nodes: Vec::new(),
         tet_locations,
     })
 }
