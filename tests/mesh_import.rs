@@ -842,7 +842,10 @@ fn gmsh_quadratic_tetrahedra_load_as_quadratic_meshes() {
     // ones, element 0 included (re-oriented back).
     for (r, w) in read.elements().iter().zip(written.elements()) {
         for (a, b) in r.iter().zip(w) {
-            let (pa, pb) = (read.positions()[*a as usize], written.positions()[*b as usize]);
+            let (pa, pb) = (
+                read.positions()[*a as usize],
+                written.positions()[*b as usize],
+            );
             assert!(pa.distance(pb) < 1e-15, "{pa} vs {pb}");
         }
     }

@@ -357,3 +357,61 @@ fn non_conforming_quadratic_mesh_is_refused() {
 fn elements_corner(mesh: &mesh::QuadraticTetMesh, element: usize, corner: usize) -> u32 {
     mesh.elements()[element][corner]
 }
+
+/// Contacts act on the quadratic body's own nodes (the surface of its subdivision), so a
+/// quadratic cube dropped into a rapier world comes to rest on the ground collider with the
+/// ground's reaction equal to its weight (1 %, the coupling tests' bound) and no node below the
+/// ground by more than 1 mm (the contact margin's scale).
+#[test]
+fn a_quadratic_cube_rests_on_a_rapier_ground() {
+    use rapier_fvm::glamx::Vec3;
+    use rapier_fvm::world::FvmWorld;
+    use rapier3d::prelude::{ColliderBuilder, SharedShape};
+
+    let mut world = FvmWorld::default();
+    let ground = world
+        .physics
+        .insert_collider(ColliderBuilder::new(SharedShape::halfspace(Vec3::Y)), None);
+    let material = Material::new(MaterialModel::StableNeoHookean, 1e5, 0.3, 1000.0).unwrap();
+    let linear = mesh::cuboid(DVec3::splat(0.1), [2, 2, 2]).unwrap();
+    let cube = SoftBodyBuilder::quadratic(
+        mesh::QuadraticTetMesh::from_linear(&linear).unwrap(),
+        material,
+    )
+    .damping(RayleighDamping::stiffness_proportional(0.01, material.lame()).unwrap())
+    .translation(DVec3::new(0.0, 0.15, 0.0))
+    .build()
+    .unwrap();
+    let cube = world.soft_bodies.insert(cube);
+    let h = f64::from(world.physics.integration_parameters.dt) / f64::from(world.coupling_substeps);
+    for _ in 0..150 {
+        for (_, outcome) in world.step() {
+            outcome.unwrap();
+        }
+    }
+    let (mut reaction, frames) = (0.0, 60);
+    for _ in 0..frames {
+        for (_, outcome) in world.step() {
+            outcome.unwrap();
+        }
+        reaction += -world.soft_bodies[cube]
+            .contact_force_on(ground, h)
+            .unwrap()
+            .0
+            .y;
+    }
+    let body = &world.soft_bodies[cube];
+    let weight = body.total_mass() * 9.81;
+    let reaction = reaction / f64::from(frames);
+    let lowest = body
+        .positions()
+        .iter()
+        .map(|x| x.y)
+        .fold(f64::INFINITY, f64::min);
+    println!(
+        "quadratic cube: reaction {reaction:.4} N vs weight {weight:.4} N, lowest node {:.3} mm",
+        lowest * 1e3
+    );
+    assert!((reaction / weight - 1.0).abs() < 0.01);
+    assert!(lowest > -1e-3);
+}

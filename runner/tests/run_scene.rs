@@ -26,6 +26,7 @@ fn out_dir(test: &str) -> PathBuf {
 fn every_shipped_scene_parses_and_builds() {
     let names = [
         "cantilever.toml",
+        "cantilever_quadratic.toml",
         "drop.toml",
         "rigid_on_soft.toml",
         "grasp.toml",

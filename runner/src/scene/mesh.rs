@@ -14,7 +14,7 @@
 use super::check::Checker;
 use super::error::{SceneError, SceneSource};
 use rapier_fvm::glamx::DVec3;
-use rapier_fvm::mesh::{self, TetMesh, import};
+use rapier_fvm::mesh::{self, QuadraticTetMesh, TetMesh, import};
 use serde::Deserialize;
 
 /// Where a soft body's mesh comes from.
@@ -125,6 +125,38 @@ impl MeshSpec {
         }
     }
 
+    /// Builds the mesh as quadratic tetrahedra: a Gmsh file of second-order tetrahedra keeps its
+    /// own mid-edge nodes, any other mesh gets them at its edges' midpoints.
+    ///
+    /// # Errors
+    /// A [`SceneError`] at `key` naming the generator's or the file's problem.
+    pub fn build_quadratic(
+        &self,
+        key: &str,
+        source: &SceneSource,
+    ) -> Result<QuadraticTetMesh, SceneError> {
+        let result = match &self.file {
+            Some(file) => import::load_quadratic(
+                source.folder().join(file),
+                self.scale.unwrap_or(1.0),
+                &self.surface_options(),
+            )
+            .map_err(|e| (format!("{key}.file"), e.to_string())),
+            None => QuadraticTetMesh::from_linear(&self.build(key, source)?)
+                .map_err(|e| (key.to_owned(), e.to_string())),
+        };
+        result.map_err(|(key, message)| source.error(&key, message))
+    }
+
+    /// How a surface file is filled.
+    fn surface_options(&self) -> import::SurfaceOptions {
+        import::SurfaceOptions {
+            cells_across: self
+                .cells_across
+                .unwrap_or(import::SurfaceOptions::default().cells_across),
+        }
+    }
+
     /// Builds the mesh (rest positions in m); files are resolved from the scene's folder.
     ///
     /// # Errors
@@ -140,15 +172,10 @@ impl MeshSpec {
             mesh::sphere(s.radius, s.cells_across)
                 .map_err(|e| (format!("{key}.sphere"), e.to_string()))
         } else if let Some(file) = &self.file {
-            let options = import::SurfaceOptions {
-                cells_across: self
-                    .cells_across
-                    .unwrap_or(import::SurfaceOptions::default().cells_across),
-            };
             import::load(
                 source.folder().join(file),
                 self.scale.unwrap_or(1.0),
-                &options,
+                &self.surface_options(),
             )
             .map_err(|e| (format!("{key}.file"), e.to_string()))
         } else {

@@ -13,6 +13,7 @@
 //! friction = 0.5                  # default 0.5
 //! self_contact = false            # default false
 //! volumetric = "per_element"      # or "nodal_average" (nearly incompressible), default per_element
+//! elements = "linear"             # or "quadratic" (10-node tetrahedra, accurate in bending)
 //! pinned = [{ min = [-0.51, -1, -1], max = [-0.49, 1, 1] }]         # boxes in rest coordinates
 //! attach = [{ rigid = "ball", min = [-1, -0.26, -1], max = [1, -0.24, 1] }]
 //! ```
@@ -56,6 +57,9 @@ pub struct SoftBodySpec {
     /// How the volumetric energy is evaluated; default per element.
     #[serde(default)]
     pub volumetric: VolumetricSpec,
+    /// The element order; default linear.
+    #[serde(default)]
+    pub elements: ElementsSpec,
     /// Regions whose nodes are held fixed.
     #[serde(default)]
     pub pinned: Vec<RegionSpec>,
@@ -77,6 +81,17 @@ pub enum VolumetricSpec {
     PerElement,
     /// Averaged over each node's tetrahedra (against locking at ν near 0.5).
     NodalAverage,
+}
+
+/// The order of a soft body's tetrahedra.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ElementsSpec {
+    /// 4-node tetrahedra.
+    #[default]
+    Linear,
+    /// 10-node tetrahedra: the mesh's, or mid-edge nodes added to it.
+    Quadratic,
 }
 
 /// A box of rest coordinates (m).

@@ -3,7 +3,7 @@
 
 use super::probe::Probe;
 use crate::scene::rigid_body::{RigidBodySpec, RigidKind, ShapeSpec};
-use crate::scene::soft_body::{SoftBodySpec, VolumetricSpec};
+use crate::scene::soft_body::{ElementsSpec, SoftBodySpec, VolumetricSpec};
 use crate::scene::{Scene, SceneError, SceneSource};
 use rapier_fvm::body::{SoftBodyBuilder, SoftBodyHandle};
 use rapier_fvm::fvm::VolumetricTreatment;
@@ -202,7 +202,14 @@ fn insert_soft(
     key: &str,
     source: &SceneSource,
 ) -> Result<SoftEntry, SceneError> {
-    let mesh = spec.mesh.build(&format!("{key}.mesh"), source)?;
+    let mesh_key = format!("{key}.mesh");
+    let (mesh, quadratic) = match spec.elements {
+        ElementsSpec::Linear => (spec.mesh.build(&mesh_key, source)?, None),
+        ElementsSpec::Quadratic => {
+            let quadratic = spec.mesh.build_quadratic(&mesh_key, source)?;
+            (quadratic.subdivided().clone(), Some(quadratic))
+        }
+    };
     let library = |key: String| move |e: rapier_fvm::Error| source.error(&key, e.to_string());
     let material = spec
         .material
@@ -229,7 +236,11 @@ fn insert_soft(
             .ok_or_else(|| source.error(&format!("{at}.rigid"), "no such rigid body"))?;
         attachments.push((nodes, body.handle, at));
     }
-    let mut builder = SoftBodyBuilder::new(mesh, material)
+    let builder = match quadratic {
+        Some(quadratic) => SoftBodyBuilder::quadratic(quadratic, material),
+        None => SoftBodyBuilder::new(mesh, material),
+    };
+    let mut builder = builder
         .translation(DVec3::from_array(spec.translation))
         .rotation(DVec3::from_array(spec.rotation))
         .linvel(DVec3::from_array(spec.linvel))

@@ -88,7 +88,7 @@ pub fn parse(data: &[u8], path: &str, scale: f64) -> Result<RawMesh, Error> {
         node_index: HashMap::new(),
         positions: Vec::new(),
         tets: Vec::new(),
-            mid_edge_tags: Vec::new(),
+        mid_edge_tags: Vec::new(),
     };
     let mut saw_nodes = false;
     while let Some(line) = source.line()? {
