@@ -117,13 +117,18 @@ impl Stiffness {
                 _ => None,
             };
             let measures = averaging.map(|(a, fvm)| a.measures(&model, fvm, x));
+            let excesses = body.elements.volumetric_excesses(&model, x);
             body.elements
                 .for_each_point(|point, nodes, gradients, weight| {
                     let f = deformation_gradient(nodes, gradients, x);
                     let changes = unit_changes();
-                    let elastic = match &measures {
-                        Some(m) => changes.map(|df| {
-                            let excess = m.excess(nodes, point);
+                    let excess = match (&measures, &excesses) {
+                        (Some(m), _) => Some(m.excess(nodes, point)),
+                        (_, Some(excesses)) => Some(excesses[point]),
+                        _ => None,
+                    };
+                    let elastic = match excess {
+                        Some(excess) => changes.map(|df| {
                             NodalAveraging::element_differential(&model, &f, excess, &df)
                         }),
                         None => model.first_piola_differentials(&f, &changes),
@@ -140,6 +145,10 @@ impl Stiffness {
                     self.add_outer(gradient, weight, &body.pinned)
                 });
             }
+            body.elements
+                .for_each_volumetric_coupling(&model, x, |gradient, weight| {
+                    self.add_outer(gradient, weight, &body.pinned)
+                });
         });
         for (node, &pinned) in body.pinned.iter().enumerate() {
             for i in 0..3 {

@@ -121,8 +121,9 @@ impl SoftBodyBuilder {
     }
 
     /// How the volumetric part of the energy is evaluated; default per element. Choose
-    /// [`VolumetricTreatment::NodalAverage`] for nearly incompressible materials (`ν` above
-    /// about 0.45), whose linear tetrahedra otherwise lock.
+    /// [`VolumetricTreatment::NodalAverage`] for linear tetrahedra and
+    /// [`VolumetricTreatment::ElementAverage`] for quadratic ones of nearly incompressible
+    /// materials (`ν` above about 0.45), which otherwise lock.
     pub fn volumetric(mut self, treatment: VolumetricTreatment) -> Self {
         self.volumetric = treatment;
         self
@@ -299,7 +300,14 @@ impl SoftBodyBuilder {
                     .into_iter()
                     .map(|volume| volume * self.material.density())
                     .collect();
-                (Elements::Quadratic(elements), masses)
+                let mean_dilatation = self.volumetric == VolumetricTreatment::ElementAverage;
+                (
+                    Elements::Quadratic {
+                        elements,
+                        mean_dilatation,
+                    },
+                    masses,
+                )
             }
         };
         let surface_triangles = self.mesh.surface_triangles();
@@ -317,14 +325,15 @@ impl SoftBodyBuilder {
         surface_nodes.sort_unstable();
         surface_nodes.dedup();
         let nodal_averaging = match (self.volumetric, &elements) {
-            (VolumetricTreatment::PerElement, _) => None,
+            (VolumetricTreatment::PerElement | VolumetricTreatment::ElementAverage, _) => None,
             (VolumetricTreatment::NodalAverage, Elements::Linear(fvm)) => {
                 Some(NodalAveraging::new(fvm))
             }
-            (VolumetricTreatment::NodalAverage, Elements::Quadratic(_)) => {
+            (VolumetricTreatment::NodalAverage, Elements::Quadratic { .. }) => {
                 return Err(Error::UnsupportedOption {
                     option: "VolumetricTreatment::NodalAverage",
-                    reason: "nodal averaging applies to linear tetrahedra",
+                    reason: "nodal averaging applies to linear tetrahedra; quadratic ones \
+                             average per element (VolumetricTreatment::ElementAverage)",
                 });
             }
         };

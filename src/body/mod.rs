@@ -122,10 +122,19 @@ impl SoftBody {
     }
 
     /// How the volumetric part of the energy is evaluated.
+    /// ([`VolumetricTreatment::ElementAverage`] on linear tetrahedra is reported as the
+    /// [`VolumetricTreatment::PerElement`] it amounts to.)
     pub fn volumetric_treatment(&self) -> VolumetricTreatment {
-        match self.nodal_averaging {
-            Some(_) => VolumetricTreatment::NodalAverage,
-            None => VolumetricTreatment::PerElement,
+        match (&self.nodal_averaging, &self.elements) {
+            (Some(_), _) => VolumetricTreatment::NodalAverage,
+            (
+                None,
+                Elements::Quadratic {
+                    mean_dilatation: true,
+                    ..
+                },
+            ) => VolumetricTreatment::ElementAverage,
+            _ => VolumetricTreatment::PerElement,
         }
     }
 

@@ -4,7 +4,7 @@
 //! `σ_vm = sqrt(3/2 s:s)`, `s = σ - tr(σ)/3 I`.
 
 use super::SoftBody;
-use crate::element::Elements;
+use crate::element::{Elements, mean_measure};
 use crate::fvm::gather;
 use crate::material::{HyperelasticModel, VolumetricTerm, with_hyperelastic_model};
 use crate::mesh::SUB_TETS;
@@ -70,8 +70,12 @@ impl SoftBody {
                         })
                         .collect()
                 }
-                Elements::Quadratic(quadratic) => {
+                Elements::Quadratic {
+                    elements: quadratic,
+                    mean_dilatation,
+                } => {
                     let rest = self.mesh.positions();
+                    let bulk = model.volumetric_modulus();
                     self.mesh
                         .tets()
                         .iter()
@@ -83,7 +87,14 @@ impl SoftBody {
                                 sub_tet.iter().map(|&n| rest[n as usize]).sum::<DVec3>() * 0.25;
                             let l = barycentric(corners, rest, centroid);
                             let f = quadratic.gradient_at(element, rest, &self.positions, l);
-                            stress(&f, model.first_piola(&f))
+                            let mut piola = model.first_piola(&f);
+                            if *mean_dilatation {
+                                let mean =
+                                    mean_measure(&model, quadratic, element, &self.positions);
+                                piola += model.volume_measure_gradient(&f)
+                                    * (bulk * (mean - model.volume_measure(&f)));
+                            }
+                            stress(&f, piola)
                         })
                         .collect()
                 }

@@ -9,11 +9,13 @@
 //! traction `P b_a` on node `a`'s control-volume boundary; a quadratic tetrahedron has four points
 //! (Galerkin quadrature, which the finite-volume form reduces to for linear elements).
 
+mod mean_dilatation;
 pub mod tet10;
 
 use crate::damping::RayleighDamping;
 use crate::fvm::FvmMesh;
-use crate::material::HyperelasticModel;
+use crate::material::VolumetricTerm;
+pub(crate) use mean_dilatation::mean_measure;
 use rapier3d::glamx::{DMat3, DVec3};
 use tet10::{QuadraticElements, deformation_gradient};
 
@@ -30,7 +32,11 @@ pub enum ElementOrder {
 #[derive(Debug, Clone)]
 pub(crate) enum Elements {
     Linear(FvmMesh),
-    Quadratic(QuadraticElements),
+    Quadratic {
+        elements: QuadraticElements,
+        /// Whether the volumetric term is averaged per element ([`mean_dilatation`]).
+        mean_dilatation: bool,
+    },
 }
 
 impl Elements {
@@ -38,7 +44,7 @@ impl Elements {
     pub(crate) fn order(&self) -> ElementOrder {
         match self {
             Self::Linear(_) => ElementOrder::Linear,
-            Self::Quadratic(_) => ElementOrder::Quadratic,
+            Self::Quadratic { .. } => ElementOrder::Quadratic,
         }
     }
 
@@ -46,7 +52,7 @@ impl Elements {
     pub(crate) fn point_count(&self) -> usize {
         match self {
             Self::Linear(fvm) => fvm.tets().len(),
-            Self::Quadratic(quadratic) => quadratic.points().len(),
+            Self::Quadratic { elements, .. } => elements.points().len(),
         }
     }
 
@@ -54,7 +60,9 @@ impl Elements {
     pub(crate) fn element_nodes(&self) -> Box<dyn Iterator<Item = &[u32]> + '_> {
         match self {
             Self::Linear(fvm) => Box::new(fvm.tets().iter().map(|t| &t[..])),
-            Self::Quadratic(quadratic) => Box::new(quadratic.elements().iter().map(|e| &e[..])),
+            Self::Quadratic { elements, .. } => {
+                Box::new(elements.elements().iter().map(|e| &e[..]))
+            }
         }
     }
 
@@ -69,7 +77,10 @@ impl Elements {
                     visit(t, tet, &rest.shape_gradients(), rest.volume);
                 }
             }
-            Self::Quadratic(quadratic) => {
+            Self::Quadratic {
+                elements: quadratic,
+                ..
+            } => {
                 for (element, nodes) in quadratic.elements().iter().enumerate() {
                     for (k, point) in quadratic.points()[4 * element..4 * element + 4]
                         .iter()
@@ -91,9 +102,25 @@ impl Elements {
         out
     }
 
+    /// Per integration point, its share `m̄_e − m_q` of the element-averaged volumetric term
+    /// at positions `x` (m), when the elements average it ([`mean_dilatation`]).
+    pub(crate) fn volumetric_excesses<M: VolumetricTerm>(
+        &self,
+        model: &M,
+        x: &[DVec3],
+    ) -> Option<Vec<f64>> {
+        match self {
+            Self::Quadratic {
+                elements,
+                mean_dilatation: true,
+            } => Some(mean_dilatation::excesses(model, elements, x)),
+            _ => None,
+        }
+    }
+
     /// Writes into `out` the internal force (N) on every node for positions `x` (m) and
     /// velocities `v` (m/s).
-    pub(crate) fn internal_forces<M: HyperelasticModel>(
+    pub(crate) fn internal_forces<M: VolumetricTerm>(
         &mut self,
         model: &M,
         damping: Option<&RayleighDamping>,
@@ -101,35 +128,55 @@ impl Elements {
         v: &[DVec3],
         out: &mut [DVec3],
     ) {
-        match self {
-            Self::Linear(fvm) => fvm.internal_forces(model, damping, x, v, out),
-            Self::Quadratic(_) => {
-                out.fill(DVec3::ZERO);
-                self.for_each_point(|_, nodes, gradients, weight| {
-                    let f = deformation_gradient(nodes, gradients, x);
-                    let mut stress = model.first_piola(&f);
-                    if let Some(damping) = damping {
-                        stress +=
-                            damping.first_piola(&f, &deformation_gradient(nodes, gradients, v));
-                    }
-                    add_point_forces(nodes, gradients, &(stress * weight), out);
-                });
-            }
+        if let Self::Linear(fvm) = self {
+            return fvm.internal_forces(model, damping, x, v, out);
         }
+        out.fill(DVec3::ZERO);
+        let excesses = self.volumetric_excesses(model, x);
+        let bulk = model.volumetric_modulus();
+        self.for_each_point(|point, nodes, gradients, weight| {
+            let f = deformation_gradient(nodes, gradients, x);
+            let mut stress = model.first_piola(&f);
+            if let Some(excesses) = &excesses {
+                stress += model.volume_measure_gradient(&f) * (bulk * excesses[point]);
+            }
+            if let Some(damping) = damping {
+                stress += damping.first_piola(&f, &deformation_gradient(nodes, gradients, v));
+            }
+            add_point_forces(nodes, gradients, &(stress * weight), out);
+        });
     }
 
     /// Elastic strain energy (J) at positions `x` (m).
-    pub(crate) fn elastic_energy<M: HyperelasticModel>(&self, model: &M, x: &[DVec3]) -> f64 {
-        match self {
-            Self::Linear(fvm) => fvm.elastic_energy(model, x),
-            Self::Quadratic(_) => {
-                let mut energy = 0.0;
-                self.for_each_point(|_, nodes, gradients, weight| {
-                    energy +=
-                        weight * model.energy_density(&deformation_gradient(nodes, gradients, x));
-                });
-                energy
-            }
+    pub(crate) fn elastic_energy<M: VolumetricTerm>(&self, model: &M, x: &[DVec3]) -> f64 {
+        let mut energy = match self {
+            Self::Linear(fvm) => return fvm.elastic_energy(model, x),
+            Self::Quadratic {
+                elements,
+                mean_dilatation: true,
+            } => mean_dilatation::energy_change(model, elements, x),
+            Self::Quadratic { .. } => 0.0,
+        };
+        self.for_each_point(|_, nodes, gradients, weight| {
+            energy += weight * model.energy_density(&deformation_gradient(nodes, gradients, x));
+        });
+        energy
+    }
+
+    /// Calls `add(gradient, weight)` for every rank-one term `weight g gᵀ` (N/m) the averaged
+    /// volumetric term adds to the tangent, `g` given per node; nothing without averaging.
+    pub(crate) fn for_each_volumetric_coupling<M: VolumetricTerm>(
+        &self,
+        model: &M,
+        x: &[DVec3],
+        add: impl FnMut(&[(u32, DVec3)], f64),
+    ) {
+        if let Self::Quadratic {
+            elements,
+            mean_dilatation: true,
+        } = self
+        {
+            mean_dilatation::for_each_coupling(model, elements, x, add);
         }
     }
 
@@ -189,13 +236,19 @@ mod tests {
     use crate::prelude::*;
 
     /// A quadratic 2 x 2 x 2-cell cube whose nodes are moved randomly by up to 7.5 % of its size.
-    fn perturbed_quadratic_cube(model: MaterialModel, nu: f64) -> SoftBody {
+    fn perturbed_quadratic_cube(
+        model: MaterialModel,
+        nu: f64,
+        treatment: VolumetricTreatment,
+    ) -> SoftBody {
         let material = Material::new(model, 1e6, nu, 1000.0).unwrap();
         let linear = mesh::cuboid(DVec3::splat(0.5), [2, 2, 2]).unwrap();
         let quadratic = mesh::QuadraticTetMesh::from_linear(&linear).unwrap();
         let mut body = SoftBodyBuilder::quadratic(quadratic, material)
+            .volumetric(treatment)
             .build()
             .unwrap();
+        assert_eq!(body.volumetric_treatment(), treatment);
         let mut seed = 11u64;
         for x in body.positions_mut() {
             for i in 0..3 {
@@ -212,8 +265,9 @@ mod tests {
         }
     }
 
-    /// For quadratic elements as for linear ones: the forces are minus the gradient of the
-    /// energy, and the assembled tangent minus the gradient of the forces, by central differences
+    /// For quadratic elements as for linear ones, with and without mean dilatation: the forces
+    /// are minus the gradient of the energy, and the assembled tangent minus the gradient of the
+    /// forces, by central differences
     /// along a fixed direction (step 1e-6 m on a 1 m cube: truncation ~1e-12, round-off ~1e-10
     /// relative, so 1e-6 and 1e-5 leave a wide margin yet catch any missing term).
     #[test]
@@ -224,8 +278,14 @@ mod tests {
             MaterialModel::Corotated,
             MaterialModel::StableNeoHookean,
         ] {
-            for nu in [0.3, 0.49, -0.6] {
-                let mut body = perturbed_quadratic_cube(model, nu);
+            for (nu, treatment) in [
+                (0.3, VolumetricTreatment::PerElement),
+                (0.49, VolumetricTreatment::PerElement),
+                (-0.6, VolumetricTreatment::PerElement),
+                (0.3, VolumetricTreatment::ElementAverage),
+                (0.499, VolumetricTreatment::ElementAverage),
+            ] {
+                let mut body = perturbed_quadratic_cube(model, nu, treatment);
                 let n = body.node_count();
                 let direction: Vec<DVec3> = (0..n)
                     .map(|i| DVec3::new((i % 3) as f64 - 1.0, (i % 5) as f64 * 0.5 - 1.0, 0.7))
@@ -241,7 +301,7 @@ mod tests {
                 let work: f64 = f0.iter().zip(&direction).map(|(f, d)| f.dot(*d)).sum();
                 assert!(
                     (slope + work).abs() <= 1e-6 * work.abs().max(1.0),
-                    "{model:?} ν = {nu}: dE/ds {slope} vs -f·d {}",
+                    "{model:?} ν = {nu} {treatment:?}: dE/ds {slope} vs -f·d {}",
                     -work
                 );
                 let mut stiffness = Stiffness::new(&body);
@@ -252,7 +312,7 @@ mod tests {
                     let difference = -(f_plus[node] - f_minus[node]) / (2.0 * h);
                     assert!(
                         (difference - k_d[node]).length() <= 1e-5 * scale,
-                        "{model:?} ν = {nu}, node {node}: K d {} vs -df/ds {difference}",
+                        "{model:?} ν = {nu} {treatment:?}, node {node}: K d {} vs -df/ds {difference}",
                         k_d[node]
                     );
                 }

@@ -86,7 +86,8 @@ fn rest_gradients(p: &[DVec3; NODES], l: [f64; 4]) -> Result<([DVec3; NODES], f6
     let natural = natural_gradients(l);
     let jacobian = rest_jacobian(p, &natural);
     let determinant = jacobian.determinant();
-    if !(determinant > 0.0) {
+    // NaN (from non-finite rest positions) is refused as well.
+    if determinant.is_nan() || determinant <= 0.0 {
         return Err(determinant);
     }
     let inverse_transpose = jacobian.inverse().transpose();

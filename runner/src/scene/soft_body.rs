@@ -12,7 +12,8 @@
 //! linvel = [0.0, 0.0, 0.0]        # m/s, default 0
 //! friction = 0.5                  # default 0.5
 //! self_contact = false            # default false
-//! volumetric = "per_element"      # or "nodal_average" (nearly incompressible), default per_element
+//! volumetric = "per_element"      # or "nodal_average" / "element_average" (nearly incompressible:
+//!                                 # linear / quadratic elements), default per_element
 //! elements = "linear"             # or "quadratic" (10-node tetrahedra, accurate in bending)
 //! pinned = [{ min = [-0.51, -1, -1], max = [-0.49, 1, 1] }]         # boxes in rest coordinates
 //! attach = [{ rigid = "ball", min = [-1, -0.26, -1], max = [1, -0.24, 1] }]
@@ -79,8 +80,10 @@ pub enum VolumetricSpec {
     /// Per tetrahedron.
     #[default]
     PerElement,
-    /// Averaged over each node's tetrahedra (against locking at ν near 0.5).
+    /// Averaged over each node's tetrahedra (against locking of linear elements at ν near 0.5).
     NodalAverage,
+    /// Averaged over each element (against locking of quadratic elements at ν near 0.5).
+    ElementAverage,
 }
 
 /// The order of a soft body's tetrahedra.

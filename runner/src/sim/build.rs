@@ -250,6 +250,7 @@ fn insert_soft(
         .volumetric(match spec.volumetric {
             VolumetricSpec::PerElement => VolumetricTreatment::PerElement,
             VolumetricSpec::NodalAverage => VolumetricTreatment::NodalAverage,
+            VolumetricSpec::ElementAverage => VolumetricTreatment::ElementAverage,
         });
     if let Some(damping) = &spec.damping {
         builder = builder.damping(
