@@ -118,10 +118,10 @@ impl Stiffness {
             };
             let measures = averaging.map(|(a, fvm)| a.measures(&model, fvm, x));
             let excesses = body.elements.volumetric_excesses(&model, x);
+            let changes = unit_changes();
             body.elements
                 .for_each_point(|point, nodes, gradients, weight| {
                     let f = deformation_gradient(nodes, gradients, x);
-                    let changes = unit_changes();
                     let excess = match (&measures, &excesses) {
                         (Some(m), _) => Some(m.excess(nodes, point)),
                         (_, Some(excesses)) => Some(excesses[point]),

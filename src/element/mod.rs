@@ -198,9 +198,12 @@ impl Elements {
                 return;
             }
             let spatial = f.inverse().transpose();
-            let lengths: Vec<f64> = gradients.iter().map(|g| (spatial * *g).length()).collect();
+            let mut lengths = [0.0; tet10::NODES];
+            for (length, g) in lengths.iter_mut().zip(gradients) {
+                *length = (spatial * *g).length();
+            }
             let total: f64 = lengths.iter().sum();
-            for (&n, length) in nodes.iter().zip(&lengths) {
+            for (&n, length) in nodes.iter().zip(lengths) {
                 row_sum[n as usize] += weight * length * total;
             }
         });
