@@ -235,7 +235,7 @@ pub(crate) fn add_point_forces(
 
 #[cfg(test)]
 mod tests {
-    use crate::assembly::Stiffness;
+    use crate::assembly::{assert_forces_and_tangent_match_energy, perturb_positions};
     use crate::prelude::*;
 
     /// A quadratic 2 x 2 x 2-cell cube whose nodes are moved randomly by up to 7.5 % of its size.
@@ -252,27 +252,14 @@ mod tests {
             .build()
             .unwrap();
         assert_eq!(body.volumetric_treatment(), treatment);
-        let mut seed = 11u64;
-        for x in body.positions_mut() {
-            for i in 0..3 {
-                seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1);
-                x[i] += 0.075 * ((seed >> 11) as f64 / (1u64 << 52) as f64 - 1.0);
-            }
-        }
+        perturb_positions(&mut body, 11, 0.075);
         body
-    }
-
-    fn shift(body: &mut SoftBody, direction: &[DVec3], step: f64) {
-        for (x, d) in body.positions_mut().iter_mut().zip(direction) {
-            *x += *d * step;
-        }
     }
 
     /// For quadratic elements as for linear ones, with and without mean dilatation: the forces
     /// are minus the gradient of the energy, and the assembled tangent minus the gradient of the
     /// forces, by central differences
-    /// along a fixed direction (step 1e-6 m on a 1 m cube: truncation ~1e-12, round-off ~1e-10
-    /// relative, so 1e-6 and 1e-5 leave a wide margin yet catch any missing term).
+    /// (see [`assert_forces_and_tangent_match_energy`] for the step and tolerances).
     #[test]
     fn quadratic_forces_and_tangent_match_finite_differences_of_the_energy() {
         for model in [
@@ -289,36 +276,10 @@ mod tests {
                 (0.499, VolumetricTreatment::ElementAverage),
             ] {
                 let mut body = perturbed_quadratic_cube(model, nu, treatment);
-                let n = body.node_count();
-                let direction: Vec<DVec3> = (0..n)
-                    .map(|i| DVec3::new((i % 3) as f64 - 1.0, (i % 5) as f64 * 0.5 - 1.0, 0.7))
-                    .collect();
-                let h = 1e-6;
-                let f0 = body.internal_forces().to_vec();
-                shift(&mut body, &direction, h);
-                let (e_plus, f_plus) = (body.elastic_energy(), body.internal_forces().to_vec());
-                shift(&mut body, &direction, -2.0 * h);
-                let (e_minus, f_minus) = (body.elastic_energy(), body.internal_forces().to_vec());
-                shift(&mut body, &direction, h);
-                let slope = (e_plus - e_minus) / (2.0 * h);
-                let work: f64 = f0.iter().zip(&direction).map(|(f, d)| f.dot(*d)).sum();
-                assert!(
-                    (slope + work).abs() <= 1e-6 * work.abs().max(1.0),
-                    "{model:?} ν = {nu} {treatment:?}: dE/ds {slope} vs -f·d {}",
-                    -work
+                assert_forces_and_tangent_match_energy(
+                    &mut body,
+                    &format!("{model:?} ν = {nu} {treatment:?}"),
                 );
-                let mut stiffness = Stiffness::new(&body);
-                stiffness.assemble(&body, None, false, |_, _, _| DMat3::ZERO);
-                let k_d = stiffness.multiply(&direction);
-                let scale = k_d.iter().map(|v| v.length()).fold(0.0, f64::max);
-                for node in 0..n {
-                    let difference = -(f_plus[node] - f_minus[node]) / (2.0 * h);
-                    assert!(
-                        (difference - k_d[node]).length() <= 1e-5 * scale,
-                        "{model:?} ν = {nu} {treatment:?}, node {node}: K d {} vs -df/ds {difference}",
-                        k_d[node]
-                    );
-                }
             }
         }
     }

@@ -256,7 +256,7 @@ impl NodalAveraging {
 
 #[cfg(test)]
 mod tests {
-    use crate::assembly::Stiffness;
+    use crate::assembly::{assert_forces_and_tangent_match_energy, perturb_positions};
     use crate::prelude::*;
 
     /// A 2 x 2 x 2-cell cube with nodal averaging, its nodes moved by up to 15 % of a cell.
@@ -267,13 +267,7 @@ mod tests {
             .volumetric(VolumetricTreatment::NodalAverage)
             .build()
             .unwrap();
-        let mut seed = 7u64;
-        for x in body.positions_mut() {
-            for i in 0..3 {
-                seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1);
-                x[i] += 0.075 * ((seed >> 11) as f64 / (1u64 << 52) as f64 - 1.0);
-            }
-        }
+        perturb_positions(&mut body, 7, 0.075);
         body
     }
 
@@ -281,15 +275,8 @@ mod tests {
         body.internal_forces().to_vec()
     }
 
-    /// Moves every node by `step * direction`.
-    fn shift(body: &mut SoftBody, direction: &[DVec3], step: f64) {
-        for (x, d) in body.positions_mut().iter_mut().zip(direction) {
-            *x += *d * step;
-        }
-    }
-
     /// The forces are minus the gradient of the energy, and the assembled tangent is minus the
-    /// gradient of the forces, both checked by central differences along a fixed direction.
+    /// gradient of the forces (see [`assert_forces_and_tangent_match_energy`]).
     #[test]
     fn forces_and_tangent_match_finite_differences_of_the_energy() {
         for model in [
@@ -300,36 +287,7 @@ mod tests {
         ] {
             for nu in [0.3, 0.499, -0.6] {
                 let mut body = perturbed_cube(model, nu);
-                let n = body.node_count();
-                let direction: Vec<DVec3> = (0..n)
-                    .map(|i| DVec3::new((i % 3) as f64 - 1.0, (i % 5) as f64 * 0.5 - 1.0, 0.7))
-                    .collect();
-                let h = 1e-6;
-                let f0 = forces(&mut body);
-                shift(&mut body, &direction, h);
-                let (e_plus, f_plus) = (body.elastic_energy(), forces(&mut body));
-                shift(&mut body, &direction, -2.0 * h);
-                let (e_minus, f_minus) = (body.elastic_energy(), forces(&mut body));
-                shift(&mut body, &direction, h);
-                let slope = (e_plus - e_minus) / (2.0 * h);
-                let work: f64 = f0.iter().zip(&direction).map(|(f, d)| f.dot(*d)).sum();
-                assert!(
-                    (slope + work).abs() <= 1e-6 * work.abs().max(1.0),
-                    "{model:?} ν = {nu}: dE/ds {slope} vs -f·d {}",
-                    -work
-                );
-                let mut stiffness = Stiffness::new(&body);
-                stiffness.assemble(&body, None, false, |_, _, _| DMat3::ZERO);
-                let k_d = stiffness.multiply(&direction);
-                let scale = k_d.iter().map(|v| v.length()).fold(0.0, f64::max);
-                for node in 0..n {
-                    let difference = -(f_plus[node] - f_minus[node]) / (2.0 * h);
-                    assert!(
-                        (difference - k_d[node]).length() <= 1e-5 * scale,
-                        "{model:?} ν = {nu}, node {node}: K d {} vs -df/ds {difference}",
-                        k_d[node]
-                    );
-                }
+                assert_forces_and_tangent_match_energy(&mut body, &format!("{model:?} ν = {nu}"));
             }
         }
     }

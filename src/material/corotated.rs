@@ -91,7 +91,7 @@ impl HyperelasticModel for Corotated {
         (*f - r) * (2.0 * mu) + r * (lambda * (stretch_trace - 3.0))
     }
 
-    /// Uses the differential of the polar rotation (McAdams et al. 2011).
+    /// Uses the differential of the polar rotation (`McAdams` et al. 2011).
     fn first_piola_differential(&self, f: &DMat3, df: &DMat3) -> DMat3 {
         self.first_piola_differentials(f, &[*df])[0]
     }
