@@ -415,3 +415,33 @@ fn a_quadratic_cube_rests_on_a_rapier_ground() {
     assert!((reaction / weight - 1.0).abs() < 0.01);
     assert!(lowest > -1e-3);
 }
+
+/// Curved boundary edges follow the true shape: the quadratic sphere's volume (the sum of its
+/// quadrature weights, total mass over density) is far closer to `4/3 π r³` than the flat
+/// mesh's of the same cells, and a curved cylinder's side nodes all lie on the circle.
+#[test]
+fn curved_quadratic_meshes_follow_the_round_shape() {
+    let radius: f64 = 0.1;
+    let exact = 4.0 / 3.0 * std::f64::consts::PI * radius.powi(3);
+    let material = Material::new(MaterialModel::Corotated, 1e6, 0.3, 1000.0).unwrap();
+    let flat = mesh::sphere(radius, 4).unwrap();
+    let curved = mesh::QuadraticTetMesh::sphere(radius, 4).unwrap();
+    let body = SoftBodyBuilder::quadratic(curved.clone(), material)
+        .build()
+        .unwrap();
+    let flat_error = flat.volume() / exact - 1.0;
+    let curved_error = body.total_mass() / 1000.0 / exact - 1.0;
+    println!(
+        "sphere, 4 cells across: flat volume {:+.3}%, curved quadratic {:+.4}%",
+        100.0 * flat_error,
+        100.0 * curved_error
+    );
+    assert!(curved_error.abs() < 0.1 * flat_error.abs());
+    for p in curved.positions() {
+        assert!(p.length() <= radius * (1.0 + 1e-12));
+    }
+    let cylinder = mesh::QuadraticTetMesh::cylinder(radius, 0.2, 4, 3).unwrap();
+    let side = |p: &DVec3| DVec3::new(p.x, 0.0, p.z).length();
+    let outermost = cylinder.positions().iter().map(side).fold(0.0, f64::max);
+    assert!((outermost / radius - 1.0).abs() < 1e-12);
+}

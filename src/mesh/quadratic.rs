@@ -75,6 +75,30 @@ impl QuadraticTetMesh {
     /// Those of [`QuadraticTetMesh::new`]; none for a valid `mesh` unless a sub-tetrahedron falls
     /// below the degeneracy threshold.
     pub fn from_linear(mesh: &TetMesh) -> Result<Self, Error> {
+        Self::from_linear_curved(mesh, |_, _| None)
+    }
+
+    /// Like [`QuadraticTetMesh::from_linear`], but the mid-edge node of every boundary edge
+    /// `(a, b)` (rest positions, m) is placed at `curve(a, b)` when that is `Some`: the point of
+    /// the true, curved surface between them. Curved boundary elements follow a round shape
+    /// with far fewer elements than flat ones. [`mesh::sphere`](super::sphere) and
+    /// [`mesh::cylinder`](super::cylinder) have curved versions, [`QuadraticTetMesh::sphere`]
+    /// and [`QuadraticTetMesh::cylinder`].
+    ///
+    /// # Errors
+    /// Those of [`QuadraticTetMesh::new`], e.g. [`Error::InvertedTet`] for an element that
+    /// a midpoint moved too far folds.
+    pub fn from_linear_curved(
+        mesh: &TetMesh,
+        curve: impl Fn(DVec3, DVec3) -> Option<DVec3>,
+    ) -> Result<Self, Error> {
+        let mut boundary_edges = std::collections::HashSet::new();
+        for triangle in mesh.surface_triangles() {
+            for k in 0..3 {
+                let (a, b) = (triangle[k], triangle[(k + 1) % 3]);
+                boundary_edges.insert([a.min(b), a.max(b)]);
+            }
+        }
         let mut positions = mesh.positions().to_vec();
         let mut midpoints: HashMap<[u32; 2], u32> = HashMap::new();
         let elements = mesh
@@ -84,9 +108,14 @@ impl QuadraticTetMesh {
                 let mut nodes = [0u32; NODES];
                 nodes[..4].copy_from_slice(tet);
                 for (k, [i, j]) in EDGES.iter().enumerate() {
-                    let (a, b) = (tet[*i], tet[*j]);
-                    nodes[4 + k] = *midpoints.entry([a.min(b), a.max(b)]).or_insert_with(|| {
-                        positions.push(0.5 * (positions[a as usize] + positions[b as usize]));
+                    let edge = [tet[*i].min(tet[*j]), tet[*i].max(tet[*j])];
+                    nodes[4 + k] = *midpoints.entry(edge).or_insert_with(|| {
+                        let [a, b] = edge.map(|n| positions[n as usize]);
+                        let curved = boundary_edges
+                            .contains(&edge)
+                            .then(|| curve(a, b))
+                            .flatten();
+                        positions.push(curved.unwrap_or(0.5 * (a + b)));
                         positions.len() as u32 - 1
                     });
                 }
@@ -94,6 +123,39 @@ impl QuadraticTetMesh {
             })
             .collect();
         Self::new(positions, elements)
+    }
+
+    /// [`mesh::sphere`](super::sphere) with quadratic elements whose boundary edges follow the
+    /// sphere.
+    ///
+    /// # Errors
+    /// Those of [`mesh::sphere`](super::sphere) and [`QuadraticTetMesh::new`].
+    pub fn sphere(radius: f64, cells_across: usize) -> Result<Self, Error> {
+        Self::from_linear_curved(&super::sphere(radius, cells_across)?, |a, b| {
+            Some((a + b).normalize() * radius)
+        })
+    }
+
+    /// [`mesh::cylinder`](super::cylinder) with quadratic elements whose edges on the round side
+    /// follow the circle (the flat caps stay flat).
+    ///
+    /// # Errors
+    /// Those of [`mesh::cylinder`](super::cylinder) and [`QuadraticTetMesh::new`].
+    pub fn cylinder(
+        radius: f64,
+        half_height: f64,
+        cells_across: usize,
+        cells_along: usize,
+    ) -> Result<Self, Error> {
+        let linear = super::cylinder(radius, half_height, cells_across, cells_along)?;
+        let radial = |p: DVec3| DVec3::new(p.x, 0.0, p.z);
+        let on_side = |p: DVec3| (radial(p).length() - radius).abs() <= 1e-9 * radius;
+        Self::from_linear_curved(&linear, |a, b| {
+            (on_side(a) && on_side(b)).then(|| {
+                let mid = 0.5 * (a + b);
+                radial(mid).normalize() * radius + DVec3::Y * mid.y
+            })
+        })
     }
 
     /// Rest positions of all nodes, corners and mid-edge (m).

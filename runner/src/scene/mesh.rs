@@ -125,8 +125,9 @@ impl MeshSpec {
         }
     }
 
-    /// Builds the mesh as quadratic tetrahedra: a Gmsh file of second-order tetrahedra keeps its
-    /// own mid-edge nodes, any other mesh gets them at its edges' midpoints.
+    /// Builds the mesh as quadratic tetrahedra: spheres and cylinders with boundary edges curved
+    /// to the true surface, a Gmsh file of second-order tetrahedra with its own mid-edge nodes,
+    /// any other mesh with nodes at its edges' midpoints.
     ///
     /// # Errors
     /// A [`SceneError`] at `key` naming the generator's or the file's problem.
@@ -135,15 +136,22 @@ impl MeshSpec {
         key: &str,
         source: &SceneSource,
     ) -> Result<QuadraticTetMesh, SceneError> {
-        let result = match &self.file {
-            Some(file) => import::load_quadratic(
+        let result = if let Some(c) = &self.cylinder {
+            QuadraticTetMesh::cylinder(c.radius, c.half_height, c.cells_across, c.cells_along)
+                .map_err(|e| (format!("{key}.cylinder"), e.to_string()))
+        } else if let Some(s) = &self.sphere {
+            QuadraticTetMesh::sphere(s.radius, s.cells_across)
+                .map_err(|e| (format!("{key}.sphere"), e.to_string()))
+        } else if let Some(file) = &self.file {
+            import::load_quadratic(
                 source.folder().join(file),
                 self.scale.unwrap_or(1.0),
                 &self.surface_options(),
             )
-            .map_err(|e| (format!("{key}.file"), e.to_string())),
-            None => QuadraticTetMesh::from_linear(&self.build(key, source)?)
-                .map_err(|e| (key.to_owned(), e.to_string())),
+            .map_err(|e| (format!("{key}.file"), e.to_string()))
+        } else {
+            QuadraticTetMesh::from_linear(&self.build(key, source)?)
+                .map_err(|e| (key.to_owned(), e.to_string()))
         };
         result.map_err(|(key, message)| source.error(&key, message))
     }
