@@ -296,8 +296,8 @@ impl SoftBodyBuilder {
             Some(quadratic) => {
                 let elements = QuadraticElements::new(self.mesh.positions(), quadratic)?;
                 let masses = elements
-                    .lumped_volumes(node_count)
-                    .into_iter()
+                    .lumped_volumes()
+                    .iter()
                     .map(|volume| volume * self.material.density())
                     .collect();
                 let mean_dilatation = self.volumetric == VolumetricTreatment::ElementAverage;

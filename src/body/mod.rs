@@ -188,13 +188,7 @@ impl SoftBody {
     /// critical step is about [`COURANT_NUMBER`](crate::integrate::COURANT_NUMBER) times this over
     /// the pressure wave speed.
     pub fn wave_length_scale(&self) -> f64 {
-        let density = self.material.density();
-        let control_volumes: Vec<f64> = match self.elements.order() {
-            ElementOrder::Linear => Vec::new(),
-            ElementOrder::Quadratic => self.masses.iter().map(|m| m / density).collect(),
-        };
-        self.elements
-            .wave_length_scale(&self.positions, &control_volumes)
+        self.elements.wave_length_scale(&self.positions)
     }
 
     /// Internal forces (N per node): elastic plus damping, at the current positions and velocities.

@@ -182,12 +182,12 @@ impl Elements {
 
     /// The wave length scale (m) at positions `x`, see [`FvmMesh::wave_length_scale`]; for
     /// quadratic elements the same Gershgorin bound with the sums over quadrature points and
-    /// `control_volumes` (m³, a node's lumped mass over the density) in place of a quarter of
-    /// each tetrahedron.
-    pub(crate) fn wave_length_scale(&self, x: &[DVec3], control_volumes: &[f64]) -> f64 {
-        if let Self::Linear(fvm) = self {
-            return fvm.wave_length_scale(x);
-        }
+    /// each node's lumped volume in place of a quarter of each tetrahedron.
+    pub(crate) fn wave_length_scale(&self, x: &[DVec3]) -> f64 {
+        let control_volumes = match self {
+            Self::Linear(fvm) => return fvm.wave_length_scale(x),
+            Self::Quadratic { elements, .. } => elements.lumped_volumes(),
+        };
         let mut row_sum = vec![0.0; control_volumes.len()];
         let mut flattened = false;
         self.for_each_point(|_, nodes, gradients, weight| {

@@ -108,10 +108,12 @@ pub struct QuadraturePoint {
 pub struct QuadraticElements {
     elements: Vec<[u32; NODES]>,
     points: Vec<QuadraturePoint>,
+    lumped_volumes: Vec<f64>,
 }
 
 impl QuadraticElements {
-    /// The rest data of `elements` (10 node indices each) at rest positions `positions` (m).
+    /// The rest data of `elements` (10 node indices each) at rest positions `positions` (m), one
+    /// per node.
     ///
     /// # Errors
     /// [`Error::InvertedTet`] naming the first element whose rest map folds (its Jacobian
@@ -137,9 +139,20 @@ impl QuadraticElements {
                 });
             }
         }
+        let mut lumped_volumes = vec![0.0; positions.len()];
+        for (element, nodes) in elements.iter().enumerate() {
+            let volume: f64 = points[4 * element..4 * element + 4]
+                .iter()
+                .map(|q| q.weight)
+                .sum();
+            for (&n, fraction) in nodes.iter().zip(LUMPED_MASS_FRACTIONS) {
+                lumped_volumes[n as usize] += fraction * volume;
+            }
+        }
         Ok(Self {
             elements: elements.to_vec(),
             points,
+            lumped_volumes,
         })
     }
 
@@ -164,17 +177,10 @@ impl QuadraticElements {
             .sum()
     }
 
-    /// The rest volume (m³) each of `node_count` nodes is lumped: HRZ fractions
-    /// ([`LUMPED_MASS_FRACTIONS`]) of each element's volume; times the density, the nodal masses.
-    pub fn lumped_volumes(&self, node_count: usize) -> Vec<f64> {
-        let mut volumes = vec![0.0; node_count];
-        for (element, nodes) in self.elements.iter().enumerate() {
-            let volume = self.volume(element);
-            for (&n, fraction) in nodes.iter().zip(LUMPED_MASS_FRACTIONS) {
-                volumes[n as usize] += fraction * volume;
-            }
-        }
-        volumes
+    /// The rest volume (m³) lumped on each node: HRZ fractions ([`LUMPED_MASS_FRACTIONS`]) of
+    /// each element's volume; times the density, the nodal masses.
+    pub fn lumped_volumes(&self) -> &[f64] {
+        &self.lumped_volumes
     }
 
     /// The deformation gradient of element `element` (dimensionless) at barycentric coordinates
