@@ -3,25 +3,19 @@
 //! vibration released straight under gravity (`vibration`).
 
 use crate::budget::{Budget, CASE_LIMIT_S};
-use crate::fit::fit_damped_oscillation;
 use crate::record::{self, Record};
-use crate::reference::*;
 use crate::setup::{self, Damping, FEM_CG_CAP_CHECKS, Grid, Material, SOLVERS, Solver};
-use crate::timing::Timer;
+use compare_common::beam::{
+    SETTLE_S, StaticTip, VIBRATION_S, vibration_fields, vibration_settings,
+};
+use compare_common::reference::*;
+use compare_common::timing::{CpuClock, Timer};
 use serde_json::json;
 use std::f64::consts::PI;
 use std::time::Instant;
 
 /// Particles per axis of the three beam resolutions (200 / 1600 / 12800 tets).
 const RESOLUTIONS: [[usize; 3]; 3] = [[11, 3, 3], [21, 5, 5], [41, 9, 9]];
-/// Simulated time of a static case; the tip is averaged over its last [`TAIL_S`].
-const SETTLE_S: f64 = 1.5;
-/// Averaging window at the end of a static case (s).
-const TAIL_S: f64 = 0.25;
-/// Simulated time of a vibration case (s).
-const VIBRATION_S: f64 = 2.0;
-/// Elements of the Timoshenko frequency reference (converged to ~1e-5).
-const TIMOSHENKO_ELEMENTS: usize = 400;
 
 /// The beam at `particles` resolution: x in [0, L], centred on y = 0, z in [1, 1.1].
 fn grid(particles: [usize; 3]) -> Grid {
@@ -81,7 +75,8 @@ fn run_beam(
     let z0: Vec<f64> = tip.iter().map(|&i| builder.positions[i].z as f64).collect();
     let handle = world.insert_soft_body(builder.pinned_particles(pinned.iter().map(|&i| i as u32)));
     let settings = setup::settings(&world, solver, grid, material(nu), damping);
-    let (mut timer, mut ts, mut us, mut stable) = (Timer::default(), vec![], vec![], true);
+    let (mut timer, mut ts, mut us, mut stable) =
+        (Timer::new(CpuClock::Thread), vec![], vec![], true);
     for k in 0..(t_end / dt).round() as usize {
         timer.time(|| world.step());
         let sb = &world.soft_bodies[handle];
@@ -220,20 +215,7 @@ struct StaticRun {
 /// `settled`: the drift over the averaging window is below 1 % of the reference.
 fn static_case(scene: &str, g: &Grid, dt: f64, nu: f64, solver: Solver) -> StaticRun {
     let mut run = run_beam(g, solver, dt, nu, settle_damping(), SETTLE_S);
-    let reference = beam_timoshenko_tip(nu);
-    let tail: Vec<f64> = run
-        .ts
-        .iter()
-        .zip(&run.us)
-        .filter(|(t, _)| **t > SETTLE_S - TAIL_S + 1e-9)
-        .map(|(_, u)| *u)
-        .collect();
-    let tip =
-        (run.stable && !tail.is_empty()).then(|| -tail.iter().sum::<f64>() / tail.len() as f64);
-    let drift = (run.stable && tail.len() > 1).then(|| (tail[tail.len() - 1] - tail[0]).abs());
-    // Moved against gravity or ran away: not a physical equilibrium.
-    let stable = run.stable && tip.is_some_and(|t| 0.0 < t && t < 10.0 * reference);
-    let settled = drift.is_some_and(|d| d < 0.01 * reference);
+    let tip = StaticTip::measure(&run.ts, &run.us, run.stable, nu);
     run.settings.extend(record::object(json!({
         "settle_s": SETTLE_S,
         "damping_beta": null,
@@ -248,24 +230,11 @@ fn static_case(scene: &str, g: &Grid, dt: f64, nu: f64, solver: Solver) -> Stati
         run.settings,
         run.elements,
     );
-    record::extend(
-        &mut r,
-        json!({
-            "reference": reference,
-            "reference_name": "Timoshenko q L^4/(8EI) + q L^2/(2 kappa G A), kappa = 10(1+nu)/(12+11nu)",
-            "reference_euler_bernoulli": beam_eb_tip(),
-            "tip_deflection": tip,
-            "error": if stable { rel_error(tip, reference) } else { None },
-            "error_vs_euler_bernoulli": if stable { rel_error(tip, beam_eb_tip()) } else { None },
-            "tip_drift_last_0_25s": drift,
-            "settled": settled,
-            "stable": stable,
-        }),
-    );
+    record::extend(&mut r, tip.fields());
     record::extend(&mut r, run.timer.fields());
     StaticRun {
         record: r,
-        tip,
+        tip: tip.tip,
         wall_s: run.wall_s,
     }
 }
@@ -279,7 +248,6 @@ pub fn scene_vibration(quick: bool) {
     } else {
         &[1.0 / 1000.0, 1.0 / 240.0, 1.0 / 60.0]
     };
-    let reference = beam_timoshenko_frequency(BEAM_NU, TIMOSHENKO_ELEMENTS);
     let undamped = Damping {
         elastic_ratio: 0.0,
         deformation_rate: 0.0,
@@ -287,18 +255,7 @@ pub fn scene_vibration(quick: bool) {
     for solver in SOLVERS {
         for &dt in dts {
             let mut run = run_beam(&g, solver, dt, BEAM_NU, undamped, VIBRATION_S);
-            let fit = if run.stable {
-                fit_damped_oscillation(&run.ts, &run.us)
-            } else {
-                None
-            };
-            let freq = fit.as_ref().map(|f| f.frequency_hz);
-            let zeta = fit.as_ref().map(|f| f.damping_ratio);
-            run.settings.extend(record::object(json!({
-                "damping_beta": 0.0,
-                "duration_s": VIBRATION_S,
-                "excitation": "released straight under gravity (oscillates about the static deflection)",
-            })));
+            run.settings.extend(vibration_settings());
             let case = format!(
                 "{} dt=1/{} {}",
                 g.label(),
@@ -306,22 +263,7 @@ pub fn scene_vibration(quick: bool) {
                 solver.label()
             );
             let mut r = record::base("vibration", &case, run.settings, run.elements);
-            record::extend(
-                &mut r,
-                json!({
-                    "reference": reference,
-                    "reference_name": "Timoshenko first bending frequency (shear + rotary inertia, \
-                                       400-element solve); Euler-Bernoulli (1.8751^2/(2 pi L^2)) sqrt(EI/(rho A))",
-                    "reference_euler_bernoulli": beam_eb_frequency(),
-                    "first_frequency_hz": freq,
-                    "error": rel_error(freq, reference),
-                    "damping_ratio": zeta,
-                    "numerical_damping_ratio": zeta,
-                    "damping_ratio_omega_dt_over_2": 2.0 * PI * reference * dt / 2.0,
-                    "fit": fit.as_ref().map(|f| f.to_json()),
-                    "stable": run.stable && fit.is_some(),
-                }),
-            );
+            record::extend(&mut r, vibration_fields(&run.ts, &run.us, run.stable, dt));
             record::extend(&mut r, run.timer.fields());
             record::emit(r);
         }

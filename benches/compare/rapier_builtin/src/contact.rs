@@ -5,17 +5,14 @@
 
 use crate::budget::{Budget, CASE_LIMIT_S};
 use crate::record::{self, Record};
-use crate::reference::*;
 use crate::setup::{self, DEFAULT_DAMPING, Grid, SOFT, SOLVERS, Solver};
-use crate::timing::Timer;
+use compare_common::contact::{BoxTrace, DT, DropTrace};
+use compare_common::reference::*;
+use compare_common::timing::{CpuClock, Timer};
 use rapier3d::prelude::*;
 use serde_json::json;
 use std::time::Instant;
 
-/// Step of both scenes (s).
-const DT: f64 = 1.0 / 240.0;
-/// The last half second is the resting window.
-const REST_S: f64 = 0.5;
 /// The explicit thin skin (m), the flex radius of the `MuJoCo` runs.
 const THIN_SKIN: f64 = 0.002;
 
@@ -125,7 +122,8 @@ fn drop_case(g: &Grid, radius: Option<f64>, solver: Solver) -> f64 {
     let mut settings = contact_settings(&world, solver, g, &builder, radius);
     let skin = builder.particle_radius as f64;
     let handle = world.insert_soft_body(builder);
-    let (mut timer, mut minz, mut cz, mut stable) = (Timer::default(), vec![], vec![], true);
+    let mut timer = Timer::new(CpuClock::Thread);
+    let (mut trace, mut stable) = (DropTrace::default(), true);
     for _ in 0..(T_END / DT).round() as usize {
         timer.time(|| world.step());
         let sb = &world.soft_bodies[handle];
@@ -134,12 +132,8 @@ fn drop_case(g: &Grid, radius: Option<f64>, solver: Solver) -> f64 {
             break;
         }
         let z: Vec<f64> = sb.particle_positions().map(|p| p.z as f64).collect();
-        minz.push(z.iter().copied().fold(f64::MAX, f64::min));
-        cz.push(z.iter().sum::<f64>() / z.len() as f64);
+        trace.push(&z);
     }
-    let rest = minz.len().saturating_sub((REST_S / DT).round() as usize);
-    let reference = drop_rest_centroid();
-    let h = stable.then(|| mean(&cz[rest..]));
     settings.extend(record::object(json!({
         "drop_height_bottom": DROP_HEIGHT, "duration_s": T_END,
         "ground": "fixed cuboid collider, top face at z = 0",
@@ -150,18 +144,11 @@ fn drop_case(g: &Grid, radius: Option<f64>, solver: Solver) -> f64 {
         settings,
         g.elements(),
     );
+    record::extend(&mut r, trace.fields(stable));
     record::extend(
         &mut r,
         json!({
-            "reference": reference,
-            "reference_name": "resting centroid height H/2 - rho g H^2/(3E) (uniaxial, frictionless ground)",
-            "resting_centroid_height": h,
-            "error": rel_error(h, reference),
-            "centroid_rest_std": stable.then(|| std(&cz[rest..])),
-            "peak_penetration": stable.then(|| (-min(&minz)).max(0.0)),
-            "resting_penetration": stable.then(|| -mean(&minz[rest..])),
-            "peak_penetration_into_margin": stable.then(|| (skin - min(&minz)).max(0.0)),
-            "stable": stable,
+            "peak_penetration_into_margin": stable.then(|| (skin - trace.lowest()).max(0.0)),
         }),
     );
     record::extend(&mut r, timer.fields());
@@ -193,15 +180,6 @@ pub fn scene_box_on_block(quick: bool) {
     run_cases("box_on_block", cases, block_grid, box_case);
 }
 
-/// What a box-on-block run records after every step.
-#[derive(Default)]
-struct BoxTrace {
-    z: Vec<f64>,
-    vz: Vec<f64>,
-    penetration: Vec<f64>,
-    dent: Vec<f64>,
-}
-
 /// One box on the block; returns its wall time.
 fn box_case(g: &Grid, radius: Option<f64>, solver: Solver) -> f64 {
     const T_END: f64 = 2.0;
@@ -226,7 +204,8 @@ fn box_case(g: &Grid, radius: Option<f64>, solver: Solver) -> f64 {
             .mass(BOX_MASS as Real)
             .friction(FRICTION as Real),
     );
-    let (mut timer, mut trace, mut stable) = (Timer::default(), BoxTrace::default(), true);
+    let mut timer = Timer::new(CpuClock::Thread);
+    let (mut trace, mut stable) = (BoxTrace::default(), true);
     for _ in 0..(T_END / DT).round() as usize {
         timer.time(|| world.step());
         let sb = &world.soft_bodies[handle];
@@ -239,16 +218,8 @@ fn box_case(g: &Grid, radius: Option<f64>, solver: Solver) -> f64 {
             .iter()
             .map(|&i| sb.particle_position(i).z as f64)
             .collect();
-        trace.z.push(z);
-        trace.vz.push(world.bodies[rb].linvel().z as f64);
-        trace
-            .penetration
-            .push(top_z.iter().fold(f64::MIN, |m, t| m.max(t - (z - hb))));
-        trace
-            .dent
-            .push(top_z0.iter().zip(&top_z).map(|(a, b)| a - b).sum::<f64>() / top.len() as f64);
+        trace.push(z, world.bodies[rb].linvel().z as f64, &top_z, &top_z0);
     }
-    let rest = trace.z.len().saturating_sub((REST_S / DT).round() as usize);
     settings.extend(record::object(json!({
         "block": BLOCK_SIZE, "block_support": "bottom face pinned", "box_size": BOX_SIZE,
         "box_mass": BOX_MASS, "duration_s": T_END, "box_start_bottom": start_z - hb,
@@ -260,31 +231,8 @@ fn box_case(g: &Grid, radius: Option<f64>, solver: Solver) -> f64 {
         settings,
         g.elements(),
     );
-    record::extend(
-        &mut r,
-        json!({
-            "reference": null, "error": null,
-            "sink": stable.then(|| bz - (mean(&trace.z[rest..]) - hb)),
-            "penetration": stable.then(|| mean(&trace.penetration[rest..])),
-            "surface_sink": stable.then(|| mean(&trace.dent[rest..])),
-            "vertical_velocity_std": stable.then(|| std(&trace.vz[rest..])),
-            "stable": stable,
-        }),
-    );
+    record::extend(&mut r, trace.fields(stable));
     record::extend(&mut r, timer.fields());
     record::emit(r);
     start.elapsed().as_secs_f64()
-}
-
-fn mean(v: &[f64]) -> f64 {
-    v.iter().sum::<f64>() / v.len() as f64
-}
-
-fn std(v: &[f64]) -> f64 {
-    let m = mean(v);
-    (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / v.len() as f64).sqrt()
-}
-
-fn min(v: &[f64]) -> f64 {
-    v.iter().copied().fold(f64::MAX, f64::min)
 }

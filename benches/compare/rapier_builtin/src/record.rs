@@ -1,88 +1,30 @@
-//! The JSON lines: a case's common fields, the machine it ran on, and their emission.
+//! The JSON lines of this crate's cases: the shared helpers with its engine name and version,
+//! on one thread.
 
-use serde_json::{Map, Value, json};
-use std::io::Write;
+use compare_common::record::Engine;
+pub use compare_common::record::{Record, extend, object};
 
-/// Engine name on every line.
-pub const ENGINE: &str = "rapier_builtin";
-/// The rapier3d version the crate pins (`=0.36.1` in Cargo.toml).
-pub const ENGINE_VERSION: &str = "0.36.1";
+/// Engine name and the rapier3d version the crate pins (`=0.36.1` in Cargo.toml).
+const ENGINE: Engine = Engine {
+    name: "rapier_builtin",
+    version: "0.36.1",
+};
 
-/// One line, built up field by field.
-pub type Record = Map<String, Value>;
+/// Every case runs on this one thread (rapier3d without its `parallel` feature).
+const THREADS: usize = 1;
 
 /// The fields every line starts with; `settings` also gets `elements`.
-pub fn base(scene: &str, case: &str, mut settings: Record, elements: usize) -> Record {
-    settings.insert("elements".into(), json!(elements));
-    let mut r = Record::new();
-    r.insert("engine".into(), json!(ENGINE));
-    r.insert("engine_version".into(), json!(ENGINE_VERSION));
-    r.insert("scene".into(), json!(scene));
-    r.insert("case".into(), json!(case));
-    r.insert("elements".into(), json!(elements));
-    r.insert("settings".into(), Value::Object(settings));
-    r
+pub fn base(scene: &str, case: &str, settings: Record, elements: usize) -> Record {
+    ENGINE.base(scene, case, settings, elements)
 }
 
-/// The map inside a `json!` object literal (empty for any other value).
-pub fn object(v: Value) -> Record {
-    match v {
-        Value::Object(map) => map,
-        _ => Record::new(),
-    }
-}
-
-/// Adds every field of the object `fields` to `record`.
-pub fn extend(record: &mut Record, fields: Value) {
-    if let Value::Object(map) = fields {
-        record.extend(map);
-    }
-}
-
-/// A case that was not run: `stable` and `error` are null and `reason` says why.
+/// Emits a case that was not run: `stable` and `error` are null and `reason` says why.
 pub fn skipped(scene: &str, case: &str, settings: Record, elements: usize, reason: &str) {
-    let mut r = base(scene, case, settings, elements);
-    extend(
-        &mut r,
-        json!({
-            "skipped": true, "reason": reason, "reference": null, "error": null,
-            "stable": null, "ms_per_step": null, "wall_ms_per_step": null,
-            "steps_timed": 0, "cpu_s_total": 0.0,
-        }),
-    );
     eprintln!("[{scene}] {case}: skipped ({reason})");
-    emit(r);
+    compare_common::record::skipped(base(scene, case, settings, elements), reason, THREADS);
 }
 
 /// Writes `record` (with the machine state) as one line on stdout and a summary on stderr.
-pub fn emit(mut record: Record) {
-    record.entry("machine").or_insert_with(machine_fields);
-    let line = serde_json::to_string(&record).expect("a JSON map always serializes");
-    let mut out = std::io::stdout().lock();
-    writeln!(out, "{line}").expect("stdout is writable");
-    out.flush().expect("stdout is writable");
-    let get = |k: &str| record.get(k).cloned().unwrap_or(Value::Null);
-    eprintln!(
-        "[{}] {}: error={} ms/step={} stable={}",
-        get("scene").as_str().unwrap_or("?"),
-        get("case").as_str().unwrap_or("?"),
-        get("error"),
-        get("ms_per_step")
-            .as_f64()
-            .map_or("null".into(), |v| format!("{v:.3}")),
-        get("stable"),
-    );
-}
-
-/// CPU count, 1-minute load average and platform at the time of the case.
-fn machine_fields() -> Value {
-    let load1 = std::fs::read_to_string("/proc/loadavg")
-        .ok()
-        .and_then(|s| s.split_whitespace().next()?.parse::<f64>().ok());
-    json!({
-        "host_cpus": std::thread::available_parallelism().map(|n| n.get()).ok(),
-        "load1": load1,
-        "platform": format!("{}-{}", std::env::consts::OS, std::env::consts::ARCH),
-        "threads": 1,
-    })
+pub fn emit(record: Record) {
+    compare_common::record::emit(record, THREADS);
 }

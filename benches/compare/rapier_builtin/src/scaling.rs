@@ -3,9 +3,9 @@
 //! last case's wall time scaled by the element ratio exceeds the budget.
 
 use crate::record::{self, Record};
-use crate::reference::*;
 use crate::setup::{self, DEFAULT_DAMPING, Grid, SOFT, SOLVERS, Solver};
-use crate::timing::Timer;
+use compare_common::reference::*;
+use compare_common::timing::{CpuClock, Timer};
 use rapier3d::prelude::*;
 use serde_json::json;
 use std::time::Instant;
@@ -91,9 +91,9 @@ fn scaling_case(g: &Grid, solver: Solver) -> f64 {
     for _ in 0..WARM_UP_STEPS {
         world.step();
     }
-    let mut timer = Timer::default();
+    let mut timer = Timer::new(CpuClock::Thread);
     let t0 = Instant::now();
-    while timer.len() < MAX_TIMED_STEPS && t0.elapsed().as_secs_f64() < MAX_TIMED_S {
+    while timer.steps_timed() < MAX_TIMED_STEPS && t0.elapsed().as_secs_f64() < MAX_TIMED_S {
         timer.time(|| world.step());
     }
     let case_wall_s = w0.elapsed().as_secs_f64();

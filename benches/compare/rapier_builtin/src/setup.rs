@@ -3,7 +3,7 @@
 //! and one of rapier's two soft-body solvers.
 
 use crate::record::{self, Record};
-use crate::reference::{FRICTION, G, SOFT_E, SOFT_NU, SOFT_RHO};
+use compare_common::reference::{FRICTION, G, SOFT_E, SOFT_NU, SOFT_RHO};
 use rapier3d::prelude::*;
 use serde_json::json;
 

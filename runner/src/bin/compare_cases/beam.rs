@@ -3,24 +3,18 @@
 //! vibration released straight under gravity (`vibration`).
 
 use crate::budget::{CASE_LIMIT_S, Deadline};
-use crate::fit::fit_damped_oscillation;
 use crate::knobs::{self, Body, Stepper};
 use crate::record::{self, Record};
-use crate::reference::*;
-use crate::timing::{CpuClock, Timer};
+use compare_common::beam::{
+    SETTLE_S, StaticTip, VIBRATION_S, vibration_fields, vibration_settings,
+};
+use compare_common::reference::*;
+use compare_common::timing::{CpuClock, Timer};
 use rapier_fvm::element::ElementOrder::{Linear as Lin, Quadratic as Quad};
 use rapier_fvm::prelude::*;
 use serde_json::json;
 use std::f64::consts::PI;
 
-/// Simulated time of a static case; the tip is averaged over its last [`TAIL_S`].
-const SETTLE_S: f64 = 1.5;
-/// Averaging window at the end of a static case (s).
-const TAIL_S: f64 = 0.25;
-/// Simulated time of a vibration case (s).
-const VIBRATION_S: f64 = 2.0;
-/// Elements of the Timoshenko frequency reference (converged to ~1e-5).
-const TIMOSHENKO_ELEMENTS: usize = 400;
 /// The corotated model (the crate's choice for games).
 const COROTATED: MaterialModel = MaterialModel::Corotated;
 /// Linear elasticity (small deflection).
@@ -282,86 +276,44 @@ fn static_case(scene: &str, body: Body, stepper: Stepper, dt: f64, nu: f64) {
         "settling": "stiffness-proportional damping beta = 2/omega_1 (first mode critically \
                      damped), tip averaged over the last 0.25 s",
     }));
-    let mut r = beam_record(scene, body, stepper, (dt, nu), extra);
+    let r = beam_record(scene, body, stepper, (dt, nu), extra);
     let run = match run_beam(body, stepper, dt, nu, Some(beta), SETTLE_S) {
         Ok(run) => run,
         Err(reason) => return record::skipped(r, &reason),
     };
-    let reference = beam_timoshenko_tip(nu);
-    let tail: Vec<f64> = run
-        .ts
-        .iter()
-        .zip(&run.us)
-        .filter(|(t, _)| **t > SETTLE_S - TAIL_S + 1e-9)
-        .map(|(_, u)| *u)
-        .collect();
-    let ok = run.completed() && !tail.is_empty();
-    let tip = ok.then(|| -tail.iter().sum::<f64>() / tail.len() as f64);
-    let drift = (ok && tail.len() > 1).then(|| (tail[tail.len() - 1] - tail[0]).abs());
-    // Moved against gravity or ran away: not a physical equilibrium.
-    let stable = ok && tip.is_some_and(|t| 0.0 < t && t < 10.0 * reference);
-    if let Some(settings) = r.get_mut("settings").and_then(|s| s.as_object_mut()) {
-        settings.insert("nodes".into(), json!(run.nodes));
-        settings.insert("dofs".into(), json!(run.dofs));
-    }
-    record::extend(
-        &mut r,
-        json!({
-            "reference": reference,
-            "reference_name": "Timoshenko q L^4/(8EI) + q L^2/(2 kappa G A), kappa = 10(1+nu)/(12+11nu)",
-            "reference_euler_bernoulli": beam_eb_tip(),
-            "tip_deflection": tip,
-            "error": if stable { rel_error(tip, reference) } else { None },
-            "error_vs_euler_bernoulli": if stable { rel_error(tip, beam_eb_tip()) } else { None },
-            "tip_drift_last_0_25s": drift,
-            "settled": drift.is_some_and(|d| d < 0.01 * reference),
-            "stable": stable,
-            "failure": run.failure,
-            "solver_work": run.work_fields(stepper),
-        }),
-    );
-    record::extend(&mut r, run.timer.fields());
-    record::emit(r);
+    let tip = StaticTip::measure(&run.ts, &run.us, run.completed(), nu);
+    emit_run(r, run, stepper, tip.fields());
 }
 
 /// One undamped vibration case: the fit of the tip's oscillation against Timoshenko's first
 /// frequency; the damping ratio is all numerical (the beam has no damping).
 fn vibration_case(body: Body, stepper: Stepper, dt: f64) {
-    let reference = beam_timoshenko_frequency(BEAM_NU, TIMOSHENKO_ELEMENTS);
-    let extra = record::object(json!({
-        "damping_beta": 0.0, "duration_s": VIBRATION_S,
-        "excitation": "released straight under gravity (oscillates about the static deflection)",
-    }));
-    let mut r = beam_record("vibration", body, stepper, (dt, BEAM_NU), extra);
+    let r = beam_record(
+        "vibration",
+        body,
+        stepper,
+        (dt, BEAM_NU),
+        vibration_settings(),
+    );
     let run = match run_beam(body, stepper, dt, BEAM_NU, None, VIBRATION_S) {
         Ok(run) => run,
         Err(reason) => return record::skipped(r, &reason),
     };
-    let fit = if run.completed() {
-        fit_damped_oscillation(&run.ts, &run.us)
-    } else {
-        None
-    };
-    let freq = fit.as_ref().map(|f| f.frequency_hz);
-    let zeta = fit.as_ref().map(|f| f.damping_ratio);
+    let measures = vibration_fields(&run.ts, &run.us, run.completed(), dt);
+    emit_run(r, run, stepper, measures);
+}
+
+/// Completes a beam case's line with the run's node and dof counts, `measures`, its failure,
+/// work and times, and emits it.
+fn emit_run(mut r: Record, run: BeamRun, stepper: Stepper, measures: serde_json::Value) {
     if let Some(settings) = r.get_mut("settings").and_then(|s| s.as_object_mut()) {
         settings.insert("nodes".into(), json!(run.nodes));
         settings.insert("dofs".into(), json!(run.dofs));
     }
+    record::extend(&mut r, measures);
     record::extend(
         &mut r,
         json!({
-            "reference": reference,
-            "reference_name": "Timoshenko first bending frequency (shear + rotary inertia, \
-                               400-element solve); Euler-Bernoulli (1.8751^2/(2 pi L^2)) sqrt(EI/(rho A))",
-            "reference_euler_bernoulli": beam_eb_frequency(),
-            "first_frequency_hz": freq,
-            "error": rel_error(freq, reference),
-            "damping_ratio": zeta,
-            "numerical_damping_ratio": zeta,
-            "damping_ratio_omega_dt_over_2": 2.0 * PI * reference * dt / 2.0,
-            "fit": fit.as_ref().map(|f| f.to_json()),
-            "stable": run.completed() && fit.is_some(),
             "failure": run.failure,
             "solver_work": run.work_fields(stepper),
         }),

@@ -7,8 +7,9 @@ use crate::beam::GRAVITY;
 use crate::budget::{CASE_LIMIT_S, Deadline};
 use crate::knobs::{self, Body};
 use crate::record::{self, Record};
-use crate::reference::*;
-use crate::timing::{CpuClock, Timer};
+use compare_common::contact::{BoxTrace, DT, DropTrace};
+use compare_common::reference::*;
+use compare_common::timing::{CpuClock, Timer};
 use rapier_fvm::element::ElementOrder::{Linear as Lin, Quadratic as Quad};
 use rapier_fvm::glamx::Vec3;
 use rapier_fvm::integrate::AutomaticReport;
@@ -17,10 +18,6 @@ use rapier_fvm::world::FvmWorld;
 use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder, SharedShape};
 use serde_json::json;
 
-/// Frame step of both scenes (s).
-const DT: f64 = 1.0 / 240.0;
-/// The last half second is the resting window.
-const REST_S: f64 = 0.5;
 /// The stable Neo-Hookean model (the crate's default).
 const SNH: MaterialModel = MaterialModel::StableNeoHookean;
 /// The corotated model.
@@ -192,20 +189,13 @@ pub fn scene_drop(quick: bool) {
     }
 }
 
-/// The lowest and the mean node height after every frame.
-#[derive(Default)]
-struct DropTrace {
-    min_y: Vec<f64>,
-    mean_y: Vec<f64>,
-}
-
 /// One drop.
 fn drop_case(case: &Contact) {
     /// Simulated time (s).
     const T_END: f64 = 2.5;
     let mut world = case.world();
     let [n, _, _] = case.body.cells;
-    let mut r = case.record("drop", &format!("{n}^3"), &world);
+    let r = case.record("drop", &format!("{n}^3"), &world);
     world.physics.insert_collider(
         ColliderBuilder::new(SharedShape::halfspace(Vec3::Y)).friction(FRICTION as f32),
         None,
@@ -234,39 +224,14 @@ fn drop_case(case: &Contact) {
             failure = Some("a node went non-finite or beyond 100 m".into());
             break;
         }
-        let ys = body.positions().iter().map(|x| x.y);
-        trace.min_y.push(ys.clone().fold(f64::INFINITY, f64::min));
-        trace
-            .mean_y
-            .push(ys.sum::<f64>() / body.node_count() as f64);
+        let ys: Vec<f64> = body.positions().iter().map(|x| x.y).collect();
+        trace.push(&ys);
         if let Err(reason) = deadline.check(k + 1, frames) {
             return record::skipped(r, &reason);
         }
     }
-    let stable = failure.is_none();
-    let rest = trace
-        .min_y
-        .len()
-        .saturating_sub((REST_S / DT).round() as usize);
-    let reference = drop_rest_centroid();
-    let h = stable.then(|| mean(&trace.mean_y[rest..]));
-    record::extend(
-        &mut r,
-        json!({
-            "reference": reference,
-            "reference_name": "resting centroid height H/2 - rho g H^2/(3E) (uniaxial, frictionless ground)",
-            "resting_centroid_height": h,
-            "error": rel_error(h, reference),
-            "centroid_rest_std": stable.then(|| std(&trace.mean_y[rest..])),
-            "peak_penetration": stable.then(|| (-min(&trace.min_y)).max(0.0)),
-            "resting_penetration": stable.then(|| -mean(&trace.min_y[rest..])),
-            "stable": stable,
-            "failure": failure,
-            "solver_work": work.to_json(),
-        }),
-    );
-    record::extend(&mut r, timer.fields());
-    record::emit(r);
+    let measures = trace.fields(failure.is_none());
+    emit_run(r, measures, failure, &work, &timer);
 }
 
 /// The cases of scene 5: two resolutions of linear tetrahedra with the default and 16
@@ -291,15 +256,6 @@ pub fn scene_box_on_block(quick: bool) {
     for case in cases {
         box_case(case);
     }
-}
-
-/// What a box-on-block run records after every frame.
-#[derive(Default)]
-struct BoxTrace {
-    y: Vec<f64>,
-    vy: Vec<f64>,
-    penetration: Vec<f64>,
-    dent: Vec<f64>,
 }
 
 /// One box on the block.
@@ -352,20 +308,11 @@ fn box_case(case: &Contact) {
             break;
         }
         let top_y: Vec<f64> = top.iter().map(|&n| block.positions()[n].y).collect();
-        trace.y.push(y);
-        trace.vy.push(f64::from(rigid.linvel().y));
-        trace
-            .penetration
-            .push(top_y.iter().fold(f64::MIN, |m, t| m.max(t - (y - hb))));
-        trace
-            .dent
-            .push(top_y0.iter().zip(&top_y).map(|(a, b)| a - b).sum::<f64>() / top.len() as f64);
+        trace.push(y, f64::from(rigid.linvel().y), &top_y, &top_y0);
         if let Err(reason) = deadline.check(k + 1, frames) {
             return record::skipped(r, &reason);
         }
     }
-    let stable = failure.is_none();
-    let rest = trace.y.len().saturating_sub((REST_S / DT).round() as usize);
     if let Some(settings) = r.get_mut("settings").and_then(|s| s.as_object_mut()) {
         settings.extend(record::object(json!({
             "block": BLOCK_SIZE, "block_support": "bottom face pinned", "box_size": BOX_SIZE,
@@ -373,35 +320,24 @@ fn box_case(case: &Contact) {
             "resolution_peer_order": [x, z, y],
         })));
     }
+    let measures = trace.fields(failure.is_none());
+    emit_run(r, measures, failure, &work, &timer);
+}
+
+/// Completes a contact case's line with `measures`, the run's failure, work and times, and
+/// emits it.
+fn emit_run(
+    mut r: Record,
+    measures: serde_json::Value,
+    failure: Option<String>,
+    work: &FrameWork,
+    timer: &Timer,
+) {
+    record::extend(&mut r, measures);
     record::extend(
         &mut r,
-        json!({
-            "reference": null, "error": null,
-            "sink": stable.then(|| height - (mean(&trace.y[rest..]) - hb)),
-            "penetration": stable.then(|| mean(&trace.penetration[rest..])),
-            "surface_sink": stable.then(|| mean(&trace.dent[rest..])),
-            "vertical_velocity_std": stable.then(|| std(&trace.vy[rest..])),
-            "stable": stable,
-            "failure": failure,
-            "solver_work": work.to_json(),
-        }),
+        json!({ "failure": failure, "solver_work": work.to_json() }),
     );
     record::extend(&mut r, timer.fields());
     record::emit(r);
-}
-
-/// Mean of `v`.
-fn mean(v: &[f64]) -> f64 {
-    v.iter().sum::<f64>() / v.len() as f64
-}
-
-/// Population standard deviation of `v`.
-fn std(v: &[f64]) -> f64 {
-    let m = mean(v);
-    (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / v.len() as f64).sqrt()
-}
-
-/// Smallest of `v`.
-fn min(v: &[f64]) -> f64 {
-    v.iter().copied().fold(f64::MAX, f64::min)
 }

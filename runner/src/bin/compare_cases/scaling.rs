@@ -11,8 +11,8 @@
 use crate::contact::{self, Contact, FrameWork};
 use crate::knobs::{self, Body};
 use crate::record::{self, Record};
-use crate::reference::*;
-use crate::timing::{CpuClock, Timer};
+use compare_common::reference::*;
+use compare_common::timing::{CpuClock, Timer};
 use rapier_fvm::element::ElementOrder;
 use rapier_fvm::glamx::Vec3;
 use rapier_fvm::prelude::*;
@@ -200,7 +200,9 @@ fn scaling_case(case: &Contact, n: usize, threads: usize, window: Window) -> (f6
     let mut failure = (0..WARM_UP_FRAMES)
         .find_map(|_| contact::step(&mut world, &mut warm_up, &mut FrameWork::default()).err());
     let mut timer = Timer::new(clock(threads));
-    while failure.is_none() && timer.len() < window.frames && timer.wall_total_s() < window.seconds
+    while failure.is_none()
+        && timer.steps_timed() < window.frames
+        && timer.wall_total_s() < window.seconds
     {
         failure = contact::step(&mut world, &mut timer, &mut work).err();
     }
@@ -225,7 +227,7 @@ fn scaling_case(case: &Contact, n: usize, threads: usize, window: Window) -> (f6
             },
         }),
     );
-    let frames = timer.len();
+    let frames = timer.steps_timed();
     record::extend(&mut r, timer.fields());
     record::emit(r);
     (case_wall_s, frames)

@@ -1,7 +1,7 @@
 //! Least-squares fit of a damped oscillation `u(t) = c + exp(-s t)(a cos wt + b sin wt)`, the
 //! same grid search as `fit_damped_oscillation` in `common.py`.
 
-use rapier3d::na::{Matrix3, Vector3};
+use nalgebra::{Matrix3, Vector3};
 use serde_json::{Value, json};
 use std::f64::consts::PI;
 

@@ -1,9 +1,10 @@
 //! Scene constants and closed-form references, the same as `benches/compare/common.py`.
 
-use rapier3d::na::{DMatrix, DVector};
+use nalgebra::{DMatrix, DVector};
 use std::f64::consts::PI;
 
-/// Gravity (m/s^2), along -z.
+/// Gravity (m/s^2): along -z in the peers' scripts and `rapier_builtin`, along -y (rapier's
+/// default) in `compare_cases`.
 pub const G: f64 = 9.81;
 
 /// Cantilever length (m); clamped at x = 0.
@@ -41,6 +42,8 @@ pub const BOX_MASS: f64 = 1.0;
 pub const FRICTION: f64 = 0.5;
 /// The scaling scene stops before a size predicted to take longer than this (s).
 pub const SCALING_CASE_BUDGET_S: f64 = 30.0;
+/// Stiffness-proportional damping time of the contact and scaling scenes (s).
+pub const SOFT_BETA: f64 = 0.01;
 
 /// Shear correction of a rectangular section (Cowper 1966): 10(1+nu)/(12+11nu).
 pub fn cowper_kappa(nu: f64) -> f64 {

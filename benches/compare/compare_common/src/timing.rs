@@ -62,7 +62,7 @@ impl Timer {
     }
 
     /// Number of timed steps.
-    pub fn len(&self) -> usize {
+    pub fn steps_timed(&self) -> usize {
         self.cpu.len()
     }
 
@@ -114,6 +114,6 @@ mod tests {
                 .map(|k| k ^ (k >> 3))
                 .sum::<u64>()
         });
-        assert!(sum > 0 && timer.len() == 1 && timer.cpu[0] > 0.0);
+        assert!(sum > 0 && timer.steps_timed() == 1 && timer.cpu[0] > 0.0);
     }
 }
