@@ -1,5 +1,10 @@
 //! The implicit solver's and the contact pipeline's kernels, each on a fixed state:
 //!
+//! - one backward Euler frame of 1/60 s of the stiff reference beam (E = 1e9 Pa, stable
+//!   Neo-Hookean, 1 600 tetrahedra) under gravity: backward Euler damps the beam within a few
+//!   frames, so most measured frames start near equilibrium and take zero or one Newton
+//!   iteration, the cost of a body at rest (`examples/implicit_scaling.rs` prints frames in
+//!   motion and larger sizes);
 //! - one Newton iteration (assembly, direct solve, line search) of a 1/60 s frame of the stiff
 //!   reference beam (E = 1e9 Pa, stable Neo-Hookean, 1 600 tetrahedra) released from rest;
 //! - the same iteration with its linear system solved by the conjugate gradient capped at 1 and
@@ -34,6 +39,22 @@ fn beam() -> SoftBody {
         .step(&mut body, 1.0 / 60.0, DVec3::ZERO)
         .expect("first frame");
     body
+}
+
+fn implicit_frame(c: &mut Criterion) {
+    let mut body = beam();
+    let integrator = ImplicitIntegrator::default();
+    let mut group = c.benchmark_group("implicit_frame");
+    group.sample_size(20);
+    group.bench_function("stable_neo_hookean_1600_tets_dt_1_60", |b| {
+        b.iter(|| {
+            integrator
+                .step(&mut body, 1.0 / 60.0, GRAVITY)
+                .expect("implicit frame")
+                .newton_iterations
+        })
+    });
+    group.finish();
 }
 
 fn newton_iteration(c: &mut Criterion) {
@@ -115,5 +136,5 @@ fn contact_detection(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, newton_iteration, contact_detection);
+criterion_group!(benches, implicit_frame, newton_iteration, contact_detection);
 criterion_main!(benches);

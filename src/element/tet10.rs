@@ -41,6 +41,19 @@ pub const LUMPED_MASS_FRACTIONS: [f64; NODES] = {
     ]
 };
 
+/// The nodes of the reference element (m): corners at the origin and the unit points, mid-edge
+/// nodes halfway.
+pub fn reference_nodes() -> [DVec3; NODES] {
+    let corners = [DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z];
+    std::array::from_fn(|a| match a {
+        0..4 => corners[a],
+        _ => {
+            let [i, j] = EDGES[a - 4];
+            0.5 * (corners[i] + corners[j])
+        }
+    })
+}
+
 /// The shape functions at barycentric coordinates `l` (summing to one).
 pub fn shape_values(l: [f64; 4]) -> [f64; NODES] {
     let mut n = [0.0; NODES];
@@ -217,19 +230,6 @@ pub(crate) fn deformation_gradient(nodes: &[u32], gradients: &[DVec3], x: &[DVec
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// The reference element's nodes: corners at the origin and the unit points, mid-edge nodes
-    /// halfway.
-    fn reference_nodes() -> [DVec3; NODES] {
-        let corners = [DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z];
-        std::array::from_fn(|a| match a {
-            0..4 => corners[a],
-            _ => {
-                let [i, j] = EDGES[a - 4];
-                0.5 * (corners[i] + corners[j])
-            }
-        })
-    }
 
     fn barycentric(p: DVec3) -> [f64; 4] {
         [1.0 - p.x - p.y - p.z, p.x, p.y, p.z]

@@ -4,7 +4,7 @@
 
 use super::TetMesh;
 use crate::Error;
-use crate::element::tet10::{EDGES, NODES};
+use crate::element::tet10::{EDGES, NODES, reference_nodes};
 use rapier3d::glamx::DVec3;
 use std::collections::HashMap;
 
@@ -258,19 +258,6 @@ fn local_tets(
     std::array::from_fn(|t| match t {
         0..4 => corner_tets[t],
         _ => [a, b, cycle[t - 4], cycle[(t - 3) % 4]],
-    })
-}
-
-/// The nodes of the reference element: corners at the origin and the unit points, mid-edge nodes
-/// halfway.
-fn reference_nodes() -> [DVec3; NODES] {
-    let corners = [DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z];
-    std::array::from_fn(|a| match a {
-        0..4 => corners[a],
-        _ => {
-            let [i, j] = EDGES[a - 4];
-            0.5 * (corners[i] + corners[j])
-        }
     })
 }
 
