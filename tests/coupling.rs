@@ -1,6 +1,8 @@
 //! Soft and rigid bodies in one world ([`FvmWorld`]): momentum exchanged exactly, and support
 //! without jitter or creep.
 
+mod common;
+
 use rapier_fvm::glamx::Vec3;
 use rapier_fvm::prelude::*;
 use rapier_fvm::world::FvmWorld;
@@ -464,45 +466,15 @@ fn nodes_glued_to_a_kinematic_body_follow_its_prescribed_path() {
         Some(IntegratorKind::Explicit),
         Some(IntegratorKind::Implicit),
     ] {
-        let mut world = FvmWorld::default();
-        world.integrator.force = integrator;
-        let (radius, period) = (0.05f32, 1.0f32);
-        let (driver, _) = world.physics.insert(
-            RigidBodyBuilder::kinematic_position_based().translation(Vec3::new(radius, 0.5, 0.0)),
-            ColliderBuilder::ball(0.01).sensor(true),
-        );
         let material = rubber(1e6);
         let mesh = mesh::cuboid(DVec3::new(0.01, 0.1, 0.01), [1, 10, 1]).unwrap();
         let root = mesh.nodes_where(|p| p.y >= 0.1 - 1e-9);
-        let beam = SoftBodyBuilder::new(mesh, material)
+        let rod = SoftBodyBuilder::new(mesh, material)
             .damping(RayleighDamping::stiffness_proportional(0.01, material.lame()).unwrap())
-            .translation(DVec3::new(f64::from(radius), 0.4, 0.0))
+            .translation(DVec3::new(common::GLUED_PATH_RADIUS, 0.4, 0.0))
             .build()
             .unwrap();
-        let beam = world.soft_bodies.insert(beam);
-        world.soft_bodies[beam]
-            .attach(root.iter().copied(), driver, &world.physics.bodies)
-            .unwrap();
-        let offsets: Vec<DVec3> = root
-            .iter()
-            .map(|&n| {
-                world.soft_bodies[beam].positions()[n as usize]
-                    - DVec3::new(f64::from(radius), 0.5, 0.0)
-            })
-            .collect();
-        let dt = world.physics.integration_parameters.dt;
-        let mut worst = 0.0f64;
-        for frame in 1..=120 {
-            let angle = std::f32::consts::TAU * frame as f32 * dt / period;
-            let centre = Vec3::new(radius * angle.cos(), 0.5, radius * angle.sin());
-            world.physics.bodies[driver].set_next_kinematic_translation(centre);
-            step(&mut world);
-            let body = &world.soft_bodies[beam];
-            for (&n, offset) in root.iter().zip(&offsets) {
-                let target = centre.as_dvec3() + *offset;
-                worst = worst.max(body.positions()[n as usize].distance(target));
-            }
-        }
+        let worst = common::glued_path_error(rod, &root, integrator);
         println!(
             "{integrator:?}: glued nodes' largest distance from the path {:.4} mm",
             worst * 1e3

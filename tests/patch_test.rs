@@ -46,12 +46,7 @@ fn interior_force_ratio(
     if let Some(damping) = damping {
         builder = builder.damping(damping);
     }
-    let mut body = builder.build().unwrap();
-    for (n, p) in mesh.positions().iter().enumerate() {
-        body.positions_mut()[n] = map(*p);
-        body.velocities_mut()[n] = rate(*p);
-    }
-    let forces = body.internal_forces().to_vec();
+    let forces = common::forces_under(&mut builder.build().unwrap(), map, rate);
     let (mut interior, mut boundary) = (0.0f64, 0.0f64);
     for (p, f) in mesh.positions().iter().zip(&forces) {
         if is_interior(*p) {

@@ -42,7 +42,8 @@ fn is_interior(p: DVec3) -> bool {
     p.abs().max_element() < HALF - 1e-9
 }
 
-/// The body of `mesh` with every node placed at `map(p)` moving at `rate(p)`, and its forces.
+/// The quadratic body of `mesh` with every node placed at `map(p)` moving at `rate(p)`, and its
+/// forces.
 fn forces_under(
     mesh: &mesh::QuadraticTetMesh,
     model: MaterialModel,
@@ -55,12 +56,7 @@ fn forces_under(
     if let Some(damping) = damping {
         builder = builder.damping(damping);
     }
-    let mut body = builder.build().unwrap();
-    for (n, p) in mesh.positions().iter().enumerate() {
-        body.positions_mut()[n] = map(*p);
-        body.velocities_mut()[n] = rate(*p);
-    }
-    body.internal_forces().to_vec()
+    common::forces_under(&mut builder.build().unwrap(), map, rate)
 }
 
 /// Largest interior force over largest boundary force.
@@ -455,55 +451,21 @@ fn curved_quadratic_meshes_follow_the_round_shape() {
 /// 0.0855 mm implicit, below a micrometre explicit.
 #[test]
 fn glued_quadratic_nodes_follow_a_moving_kinematic_body() {
-    use rapier_fvm::glamx::Vec3;
-    use rapier_fvm::world::FvmWorld;
-    use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder};
-
     for integrator in [
         None,
         Some(IntegratorKind::Explicit),
         Some(IntegratorKind::Implicit),
     ] {
-        let mut world = FvmWorld::default();
-        world.integrator.force = integrator;
-        let (radius, period) = (0.05f32, 1.0f32);
-        let (driver, _) = world.physics.insert(
-            RigidBodyBuilder::kinematic_position_based().translation(Vec3::new(radius, 0.5, 0.0)),
-            ColliderBuilder::ball(0.01).sensor(true),
-        );
         let material = Material::new(MaterialModel::StableNeoHookean, 1e6, 0.3, 1000.0).unwrap();
         let linear = mesh::cuboid(DVec3::new(0.01, 0.1, 0.01), [1, 5, 1]).unwrap();
         let quadratic = mesh::QuadraticTetMesh::from_linear(&linear).unwrap();
         let root = quadratic.nodes_where(|p| p.y >= 0.1 - 1e-9);
-        let beam = SoftBodyBuilder::quadratic(quadratic, material)
+        let rod = SoftBodyBuilder::quadratic(quadratic, material)
             .damping(RayleighDamping::stiffness_proportional(1e-3, material.lame()).unwrap())
-            .translation(DVec3::new(f64::from(radius), 0.4, 0.0))
+            .translation(DVec3::new(common::GLUED_PATH_RADIUS, 0.4, 0.0))
             .build()
             .unwrap();
-        let beam = world.soft_bodies.insert(beam);
-        world.soft_bodies[beam]
-            .attach(root.iter().copied(), driver, &world.physics.bodies)
-            .unwrap();
-        let centre_at_start = DVec3::new(f64::from(radius), 0.5, 0.0);
-        let offsets: Vec<DVec3> = root
-            .iter()
-            .map(|&n| world.soft_bodies[beam].positions()[n as usize] - centre_at_start)
-            .collect();
-        let dt = world.physics.integration_parameters.dt;
-        let mut worst = 0.0f64;
-        for frame in 1..=120 {
-            let angle = std::f32::consts::TAU * frame as f32 * dt / period;
-            let centre = Vec3::new(radius * angle.cos(), 0.5, radius * angle.sin());
-            world.physics.bodies[driver].set_next_kinematic_translation(centre);
-            for (_, outcome) in world.step() {
-                outcome.unwrap();
-            }
-            let body = &world.soft_bodies[beam];
-            for (&n, offset) in root.iter().zip(&offsets) {
-                let target = centre.as_dvec3() + *offset;
-                worst = worst.max(body.positions()[n as usize].distance(target));
-            }
-        }
+        let worst = common::glued_path_error(rod, &root, integrator);
         println!(
             "{integrator:?}: quadratic glued nodes' largest distance from the path {:.4} mm",
             worst * 1e3

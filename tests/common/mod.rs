@@ -148,3 +148,64 @@ pub fn elastica_tip_deflection(young_modulus: f64) -> f64 {
     }
     shoot(0.5 * (low + high)).1
 }
+
+/// Places every node of `body` at `map(p)` moving at `rate(p)`, `p` its rest position, and
+/// returns the internal forces (N per node) there.
+pub fn forces_under(
+    body: &mut SoftBody,
+    map: impl Fn(DVec3) -> DVec3,
+    rate: impl Fn(DVec3) -> DVec3,
+) -> Vec<DVec3> {
+    let rest = body.mesh().positions().to_vec();
+    for (n, p) in rest.iter().enumerate() {
+        body.positions_mut()[n] = map(*p);
+        body.velocities_mut()[n] = rate(*p);
+    }
+    body.internal_forces().to_vec()
+}
+
+/// Hangs `rod` (placed 0.1 m below (0.05, 0.5, 0) m) by its nodes `root` from a position-based
+/// kinematic body that is driven around a horizontal 5 cm circle centred on the y axis once a
+/// second, for 120 frames of an [`FvmWorld`](rapier_fvm::world::FvmWorld) stepped by
+/// `integrator` (`None`: automatic). Returns the largest distance (m) of a glued node from where
+/// the path puts its anchor.
+pub fn glued_path_error(rod: SoftBody, root: &[u32], integrator: Option<IntegratorKind>) -> f64 {
+    use rapier_fvm::glamx::Vec3;
+    use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder};
+
+    let mut world = rapier_fvm::world::FvmWorld::default();
+    world.integrator.force = integrator;
+    let (radius, period) = (GLUED_PATH_RADIUS as f32, 1.0f32);
+    let start = Vec3::new(radius, 0.5, 0.0);
+    let (driver, _) = world.physics.insert(
+        RigidBodyBuilder::kinematic_position_based().translation(start),
+        ColliderBuilder::ball(0.01).sensor(true),
+    );
+    let rod = world.soft_bodies.insert(rod);
+    world.soft_bodies[rod]
+        .attach(root.iter().copied(), driver, &world.physics.bodies)
+        .unwrap();
+    let offsets: Vec<DVec3> = root
+        .iter()
+        .map(|&n| world.soft_bodies[rod].positions()[n as usize] - start.as_dvec3())
+        .collect();
+    let dt = world.physics.integration_parameters.dt;
+    let mut worst = 0.0f64;
+    for frame in 1..=120 {
+        let angle = std::f32::consts::TAU * frame as f32 * dt / period;
+        let centre = Vec3::new(radius * angle.cos(), 0.5, radius * angle.sin());
+        world.physics.bodies[driver].set_next_kinematic_translation(centre);
+        for (handle, outcome) in world.step() {
+            outcome.unwrap_or_else(|e| panic!("{handle:?}: {e}"));
+        }
+        let body = &world.soft_bodies[rod];
+        for (&n, offset) in root.iter().zip(&offsets) {
+            let target = centre.as_dvec3() + *offset;
+            worst = worst.max(body.positions()[n as usize].distance(target));
+        }
+    }
+    worst
+}
+
+/// The radius (m) of [`glued_path_error`]'s circle.
+pub const GLUED_PATH_RADIUS: f64 = 0.05;

@@ -483,7 +483,7 @@ impl Reader {
 
     fn nodes_v4(&mut self, source: &mut Source<'_>) -> Result<(), Error> {
         let (blocks, total) = self.block_header(source, "node")?;
-        let mut read = 0usize;
+        let mut blocks_read = BlockCount::new("a node block", "node", total);
         for _ in 0..blocks {
             let location = source.location();
             let (dim, parametric, count) = if self.format.binary {
@@ -508,18 +508,7 @@ impl Reader {
                     format!("entity dimension {dim} or parametric flag {parametric} is invalid"),
                 ));
             }
-            let count = usize::try_from(count).unwrap_or(usize::MAX);
-            if count > total - read {
-                return Err(source.error_at(
-                    location,
-                    ImportErrorKind::BadCount,
-                    format!(
-                        "a node block of {count} nodes, but {} of the {total} announced remain",
-                        total - read
-                    ),
-                ));
-            }
-            read += count;
+            let count = blocks_read.take(source, location, count)?;
             let extra = if parametric == 1 { dim as usize } else { 0 };
             // Tags first, then coordinates.
             let mut tags = Vec::with_capacity(source.capacity(count, 2));
@@ -559,18 +548,12 @@ impl Reader {
                 self.add_node(source, tag, p)?;
             }
         }
-        if read != total {
-            return Err(source.error(
-                ImportErrorKind::BadCount,
-                format!("the node blocks hold {read} nodes, the section header says {total}"),
-            ));
-        }
-        Ok(())
+        blocks_read.finish(source)
     }
 
     fn elements_v4(&mut self, source: &mut Source<'_>) -> Result<(), Error> {
         let (blocks, total) = self.block_header(source, "element")?;
-        let mut read = 0usize;
+        let mut blocks_read = BlockCount::new("an element block", "element", total);
         for _ in 0..blocks {
             let location = source.location();
             let (element_type, count) = if self.format.binary {
@@ -588,19 +571,7 @@ impl Reader {
                 let count: u64 = parse_token(source, tokens.next(), "element block size")?;
                 (element_type, count)
             };
-            let count = usize::try_from(count).unwrap_or(usize::MAX);
-            if count > total - read {
-                return Err(source.error_at(
-                    location,
-                    ImportErrorKind::BadCount,
-                    format!(
-                        "an element block of {count} elements, but {} of the {total} announced \
-                         remain",
-                        total - read
-                    ),
-                ));
-            }
-            read += count;
+            let count = blocks_read.take(source, location, count)?;
             let Some((node_count, _)) = element_shape(element_type) else {
                 return Err(source.error_at(
                     location,
@@ -625,13 +596,7 @@ impl Reader {
                 }
             }
         }
-        if read != total {
-            return Err(source.error(
-                ImportErrorKind::BadCount,
-                format!("the element blocks hold {read} elements, the section header says {total}"),
-            ));
-        }
-        Ok(())
+        blocks_read.finish(source)
     }
 
     /// The `numEntityBlocks numX minTag maxTag` header of a 4.1 section: (blocks, total).
@@ -698,5 +663,60 @@ impl Reader {
             mid_edge_nodes,
             tet_locations,
         })
+    }
+}
+
+/// The items a 4.1 section's blocks have announced so far, against the section's total.
+struct BlockCount {
+    /// "a node block" / "an element block", for messages.
+    block: &'static str,
+    /// "node" / "element".
+    kind: &'static str,
+    total: usize,
+    read: usize,
+}
+
+impl BlockCount {
+    fn new(block: &'static str, kind: &'static str, total: usize) -> Self {
+        Self {
+            block,
+            kind,
+            total,
+            read: 0,
+        }
+    }
+
+    /// Counts a block of `count` items, or [`ImportErrorKind::BadCount`] at `location` if it
+    /// holds more than the section has left.
+    fn take(
+        &mut self,
+        source: &Source<'_>,
+        location: FileLocation,
+        count: u64,
+    ) -> Result<usize, Error> {
+        let count = usize::try_from(count).unwrap_or(usize::MAX);
+        let left = self.total - self.read;
+        if count > left {
+            let (block, kind, total) = (self.block, self.kind, self.total);
+            return Err(source.error_at(
+                location,
+                ImportErrorKind::BadCount,
+                format!("{block} of {count} {kind}s, but {left} of the {total} announced remain"),
+            ));
+        }
+        self.read += count;
+        Ok(count)
+    }
+
+    /// [`ImportErrorKind::BadCount`] unless the blocks held the announced total.
+    fn finish(&self, source: &Source<'_>) -> Result<(), Error> {
+        if self.read == self.total {
+            return Ok(());
+        }
+        let (kind, read, total) = (self.kind, self.read, self.total);
+        Err(source.error(
+            ImportErrorKind::BadCount,
+            format!("the {kind} blocks hold {read} {kind}s, the section header says {total}"),
+        ))
     }
 }
