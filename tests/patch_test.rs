@@ -83,15 +83,7 @@ fn linear_patch_test_small_affine_displacement() {
 
 #[test]
 fn every_model_passes_the_patch_test_under_a_finite_homogeneous_deformation() {
-    // 20 % stretch, 10 % shear, then a 40 degree rotation: a large homogeneous deformation.
-    let stretch_shear = DMat3::from_cols(
-        DVec3::new(1.2, 0.0, 0.0),
-        DVec3::new(0.1, 0.9, 0.0),
-        DVec3::new(0.0, 0.05, 1.1),
-    );
-    let rotation =
-        DMat3::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 40f64.to_radians());
-    let f = rotation * stretch_shear;
+    let f = common::finite_homogeneous_deformation();
     for model in MODELS {
         let ratio = interior_force_ratio(model, None, |p| f * p + DVec3::X, |_| DVec3::ZERO);
         println!("{model:?} finite patch test: interior/boundary force = {ratio:.2e}");
@@ -106,11 +98,7 @@ fn damping_passes_the_patch_test_under_a_homogeneous_strain_rate() {
         DVec3::new(0.0, 0.95, 0.02),
         DVec3::new(0.03, 0.0, 1.0),
     );
-    let f_dot = DMat3::from_cols(
-        DVec3::new(0.5, -0.2, 0.1),
-        DVec3::new(0.3, -0.4, 0.0),
-        DVec3::new(0.0, 0.2, 0.6),
-    );
+    let f_dot = common::homogeneous_deformation_rate();
     let damping = RayleighDamping::new(2e4, 1e4).unwrap();
     for model in MODELS {
         let ratio = interior_force_ratio(model, Some(damping), |p| f * p, |p| f_dot * p);

@@ -79,19 +79,8 @@ fn interior_ratio(mesh: &mesh::QuadraticTetMesh, forces: &[DVec3]) -> f64 {
 #[test]
 fn every_model_passes_the_patch_test_under_a_finite_homogeneous_deformation() {
     let mesh = distorted_quadratic_box();
-    let stretch_shear = DMat3::from_cols(
-        DVec3::new(1.2, 0.0, 0.0),
-        DVec3::new(0.1, 0.9, 0.0),
-        DVec3::new(0.0, 0.05, 1.1),
-    );
-    let rotation =
-        DMat3::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 40f64.to_radians());
-    let f = rotation * stretch_shear;
-    let f_dot = DMat3::from_cols(
-        DVec3::new(0.5, -0.2, 0.1),
-        DVec3::new(0.3, -0.4, 0.0),
-        DVec3::new(0.0, 0.2, 0.6),
-    );
+    let f = common::finite_homogeneous_deformation();
+    let f_dot = common::homogeneous_deformation_rate();
     let damping = RayleighDamping::new(2e4, 1e4).unwrap();
     for model in MODELS {
         let elastic = forces_under(&mesh, model, None, |p| f * p + DVec3::X, |_| DVec3::ZERO);

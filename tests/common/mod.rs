@@ -209,3 +209,25 @@ pub fn glued_path_error(rod: SoftBody, root: &[u32], integrator: Option<Integrat
 
 /// The radius (m) of [`glued_path_error`]'s circle.
 pub const GLUED_PATH_RADIUS: f64 = 0.05;
+
+/// A large homogeneous deformation gradient for patch tests: 20 % stretch, 10 % shear, then a
+/// 40 degree rotation.
+pub fn finite_homogeneous_deformation() -> DMat3 {
+    let stretch_shear = DMat3::from_cols(
+        DVec3::new(1.2, 0.0, 0.0),
+        DVec3::new(0.1, 0.9, 0.0),
+        DVec3::new(0.0, 0.05, 1.1),
+    );
+    let rotation =
+        DMat3::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 40f64.to_radians());
+    rotation * stretch_shear
+}
+
+/// A homogeneous deformation rate `Ḟ` (1/s) for damping patch tests: stretching and shearing.
+pub fn homogeneous_deformation_rate() -> DMat3 {
+    DMat3::from_cols(
+        DVec3::new(0.5, -0.2, 0.1),
+        DVec3::new(0.3, -0.4, 0.0),
+        DVec3::new(0.0, 0.2, 0.6),
+    )
+}

@@ -25,6 +25,24 @@ const TETRAHEDRON: u32 = 4;
 /// Gmsh's quadratic (10-node) tetrahedron.
 const QUADRATIC_TETRAHEDRON: u32 = 11;
 
+/// The node count of Gmsh's element type `element_type`, or
+/// [`ImportErrorKind::UnsupportedElement`] at `location` for a type it does not define.
+fn nodes_per_element(
+    source: &Source<'_>,
+    location: FileLocation,
+    element_type: u32,
+) -> Result<usize, Error> {
+    element_shape(element_type)
+        .map(|(nodes, _)| nodes)
+        .ok_or_else(|| {
+            source.error_at(
+                location,
+                ImportErrorKind::UnsupportedElement,
+                format!("unknown element type {element_type}"),
+            )
+        })
+}
+
 /// Nodes per element and dimension of Gmsh's element types 1 to 31.
 fn element_shape(element_type: u32) -> Option<(usize, u8)> {
     Some(match element_type {
@@ -408,13 +426,7 @@ impl Reader {
                         ),
                     ));
                 }
-                let Some((node_count, _)) = element_shape(element_type) else {
-                    return Err(source.error_at(
-                        location,
-                        ImportErrorKind::UnsupportedElement,
-                        format!("unknown element type {element_type}"),
-                    ));
-                };
+                let node_count = nodes_per_element(source, location, element_type)?;
                 let mut nodes = [0u64; 56];
                 for _ in 0..following {
                     let location = source.location();
@@ -454,12 +466,7 @@ impl Reader {
         tokens: impl Iterator<Item = &'t str>,
     ) -> Result<(), Error> {
         let location = source.location();
-        let Some((node_count, _)) = element_shape(element_type) else {
-            return Err(source.error(
-                ImportErrorKind::UnsupportedElement,
-                format!("unknown element type {element_type}"),
-            ));
-        };
+        let node_count = nodes_per_element(source, location, element_type)?;
         let mut nodes = [0u64; 56];
         let mut n = 0;
         for token in tokens {
@@ -572,13 +579,7 @@ impl Reader {
                 (element_type, count)
             };
             let count = blocks_read.take(source, location, count)?;
-            let Some((node_count, _)) = element_shape(element_type) else {
-                return Err(source.error_at(
-                    location,
-                    ImportErrorKind::UnsupportedElement,
-                    format!("unknown element type {element_type}"),
-                ));
-            };
+            let node_count = nodes_per_element(source, location, element_type)?;
             let mut nodes = [0u64; 56];
             for _ in 0..count {
                 if self.format.binary {
