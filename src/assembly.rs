@@ -11,7 +11,6 @@
 
 use crate::Error;
 use crate::body::SoftBody;
-use crate::element::Elements;
 use crate::element::tet10::deformation_gradient;
 use crate::fvm::NodalAveraging;
 use crate::material::{HyperelasticModel, with_hyperelastic_model};
@@ -51,7 +50,7 @@ impl Stiffness {
         let n = body.node_count();
         let mut lower_neighbours: Vec<Vec<u32>> = (0..n as u32).map(|b| vec![b]).collect();
         couple_all_pairs(&mut lower_neighbours, body.elements.element_nodes());
-        if body.nodal_averaging.is_some() {
+        if body.elements.nodal_averaging().is_some() {
             // A node's patch: itself and every node sharing a tetrahedron with it.
             let mut patches: Vec<Vec<u32>> = lower_neighbours.clone();
             for (b, list) in lower_neighbours.iter().enumerate() {
@@ -112,10 +111,7 @@ impl Stiffness {
         self.values.fill(0.0);
         let x = body.positions();
         with_hyperelastic_model!(body.material, |model| {
-            let averaging = match (&body.nodal_averaging, &body.elements) {
-                (Some(averaging), Elements::Linear(fvm)) => Some((averaging, fvm)),
-                _ => None,
-            };
+            let averaging = body.elements.nodal_averaging();
             let measures = averaging.map(|(a, fvm)| a.measures(&model, fvm, x));
             let excesses = body.elements.volumetric_excesses(&model, x);
             let changes = unit_changes();

@@ -289,11 +289,26 @@ impl SoftBodyBuilder {
             .map(|n| if pinned[n] { DVec3::ZERO } else { self.linvel })
             .collect();
         let (elements, masses) = match &self.quadratic {
-            None => (
-                Elements::Linear(FvmMesh::new(&self.mesh)),
-                lumped_masses(&self.mesh, self.material.density()),
-            ),
+            None => {
+                let fvm = FvmMesh::new(&self.mesh);
+                let nodal_averaging = (self.volumetric == VolumetricTreatment::NodalAverage)
+                    .then(|| NodalAveraging::new(&fvm));
+                (
+                    Elements::Linear {
+                        fvm,
+                        nodal_averaging,
+                    },
+                    lumped_masses(&self.mesh, self.material.density()),
+                )
+            }
             Some(quadratic) => {
+                if self.volumetric == VolumetricTreatment::NodalAverage {
+                    return Err(Error::UnsupportedOption {
+                        option: "VolumetricTreatment::NodalAverage",
+                        reason: "nodal averaging applies to linear tetrahedra; quadratic ones \
+                                 average per element (VolumetricTreatment::ElementAverage)",
+                    });
+                }
                 let elements = QuadraticElements::new(self.mesh.positions(), quadratic)?;
                 let masses = elements
                     .lumped_volumes()
@@ -324,22 +339,8 @@ impl SoftBodyBuilder {
         let mut surface_nodes: Vec<u32> = surface_triangles.iter().flatten().copied().collect();
         surface_nodes.sort_unstable();
         surface_nodes.dedup();
-        let nodal_averaging = match (self.volumetric, &elements) {
-            (VolumetricTreatment::PerElement | VolumetricTreatment::ElementAverage, _) => None,
-            (VolumetricTreatment::NodalAverage, Elements::Linear(fvm)) => {
-                Some(NodalAveraging::new(fvm))
-            }
-            (VolumetricTreatment::NodalAverage, Elements::Quadratic { .. }) => {
-                return Err(Error::UnsupportedOption {
-                    option: "VolumetricTreatment::NodalAverage",
-                    reason: "nodal averaging applies to linear tetrahedra; quadratic ones \
-                             average per element (VolumetricTreatment::ElementAverage)",
-                });
-            }
-        };
         Ok(SoftBody {
             elements,
-            nodal_averaging,
             masses,
             forces: vec![DVec3::ZERO; node_count],
             saved_state: (

@@ -13,7 +13,7 @@ use crate::attachment::Attachment;
 use crate::contact::{ContactSettings, CornerContact, NodeContact, RigidProxy};
 use crate::damping::RayleighDamping;
 use crate::element::{ElementOrder, Elements};
-use crate::fvm::{NodalAveraging, VolumetricTreatment};
+use crate::fvm::VolumetricTreatment;
 use crate::material::{Material, with_hyperelastic_model};
 use crate::mesh::TetMesh;
 use rapier3d::dynamics::CoefficientCombineRule;
@@ -33,8 +33,6 @@ pub struct SoftBody {
     pub(crate) elements: Elements,
     pub(crate) material: Material,
     pub(crate) damping: Option<RayleighDamping>,
-    /// The incidence data of nodal averaging, when the body uses it.
-    pub(crate) nodal_averaging: Option<NodalAveraging>,
     pub(crate) positions: Vec<DVec3>,
     pub(crate) velocities: Vec<DVec3>,
     pub(crate) masses: Vec<f64>,
@@ -125,17 +123,7 @@ impl SoftBody {
     /// ([`VolumetricTreatment::ElementAverage`] on linear tetrahedra is reported as the
     /// [`VolumetricTreatment::PerElement`] it amounts to.)
     pub fn volumetric_treatment(&self) -> VolumetricTreatment {
-        match (&self.nodal_averaging, &self.elements) {
-            (Some(_), _) => VolumetricTreatment::NodalAverage,
-            (
-                None,
-                Elements::Quadratic {
-                    mean_dilatation: true,
-                    ..
-                },
-            ) => VolumetricTreatment::ElementAverage,
-            _ => VolumetricTreatment::PerElement,
-        }
+        self.elements.volumetric_treatment()
     }
 
     /// Number of nodes.
@@ -257,7 +245,6 @@ impl SoftBody {
             elements,
             material,
             damping,
-            nodal_averaging,
             positions,
             velocities,
             forces,
@@ -265,23 +252,14 @@ impl SoftBody {
         } = self;
         with_hyperelastic_model!(material, |model| {
             elements.internal_forces(&model, damping.as_ref(), positions, velocities, forces);
-            if let (Some(averaging), Elements::Linear(fvm)) = (nodal_averaging, elements) {
-                averaging.add_forces(&model, fvm, positions, forces);
-            }
         });
     }
 
     /// Elastic strain energy (J) at the current positions.
     pub fn elastic_energy(&self) -> f64 {
-        with_hyperelastic_model!(self.material, |model| match (
-            &self.nodal_averaging,
-            &self.elements
-        ) {
-            (Some(averaging), Elements::Linear(fvm)) => {
-                averaging.elastic_energy(&model, fvm, &self.positions)
-            }
-            _ => self.elements.elastic_energy(&model, &self.positions),
-        })
+        with_hyperelastic_model!(self.material, |model| self
+            .elements
+            .elastic_energy(&model, &self.positions))
     }
 
     /// Kinetic energy `Σ m v²/2` (J).

@@ -50,9 +50,11 @@ impl SoftBody {
                 }
             };
             match &self.elements {
-                Elements::Linear(fvm) => {
-                    let measures = self
-                        .nodal_averaging
+                Elements::Linear {
+                    fvm,
+                    nodal_averaging,
+                } => {
+                    let measures = nodal_averaging
                         .as_ref()
                         .map(|averaging| averaging.measures(&model, fvm, &self.positions));
                     let bulk = model.volumetric_modulus();

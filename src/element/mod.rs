@@ -13,7 +13,7 @@ mod mean_dilatation;
 pub mod tet10;
 
 use crate::damping::RayleighDamping;
-use crate::fvm::FvmMesh;
+use crate::fvm::{FvmMesh, NodalAveraging, VolumetricTreatment};
 use crate::material::VolumetricTerm;
 pub(crate) use mean_dilatation::mean_measure;
 use rapier3d::glamx::{DMat3, DVec3};
@@ -31,7 +31,12 @@ pub enum ElementOrder {
 /// A body's elements with their rest data.
 #[derive(Debug, Clone)]
 pub(crate) enum Elements {
-    Linear(FvmMesh),
+    Linear {
+        fvm: FvmMesh,
+        /// The node patches the volumetric term is averaged over, when it is
+        /// ([`crate::fvm::VolumetricTreatment::NodalAverage`]).
+        nodal_averaging: Option<NodalAveraging>,
+    },
     Quadratic {
         elements: QuadraticElements,
         /// Whether the volumetric term is averaged per element ([`mean_dilatation`]).
@@ -43,15 +48,41 @@ impl Elements {
     /// The order of the elements.
     pub(crate) fn order(&self) -> ElementOrder {
         match self {
-            Self::Linear(_) => ElementOrder::Linear,
+            Self::Linear { .. } => ElementOrder::Linear,
             Self::Quadratic { .. } => ElementOrder::Quadratic,
+        }
+    }
+
+    /// How the volumetric part of the energy is evaluated.
+    pub(crate) fn volumetric_treatment(&self) -> VolumetricTreatment {
+        match self {
+            Self::Linear {
+                nodal_averaging: Some(_),
+                ..
+            } => VolumetricTreatment::NodalAverage,
+            Self::Quadratic {
+                mean_dilatation: true,
+                ..
+            } => VolumetricTreatment::ElementAverage,
+            _ => VolumetricTreatment::PerElement,
+        }
+    }
+
+    /// The nodal averaging and the linear elements it averages over, when the body uses it.
+    pub(crate) fn nodal_averaging(&self) -> Option<(&NodalAveraging, &FvmMesh)> {
+        match self {
+            Self::Linear {
+                fvm,
+                nodal_averaging: Some(averaging),
+            } => Some((averaging, fvm)),
+            _ => None,
         }
     }
 
     /// Number of integration points.
     pub(crate) fn point_count(&self) -> usize {
         match self {
-            Self::Linear(fvm) => fvm.tets().len(),
+            Self::Linear { fvm, .. } => fvm.tets().len(),
             Self::Quadratic { elements, .. } => elements.points().len(),
         }
     }
@@ -59,7 +90,7 @@ impl Elements {
     /// The node lists of the elements (the nodes each couples in the tangent).
     pub(crate) fn element_nodes(&self) -> Box<dyn Iterator<Item = &[u32]> + '_> {
         match self {
-            Self::Linear(fvm) => Box::new(fvm.tets().iter().map(|t| &t[..])),
+            Self::Linear { fvm, .. } => Box::new(fvm.tets().iter().map(|t| &t[..])),
             Self::Quadratic { elements, .. } => {
                 Box::new(elements.elements().iter().map(|e| &e[..]))
             }
@@ -71,7 +102,7 @@ impl Elements {
     /// volume it stands for (m³).
     pub(crate) fn for_each_point(&self, mut visit: impl FnMut(usize, &[u32], &[DVec3], f64)) {
         match self {
-            Self::Linear(fvm) => {
+            Self::Linear { fvm, .. } => {
                 for (t, tet) in fvm.tets().iter().enumerate() {
                     let rest = fvm.tet_rest(t);
                     visit(t, tet, &rest.shape_gradients(), rest.volume);
@@ -128,8 +159,16 @@ impl Elements {
         v: &[DVec3],
         out: &mut [DVec3],
     ) {
-        if let Self::Linear(fvm) = self {
-            return fvm.internal_forces(model, damping, x, v, out);
+        if let Self::Linear {
+            fvm,
+            nodal_averaging,
+        } = self
+        {
+            fvm.internal_forces(model, damping, x, v, out);
+            if let Some(averaging) = nodal_averaging {
+                averaging.add_forces(model, fvm, x, out);
+            }
+            return;
         }
         out.fill(DVec3::ZERO);
         let excesses = self.volumetric_excesses(model, x);
@@ -150,7 +189,11 @@ impl Elements {
     /// Elastic strain energy (J) at positions `x` (m).
     pub(crate) fn elastic_energy<M: VolumetricTerm>(&self, model: &M, x: &[DVec3]) -> f64 {
         let mut energy = match self {
-            Self::Linear(fvm) => return fvm.elastic_energy(model, x),
+            Self::Linear {
+                fvm,
+                nodal_averaging: Some(averaging),
+            } => return averaging.elastic_energy(model, fvm, x),
+            Self::Linear { fvm, .. } => return fvm.elastic_energy(model, x),
             Self::Quadratic {
                 elements,
                 mean_dilatation: true,
@@ -185,7 +228,7 @@ impl Elements {
     /// each node's lumped volume in place of a quarter of each tetrahedron.
     pub(crate) fn wave_length_scale(&self, x: &[DVec3]) -> f64 {
         let control_volumes = match self {
-            Self::Linear(fvm) => return fvm.wave_length_scale(x),
+            Self::Linear { fvm, .. } => return fvm.wave_length_scale(x),
             Self::Quadratic { elements, .. } => elements.lumped_volumes(),
         };
         let mut row_sum = vec![0.0; control_volumes.len()];
