@@ -1,5 +1,6 @@
 //! Accuracy per cost on the reference cantilever (L = 1 m, 0.1 x 0.1 m, E = 1e8 Pa, ν = 0.3,
-//! ρ = 1000 kg/m³, clamped face pinned): linear against quadratic tetrahedra.
+//! ρ = 1000 kg/m³, clamped face pinned): linear and quadratic tetrahedra against a coarse cage of
+//! quadratic hexahedra.
 //!
 //! 1. Static equilibrium and first bending frequency per resolution, against Timoshenko beam
 //!    theory, at ν = 0.3 and at ν = 0 (where the clamped face does not hold back the Poisson
@@ -16,7 +17,6 @@
 //! for the most accurate dynamic setting within the time target of 1.2 ms per step (or
 //! the fastest, if none is).
 
-use rapier_fvm::element::ElementOrder;
 use rapier_fvm::prelude::*;
 use rapier_fvm::statics::{self, StaticSettings};
 use std::time::Instant;
@@ -49,11 +49,22 @@ fn euler_bernoulli_omega() -> f64 {
 /// included; computed with 400 beam elements in `benches/compare/common.py`.
 const TIMOSHENKO_FREQUENCY_HZ: f64 = 5.069;
 
-/// A beam setting: element order, cells per axis, material model, Poisson's ratio, and how the
+/// The elements of a beam.
+#[derive(Clone, Copy)]
+enum Kind {
+    /// Linear tetrahedra, five per cell.
+    LinearTet,
+    /// Quadratic (10-node) tetrahedra, five per cell.
+    QuadraticTet,
+    /// A cage of quadratic (27-node) hexahedra, one per cell.
+    QuadraticHex,
+}
+
+/// A beam setting: element kind, cells per axis, material model, Poisson's ratio, and how the
 /// volumetric term is evaluated.
 #[derive(Clone, Copy)]
 struct Beam {
-    order: ElementOrder,
+    kind: Kind,
     cells: [usize; 3],
     model: MaterialModel,
     nu: f64,
@@ -62,9 +73,10 @@ struct Beam {
 
 impl Beam {
     fn label(&self) -> String {
-        let order = match self.order {
-            ElementOrder::Linear => "linear",
-            ElementOrder::Quadratic => "quadratic",
+        let order = match self.kind {
+            Kind::LinearTet => "linear",
+            Kind::QuadraticTet => "quadratic",
+            Kind::QuadraticHex => "hex27 cage",
         };
         let [x, y, z] = self.cells;
         format!("{order} {x}x{y}x{z}")
@@ -76,15 +88,20 @@ impl Beam {
         let linear = mesh::cuboid(half, self.cells)?;
         let material = Material::new(self.model, YOUNG, self.nu, DENSITY)?;
         let clamped = |p: DVec3| p.x <= -half.x + 1e-9;
-        let mut builder = match self.order {
-            ElementOrder::Linear => {
+        let mut builder = match self.kind {
+            Kind::LinearTet => {
                 let pins = linear.nodes_where(clamped);
                 SoftBodyBuilder::new(linear, material).pinned_nodes(pins)
             }
-            ElementOrder::Quadratic => {
+            Kind::QuadraticTet => {
                 let quadratic = mesh::QuadraticTetMesh::from_linear(&linear)?;
                 let pins = quadratic.nodes_where(clamped);
                 SoftBodyBuilder::quadratic(quadratic, material).pinned_nodes(pins)
+            }
+            Kind::QuadraticHex => {
+                let cage = mesh::QuadraticHexMesh::cuboid(half, self.cells)?;
+                let pins = cage.nodes_where(clamped);
+                SoftBodyBuilder::quadratic_hex(cage, material).pinned_nodes(pins)
             }
         };
         if let Some(beta) = damping {
@@ -101,6 +118,15 @@ impl Beam {
             .filter(|&n| body.mesh().positions()[n].x >= half.x - 1e-9)
             .collect();
         Ok((body, tip))
+    }
+}
+
+/// A short name of a volumetric treatment for the tables.
+fn volumetric_label(treatment: VolumetricTreatment) -> &'static str {
+    match treatment {
+        VolumetricTreatment::PerElement => "per point",
+        VolumetricTreatment::NodalAverage => "nodal avg",
+        VolumetricTreatment::ElementAverage => "projected",
     }
 }
 
@@ -197,17 +223,22 @@ fn main() -> Result<(), Error> {
         "elements", "dofs", "tip err nu=0.3", "tip err nu=0", "f1 (Hz)", "f1 err"
     );
     let resolutions = [
-        (ElementOrder::Linear, [10, 1, 1]),
-        (ElementOrder::Linear, [20, 2, 2]),
-        (ElementOrder::Linear, [40, 4, 4]),
-        (ElementOrder::Quadratic, [5, 1, 1]),
-        (ElementOrder::Quadratic, [10, 1, 1]),
-        (ElementOrder::Quadratic, [20, 2, 2]),
-        (ElementOrder::Quadratic, [40, 4, 4]),
+        (Kind::LinearTet, [10, 1, 1]),
+        (Kind::LinearTet, [20, 2, 2]),
+        (Kind::LinearTet, [40, 4, 4]),
+        (Kind::QuadraticTet, [5, 1, 1]),
+        (Kind::QuadraticTet, [10, 1, 1]),
+        (Kind::QuadraticTet, [20, 2, 2]),
+        (Kind::QuadraticTet, [40, 4, 4]),
+        (Kind::QuadraticHex, [2, 1, 1]),
+        (Kind::QuadraticHex, [4, 1, 1]),
+        (Kind::QuadraticHex, [5, 1, 1]),
+        (Kind::QuadraticHex, [10, 1, 1]),
+        (Kind::QuadraticHex, [20, 2, 2]),
     ];
-    for (order, cells) in resolutions {
+    for (kind, cells) in resolutions {
         let beam = |nu| Beam {
-            order,
+            kind,
             cells,
             model: MaterialModel::Linear,
             nu,
@@ -226,71 +257,91 @@ fn main() -> Result<(), Error> {
         );
     }
 
-    println!("\n2. Nearly incompressible (static, linear elasticity): tip error vs Timoshenko");
+    println!("\n2. Volumetric treatment (static, linear elasticity): tip error vs Timoshenko");
     println!(
-        "{:<18} {:<15} {:>6} {:>9} {:>9} {:>9}",
-        "elements", "volumetric", "dofs", "nu=0.45", "nu=0.49", "nu=0.499"
+        "{:<18} {:<15} {:>6} {:>9} {:>9} {:>9} {:>9} {:>9}",
+        "elements", "volumetric", "dofs", "nu=0", "nu=0.3", "nu=0.45", "nu=0.49", "nu=0.499"
     );
-    for (order, cells, volumetric) in [
+    for (kind, cells, volumetric) in [
         (
-            ElementOrder::Linear,
+            Kind::LinearTet,
             [40, 4, 4],
             VolumetricTreatment::PerElement,
         ),
         (
-            ElementOrder::Linear,
+            Kind::LinearTet,
             [40, 4, 4],
             VolumetricTreatment::NodalAverage,
         ),
         (
-            ElementOrder::Quadratic,
+            Kind::QuadraticTet,
             [10, 1, 1],
             VolumetricTreatment::PerElement,
         ),
         (
-            ElementOrder::Quadratic,
+            Kind::QuadraticTet,
             [10, 1, 1],
             VolumetricTreatment::ElementAverage,
         ),
         (
-            ElementOrder::Quadratic,
+            Kind::QuadraticTet,
             [20, 1, 1],
             VolumetricTreatment::PerElement,
         ),
         (
-            ElementOrder::Quadratic,
+            Kind::QuadraticTet,
             [20, 1, 1],
             VolumetricTreatment::ElementAverage,
         ),
         (
-            ElementOrder::Quadratic,
+            Kind::QuadraticTet,
             [10, 2, 2],
             VolumetricTreatment::PerElement,
         ),
         (
-            ElementOrder::Quadratic,
+            Kind::QuadraticTet,
             [10, 2, 2],
             VolumetricTreatment::ElementAverage,
         ),
         (
-            ElementOrder::Quadratic,
+            Kind::QuadraticTet,
             [20, 2, 2],
             VolumetricTreatment::PerElement,
         ),
         (
-            ElementOrder::Quadratic,
+            Kind::QuadraticTet,
+            [20, 2, 2],
+            VolumetricTreatment::ElementAverage,
+        ),
+        (
+            Kind::QuadraticHex,
+            [5, 1, 1],
+            VolumetricTreatment::PerElement,
+        ),
+        (
+            Kind::QuadraticHex,
+            [5, 1, 1],
+            VolumetricTreatment::ElementAverage,
+        ),
+        (
+            Kind::QuadraticHex,
+            [10, 1, 1],
+            VolumetricTreatment::ElementAverage,
+        ),
+        (
+            Kind::QuadraticHex,
             [20, 2, 2],
             VolumetricTreatment::ElementAverage,
         ),
     ] {
         let beam = |nu| Beam {
-            order,
+            kind,
             cells,
             model: MaterialModel::Linear,
             nu,
             volumetric,
         };
-        let errors = [0.45, 0.49, 0.499].map(|nu| static_case(&beam(nu)).map(|(e, _, _)| e));
+        let errors = [0.0, 0.3, 0.45, 0.49, 0.499].map(|nu| static_case(&beam(nu)).map(|(e, _, _)| e));
         let (_, _, dofs) = static_case(&beam(0.45))?;
         print!(
             "{:<18} {:<15} {:>6}",
@@ -306,35 +357,51 @@ fn main() -> Result<(), Error> {
 
     println!("\n3. Dynamics to rest (nu = 0.3), error of the settled tip vs Timoshenko");
     println!(
-        "{:<18} {:<12} {:<14} {:>8} {:>6} {:>9} {:>9} {:>10}",
-        "elements", "model", "integrator", "dt", "dofs", "error", "ms/step", "work/step"
+        "{:<18} {:<12} {:<14} {:<10} {:>8} {:>6} {:>9} {:>9} {:>10}",
+        "elements",
+        "model",
+        "integrator",
+        "volumetric",
+        "dt",
+        "dofs",
+        "error",
+        "ms/step",
+        "work/step"
     );
     let mut best: Option<(Beam, &str, f64, Dynamic)> = None;
+    let per_element = VolumetricTreatment::PerElement;
+    let averaged = VolumetricTreatment::ElementAverage;
     let dynamic_cases = [
-        (ElementOrder::Linear, [20, 2, 2], Stepper::BackwardEuler),
-        (ElementOrder::Linear, [40, 4, 4], Stepper::BackwardEuler),
-        (ElementOrder::Quadratic, [5, 1, 1], Stepper::BackwardEuler),
-        (ElementOrder::Quadratic, [10, 1, 1], Stepper::BackwardEuler),
-        (ElementOrder::Quadratic, [10, 1, 1], Stepper::Bdf2),
-        (ElementOrder::Quadratic, [20, 2, 2], Stepper::BackwardEuler),
-        (ElementOrder::Quadratic, [20, 1, 1], Stepper::BackwardEuler),
+        (Kind::LinearTet, [20, 2, 2], Stepper::BackwardEuler, per_element),
+        (Kind::LinearTet, [40, 4, 4], Stepper::BackwardEuler, per_element),
+        (Kind::QuadraticTet, [5, 1, 1], Stepper::BackwardEuler, per_element),
+        (Kind::QuadraticTet, [10, 1, 1], Stepper::BackwardEuler, per_element),
+        (Kind::QuadraticTet, [10, 1, 1], Stepper::Bdf2, per_element),
+        (Kind::QuadraticTet, [20, 2, 2], Stepper::BackwardEuler, per_element),
+        (Kind::QuadraticTet, [20, 1, 1], Stepper::BackwardEuler, per_element),
+        (Kind::QuadraticHex, [4, 1, 1], Stepper::BackwardEuler, averaged),
+        (Kind::QuadraticHex, [5, 1, 1], Stepper::BackwardEuler, per_element),
+        (Kind::QuadraticHex, [5, 1, 1], Stepper::BackwardEuler, averaged),
+        (Kind::QuadraticHex, [5, 1, 1], Stepper::Bdf2, averaged),
+        (Kind::QuadraticHex, [10, 1, 1], Stepper::BackwardEuler, averaged),
     ];
-    for (order, cells, stepper) in dynamic_cases {
+    for (kind, cells, stepper, volumetric) in dynamic_cases {
         for model in [MaterialModel::Linear, MaterialModel::Corotated] {
             for dt in [1.0 / 240.0, 1.0 / 60.0] {
                 let beam = Beam {
-                    order,
+                    kind,
                     cells,
                     model,
                     nu: POISSON,
-                    volumetric: VolumetricTreatment::PerElement,
+                    volumetric,
                 };
                 let outcome = dynamic_case(&beam, stepper, dt)?;
                 println!(
-                    "{:<18} {:<12} {:<14} {:>8} {:>6} {:>8.2}% {:>9.3} {:>10.1}",
+                    "{:<18} {:<12} {:<14} {:<10} {:>8} {:>6} {:>8.2}% {:>9.3} {:>10.1}",
                     beam.label(),
                     format!("{model:?}"),
                     stepper.label(),
+                    volumetric_label(volumetric),
                     format!("1/{:.0}", 1.0 / dt),
                     outcome.dofs,
                     100.0 * outcome.error,
@@ -361,9 +428,10 @@ fn main() -> Result<(), Error> {
     }
     let (beam, stepper, dt, outcome) = best.expect("at least one case ran");
     println!(
-        "{{\"setting\": \"{} {:?} {stepper} dt=1/{:.0}\", \"rel_error\": {:.5}, \"ms_per_step\": {:.4}, \"dofs\": {}}}",
+        "{{\"setting\": \"{} {:?} {stepper} {} dt=1/{:.0}\", \"rel_error\": {:.5}, \"ms_per_step\": {:.4}, \"dofs\": {}}}",
         beam.label(),
         beam.model,
+        volumetric_label(beam.volumetric),
         1.0 / dt,
         outcome.error,
         outcome.ms_per_step,

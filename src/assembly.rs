@@ -3,7 +3,7 @@
 //!
 //! An integration point of weight `w` contributes `w Gᵀ A G`, where `A = ∂P/∂F` is the 9 x 9
 //! tangent of the stress with respect to the deformation gradient and `G` maps its element's node
-//! displacements to `dF` (4 nodes for linear tetrahedra, 10 for quadratic ones).
+//! displacements to `dF` (4 nodes for linear tetrahedra, 10 or 27 for quadratic elements).
 //! On request `A` is first projected onto its positive semi-definite part, so that `K_e` has no
 //! negative eigenvalue and Newton steps always descend (the stress tangents of St.
 //! Venant–Kirchhoff and Neo-Hookean are indefinite under compression); the projection stiffens
@@ -11,7 +11,8 @@
 
 use crate::Error;
 use crate::body::SoftBody;
-use crate::element::tet10::deformation_gradient;
+use crate::contact::Stencil;
+use crate::element::deformation_gradient;
 use crate::fvm::NodalAveraging;
 use crate::material::{HyperelasticModel, with_hyperelastic_model};
 use faer::linalg::solvers::Solve;
@@ -24,9 +25,6 @@ use rapier3d::na;
 /// A 9 x 9 stress tangent `A[(r, c), (s, d)] = ∂P_rc / ∂F_sd` (Pa), indices column-major
 /// (`3 c + r`).
 pub(crate) type StressTangent = na::SMatrix<f64, 9, 9>;
-
-/// The most nodes an element has (quadratic tetrahedra).
-const MAX_ELEMENT_NODES: usize = crate::element::tet10::NODES;
 
 /// The sparsity pattern of the lower triangle of the 3n x 3n tangent of a mesh, and its values.
 #[derive(Debug, Clone)]
@@ -41,6 +39,8 @@ pub(crate) struct Stiffness {
     /// The symbolic Cholesky factorization (fill-reducing ordering and elimination tree) of the
     /// pattern, computed at the first factorization and reused by every later one.
     symbolic: Option<SymbolicLlt<usize>>,
+    /// Scratch of [`Stiffness::add_point`]: per node of an element, `A ∇N_b`.
+    stress_maps: Vec<na::SMatrix<f64, 9, 3>>,
 }
 
 impl Stiffness {
@@ -79,6 +79,7 @@ impl Stiffness {
             row_idx,
             lower_neighbours,
             symbolic: None,
+            stress_maps: Vec::new(),
         }
     }
 
@@ -168,6 +169,20 @@ impl Stiffness {
         }
     }
 
+    /// Adds the tangent `w_a w_b block` (N/m) of a term acting on a point that moves with the
+    /// nodes of `at` (a node, or an embedded vertex with its element's nodes), skipping pinned
+    /// nodes.
+    pub(crate) fn add_stencil_block(&mut self, at: Stencil, block: &DMat3, pinned: &[bool]) {
+        for (&b, wb) in at.nodes.iter().zip(at.weights) {
+            for (&a, wa) in at.nodes.iter().zip(at.weights) {
+                let weight = wa * wb;
+                self.add_pair_block(a as usize, b as usize, pinned, |i, j| {
+                    weight * block.col(j)[i]
+                });
+            }
+        }
+    }
+
     /// Adds `weight g gᵀ` (N/m), `g` given per node, skipping pinned nodes.
     fn add_outer(&mut self, gradient: &[(u32, DVec3)], weight: f64, pinned: &[bool]) {
         for &(b, gb) in gradient {
@@ -191,12 +206,13 @@ impl Stiffness {
         pinned: &[bool],
     ) {
         // A g_b: per node, the 9 x 3 map from its displacement to dP.
-        let mut stress_maps = [na::SMatrix::<f64, 9, 3>::zeros(); MAX_ELEMENT_NODES];
-        for (map, g) in stress_maps.iter_mut().zip(gradients) {
-            *map = na::SMatrix::<f64, 9, 3>::from_fn(|row, j| {
+        let mut stress_maps = std::mem::take(&mut self.stress_maps);
+        stress_maps.clear();
+        stress_maps.extend(gradients.iter().map(|g| {
+            na::SMatrix::<f64, 9, 3>::from_fn(|row, j| {
                 (0..3).map(|d| tangent[(row, 3 * d + j)] * g[d]).sum()
-            });
-        }
+            })
+        }));
         for (cb, &b) in nodes.iter().enumerate() {
             for (ca, &a) in nodes.iter().enumerate() {
                 let (ga, map) = (gradients[ca], &stress_maps[cb]);
@@ -205,6 +221,7 @@ impl Stiffness {
                 });
             }
         }
+        self.stress_maps = stress_maps;
     }
 
     /// Adds `value(i, j)` to the entries (row `3a + i`, column `3b + j`) of the lower triangle,

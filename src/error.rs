@@ -110,6 +110,15 @@ pub enum Error {
         /// The mid-edge node an earlier element gave.
         other: u32,
     },
+    /// A vertex of a mesh to embed lies outside the body's simulation mesh (farther than half a
+    /// tetrahedron from its nearest simulation tetrahedron), so no element carries it.
+    #[error("vertex {vertex} of the embedded mesh, at {position:?}, lies outside the simulation mesh")]
+    OutsideSimulationMesh {
+        /// Index of the offending vertex of the embedded mesh.
+        vertex: usize,
+        /// Its rest position (m).
+        position: [f64; 3],
+    },
     /// An option the body's other settings do not support.
     #[error("{option} is not supported here: {reason}")]
     UnsupportedOption {

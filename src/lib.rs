@@ -47,6 +47,7 @@ pub mod body;
 pub mod contact;
 pub mod damping;
 pub mod element;
+pub mod embedding;
 mod error;
 pub mod fvm;
 pub mod integrate;
@@ -73,7 +74,7 @@ pub use rapier3d::glamx;
 pub mod prelude {
     pub use crate::Error;
     pub use crate::body::{SoftBody, SoftBodyBuilder, SoftBodyHandle, SoftBodySet};
-    pub use crate::contact::{ContactSettings, ContactTarget, NodeContact};
+    pub use crate::contact::{BodyPoint, ContactSettings, ContactTarget, NodeContact};
     pub use crate::damping::RayleighDamping;
     pub use crate::fvm::VolumetricTreatment;
     pub use crate::integrate::{

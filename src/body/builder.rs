@@ -4,11 +4,11 @@ use super::{SoftBody, lumped_masses};
 use crate::Error;
 use crate::contact::ContactSettings;
 use crate::damping::RayleighDamping;
-use crate::element::Elements;
-use crate::element::tet10::{self, QuadraticElements};
+use crate::element::{ElementShape, Elements, QuadraticElements};
+use crate::embedding::Embedding;
 use crate::fvm::{FvmMesh, NodalAveraging, VolumetricTreatment};
 use crate::material::Material;
-use crate::mesh::{QuadraticTetMesh, TetMesh};
+use crate::mesh::{QuadraticHexMesh, QuadraticTetMesh, SUB_TETS, TetMesh};
 use rapier3d::dynamics::CoefficientCombineRule;
 use rapier3d::geometry::InteractionGroups;
 use rapier3d::glamx::{DQuat, DVec3};
@@ -36,7 +36,7 @@ pub struct SoftBodyBuilder {
     /// The linear tetrahedra: the body's elements, or the subdivision of its quadratic ones.
     mesh: TetMesh,
     /// The quadratic elements, for a body of them.
-    quadratic: Option<Vec<[u32; tet10::NODES]>>,
+    quadratic: Option<QuadraticSpec>,
     material: Material,
     damping: Option<RayleighDamping>,
     volumetric: VolumetricTreatment,
@@ -52,6 +52,17 @@ pub struct SoftBodyBuilder {
     restitution: f64,
     restitution_combine_rule: CoefficientCombineRule,
     self_contact: bool,
+    embedded: Option<TetMesh>,
+}
+
+/// The quadratic elements a builder was given.
+#[derive(Debug, Clone)]
+struct QuadraticSpec {
+    shape: ElementShape,
+    /// The elements' nodes, `shape.node_count()` each.
+    nodes: Vec<u32>,
+    /// The element each tetrahedron of the subdivision lies in.
+    parents: Vec<u32>,
 }
 
 /// Default [`SoftBodyBuilder::friction`]: rapier's default collider friction.
@@ -83,6 +94,7 @@ impl SoftBodyBuilder {
             restitution: 0.0,
             restitution_combine_rule: CoefficientCombineRule::Average,
             self_contact: false,
+            embedded: None,
         }
     }
 
@@ -107,9 +119,45 @@ impl SoftBodyBuilder {
     /// # Ok::<(), rapier_fvm::Error>(())
     /// ```
     pub fn quadratic(mesh: QuadraticTetMesh, material: Material) -> Self {
-        let elements = mesh.elements().to_vec();
+        let parents = (0..mesh.subdivided().tet_count())
+            .map(|t| (t / SUB_TETS) as u32)
+            .collect();
         Self {
-            quadratic: Some(elements),
+            quadratic: Some(QuadraticSpec {
+                shape: ElementShape::Tetrahedron,
+                nodes: mesh.elements().as_flattened().to_vec(),
+                parents,
+            }),
+            ..Self::new(mesh.subdivided().clone(), material)
+        }
+    }
+
+    /// A body simulated on a coarse cage of quadratic (27-node) hexahedra: one element across a
+    /// beam's section bends it as a continuum does (see [`crate::element::hex27`]), so bending
+    /// bodies need the fewest nodes this way. The body's [`SoftBody::mesh`] is the cage's
+    /// [subdivision](QuadraticHexMesh::subdivided), on the same nodes.
+    ///
+    /// # Example
+    /// ```
+    /// use rapier_fvm::prelude::*;
+    ///
+    /// let cage = mesh::QuadraticHexMesh::cuboid(DVec3::new(0.5, 0.05, 0.05), [5, 1, 1])?;
+    /// let clamped = cage.nodes_where(|p| p.x <= -0.5 + 1e-9);
+    /// let material = Material::new(MaterialModel::Corotated, 1e8, 0.3, 1000.0)?;
+    /// let beam = SoftBodyBuilder::quadratic_hex(cage, material)
+    ///     .pinned_nodes(clamped)
+    ///     .build()?;
+    /// assert_eq!(beam.element_shape(), rapier_fvm::element::ElementShape::Hexahedron);
+    /// assert!((beam.total_mass() - 10.0).abs() < 1e-12);
+    /// # Ok::<(), rapier_fvm::Error>(())
+    /// ```
+    pub fn quadratic_hex(mesh: QuadraticHexMesh, material: Material) -> Self {
+        Self {
+            quadratic: Some(QuadraticSpec {
+                shape: ElementShape::Hexahedron,
+                nodes: mesh.elements().as_flattened().to_vec(),
+                parents: mesh.subdivision_parents().to_vec(),
+            }),
             ..Self::new(mesh.subdivided().clone(), material)
         }
     }
@@ -211,6 +259,35 @@ impl SoftBodyBuilder {
         self
     }
 
+    /// A fine tetrahedral mesh (rest positions in the same frame as the body's mesh, m) for the
+    /// body to carry: each vertex moves with the element it lies in at rest (see
+    /// [`crate::embedding`]), and contacts with colliders act on its surface instead of the
+    /// simulation mesh's. A coarse cage of quadratic elements then sets the cost and accuracy
+    /// of the elasticity, and the fine mesh the resolution of contact and output
+    /// ([`SoftBody::embedded_positions`]). Self-contact, contacts between soft bodies and rigid
+    /// corners pressing on the body act on the simulation mesh's surface.
+    ///
+    /// # Example
+    /// ```
+    /// use rapier_fvm::prelude::*;
+    ///
+    /// // A 4-cell cage of quadratic hexahedra carrying a beam of 3 840 linear tetrahedra.
+    /// let half = DVec3::new(0.5, 0.05, 0.05);
+    /// let cage = mesh::QuadraticHexMesh::cuboid(half, [4, 1, 1])?;
+    /// let fine = mesh::cuboid(half, [32, 4, 4])?;
+    /// let material = Material::new(MaterialModel::Corotated, 1e6, 0.3, 1000.0)?;
+    /// let beam = SoftBodyBuilder::quadratic_hex(cage, material)
+    ///     .embedded(fine)
+    ///     .build()?;
+    /// let surface = beam.embedded_positions().expect("embedded");
+    /// assert_eq!(surface.len(), 33 * 5 * 5);
+    /// # Ok::<(), rapier_fvm::Error>(())
+    /// ```
+    pub fn embedded(mut self, fine: TetMesh) -> Self {
+        self.embedded = Some(fine);
+        self
+    }
+
     /// User data stored on the body.
     pub fn user_data(mut self, user_data: u128) -> Self {
         self.user_data = user_data;
@@ -227,6 +304,8 @@ impl SoftBodyBuilder {
     /// [`Error::SliverTet`] for a tetrahedron below the minimum quality (of the subdivision, for
     /// quadratic elements); [`Error::InvertedTet`] for a quadratic element whose rest map folds;
     /// [`Error::UnsupportedOption`] for nodal averaging on quadratic elements;
+    /// [`Error::OutsideSimulationMesh`] naming a vertex of the embedded mesh that no element
+    /// carries;
     /// [`Error::InvalidSetting`] for a minimum quality outside `[0, 1)` or a negative or
     /// non-finite friction or restitution.
     pub fn build(self) -> Result<SoftBody, Error> {
@@ -288,6 +367,10 @@ impl SoftBodyBuilder {
         let velocities = (0..node_count)
             .map(|n| if pinned[n] { DVec3::ZERO } else { self.linvel })
             .collect();
+        let subdivision_parents = self
+            .quadratic
+            .as_ref()
+            .map_or_else(Vec::new, |quadratic| quadratic.parents.clone());
         let (elements, masses) = match &self.quadratic {
             None => {
                 let fvm = FvmMesh::new(&self.mesh);
@@ -309,7 +392,8 @@ impl SoftBodyBuilder {
                                  average per element (VolumetricTreatment::ElementAverage)",
                     });
                 }
-                let elements = QuadraticElements::new(self.mesh.positions(), quadratic)?;
+                let elements =
+                    QuadraticElements::new(quadratic.shape, self.mesh.positions(), &quadratic.nodes)?;
                 let masses = elements
                     .lumped_volumes()
                     .iter()
@@ -324,6 +408,15 @@ impl SoftBodyBuilder {
                     masses,
                 )
             }
+        };
+        let embedding = match self.embedded {
+            Some(fine) => Some(Embedding::new(
+                fine,
+                &self.mesh,
+                &elements,
+                &subdivision_parents,
+            )?),
+            None => None,
         };
         let surface_triangles = self.mesh.surface_triangles();
         let mut surface_rings = vec![Vec::new(); node_count];
@@ -350,12 +443,14 @@ impl SoftBodyBuilder {
             previous_step: None,
             tangent: None,
             mesh: self.mesh,
+            subdivision_parents,
             material: self.material,
             damping: self.damping,
             positions,
             velocities,
             pinned,
             surface_nodes,
+            embedding,
             surface_triangles,
             surface_rings,
             contacts: Vec::new(),

@@ -12,7 +12,8 @@ use crate::assembly::Stiffness;
 use crate::attachment::Attachment;
 use crate::contact::{ContactSettings, CornerContact, NodeContact, RigidProxy};
 use crate::damping::RayleighDamping;
-use crate::element::{ElementOrder, Elements};
+use crate::element::{ElementOrder, ElementShape, Elements};
+use crate::embedding::Embedding;
 use crate::fvm::VolumetricTreatment;
 use crate::material::{Material, with_hyperelastic_model};
 use crate::mesh::TetMesh;
@@ -31,6 +32,8 @@ pub struct SoftBody {
     /// The linear tetrahedra: the elements, or the subdivision of the quadratic ones.
     pub(crate) mesh: TetMesh,
     pub(crate) elements: Elements,
+    /// For quadratic elements, the element each tetrahedron of `mesh` lies in.
+    pub(crate) subdivision_parents: Vec<u32>,
     pub(crate) material: Material,
     pub(crate) damping: Option<RayleighDamping>,
     pub(crate) positions: Vec<DVec3>,
@@ -47,8 +50,11 @@ pub struct SoftBody {
     /// The sparse tangent's pattern and symbolic factorization, built by the first implicit or
     /// static solve and kept for the next.
     pub(crate) tangent: Option<Stiffness>,
-    /// The nodes on the mesh's boundary, which contacts are detected for.
+    /// The nodes on the mesh's boundary, which contacts are detected for (unless the body has an
+    /// embedded mesh).
     pub(crate) surface_nodes: Vec<u32>,
+    /// A fine mesh carried by the nodes, whose surface contacts with colliders act on.
+    pub(crate) embedding: Option<Embedding>,
     /// The mesh's boundary triangles, outward-oriented, which self-contact pushes against.
     pub(crate) surface_triangles: Vec<[u32; 3]>,
     /// Per node, the boundary nodes sharing a boundary triangle with it, itself included, sorted
@@ -107,6 +113,25 @@ impl SoftBody {
     /// The order of the elements the body is simulated with.
     pub fn element_order(&self) -> ElementOrder {
         self.elements.order()
+    }
+
+    /// The fine mesh the body carries for contact and output, if it was built with one
+    /// ([`SoftBodyBuilder::embedded`]).
+    pub fn embedding(&self) -> Option<&Embedding> {
+        self.embedding.as_ref()
+    }
+
+    /// The world positions (m) of the embedded mesh's vertices, interpolated from the nodes';
+    /// `None` without an embedded mesh.
+    pub fn embedded_positions(&self) -> Option<Vec<DVec3>> {
+        self.embedding
+            .as_ref()
+            .map(|embedding| embedding.positions(&self.positions))
+    }
+
+    /// The shape of the elements the body is simulated with.
+    pub fn element_shape(&self) -> ElementShape {
+        self.elements.shape()
     }
 
     /// The material.

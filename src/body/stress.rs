@@ -4,24 +4,10 @@
 //! `σ_vm = sqrt(3/2 s:s)`, `s = σ - tr(σ)/3 I`.
 
 use super::SoftBody;
-use crate::element::{Elements, mean_measure};
+use crate::element::{Elements, projected_measure};
 use crate::fvm::gather;
 use crate::material::{HyperelasticModel, VolumetricTerm, with_hyperelastic_model};
-use crate::mesh::SUB_TETS;
 use rapier3d::glamx::{DMat3, DVec3};
-
-/// The barycentric coordinates of `point` (m) in the tetrahedron of corners `corners` at rest
-/// positions `rest`.
-fn barycentric(corners: &[u32], rest: &[DVec3], point: DVec3) -> [f64; 4] {
-    let p0 = rest[corners[0] as usize];
-    let edges = DMat3::from_cols(
-        rest[corners[1] as usize] - p0,
-        rest[corners[2] as usize] - p0,
-        rest[corners[3] as usize] - p0,
-    );
-    let l = edges.inverse() * (point - p0);
-    [1.0 - l.x - l.y - l.z, l.x, l.y, l.z]
-}
 
 impl SoftBody {
     /// The Cauchy stress `σ = P Fᵀ / det F` (Pa) of every tetrahedron of [`SoftBody::mesh`] at
@@ -78,23 +64,36 @@ impl SoftBody {
                 } => {
                     let rest = self.mesh.positions();
                     let bulk = model.volumetric_modulus();
+                    let reference = quadratic.shape().reference_nodes();
                     self.mesh
                         .tets()
                         .iter()
                         .enumerate()
                         .map(|(t, sub_tet)| {
-                            let element = t / SUB_TETS;
-                            let corners = &quadratic.elements()[element][..4];
-                            let centroid =
-                                sub_tet.iter().map(|&n| rest[n as usize]).sum::<DVec3>() * 0.25;
-                            let l = barycentric(corners, rest, centroid);
-                            let f = quadratic.gradient_at(element, rest, &self.positions, l);
+                            let element = self.subdivision_parents[t] as usize;
+                            // The centroid's natural coordinates: the tetrahedron's nodes are
+                            // the element's own.
+                            let nodes = quadratic.element(element);
+                            let xi = sub_tet
+                                .iter()
+                                .map(|n| {
+                                    let local = nodes.iter().position(|m| m == n).unwrap_or(0);
+                                    reference[local]
+                                })
+                                .sum::<DVec3>()
+                                * 0.25;
+                            let f = quadratic.gradient_at(element, rest, &self.positions, xi);
                             let mut piola = model.first_piola(&f);
                             if *mean_dilatation {
-                                let mean =
-                                    mean_measure(&model, quadratic, element, &self.positions);
+                                let projected = projected_measure(
+                                    &model,
+                                    quadratic,
+                                    element,
+                                    xi,
+                                    &self.positions,
+                                );
                                 piola += model.volume_measure_gradient(&f)
-                                    * (bulk * (mean - model.volume_measure(&f)));
+                                    * (bulk * (projected - model.volume_measure(&f)));
                             }
                             stress(&f, piola)
                         })

@@ -48,12 +48,14 @@ mod velocity_constraint;
 pub(crate) use between::{BetweenContact, detect_between, prepare_between, solve_between};
 pub(crate) use corner::{CornerContact, advance_corners, prepare_corners, solve_corners};
 pub(crate) use rigid::{RigidProxy, coming_velocity};
+pub(crate) use soft_point::Stencil;
 use soft_point::{SoftPoint, node_inverse_mass};
 pub use velocity_constraint::RESTITUTION_THRESHOLD;
 pub(crate) use velocity_constraint::{ContactSides, VelocityConstraint};
 
 use crate::Error;
 use crate::body::SoftBody;
+use crate::embedding::Embedding;
 use rapier3d::dynamics::{CoefficientCombineRule, RigidBodyHandle, RigidBodySet};
 use rapier3d::geometry::{ColliderHandle, ColliderSet, Shape, SharedShape};
 use rapier3d::glamx::{DMat3, DVec3};
@@ -166,14 +168,41 @@ pub enum ContactTarget {
     },
 }
 
-/// A surface node's contact for the coming frame: the plane through `point` with outward normal
-/// `normal` that the node must not cross. Against a collider, the explicit integrator re-projects
+/// Where on a soft body a contact acts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BodyPoint {
+    /// A simulation node.
+    Node(u32),
+    /// A vertex of the body's embedded mesh ([`SoftBody::embedding`]), which moves with the nodes
+    /// of the element it lies in and shares its impulses among them by their weights.
+    Embedded(u32),
+}
+
+impl BodyPoint {
+    /// The nodes the point moves with and their weights.
+    fn stencil<'a>(&'a self, embedding: Option<&'a Embedding>) -> Stencil<'a> {
+        match (self, embedding) {
+            (Self::Embedded(vertex), Some(embedding)) => {
+                let (nodes, weights) = embedding.stencil(*vertex);
+                Stencil { nodes, weights }
+            }
+            (Self::Node(node), _) | (Self::Embedded(node), None) => Stencil {
+                nodes: std::slice::from_ref(node),
+                weights: &[1.0],
+            },
+        }
+    }
+}
+
+/// A surface point's contact for the coming frame: the plane through `point` with outward normal
+/// `normal` that the point (a surface node, or a surface vertex of the body's embedded mesh) must
+/// not cross. Against a collider, the explicit integrator re-projects
 /// the node onto the collider's shape (at its pose when detected) every substep to update the
 /// plane; against a triangle of the body's own surface the plane follows the triangle.
 #[derive(Clone)]
 pub struct NodeContact {
-    /// The soft body's node.
-    pub node: u32,
+    /// The point of the soft body in contact.
+    pub at: BodyPoint,
     /// What it touches.
     pub target: ContactTarget,
     /// The nearest point of the target's surface to the node when detected (m).
@@ -215,7 +244,7 @@ enum Obstacle {
 impl std::fmt::Debug for NodeContact {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("NodeContact")
-            .field("node", &self.node)
+            .field("at", &self.at)
             .field("target", &self.target)
             .field("point", &self.point)
             .field("normal", &self.normal)
@@ -226,10 +255,10 @@ impl std::fmt::Debug for NodeContact {
 }
 
 impl NodeContact {
-    /// A contact of `node` with `target` through the plane at `point` (m) with outward unit
+    /// A contact of `at` with `target` through the plane at `point` (m) with outward unit
     /// `normal`, with `coefficients`, enforced against `obstacle`.
     fn new(
-        node: u32,
+        at: BodyPoint,
         target: ContactTarget,
         point: DVec3,
         normal: DVec3,
@@ -237,7 +266,7 @@ impl NodeContact {
         obstacle: Obstacle,
     ) -> Self {
         Self {
-            node,
+            at,
             target,
             point,
             normal,
@@ -429,12 +458,15 @@ impl SoftBody {
             let coefficients = SurfaceCoefficients::of_body(self)
                 .combine(SurfaceCoefficients::of_collider(collider));
             let mut proxy = None;
-            for &node in &self.surface_nodes {
-                let n = node as usize;
-                if self.pinned[n] || glued.contains(&node) {
+            for at in self.contact_points() {
+                let stencil = at.stencil(self.embedding.as_ref());
+                // A point that cannot move, or moves with a node glued to the collider's body.
+                if stencil.nodes.iter().all(|&n| self.pinned[n as usize])
+                    || stencil.nodes.iter().any(|n| glued.contains(n))
+                {
                     continue;
                 }
-                let x = self.positions[n];
+                let x = stencil.interpolate(&self.positions);
                 if (x + DVec3::splat(reach)).cmplt(lo).any()
                     || (x - DVec3::splat(reach)).cmpgt(hi).any()
                 {
@@ -449,7 +481,7 @@ impl SoftBody {
                         proxy = Some(RigidProxy::index_in(&mut proxies, handle, body, frame_dt));
                     }
                     contacts.push(NodeContact::new(
-                        node,
+                        at,
                         ContactTarget::Collider(handle),
                         point,
                         normal,
@@ -497,6 +529,23 @@ impl SoftBody {
         }
         self.contact_settings = *settings;
         Ok(&self.contacts)
+    }
+
+    /// The points contacts with colliders are detected for: the surface vertices of the
+    /// embedded mesh if the body has one, else its surface nodes.
+    fn contact_points(&self) -> Vec<BodyPoint> {
+        match &self.embedding {
+            Some(embedding) => embedding
+                .surface_vertices()
+                .iter()
+                .map(|&v| BodyPoint::Embedded(v))
+                .collect(),
+            None => self
+                .surface_nodes
+                .iter()
+                .map(|&n| BodyPoint::Node(n))
+                .collect(),
+        }
     }
 
     /// The contacts found by the last [`SoftBody::detect_contacts`].
@@ -549,12 +598,14 @@ impl SoftBody {
                 reason: "must be positive and finite",
             });
         }
-        let positions = &self.positions;
         let from_nodes = self
             .contacts
             .iter()
             .filter(|c| c.target == ContactTarget::Collider(collider))
-            .map(|c| (positions[c.node as usize], -c.impulse / dt));
+            .map(|c| {
+                let at = c.at.stencil(self.embedding.as_ref());
+                (at.interpolate(&self.positions), -c.impulse / dt)
+            });
         let from_corners = self
             .corner_contacts
             .iter()
@@ -623,11 +674,6 @@ struct Partners<'a> {
 }
 
 impl Partners<'_> {
-    /// The inverse mass (1/kg) of the body's node `n`: zero when pinned.
-    fn own_inverse_mass(&self, n: usize) -> f64 {
-        node_inverse_mass(self.masses[n], self.pinned[n])
-    }
-
     /// Velocity (m/s) of the obstacle's material point at `x` (m): zero for a fixed collider.
     fn velocity_at(&self, obstacle: &Obstacle, x: DVec3) -> DVec3 {
         match obstacle {
@@ -663,8 +709,16 @@ impl Partners<'_> {
     }
 }
 
-/// Splits `body` into its contacts, its positions and what the contacts push against.
-fn contacts_and_partners(body: &mut SoftBody) -> (&mut [NodeContact], &[DVec3], Partners<'_>) {
+/// Splits `body` into its contacts, its positions, its embedded mesh and what the contacts push
+/// against.
+fn contacts_and_partners(
+    body: &mut SoftBody,
+) -> (
+    &mut [NodeContact],
+    &[DVec3],
+    Option<&Embedding>,
+    Partners<'_>,
+) {
     let SoftBody {
         contacts,
         rigid_proxies,
@@ -672,11 +726,13 @@ fn contacts_and_partners(body: &mut SoftBody) -> (&mut [NodeContact], &[DVec3], 
         velocities,
         masses,
         pinned,
+        embedding,
         ..
     } = body;
     (
         contacts,
         positions,
+        embedding.as_ref(),
         Partners {
             rigid: rigid_proxies,
             velocities,
@@ -711,16 +767,17 @@ impl SoftBody {
 /// cross it within the substep, or, found inside, leaves at most at the depenetration speed.
 pub(crate) fn prepare_velocities(body: &mut SoftBody, h: f64) {
     let depenetration_speed = body.contact_settings.depenetration_speed;
-    let (contacts, positions, mut partners) = contacts_and_partners(body);
+    let (contacts, positions, embedding, mut partners) = contacts_and_partners(body);
     for contact in contacts.iter_mut() {
-        let n = contact.node as usize;
-        let x = positions[n];
+        let point = contact.at;
+        let at = point.stencil(embedding);
+        let x = at.interpolate(positions);
         contact.refresh(x, positions);
         let gap = contact.gap(x);
         let sides = WithinBody {
             partners: &mut partners,
             obstacle: &contact.obstacle,
-            node: n,
+            at,
             x,
         };
         let normal = contact.normal;
@@ -738,14 +795,15 @@ pub(crate) fn prepare_velocities(body: &mut SoftBody, h: f64) {
 /// velocities are relative, the obstacle's effective mass counts, and the obstacle receives the
 /// opposite impulse.
 pub(crate) fn solve_velocities(body: &mut SoftBody) {
-    let (contacts, positions, mut partners) = contacts_and_partners(body);
+    let (contacts, positions, embedding, mut partners) = contacts_and_partners(body);
     for contact in contacts.iter_mut() {
-        let n = contact.node as usize;
+        let point = contact.at;
+        let at = point.stencil(embedding);
         let mut sides = WithinBody {
             partners: &mut partners,
             obstacle: &contact.obstacle,
-            node: n,
-            x: positions[n],
+            at,
+            x: at.interpolate(positions),
         };
         contact.impulse += contact
             .constraint
@@ -753,28 +811,35 @@ pub(crate) fn solve_velocities(body: &mut SoftBody) {
     }
 }
 
-/// A contact's node and obstacle within one body's sweep.
+/// A contact's point and obstacle within one body's sweep.
 struct WithinBody<'a, 'b> {
     partners: &'a mut Partners<'b>,
     obstacle: &'a Obstacle,
-    node: usize,
+    at: Stencil<'a>,
     x: DVec3,
 }
 
 impl ContactSides for WithinBody<'_, '_> {
     fn relative_velocity(&self) -> DVec3 {
-        self.partners.velocities[self.node] - self.partners.velocity_at(self.obstacle, self.x)
+        self.at.interpolate(self.partners.velocities)
+            - self.partners.velocity_at(self.obstacle, self.x)
     }
 
     fn inverse_mass_along(&self, direction: DVec3) -> f64 {
-        self.partners.own_inverse_mass(self.node)
+        self.at
+            .inverse_mass(self.partners.masses, self.partners.pinned)
             + self
                 .partners
                 .inverse_mass_along(self.obstacle, self.x, direction)
     }
 
     fn exchange(&mut self, impulse: DVec3) {
-        self.partners.velocities[self.node] += impulse * self.partners.own_inverse_mass(self.node);
+        self.at.apply(
+            impulse,
+            self.partners.velocities,
+            self.partners.masses,
+            self.partners.pinned,
+        );
         self.partners.apply(self.obstacle, -impulse, self.x);
     }
 }
@@ -789,16 +854,16 @@ fn implicit_contacts(contacts: &mut [NodeContact]) -> impl Iterator<Item = &mut 
 /// length `h` (s), at the positions that ended it, and hands their opposite to the rigid bodies.
 pub(crate) fn record_penalty_impulses(body: &mut SoftBody, effective_h: f64, h: f64) {
     let settings = body.contact_settings;
-    let (contacts, positions, mut partners) = contacts_and_partners(body);
+    let (contacts, positions, embedding, mut partners) = contacts_and_partners(body);
     for contact in implicit_contacts(contacts) {
-        let n = contact.node as usize;
-        let x = positions[n];
+        let point = contact.at;
+        let at = point.stencil(embedding);
+        let x = at.interpolate(positions);
         let mut force = contact
             .friction_term(x, &settings, effective_h)
             .map_or(DVec3::ZERO, |(_, force, _)| force);
-        if let Some((stiffness, gap)) =
-            contact.penalty(x, partners.masses[n], &settings, effective_h)
-        {
+        let mass = effective_mass(&at, partners.masses, partners.pinned);
+        if let Some((stiffness, gap)) = contact.penalty(x, mass, &settings, effective_h) {
             force -= contact.normal * (stiffness * gap);
         }
         let impulse = force * h;
@@ -811,51 +876,64 @@ pub(crate) fn record_penalty_impulses(body: &mut SoftBody, effective_h: f64, h: 
 /// each contact's friction limit is its penalty force there, and slip is measured from there.
 pub(crate) fn lag_friction(body: &mut SoftBody, h: f64) {
     let settings = body.contact_settings;
-    let (contacts, positions, partners) = contacts_and_partners(body);
+    let (contacts, positions, embedding, partners) = contacts_and_partners(body);
     for contact in implicit_contacts(contacts) {
-        let n = contact.node as usize;
-        let x = positions[n];
+        let point = contact.at;
+        let at = point.stencil(embedding);
+        let x = at.interpolate(positions);
+        let mass = effective_mass(&at, partners.masses, partners.pinned);
         contact.lagged_normal_force = contact
-            .penalty(x, partners.masses[n], &settings, h)
+            .penalty(x, mass, &settings, h)
             .map_or(0.0, |(stiffness, gap)| -stiffness * gap);
         contact.slip_origin = x;
         contact.surface_velocity = partners.velocity_at(&contact.obstacle, x);
     }
 }
 
+/// The effective mass (kg) of a contact point: `1 / Σ w² / m` over its free nodes, the node's
+/// own mass for a node.
+fn effective_mass(at: &Stencil, masses: &[f64], pinned: &[bool]) -> f64 {
+    at.inverse_mass(masses, pinned).recip()
+}
+
 /// The implicit friction of the contacts for an effective step `h` (s), at the body's positions:
-/// calls `each(node, energy (J), force (N), tangent (N/m))` for every contact with a friction
-/// limit (see [`lag_friction`]).
+/// calls `each(point, energy (J), force (N), tangent (N/m))` for every contact with a friction
+/// limit (see [`lag_friction`]); the force acts on the contact point, so node `a` of its stencil
+/// takes `w_a f` and the tangent couples nodes `a, b` by `w_a w_b T`.
 pub(crate) fn for_each_friction(
     body: &SoftBody,
     h: f64,
-    mut each: impl FnMut(usize, f64, DVec3, DMat3),
+    mut each: impl FnMut(Stencil, f64, DVec3, DMat3),
 ) {
     for contact in body.contacts.iter().filter(|c| c.is_implicit()) {
-        let n = contact.node as usize;
+        let at = contact.at.stencil(body.embedding.as_ref());
         if let Some((energy, force, tangent)) =
-            contact.friction_term(body.positions[n], &body.contact_settings, h)
+            contact.friction_term(at.interpolate(&body.positions), &body.contact_settings, h)
         {
-            each(n, energy, force, tangent);
+            each(at, energy, force, tangent);
         }
     }
 }
 
 /// The implicit penalty of the contacts for an effective step `h` (s), at the body's positions:
-/// calls `each(node, stiffness k (N/m), gap g (m), normal)` for every contact whose node is
-/// inside its plane (`g < 0`); the penalty energy is `Σ k g²/2`, its force on the node `-k g n`
-/// and its tangent `k n nᵀ`.
+/// calls `each(point, stiffness k (N/m), gap g (m), normal)` for every contact whose point is
+/// inside its plane (`g < 0`); the penalty energy is `Σ k g²/2`, its force on the point `-k g n`
+/// (on node `a` of its stencil, `w_a` of it) and its tangent `w_a w_b k n nᵀ`.
 pub(crate) fn for_each_active_penalty(
     body: &SoftBody,
     h: f64,
-    mut each: impl FnMut(usize, f64, f64, DVec3),
+    mut each: impl FnMut(Stencil, f64, f64, DVec3),
 ) {
     for contact in body.contacts.iter().filter(|c| c.is_implicit()) {
-        let n = contact.node as usize;
-        if let Some((stiffness, gap)) =
-            contact.penalty(body.positions[n], body.masses[n], &body.contact_settings, h)
-        {
-            each(n, stiffness, gap, contact.normal);
+        let at = contact.at.stencil(body.embedding.as_ref());
+        let mass = effective_mass(&at, &body.masses, &body.pinned);
+        if let Some((stiffness, gap)) = contact.penalty(
+            at.interpolate(&body.positions),
+            mass,
+            &body.contact_settings,
+            h,
+        ) {
+            each(at, stiffness, gap, contact.normal);
         }
     }
 }

@@ -13,7 +13,7 @@
 //! conserved within the body.
 
 use super::surface_tree::SurfaceTree;
-use super::{ContactTarget, NodeContact, Obstacle, SurfaceCoefficients};
+use super::{BodyPoint, ContactTarget, NodeContact, Obstacle, SurfaceCoefficients};
 use crate::body::SoftBody;
 
 impl SoftBody {
@@ -36,7 +36,7 @@ impl SoftBody {
                 tree.nearest_facing(self, self.positions[n], node_normals[n], reach, near)
             {
                 found.push(NodeContact::new(
-                    node,
+                    BodyPoint::Node(node),
                     ContactTarget::OwnSurface {
                         triangle: hit.triangle,
                     },

@@ -1,5 +1,6 @@
 //! The elements a body is discretized by: linear tetrahedra (the finite-volume kernel of
-//! [`crate::fvm`]) or 10-node quadratic tetrahedra ([`tet10`]).
+//! [`crate::fvm`]), 10-node quadratic tetrahedra ([`tet10`]) or 27-node quadratic hexahedra
+//! ([`hex27`], the element of a coarse cage).
 //!
 //! Both are seen by the rest of the crate as integration points: a point has the nodes of its
 //! element, the rest gradients `∇N_a` (1/m) of their shape functions there, and the rest volume
@@ -7,24 +8,32 @@
 //! `a` is `−w P ∇N_a`, the energy `Σ w Ψ(F)` and the tangent `Σ w ∇N_aᵀ (∂P/∂F) ∇N_b`. A linear
 //! tetrahedron is one point with its whole volume, and `−V P ∇N_a` is exactly the finite-volume
 //! traction `P b_a` on node `a`'s control-volume boundary; a quadratic tetrahedron has four points
-//! (Galerkin quadrature, which the finite-volume form reduces to for linear elements).
+//! and a quadratic hexahedron 27 (Galerkin quadrature, which the finite-volume form reduces to for
+//! linear elements).
 
+pub mod hex27;
 mod mean_dilatation;
+mod quadratic;
 pub mod tet10;
 
 use crate::damping::RayleighDamping;
 use crate::fvm::{FvmMesh, NodalAveraging, VolumetricTreatment};
 use crate::material::VolumetricTerm;
-pub(crate) use mean_dilatation::mean_measure;
+pub(crate) use mean_dilatation::projected_measure;
+pub use quadratic::{ElementShape, QuadraticElements};
+pub(crate) use quadratic::deformation_gradient;
 use rapier3d::glamx::{DMat3, DVec3};
-use tet10::{QuadraticElements, deformation_gradient};
+
+/// The most nodes an element has (quadratic hexahedra).
+pub(crate) const MAX_ELEMENT_NODES: usize = hex27::NODES;
 
 /// The polynomial order of a body's elements.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ElementOrder {
     /// 4-node tetrahedra, linear motion and constant strain per element.
     Linear,
-    /// 10-node tetrahedra with mid-edge nodes, quadratic motion and linear strain per element.
+    /// Quadratic motion and linear strain per element: 10-node tetrahedra with mid-edge nodes,
+    /// or 27-node hexahedra (see [`ElementShape`]).
     Quadratic,
 }
 
@@ -50,6 +59,14 @@ impl Elements {
         match self {
             Self::Linear { .. } => ElementOrder::Linear,
             Self::Quadratic { .. } => ElementOrder::Quadratic,
+        }
+    }
+
+    /// The shape of the elements.
+    pub(crate) fn shape(&self) -> ElementShape {
+        match self {
+            Self::Linear { .. } => ElementShape::Tetrahedron,
+            Self::Quadratic { elements, .. } => elements.shape(),
         }
     }
 
@@ -83,7 +100,7 @@ impl Elements {
     pub(crate) fn point_count(&self) -> usize {
         match self {
             Self::Linear { fvm, .. } => fvm.tets().len(),
-            Self::Quadratic { elements, .. } => elements.points().len(),
+            Self::Quadratic { elements, .. } => elements.point_count(),
         }
     }
 
@@ -91,9 +108,7 @@ impl Elements {
     pub(crate) fn element_nodes(&self) -> Box<dyn Iterator<Item = &[u32]> + '_> {
         match self {
             Self::Linear { fvm, .. } => Box::new(fvm.tets().iter().map(|t| &t[..])),
-            Self::Quadratic { elements, .. } => {
-                Box::new(elements.elements().iter().map(|e| &e[..]))
-            }
+            Self::Quadratic { elements, .. } => Box::new(elements.elements()),
         }
     }
 
@@ -112,12 +127,14 @@ impl Elements {
                 elements: quadratic,
                 ..
             } => {
-                for (element, nodes) in quadratic.elements().iter().enumerate() {
-                    for (k, point) in quadratic.points()[4 * element..4 * element + 4]
-                        .iter()
-                        .enumerate()
-                    {
-                        visit(4 * element + k, nodes, &point.gradients, point.weight);
+                for (element, nodes) in quadratic.elements().enumerate() {
+                    for point in quadratic.element_points(element) {
+                        visit(
+                            point,
+                            nodes,
+                            quadratic.point_gradients(point),
+                            quadratic.point_weight(point),
+                        );
                     }
                 }
             }
@@ -241,7 +258,7 @@ impl Elements {
                 return;
             }
             let spatial = f.inverse().transpose();
-            let mut lengths = [0.0; tet10::NODES];
+            let mut lengths = [0.0; MAX_ELEMENT_NODES];
             for (length, g) in lengths.iter_mut().zip(gradients) {
                 *length = (spatial * *g).length();
             }
@@ -299,7 +316,25 @@ mod tests {
         body
     }
 
-    /// For quadratic elements as for linear ones, with and without mean dilatation: the forces
+    /// A 2 x 1 x 1-cell cage of quadratic hexahedra (each 0.5 m wide) whose nodes are moved
+    /// randomly by up to 3.75 % of its size.
+    fn perturbed_hex_cage(
+        model: MaterialModel,
+        nu: f64,
+        treatment: VolumetricTreatment,
+    ) -> SoftBody {
+        let material = Material::new(model, 1e6, nu, 1000.0).unwrap();
+        let cage = mesh::QuadraticHexMesh::cuboid(DVec3::new(0.5, 0.25, 0.25), [2, 1, 1]).unwrap();
+        let mut body = SoftBodyBuilder::quadratic_hex(cage, material)
+            .volumetric(treatment)
+            .build()
+            .unwrap();
+        perturb_positions(&mut body, 13, 0.0375);
+        body
+    }
+
+    /// For quadratic elements of both shapes as for linear ones, with and without mean dilatation
+    /// (the projected volumetric term): the forces
     /// are minus the gradient of the energy, and the assembled tangent minus the gradient of the
     /// forces, by central differences
     /// (see [`assert_forces_and_tangent_match_energy`] for the step and tolerances).
@@ -322,6 +357,11 @@ mod tests {
                 assert_forces_and_tangent_match_energy(
                     &mut body,
                     &format!("{model:?} ν = {nu} {treatment:?}"),
+                );
+                let mut cage = perturbed_hex_cage(model, nu, treatment);
+                assert_forces_and_tangent_match_energy(
+                    &mut cage,
+                    &format!("hexahedra: {model:?} ν = {nu} {treatment:?}"),
                 );
             }
         }

@@ -12,8 +12,7 @@
 //! rule exact for quadratic polynomials ([`QUADRATURE`]): on straight-sided elements the
 //! stiffness integrand of linear elasticity is quadratic, so it is integrated exactly.
 
-use crate::Error;
-use rapier3d::glamx::{DMat3, DVec3};
+use rapier3d::glamx::DVec3;
 
 /// Nodes per element.
 pub const NODES: usize = 10;
@@ -81,152 +80,6 @@ pub fn natural_gradients(l: [f64; 4]) -> [DVec3; NODES] {
     by_barycentric.map(|d| DVec3::new(d[1] - d[0], d[2] - d[0], d[3] - d[0]))
 }
 
-/// The rest map of one element at one point: `J = ∂p/∂ξ` (m) from the rest positions `p` of its
-/// nodes and the natural gradients there.
-fn rest_jacobian(p: &[DVec3; NODES], natural: &[DVec3; NODES]) -> DMat3 {
-    let mut columns = [DVec3::ZERO; 3];
-    for (position, gradient) in p.iter().zip(natural) {
-        for (k, column) in columns.iter_mut().enumerate() {
-            *column += *position * gradient[k];
-        }
-    }
-    DMat3::from_cols(columns[0], columns[1], columns[2])
-}
-
-/// The spatial (rest) gradients `∇N_a = J⁻ᵀ ∂N_a/∂ξ` (1/m) at barycentric coordinates `l` and
-/// the Jacobian determinant there, or the determinant alone when it is not positive.
-fn rest_gradients(p: &[DVec3; NODES], l: [f64; 4]) -> Result<([DVec3; NODES], f64), f64> {
-    let natural = natural_gradients(l);
-    let jacobian = rest_jacobian(p, &natural);
-    let determinant = jacobian.determinant();
-    // NaN (from non-finite rest positions) is refused as well.
-    if determinant.is_nan() || determinant <= 0.0 {
-        return Err(determinant);
-    }
-    let inverse_transpose = jacobian.inverse().transpose();
-    Ok((natural.map(|g| inverse_transpose * g), determinant))
-}
-
-/// One quadrature point of an element in its rest configuration.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct QuadraturePoint {
-    /// `∇N_a` (1/m) of the ten shape functions at the point, in rest coordinates.
-    pub gradients: [DVec3; NODES],
-    /// The rest volume the point stands for (m³): its weight times the Jacobian determinant.
-    pub weight: f64,
-}
-
-/// The rest data of a mesh of quadratic tetrahedra: four quadrature points per element.
-#[derive(Debug, Clone)]
-pub struct QuadraticElements {
-    elements: Vec<[u32; NODES]>,
-    points: Vec<QuadraturePoint>,
-    lumped_volumes: Vec<f64>,
-}
-
-impl QuadraticElements {
-    /// The rest data of `elements` (10 node indices each) at rest positions `positions` (m), one
-    /// per node.
-    ///
-    /// # Errors
-    /// [`Error::InvertedTet`] naming the first element whose rest map folds (its Jacobian
-    /// determinant is not positive at a quadrature point or corner): a badly curved element.
-    pub fn new(positions: &[DVec3], elements: &[[u32; NODES]]) -> Result<Self, Error> {
-        let mut points = Vec::with_capacity(4 * elements.len());
-        for (element, nodes) in elements.iter().enumerate() {
-            let p = nodes.map(|n| positions[n as usize]);
-            let inverted = |determinant: f64| Error::InvertedTet {
-                tet: element,
-                volume: determinant / 6.0,
-            };
-            for corner in 0..4 {
-                let mut l = [0.0; 4];
-                l[corner] = 1.0;
-                rest_gradients(&p, l).map_err(inverted)?;
-            }
-            for l in QUADRATURE {
-                let (gradients, determinant) = rest_gradients(&p, l).map_err(inverted)?;
-                points.push(QuadraturePoint {
-                    gradients,
-                    weight: determinant / 24.0,
-                });
-            }
-        }
-        let mut lumped_volumes = vec![0.0; positions.len()];
-        for (element, nodes) in elements.iter().enumerate() {
-            let volume: f64 = points[4 * element..4 * element + 4]
-                .iter()
-                .map(|q| q.weight)
-                .sum();
-            for (&n, fraction) in nodes.iter().zip(LUMPED_MASS_FRACTIONS) {
-                lumped_volumes[n as usize] += fraction * volume;
-            }
-        }
-        Ok(Self {
-            elements: elements.to_vec(),
-            points,
-            lumped_volumes,
-        })
-    }
-
-    /// The elements (10 node indices each).
-    pub fn elements(&self) -> &[[u32; NODES]] {
-        &self.elements
-    }
-
-    /// The quadrature points, four per element in element order.
-    pub fn points(&self) -> &[QuadraturePoint] {
-        &self.points
-    }
-
-    /// Rest volume of element `element` (m³), the sum of its quadrature weights.
-    ///
-    /// # Panics
-    /// If the element does not exist.
-    pub fn volume(&self, element: usize) -> f64 {
-        self.points[4 * element..4 * element + 4]
-            .iter()
-            .map(|q| q.weight)
-            .sum()
-    }
-
-    /// The rest volume (m³) lumped on each node: HRZ fractions ([`LUMPED_MASS_FRACTIONS`]) of
-    /// each element's volume; times the density, the nodal masses.
-    pub fn lumped_volumes(&self) -> &[f64] {
-        &self.lumped_volumes
-    }
-
-    /// The deformation gradient of element `element` (dimensionless) at barycentric coordinates
-    /// `l` for node positions `x` (m): `F = Σ_a x_a ⊗ ∇N_a`, with the gradients at that point.
-    ///
-    /// # Panics
-    /// If the element does not exist.
-    pub fn gradient_at(&self, element: usize, rest: &[DVec3], x: &[DVec3], l: [f64; 4]) -> DMat3 {
-        let nodes = &self.elements[element];
-        let p = nodes.map(|n| rest[n as usize]);
-        match rest_gradients(&p, l) {
-            Ok((gradients, _)) => deformation_gradient(nodes, &gradients, x),
-            // The constructor checked the corners and quadrature points; a point between them
-            // cannot fold for an element that passed, but stay finite if it does.
-            Err(_) => DMat3::IDENTITY,
-        }
-    }
-}
-
-/// `F = Σ_a x_a ⊗ ∇N_a` (dimensionless) over the nodes `nodes` with shape-function gradients
-/// `gradients` (1/m), for positions `x` (m); with velocities it is the rate `Ḟ` (1/s).
-#[inline]
-pub(crate) fn deformation_gradient(nodes: &[u32], gradients: &[DVec3], x: &[DVec3]) -> DMat3 {
-    let mut columns = [DVec3::ZERO; 3];
-    for (&n, g) in nodes.iter().zip(gradients) {
-        let xn = x[n as usize];
-        columns[0] += xn * g.x;
-        columns[1] += xn * g.y;
-        columns[2] += xn * g.z;
-    }
-    DMat3::from_cols(columns[0], columns[1], columns[2])
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -285,36 +138,5 @@ mod tests {
         assert!((LUMPED_MASS_FRACTIONS[0] - corner / total).abs() < 1e-15);
         assert!((LUMPED_MASS_FRACTIONS[4] - edge / total).abs() < 1e-15);
         assert!((LUMPED_MASS_FRACTIONS.iter().sum::<f64>() - 1.0).abs() < 1e-15);
-    }
-
-    #[test]
-    fn quadratic_displacement_gives_its_exact_linear_gradient() {
-        // x = p + u(p) with u quadratic: F = I + ∇u exactly at every point.
-        let u = |p: DVec3| DVec3::new(0.3 * p.y * p.y, 0.2 * p.x * p.z, -0.1 * p.x * p.x);
-        let grad_u = |p: DVec3| {
-            DMat3::from_cols(
-                DVec3::new(0.0, 0.2 * p.z, -0.2 * p.x),
-                DVec3::new(0.6 * p.y, 0.0, 0.0),
-                DVec3::new(0.0, 0.2 * p.x, 0.0),
-            )
-        };
-        let rest = reference_nodes();
-        let x: Vec<DVec3> = rest.iter().map(|p| *p + u(*p)).collect();
-        let elements = QuadraticElements::new(&rest, &[std::array::from_fn(|a| a as u32)]).unwrap();
-        let l = [0.1, 0.2, 0.3, 0.4];
-        let p = DVec3::new(l[1], l[2], l[3]);
-        let f = elements.gradient_at(0, &rest, &x, l);
-        let error = f - (DMat3::IDENTITY + grad_u(p));
-        assert!(error.to_cols_array().iter().all(|e| e.abs() < 1e-14));
-        assert!((elements.volume(0) - 1.0 / 6.0).abs() < 1e-15);
-    }
-
-    #[test]
-    fn a_folded_element_is_refused_by_index() {
-        let mut rest = reference_nodes();
-        // Pull the (0,1) mid-edge node past corner 1: the rest map folds near that corner.
-        rest[4] = DVec3::new(1.2, 0.0, 0.0);
-        let error = QuadraticElements::new(&rest, &[std::array::from_fn(|a| a as u32)]);
-        assert!(matches!(error, Err(Error::InvertedTet { tet: 0, .. })));
     }
 }

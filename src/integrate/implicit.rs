@@ -23,7 +23,7 @@ use crate::assembly::Stiffness;
 use crate::body::{PreviousStep, SoftBody};
 use crate::damping::RayleighDamping;
 use crate::element::add_point_forces;
-use crate::element::tet10::deformation_gradient;
+use crate::element::deformation_gradient;
 use crate::linear_solver::{LinearSolver, Method, solve_newton_system};
 use crate::material::green_strain;
 use crate::newton::{check_tolerance, descend, norm};
@@ -415,11 +415,15 @@ impl StepStart {
         if let Some(damping) = body.damping {
             self.add_damping_forces(body, &damping, &mut residual);
         }
-        contact::for_each_active_penalty(body, self.h, |node, stiffness, gap, normal| {
-            residual[node] -= normal * (stiffness * gap);
+        contact::for_each_active_penalty(body, self.h, |at, stiffness, gap, normal| {
+            for (&node, w) in at.nodes.iter().zip(at.weights) {
+                residual[node as usize] -= normal * (w * stiffness * gap);
+            }
         });
-        contact::for_each_friction(body, self.h, |node, _, force, _| {
-            residual[node] += force;
+        contact::for_each_friction(body, self.h, |at, _, force, _| {
+            for (&node, w) in at.nodes.iter().zip(at.weights) {
+                residual[node as usize] += force * *w;
+            }
         });
         attachment::for_each_spring(body, self.h, |node, stiffness, target| {
             residual[node] += (target - body.positions[node]) * stiffness;
@@ -500,11 +504,11 @@ impl StepStart {
             Some(d) => d.step_first_piola_differential(f, &self.green[t], self.h, df),
             None => DMat3::ZERO,
         });
-        contact::for_each_active_penalty(body, self.h, |node, k, _, normal| {
-            stiffness.add_node_block(node, &contact::penalty_tangent(k, normal));
+        contact::for_each_active_penalty(body, self.h, |at, k, _, normal| {
+            stiffness.add_stencil_block(at, &contact::penalty_tangent(k, normal), &body.pinned);
         });
-        contact::for_each_friction(body, self.h, |node, _, _, tangent| {
-            stiffness.add_node_block(node, &tangent);
+        contact::for_each_friction(body, self.h, |at, _, _, tangent| {
+            stiffness.add_stencil_block(at, &tangent, &body.pinned);
         });
         attachment::for_each_spring(body, self.h, |node, k, _| {
             stiffness.add_node_block(node, &(DMat3::IDENTITY * k));

@@ -9,11 +9,13 @@ mod generators;
 mod hex_mesher;
 pub mod import;
 mod quadratic;
+mod quadratic_hex;
 mod surface;
 
 pub use generators::{cuboid, cylinder, sphere};
 pub use quadratic::QuadraticTetMesh;
 pub(crate) use quadratic::SUB_TETS;
+pub use quadratic_hex::QuadraticHexMesh;
 
 use crate::Error;
 use rapier3d::glamx::DVec3;
