@@ -263,11 +263,7 @@ fn main() -> Result<(), Error> {
         "elements", "volumetric", "dofs", "nu=0", "nu=0.3", "nu=0.45", "nu=0.49", "nu=0.499"
     );
     for (kind, cells, volumetric) in [
-        (
-            Kind::LinearTet,
-            [40, 4, 4],
-            VolumetricTreatment::PerElement,
-        ),
+        (Kind::LinearTet, [40, 4, 4], VolumetricTreatment::PerElement),
         (
             Kind::LinearTet,
             [40, 4, 4],
@@ -341,7 +337,8 @@ fn main() -> Result<(), Error> {
             nu,
             volumetric,
         };
-        let errors = [0.0, 0.3, 0.45, 0.49, 0.499].map(|nu| static_case(&beam(nu)).map(|(e, _, _)| e));
+        let errors =
+            [0.0, 0.3, 0.45, 0.49, 0.499].map(|nu| static_case(&beam(nu)).map(|(e, _, _)| e));
         let (_, _, dofs) = static_case(&beam(0.45))?;
         print!(
             "{:<18} {:<15} {:>6}",
@@ -372,18 +369,68 @@ fn main() -> Result<(), Error> {
     let per_element = VolumetricTreatment::PerElement;
     let averaged = VolumetricTreatment::ElementAverage;
     let dynamic_cases = [
-        (Kind::LinearTet, [20, 2, 2], Stepper::BackwardEuler, per_element),
-        (Kind::LinearTet, [40, 4, 4], Stepper::BackwardEuler, per_element),
-        (Kind::QuadraticTet, [5, 1, 1], Stepper::BackwardEuler, per_element),
-        (Kind::QuadraticTet, [10, 1, 1], Stepper::BackwardEuler, per_element),
+        (
+            Kind::LinearTet,
+            [20, 2, 2],
+            Stepper::BackwardEuler,
+            per_element,
+        ),
+        (
+            Kind::LinearTet,
+            [40, 4, 4],
+            Stepper::BackwardEuler,
+            per_element,
+        ),
+        (
+            Kind::QuadraticTet,
+            [5, 1, 1],
+            Stepper::BackwardEuler,
+            per_element,
+        ),
+        (
+            Kind::QuadraticTet,
+            [10, 1, 1],
+            Stepper::BackwardEuler,
+            per_element,
+        ),
         (Kind::QuadraticTet, [10, 1, 1], Stepper::Bdf2, per_element),
-        (Kind::QuadraticTet, [20, 2, 2], Stepper::BackwardEuler, per_element),
-        (Kind::QuadraticTet, [20, 1, 1], Stepper::BackwardEuler, per_element),
-        (Kind::QuadraticHex, [4, 1, 1], Stepper::BackwardEuler, averaged),
-        (Kind::QuadraticHex, [5, 1, 1], Stepper::BackwardEuler, per_element),
-        (Kind::QuadraticHex, [5, 1, 1], Stepper::BackwardEuler, averaged),
+        (
+            Kind::QuadraticTet,
+            [20, 2, 2],
+            Stepper::BackwardEuler,
+            per_element,
+        ),
+        (
+            Kind::QuadraticTet,
+            [20, 1, 1],
+            Stepper::BackwardEuler,
+            per_element,
+        ),
+        (
+            Kind::QuadraticHex,
+            [4, 1, 1],
+            Stepper::BackwardEuler,
+            averaged,
+        ),
+        (
+            Kind::QuadraticHex,
+            [5, 1, 1],
+            Stepper::BackwardEuler,
+            per_element,
+        ),
+        (
+            Kind::QuadraticHex,
+            [5, 1, 1],
+            Stepper::BackwardEuler,
+            averaged,
+        ),
         (Kind::QuadraticHex, [5, 1, 1], Stepper::Bdf2, averaged),
-        (Kind::QuadraticHex, [10, 1, 1], Stepper::BackwardEuler, averaged),
+        (
+            Kind::QuadraticHex,
+            [10, 1, 1],
+            Stepper::BackwardEuler,
+            averaged,
+        ),
     ];
     for (kind, cells, stepper, volumetric) in dynamic_cases {
         for model in [MaterialModel::Linear, MaterialModel::Corotated] {

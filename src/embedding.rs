@@ -173,14 +173,17 @@ struct TetGrid {
 impl TetGrid {
     fn new(mesh: &TetMesh) -> Self {
         let p = mesh.positions();
-        let (lo, hi) = p
-            .iter()
-            .fold((DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)), |(lo, hi), x| {
-                (lo.min(*x), hi.max(*x))
-            });
+        let (lo, hi) = p.iter().fold(
+            (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+            |(lo, hi), x| (lo.min(*x), hi.max(*x)),
+        );
         // About one tetrahedron per cell.
-        let volume = (hi - lo).max(DVec3::splat(f64::MIN_POSITIVE)).element_product();
-        let cell = (volume / mesh.tet_count() as f64).cbrt().max(f64::MIN_POSITIVE);
+        let volume = (hi - lo)
+            .max(DVec3::splat(f64::MIN_POSITIVE))
+            .element_product();
+        let cell = (volume / mesh.tet_count() as f64)
+            .cbrt()
+            .max(f64::MIN_POSITIVE);
         let extent = ((hi - lo) / cell).ceil().max(DVec3::ONE);
         let counts = [extent.x as usize, extent.y as usize, extent.z as usize];
         let mut grid = Self {

@@ -112,7 +112,9 @@ pub enum Error {
     },
     /// A vertex of a mesh to embed lies outside the body's simulation mesh (farther than half a
     /// tetrahedron from its nearest simulation tetrahedron), so no element carries it.
-    #[error("vertex {vertex} of the embedded mesh, at {position:?}, lies outside the simulation mesh")]
+    #[error(
+        "vertex {vertex} of the embedded mesh, at {position:?}, lies outside the simulation mesh"
+    )]
     OutsideSimulationMesh {
         /// Index of the offending vertex of the embedded mesh.
         vertex: usize,

@@ -182,11 +182,17 @@ fn hex_cage_cantilever_matches_beam_theory_at_any_poisson_ratio() {
     ] {
         let (body, error) = static_cage_tip_error([5, 1, 1], nu, treatment);
         assert_eq!(body.element_shape(), ElementShape::Hexahedron);
-        println!("hex cage 5x1x1 nu = {nu} {treatment:?}: tip error {:+.2}%", 100.0 * error);
+        println!(
+            "hex cage 5x1x1 nu = {nu} {treatment:?}: tip error {:+.2}%",
+            100.0 * error
+        );
         assert!(error.abs() < bound, "nu = {nu}: {error}");
     }
     let (_, locked) = static_cage_tip_error([5, 1, 1], 0.499, VolumetricTreatment::PerElement);
-    println!("hex cage 5x1x1 nu = 0.499 per point: tip error {:+.2}%", 100.0 * locked);
+    println!(
+        "hex cage 5x1x1 nu = 0.499 per point: tip error {:+.2}%",
+        100.0 * locked
+    );
     assert!(locked < -0.2, "the per-point term locks: {locked}");
 }
 
@@ -233,6 +239,9 @@ fn hex_cage_first_frequency_matches_timoshenko() {
     let (body, _) = cage_beam([5, 1, 1], 0.3, VolumetricTreatment::ElementAverage);
     let frequency = statics::fundamental_frequency(&body).unwrap();
     let error = frequency / 5.069 - 1.0;
-    println!("hex cage 5x1x1 first frequency {frequency:.4} Hz ({:+.2}%)", 100.0 * error);
+    println!(
+        "hex cage 5x1x1 first frequency {frequency:.4} Hz ({:+.2}%)",
+        100.0 * error
+    );
     assert!(error.abs() < 0.01);
 }

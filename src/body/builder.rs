@@ -392,8 +392,11 @@ impl SoftBodyBuilder {
                                  average per element (VolumetricTreatment::ElementAverage)",
                     });
                 }
-                let elements =
-                    QuadraticElements::new(quadratic.shape, self.mesh.positions(), &quadratic.nodes)?;
+                let elements = QuadraticElements::new(
+                    quadratic.shape,
+                    self.mesh.positions(),
+                    &quadratic.nodes,
+                )?;
                 let masses = elements
                     .lumped_volumes()
                     .iter()

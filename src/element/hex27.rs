@@ -90,7 +90,11 @@ pub fn natural_gradients(xi: DVec3) -> [DVec3; NODES] {
     let ((x, dx), (y, dy), (z, dz)) = (lagrange(xi.x), lagrange(xi.y), lagrange(xi.z));
     std::array::from_fn(|a| {
         let [i, j, k] = lattice(a);
-        DVec3::new(dx[i] * y[j] * z[k], x[i] * dy[j] * z[k], x[i] * y[j] * dz[k])
+        DVec3::new(
+            dx[i] * y[j] * z[k],
+            x[i] * dy[j] * z[k],
+            x[i] * y[j] * dz[k],
+        )
     })
 }
 

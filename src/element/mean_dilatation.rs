@@ -226,7 +226,11 @@ impl Projection {
             .collect();
         let values: Vec<Vec<f64>> = rule.iter().map(|(xi, _)| basis.at(*xi)).collect();
         let mut coefficients = vec![0.0; basis.coefficients.len()];
-        for ((q, m), phi) in quadratic.element_points(element).zip(&measures).zip(&values) {
+        for ((q, m), phi) in quadratic
+            .element_points(element)
+            .zip(&measures)
+            .zip(&values)
+        {
             let w = quadratic.point_weight(q);
             for (b, p) in coefficients.iter_mut().zip(phi) {
                 *b += w * p * m;

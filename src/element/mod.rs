@@ -20,8 +20,8 @@ use crate::damping::RayleighDamping;
 use crate::fvm::{FvmMesh, NodalAveraging, VolumetricTreatment};
 use crate::material::VolumetricTerm;
 pub(crate) use mean_dilatation::projected_measure;
-pub use quadratic::{ElementShape, QuadraticElements};
 pub(crate) use quadratic::deformation_gradient;
+pub use quadratic::{ElementShape, QuadraticElements};
 use rapier3d::glamx::{DMat3, DVec3};
 
 /// The most nodes an element has (quadratic hexahedra).

@@ -105,11 +105,7 @@ fn rest_jacobian(p: &[DVec3], natural: &[DVec3]) -> DMat3 {
 
 /// The spatial (rest) gradients `∇N_a = J⁻ᵀ ∂N_a/∂ξ` (1/m) at natural coordinates `xi` and the
 /// Jacobian determinant there, or the determinant alone when it is not positive.
-fn rest_gradients(
-    shape: ElementShape,
-    p: &[DVec3],
-    xi: DVec3,
-) -> Result<(Vec<DVec3>, f64), f64> {
+fn rest_gradients(shape: ElementShape, p: &[DVec3], xi: DVec3) -> Result<(Vec<DVec3>, f64), f64> {
     let mut natural = shape.natural_gradients(xi);
     let jacobian = rest_jacobian(p, &natural);
     let determinant = jacobian.determinant();
@@ -154,7 +150,10 @@ impl QuadraticElements {
         let mut gradients = Vec::with_capacity(nodes.len() * rule.len());
         let mut weights = Vec::with_capacity(element_count * rule.len());
         for (element, element_nodes) in nodes.chunks_exact(per_element).enumerate() {
-            let p: Vec<DVec3> = element_nodes.iter().map(|&n| positions[n as usize]).collect();
+            let p: Vec<DVec3> = element_nodes
+                .iter()
+                .map(|&n| positions[n as usize])
+                .collect();
             let inverted = |determinant: f64| Error::InvertedTet {
                 tet: element,
                 volume: determinant * reference_volume,
@@ -345,7 +344,11 @@ mod tests {
     #[test]
     fn quadratic_displacement_gives_its_exact_gradient_in_both_shapes() {
         for (shape, volume, xi) in [
-            (ElementShape::Tetrahedron, 1.0 / 6.0, DVec3::new(0.2, 0.3, 0.4)),
+            (
+                ElementShape::Tetrahedron,
+                1.0 / 6.0,
+                DVec3::new(0.2, 0.3, 0.4),
+            ),
             (ElementShape::Hexahedron, 8.0, DVec3::new(0.3, -0.7, 0.45)),
         ] {
             let rest = shape.reference_nodes();

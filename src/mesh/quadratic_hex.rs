@@ -44,7 +44,8 @@ impl QuadraticHexMesh {
         // The lattice of every element's nodes is the tetrahedral box of twice the cells.
         let subdivided = super::cuboid(half_extents, cells.map(|c| 2 * c))?;
         let [nx, ny, nz] = cells;
-        let node = |i: usize, j: usize, k: usize| (i + (2 * nx + 1) * (j + (2 * ny + 1) * k)) as u32;
+        let node =
+            |i: usize, j: usize, k: usize| (i + (2 * nx + 1) * (j + (2 * ny + 1) * k)) as u32;
         let mut elements = Vec::with_capacity(nx * ny * nz);
         for ez in 0..nz {
             for ey in 0..ny {
@@ -170,7 +171,10 @@ mod tests {
             let centre = p[element[13] as usize];
             for (a, &n) in element.iter().enumerate() {
                 let expected = centre + reference[a] * cell * 0.5;
-                assert!(p[n as usize].distance(expected) < 1e-12, "element {e}, node {a}");
+                assert!(
+                    p[n as usize].distance(expected) < 1e-12,
+                    "element {e}, node {a}"
+                );
             }
         }
         for (t, tet) in cage.subdivided().tets().iter().enumerate() {
