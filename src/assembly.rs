@@ -41,6 +41,11 @@ pub(crate) struct Stiffness {
     symbolic: Option<SymbolicLlt<usize>>,
     /// Scratch of [`Stiffness::add_point`]: per node of an element, `A ∇N_b`.
     stress_maps: Vec<na::SMatrix<f64, 9, 3>>,
+    /// The element whose points are being added, and its dense tangent so far (`3n x 3n`,
+    /// column-major, local node order): scattered into `values` once per element, so that an
+    /// element of many points searches the pattern once per node pair.
+    element_nodes: Vec<u32>,
+    element_block: Vec<f64>,
 }
 
 impl Stiffness {
@@ -80,6 +85,8 @@ impl Stiffness {
             lower_neighbours,
             symbolic: None,
             stress_maps: Vec::new(),
+            element_nodes: Vec::new(),
+            element_block: Vec::new(),
         }
     }
 
@@ -136,6 +143,7 @@ impl Stiffness {
                     let a = if project { project_positive(a) } else { a };
                     self.add_point(nodes, gradients, weight, &a, &body.pinned);
                 });
+            self.flush_element(&body.pinned);
             // The coupling is positive semi-definite (K > 0), so it needs no projection.
             if let Some((averaging, fvm)) = averaging {
                 averaging.for_each_coupling(&model, fvm, x, |gradient, weight| {
@@ -196,7 +204,8 @@ impl Stiffness {
 
     /// Adds one integration point's `w ∇N_aᵀ A ∇N_b` (N/m) for every pair of its nodes:
     /// `K_ab[i][j] = w Σ_cd A[(i,c),(j,d)] g_a,c g_b,d`, with `g` the shape-function gradients
-    /// (1/m), `w` the point's rest volume (m³) and `A` the stress tangent (Pa).
+    /// (1/m), `w` the point's rest volume (m³) and `A` the stress tangent (Pa). Points of one
+    /// element are summed densely; [`Stiffness::flush_element`] scatters the sum.
     fn add_point(
         &mut self,
         nodes: &[u32],
@@ -205,6 +214,12 @@ impl Stiffness {
         tangent: &StressTangent,
         pinned: &[bool],
     ) {
+        if self.element_nodes != nodes {
+            self.flush_element(pinned);
+            self.element_nodes.extend_from_slice(nodes);
+            self.element_block
+                .resize(9 * nodes.len() * nodes.len(), 0.0);
+        }
         // A g_b: per node, the 9 x 3 map from its displacement to dP.
         let mut stress_maps = std::mem::take(&mut self.stress_maps);
         stress_maps.clear();
@@ -213,15 +228,42 @@ impl Stiffness {
                 (0..3).map(|d| tangent[(row, 3 * d + j)] * g[d]).sum()
             })
         }));
+        let rows = 3 * nodes.len();
         for (cb, &b) in nodes.iter().enumerate() {
+            let map = &stress_maps[cb];
             for (ca, &a) in nodes.iter().enumerate() {
-                let (ga, map) = (gradients[ca], &stress_maps[cb]);
-                self.add_pair_block(a as usize, b as usize, pinned, |i, j| {
-                    weight * (0..3).map(|c| ga[c] * map[(3 * c + i, j)]).sum::<f64>()
-                });
+                // The lower triangle of the global matrix only.
+                if a < b {
+                    continue;
+                }
+                let ga = gradients[ca] * weight;
+                for j in 0..3 {
+                    let column = &mut self.element_block[rows * (3 * cb + j) + 3 * ca..][..3];
+                    for (i, entry) in column.iter_mut().enumerate() {
+                        *entry += (0..3).map(|c| ga[c] * map[(3 * c + i, j)]).sum::<f64>();
+                    }
+                }
             }
         }
         self.stress_maps = stress_maps;
+    }
+
+    /// Scatters the dense tangent of the element being added into `values`, and forgets it.
+    fn flush_element(&mut self, pinned: &[bool]) {
+        let nodes = std::mem::take(&mut self.element_nodes);
+        let mut block = std::mem::take(&mut self.element_block);
+        let rows = 3 * nodes.len();
+        for (cb, &b) in nodes.iter().enumerate() {
+            for (ca, &a) in nodes.iter().enumerate() {
+                self.add_pair_block(a as usize, b as usize, pinned, |i, j| {
+                    block[rows * (3 * cb + j) + 3 * ca + i]
+                });
+            }
+        }
+        block.fill(0.0);
+        self.element_nodes = nodes;
+        self.element_nodes.clear();
+        self.element_block = block;
     }
 
     /// Adds `value(i, j)` to the entries (row `3a + i`, column `3b + j`) of the lower triangle,

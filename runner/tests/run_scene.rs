@@ -27,6 +27,7 @@ fn every_shipped_scene_parses_and_builds() {
     let names = [
         "cantilever.toml",
         "cantilever_quadratic.toml",
+        "cage_beam.toml",
         "drop.toml",
         "rigid_on_soft.toml",
         "grasp.toml",

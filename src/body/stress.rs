@@ -9,6 +9,18 @@ use crate::fvm::gather;
 use crate::material::{HyperelasticModel, VolumetricTerm, with_hyperelastic_model};
 use rapier3d::glamx::{DMat3, DVec3};
 
+/// The Cauchy stress `P Fᵀ / det F` (Pa) for a deformation gradient `f` and first
+/// Piola–Kirchhoff stress `piola` (Pa); the Kirchhoff stress `P Fᵀ` where `det F <= 0`.
+fn cauchy_from_piola(f: &DMat3, piola: DMat3) -> DMat3 {
+    let kirchhoff = piola * f.transpose();
+    let volume_ratio = f.determinant();
+    if volume_ratio > 0.0 {
+        kirchhoff * volume_ratio.recip()
+    } else {
+        kirchhoff
+    }
+}
+
 impl SoftBody {
     /// The Cauchy stress `σ = P Fᵀ / det F` (Pa) of every tetrahedron of [`SoftBody::mesh`] at
     /// the current positions, in mesh order and world axes; symmetric for every model. For
@@ -26,15 +38,7 @@ impl SoftBody {
     /// elements with [`SoftBody::inverted_tet_count`].
     pub fn cauchy_stresses(&self) -> Vec<DMat3> {
         with_hyperelastic_model!(self.material, |model| {
-            let stress = |f: &DMat3, piola: DMat3| {
-                let kirchhoff = piola * f.transpose();
-                let volume_ratio = f.determinant();
-                if volume_ratio > 0.0 {
-                    kirchhoff * volume_ratio.recip()
-                } else {
-                    kirchhoff
-                }
-            };
+            let stress = cauchy_from_piola;
             match &self.elements {
                 Elements::Linear {
                     fvm,
@@ -101,6 +105,35 @@ impl SoftBody {
                 }
             }
         })
+    }
+
+    /// The Cauchy stress (Pa) of every tetrahedron of the embedded mesh
+    /// ([`SoftBody::embedding`]) at the current positions, in its mesh order and world axes;
+    /// `None` without one. Each is the material's stress at the fine tetrahedron's own
+    /// deformation gradient, from its interpolated vertices: the simulated field's mean over
+    /// the tetrahedron (exact for a fine tetrahedron inside one linear element). The
+    /// volumetric projection of [`VolumetricTreatment::ElementAverage`](crate::fvm::VolumetricTreatment::ElementAverage)
+    /// and the viscous stress are not included; inverted tetrahedra get the Kirchhoff stress,
+    /// as in [`SoftBody::cauchy_stresses`].
+    pub fn embedded_cauchy_stresses(&self) -> Option<Vec<DMat3>> {
+        let embedding = self.embedding.as_ref()?;
+        let x = embedding.positions(&self.positions);
+        let rest = embedding.mesh().positions();
+        Some(with_hyperelastic_model!(self.material, |model| {
+            embedding
+                .mesh()
+                .tets()
+                .iter()
+                .map(|tet| {
+                    let [p0, p1, p2, p3] = tet.map(|n| rest[n as usize]);
+                    let [x0, x1, x2, x3] = tet.map(|n| x[n as usize]);
+                    let rest_edges = DMat3::from_cols(p1 - p0, p2 - p0, p3 - p0);
+                    let edges = DMat3::from_cols(x1 - x0, x2 - x0, x3 - x0);
+                    let f = edges * rest_edges.inverse();
+                    cauchy_from_piola(&f, model.first_piola(&f))
+                })
+                .collect()
+        }))
     }
 
     /// The von Mises equivalent stress `sqrt(3/2 s:s)` (Pa) of a stress tensor `stress` (Pa),

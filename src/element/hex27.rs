@@ -121,8 +121,8 @@ mod tests {
         let xi = DVec3::new(0.3, -0.7, 0.45);
         let h = 1e-6;
         let gradients = natural_gradients(xi);
-        for k in 0..3 {
-            let step = DVec3::AXES[k] * h;
+        for (k, axis) in DVec3::AXES.into_iter().enumerate() {
+            let step = axis * h;
             let (plus, minus) = (shape_values(xi + step), shape_values(xi - step));
             for a in 0..NODES {
                 let fd = (plus[a] - minus[a]) / (2.0 * h);

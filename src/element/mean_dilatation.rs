@@ -74,17 +74,21 @@ pub(crate) fn for_each_coupling<M: VolumetricTerm>(
 ) {
     let bulk = model.volumetric_modulus();
     let mut gradient: Vec<(u32, DVec3)> = Vec::new();
+    let mut measure_gradients: Vec<DMat3> = Vec::new();
     for (element, nodes) in quadratic.elements().enumerate() {
         let points = quadratic.element_points(element);
-        let values = PressureBasis::values_at_points(quadratic, element);
-        for function in &values {
+        // `w_q ∂m/∂F` per point, shared by the element's pressure functions.
+        measure_gradients.clear();
+        measure_gradients.extend(points.clone().map(|point| {
+            let f = deformation_gradient(nodes, quadratic.point_gradients(point), x);
+            model.volume_measure_gradient(&f) * quadratic.point_weight(point)
+        }));
+        for function in &PressureBasis::values_at_points(quadratic, element) {
             gradient.clear();
             gradient.extend(nodes.iter().map(|&n| (n, DVec3::ZERO)));
-            for (point, phi) in points.clone().zip(function) {
-                let shapes = quadratic.point_gradients(point);
-                let f = deformation_gradient(nodes, shapes, x);
-                let dm = model.volume_measure_gradient(&f) * (quadratic.point_weight(point) * phi);
-                for ((_, g), shape) in gradient.iter_mut().zip(shapes) {
+            for ((point, phi), dm) in points.clone().zip(function).zip(&measure_gradients) {
+                let dm = *dm * *phi;
+                for ((_, g), shape) in gradient.iter_mut().zip(quadratic.point_gradients(point)) {
                     *g += dm * *shape;
                 }
             }

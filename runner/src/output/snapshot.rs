@@ -71,6 +71,19 @@ impl SoftBodySnapshot {
             body.node_count(),
             "one reference position per node"
         );
+        // A body carrying an embedded mesh is shown by that mesh, which moves with the nodes.
+        if let Some(embedding) = body.embedding() {
+            return Self {
+                name: name.into(),
+                material: material.into(),
+                rest_positions: embedding.positions(rest_positions),
+                positions: embedding.positions(body.positions()),
+                velocities: embedding.positions(body.velocities()),
+                tets: embedding.mesh().tets().to_vec(),
+                surface: embedding.surface_triangles().to_vec(),
+                cauchy_stress: body.embedded_cauchy_stresses().unwrap_or_default(),
+            };
+        }
         Self {
             name: name.into(),
             material: material.into(),

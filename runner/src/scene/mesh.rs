@@ -14,7 +14,7 @@
 use super::check::Checker;
 use super::error::{SceneError, SceneSource};
 use rapier_fvm::glamx::DVec3;
-use rapier_fvm::mesh::{self, QuadraticTetMesh, TetMesh, import};
+use rapier_fvm::mesh::{self, QuadraticHexMesh, QuadraticTetMesh, TetMesh, import};
 use serde::Deserialize;
 
 /// Where a soft body's mesh comes from.
@@ -154,6 +154,22 @@ impl MeshSpec {
                 .map_err(|e| (key.to_owned(), e.to_string()))
         };
         result.map_err(|(key, message)| source.error(&key, message))
+    }
+
+    /// Builds a cage of quadratic hexahedra over a cuboid mesh's cells.
+    ///
+    /// # Errors
+    /// A [`SceneError`] at `key` for another mesh or the generator's problem.
+    pub fn build_cage(
+        &self,
+        key: &str,
+        source: &SceneSource,
+    ) -> Result<QuadraticHexMesh, SceneError> {
+        let Some(c) = &self.cuboid else {
+            return Err(source.error(key, "\"quadratic_hex\" cages are built over a cuboid mesh"));
+        };
+        QuadraticHexMesh::cuboid(DVec3::from_array(c.half_extents), c.cells)
+            .map_err(|e| source.error(&format!("{key}.cuboid"), e.to_string()))
     }
 
     /// How a surface file is filled.

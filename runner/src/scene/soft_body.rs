@@ -14,7 +14,11 @@
 //! self_contact = false            # default false
 //! volumetric = "per_element"      # or "nodal_average" / "element_average" (nearly incompressible:
 //!                                 # linear / quadratic elements), default per_element
-//! elements = "linear"             # or "quadratic" (10-node tetrahedra, accurate in bending)
+//! elements = "linear"             # or "quadratic" (10-node tetrahedra, accurate in bending), or
+//!                                 # "quadratic_hex" (a cage of 27-node hexahedra; cuboid meshes)
+//! embedded = { cuboid = { half_extents = [0.5, 0.05, 0.05], cells = [40, 4, 4] } }
+//!                                 # a fine mesh carried by the elements: contacts and output
+//!                                 # use its surface; default none
 //! pinned = [{ min = [-0.51, -1, -1], max = [-0.49, 1, 1] }]         # boxes in rest coordinates
 //! attach = [{ rigid = "ball", min = [-1, -0.26, -1], max = [1, -0.24, 1] }]
 //! ```
@@ -58,9 +62,11 @@ pub struct SoftBodySpec {
     /// How the volumetric energy is evaluated; default per element.
     #[serde(default)]
     pub volumetric: VolumetricSpec,
-    /// The element order; default linear.
+    /// The elements; default linear tetrahedra.
     #[serde(default)]
     pub elements: ElementsSpec,
+    /// A fine mesh the elements carry, for contact and output; default none.
+    pub embedded: Option<MeshSpec>,
     /// Regions whose nodes are held fixed.
     #[serde(default)]
     pub pinned: Vec<RegionSpec>,
@@ -86,7 +92,7 @@ pub enum VolumetricSpec {
     ElementAverage,
 }
 
-/// The order of a soft body's tetrahedra.
+/// The elements of a soft body.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum ElementsSpec {
@@ -95,6 +101,8 @@ pub enum ElementsSpec {
     Linear,
     /// 10-node tetrahedra: the mesh's, or mid-edge nodes added to it.
     Quadratic,
+    /// A cage of 27-node hexahedra over a cuboid mesh's cells.
+    QuadraticHex,
 }
 
 /// A box of rest coordinates (m).
@@ -154,6 +162,15 @@ impl SoftBodySpec {
     /// Checks the values; `key` is the body's key path, `rigid_names` the scene's rigid bodies.
     pub(crate) fn check(&self, key: &str, rigid_names: &[&str], c: &mut Checker<'_>) {
         self.mesh.check(&format!("{key}.mesh"), c);
+        if let Some(embedded) = &self.embedded {
+            embedded.check(&format!("{key}.embedded"), c);
+        }
+        if self.elements == ElementsSpec::QuadraticHex && self.mesh.cuboid.is_none() {
+            c.fail(
+                &format!("{key}.elements"),
+                "\"quadratic_hex\" cages are built over a cuboid mesh".to_owned(),
+            );
+        }
         self.material.check(&format!("{key}.material"), c);
         if let Some(damping) = &self.damping {
             damping.check(&format!("{key}.damping"), c);

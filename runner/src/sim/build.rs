@@ -203,11 +203,15 @@ fn insert_soft(
     source: &SceneSource,
 ) -> Result<SoftEntry, SceneError> {
     let mesh_key = format!("{key}.mesh");
-    let (mesh, quadratic) = match spec.elements {
-        ElementsSpec::Linear => (spec.mesh.build(&mesh_key, source)?, None),
+    let (mesh, quadratic, cage) = match spec.elements {
+        ElementsSpec::Linear => (spec.mesh.build(&mesh_key, source)?, None, None),
         ElementsSpec::Quadratic => {
             let quadratic = spec.mesh.build_quadratic(&mesh_key, source)?;
-            (quadratic.subdivided().clone(), Some(quadratic))
+            (quadratic.subdivided().clone(), Some(quadratic), None)
+        }
+        ElementsSpec::QuadraticHex => {
+            let cage = spec.mesh.build_cage(&mesh_key, source)?;
+            (cage.subdivided().clone(), None, Some(cage))
         }
     };
     let library = |key: String| move |e: rapier_fvm::Error| source.error(&key, e.to_string());
@@ -236,10 +240,14 @@ fn insert_soft(
             .ok_or_else(|| source.error(&format!("{at}.rigid"), "no such rigid body"))?;
         attachments.push((nodes, body.handle, at));
     }
-    let builder = match quadratic {
-        Some(quadratic) => SoftBodyBuilder::quadratic(quadratic, material),
-        None => SoftBodyBuilder::new(mesh, material),
+    let mut builder = match (quadratic, cage) {
+        (Some(quadratic), _) => SoftBodyBuilder::quadratic(quadratic, material),
+        (_, Some(cage)) => SoftBodyBuilder::quadratic_hex(cage, material),
+        _ => SoftBodyBuilder::new(mesh, material),
     };
+    if let Some(embedded) = &spec.embedded {
+        builder = builder.embedded(embedded.build(&format!("{key}.embedded"), source)?);
+    }
     let mut builder = builder
         .translation(DVec3::from_array(spec.translation))
         .rotation(DVec3::from_array(spec.rotation))
