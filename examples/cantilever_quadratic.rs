@@ -5,7 +5,8 @@
 //! 1. Static equilibrium and first bending frequency per resolution, against Timoshenko beam
 //!    theory, at ν = 0.3 and at ν = 0 (where the clamped face does not hold back the Poisson
 //!    contraction, so the 3D beam and Timoshenko's agree).
-//! 2. Nearly incompressible materials (ν = 0.45 to 0.499), per element and averaged.
+//! 2. The volumetric term per quadrature point or projected per element (mean dilatation; linear
+//!    pressure on hexahedra), from ν = 0 to the nearly incompressible 0.499.
 //! 3. Dynamics: released from rest with stiffness-proportional damping `β = 2/ω₁` (the first mode
 //!    critically damped; the equilibrium does not depend on it), 1.5 s, tip averaged over the
 //!    last 0.25 s; wall time per step of 1/240 s and 1/60 s, per implicit scheme. (Explicit
