@@ -211,23 +211,7 @@ fn an_embedded_surface_hitting_a_free_ball_conserves_momentum() {
         *v = DVec3::X;
     }
     let soft = world.soft_bodies.insert(sphere);
-    let momenta = |world: &FvmWorld| {
-        let body = &world.soft_bodies[soft];
-        let rigid = &world.physics.bodies[ball];
-        let mass = f64::from(rigid.mass());
-        let inertia = 0.4 * mass * f64::from(radius).powi(2);
-        let (x, v) = (rigid.translation().as_dvec3(), rigid.linvel().as_dvec3());
-        let linear = body.linear_momentum() + v * mass;
-        let soft_angular: DVec3 = body
-            .positions()
-            .iter()
-            .zip(body.velocities())
-            .zip(body.masses())
-            .map(|((x, v), m)| x.cross(*v) * *m)
-            .sum();
-        let angular = soft_angular + x.cross(v) * mass + rigid.angvel().as_dvec3() * inertia;
-        (linear, angular)
-    };
+    let momenta = |world: &FvmWorld| common::soft_and_ball_momenta(world, soft, ball, radius);
     let (linear0, angular0) = momenta(&world);
     let mut fine_contacts = 0;
     for _ in 0..30 {

@@ -26,22 +26,22 @@ impl SoftPoint {
         (normal != DVec3::ZERO).then(|| (a * wa + b * wb + c * wc, normal))
     }
 
+    /// The point's nodes and weights.
+    fn stencil(&self) -> Stencil<'_> {
+        Stencil {
+            nodes: &self.nodes,
+            weights: &self.weights,
+        }
+    }
+
     /// The point's velocity (m/s), with the nodes at `velocities`.
     pub(crate) fn velocity(&self, velocities: &[DVec3]) -> DVec3 {
-        self.nodes
-            .iter()
-            .zip(self.weights)
-            .map(|(&n, w)| velocities[n as usize] * w)
-            .sum()
+        self.stencil().interpolate(velocities)
     }
 
     /// The point's inverse effective mass (1/kg): `Σ w² / m` over the free nodes.
     pub(crate) fn inverse_mass(&self, masses: &[f64], pinned: &[bool]) -> f64 {
-        self.nodes
-            .iter()
-            .zip(self.weights)
-            .map(|(&n, w)| w * w * node_inverse_mass(masses[n as usize], pinned[n as usize]))
-            .sum()
+        self.stencil().inverse_mass(masses, pinned)
     }
 
     /// Gives the point `impulse` (N s): each free node its weight's share.
@@ -52,10 +52,7 @@ impl SoftPoint {
         masses: &[f64],
         pinned: &[bool],
     ) {
-        for (&n, w) in self.nodes.iter().zip(self.weights) {
-            let n = n as usize;
-            velocities[n] += impulse * (w * node_inverse_mass(masses[n], pinned[n]));
-        }
+        self.stencil().apply(impulse, velocities, masses, pinned);
     }
 }
 

@@ -183,6 +183,21 @@ impl TetMesh {
     }
 }
 
+/// An error of a subdivision's tetrahedron re-addressed to the element `parent(tet)` it lies in.
+fn name_parent_element(error: Error, parent: impl Fn(usize) -> usize) -> Error {
+    match error {
+        Error::InvertedTet { tet, volume } => Error::InvertedTet {
+            tet: parent(tet),
+            volume,
+        },
+        Error::DegenerateTet { tet, volume } => Error::DegenerateTet {
+            tet: parent(tet),
+            volume,
+        },
+        other => other,
+    }
+}
+
 /// Signed volume of a tetrahedron (m^3): positive when positively oriented.
 pub(crate) fn signed_volume(positions: &[DVec3], tet: &[u32; 4]) -> f64 {
     let [a, b, c, d] = tet.map(|i| positions[i as usize]);

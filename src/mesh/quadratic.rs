@@ -50,17 +50,8 @@ impl QuadraticTetMesh {
             .iter()
             .flat_map(|e| subdivision(&positions, e))
             .collect();
-        let subdivided = TetMesh::new(positions, sub_tets).map_err(|error| match error {
-            Error::InvertedTet { tet, volume } => Error::InvertedTet {
-                tet: tet / SUB_TETS,
-                volume,
-            },
-            Error::DegenerateTet { tet, volume } => Error::DegenerateTet {
-                tet: tet / SUB_TETS,
-                volume,
-            },
-            other => other,
-        })?;
+        let subdivided = TetMesh::new(positions, sub_tets)
+            .map_err(|error| super::name_parent_element(error, |tet| tet / SUB_TETS))?;
         Ok(Self {
             elements,
             subdivided,

@@ -92,19 +92,8 @@ impl QuadraticHexMesh {
     pub fn map_positions(&self, map: impl Fn(DVec3) -> DVec3) -> Result<Self, Error> {
         let positions = self.positions().iter().map(|p| map(*p)).collect();
         let parent = |tet: usize| self.parents[tet] as usize;
-        let subdivided = TetMesh::new(positions, self.subdivided.tets().to_vec()).map_err(
-            |error| match error {
-                Error::InvertedTet { tet, volume } => Error::InvertedTet {
-                    tet: parent(tet),
-                    volume,
-                },
-                Error::DegenerateTet { tet, volume } => Error::DegenerateTet {
-                    tet: parent(tet),
-                    volume,
-                },
-                other => other,
-            },
-        )?;
+        let subdivided = TetMesh::new(positions, self.subdivided.tets().to_vec())
+            .map_err(|error| super::name_parent_element(error, parent))?;
         Ok(Self {
             elements: self.elements.clone(),
             subdivided,

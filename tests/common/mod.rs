@@ -231,3 +231,59 @@ pub fn homogeneous_deformation_rate() -> DMat3 {
         DVec3::new(0.0, 0.2, 0.6),
     )
 }
+
+/// The total linear momentum (kg m/s) and angular momentum about the origin (kg m²/s) of the soft
+/// body `soft` and the rigid ball `ball` of radius `radius` (m) in `world`.
+pub fn soft_and_ball_momenta(
+    world: &rapier_fvm::world::FvmWorld,
+    soft: SoftBodyHandle,
+    ball: rapier3d::prelude::RigidBodyHandle,
+    radius: f32,
+) -> (DVec3, DVec3) {
+    let body = &world.soft_bodies[soft];
+    let rigid = &world.physics.bodies[ball];
+    let mass = f64::from(rigid.mass());
+    let inertia = 0.4 * mass * f64::from(radius).powi(2);
+    let (x, v) = (rigid.translation().as_dvec3(), rigid.linvel().as_dvec3());
+    let linear = body.linear_momentum() + v * mass;
+    let soft_angular: DVec3 = body
+        .positions()
+        .iter()
+        .zip(body.velocities())
+        .zip(body.masses())
+        .map(|((x, v), m)| x.cross(*v) * *m)
+        .sum();
+    let angular = soft_angular + x.cross(v) * mass + rigid.angvel().as_dvec3() * inertia;
+    (linear, angular)
+}
+
+/// Sets every node of `body` moving at a random velocity (seed `seed`, up to 1 m/s per axis),
+/// takes ten free steps of 1/60 s without gravity (implicit or explicit), and returns the change
+/// of linear momentum and the scale it is measured against (kg m/s): the larger of the initial
+/// momentum and the sum of the nodes' momentum magnitudes at the end.
+pub fn free_momentum_change(body: &mut SoftBody, seed: u64, implicit: bool) -> (f64, f64) {
+    let mut rng = Lcg(seed);
+    for v in body.velocities_mut() {
+        *v = rng.vector();
+    }
+    let before = body.linear_momentum();
+    for _ in 0..10 {
+        if implicit {
+            ImplicitIntegrator::default()
+                .step(body, 1.0 / 60.0, DVec3::ZERO)
+                .unwrap();
+        } else {
+            SymplecticEuler::default()
+                .step(body, 1.0 / 60.0, DVec3::ZERO)
+                .unwrap();
+        }
+    }
+    let change = (body.linear_momentum() - before).length();
+    let scale: f64 = body
+        .masses()
+        .iter()
+        .zip(body.velocities())
+        .map(|(m, v)| m * v.length())
+        .sum();
+    (change, scale.max(before.length()))
+}
