@@ -11,9 +11,12 @@
 //! exactly.
 
 use crate::Error;
+use crate::contact::Stencil;
 use crate::element::{Elements, QuadraticElements};
 use crate::mesh::TetMesh;
 use rapier3d::glamx::DVec3;
+use rapier3d::parry::bounding_volume::Aabb;
+use rapier3d::parry::partitioning::{Bvh, BvhBuildStrategy};
 
 /// A fine mesh embedded in a body's simulation mesh (see the [module](self) documentation).
 /// Made by [`SoftBodyBuilder::embedded`](crate::body::SoftBodyBuilder::embedded).
@@ -43,7 +46,7 @@ impl Embedding {
         elements: &Elements,
         parents: &[u32],
     ) -> Result<Self, Error> {
-        let grid = TetGrid::new(simulation);
+        let tree = TetTree::new(simulation);
         let rest = simulation.positions();
         let quadratic = match elements {
             Elements::Quadratic { elements, .. } => Some(elements),
@@ -52,13 +55,15 @@ impl Embedding {
         let mut start = vec![0];
         let (mut nodes, mut weights) = (Vec::new(), Vec::new());
         for (vertex, &p) in fine.positions().iter().enumerate() {
-            let (tet, barycentric) = grid.locate(simulation, p);
-            if barycentric.iter().copied().fold(f64::INFINITY, f64::min) < -OUTSIDE_TOLERANCE {
+            let located = tree.locate(simulation, p).filter(|(_, l)| {
+                l.iter().copied().fold(f64::INFINITY, f64::min) >= -OUTSIDE_TOLERANCE
+            });
+            let Some((tet, barycentric)) = located else {
                 return Err(Error::OutsideSimulationMesh {
                     vertex,
                     position: p.to_array(),
                 });
-            }
+            };
             let sub_tet = simulation.tets()[tet];
             match quadratic {
                 None => {
@@ -119,12 +124,13 @@ impl Embedding {
     /// # Panics
     /// If the vertex does not exist.
     pub fn interpolate(&self, vertex: u32, x: &[DVec3]) -> DVec3 {
+        self.point_stencil(vertex).interpolate(x)
+    }
+
+    /// [`Embedding::stencil`] as a contact point's stencil.
+    pub(crate) fn point_stencil(&self, vertex: u32) -> Stencil<'_> {
         let (nodes, weights) = self.stencil(vertex);
-        nodes
-            .iter()
-            .zip(weights)
-            .map(|(&n, w)| x[n as usize] * *w)
-            .sum()
+        Stencil { nodes, weights }
     }
 
     /// The positions (m) of all fine vertices for node positions `x` (m).
@@ -157,95 +163,50 @@ fn quadratic_weights<'a>(
             reference[local] * l
         })
         .sum();
-    let (xi, _) = quadratic.natural_coordinates(element, rest, p, guess);
+    let xi = quadratic.natural_coordinates(element, rest, p, guess);
     (nodes, quadratic.shape().shape_values(xi))
 }
 
-/// A uniform grid over a tetrahedral mesh's bounding box: per cell, the tetrahedra whose
-/// bounding boxes overlap it.
-struct TetGrid {
-    origin: DVec3,
-    cell: f64,
-    counts: [usize; 3],
-    tets: Vec<Vec<u32>>,
+/// A parry bounding-volume hierarchy over a tetrahedral mesh's tetrahedra, each box padded by
+/// [`OUTSIDE_TOLERANCE`] of the tetrahedron's longest extent so that points slightly outside
+/// the mesh still find their nearest tetrahedra.
+struct TetTree {
+    bvh: Bvh,
 }
 
-impl TetGrid {
+impl TetTree {
     fn new(mesh: &TetMesh) -> Self {
         let p = mesh.positions();
-        let (lo, hi) = p.iter().fold(
-            (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-            |(lo, hi), x| (lo.min(*x), hi.max(*x)),
-        );
-        // About one tetrahedron per cell.
-        let volume = (hi - lo)
-            .max(DVec3::splat(f64::MIN_POSITIVE))
-            .element_product();
-        let cell = (volume / mesh.tet_count() as f64)
-            .cbrt()
-            .max(f64::MIN_POSITIVE);
-        let extent = ((hi - lo) / cell).ceil().max(DVec3::ONE);
-        let counts = [extent.x as usize, extent.y as usize, extent.z as usize];
-        let mut grid = Self {
-            origin: lo,
-            cell,
-            counts,
-            tets: vec![Vec::new(); counts[0] * counts[1] * counts[2]],
-        };
-        for (t, tet) in mesh.tets().iter().enumerate() {
-            let corners = tet.map(|n| p[n as usize]);
-            let tet_lo = corners.iter().fold(corners[0], |a, b| a.min(*b));
-            let tet_hi = corners.iter().fold(corners[0], |a, b| a.max(*b));
-            let (c_lo, c_hi) = (grid.cell_of(tet_lo), grid.cell_of(tet_hi));
-            for k in c_lo[2]..=c_hi[2] {
-                for j in c_lo[1]..=c_hi[1] {
-                    for i in c_lo[0]..=c_hi[0] {
-                        let index = grid.index([i, j, k]);
-                        grid.tets[index].push(t as u32);
-                    }
-                }
-            }
+        let leaves: Vec<Aabb> = mesh
+            .tets()
+            .iter()
+            .map(|tet| {
+                let corners = tet.map(|n| p[n as usize]);
+                let lo = corners.iter().fold(corners[0], |a, b| a.min(*b));
+                let hi = corners.iter().fold(corners[0], |a, b| a.max(*b));
+                let padding = DVec3::splat(OUTSIDE_TOLERANCE * (hi - lo).max_element());
+                Aabb::new((lo - padding).as_vec3(), (hi + padding).as_vec3())
+            })
+            .collect();
+        Self {
+            bvh: Bvh::from_leaves(BvhBuildStrategy::Binned, &leaves),
         }
-        grid
-    }
-
-    /// The cell containing `p`, clamped to the grid.
-    fn cell_of(&self, p: DVec3) -> [usize; 3] {
-        let c = ((p - self.origin) / self.cell).floor();
-        std::array::from_fn(|k| (c[k].max(0.0) as usize).min(self.counts[k] - 1))
-    }
-
-    fn index(&self, [i, j, k]: [usize; 3]) -> usize {
-        i + self.counts[0] * (j + self.counts[1] * k)
     }
 
     /// The tetrahedron containing `p` (m) and `p`'s barycentric coordinates in it, or, for a
     /// point outside the mesh, the nearby tetrahedron it is least outside of (the largest
-    /// smallest coordinate).
-    fn locate(&self, mesh: &TetMesh, p: DVec3) -> (usize, [f64; 4]) {
-        let mut best = (0, [f64::NEG_INFINITY; 4]);
-        let mut consider = |t: u32| {
-            let l = barycentric(mesh, t as usize, p);
-            let worst = l.iter().copied().fold(f64::INFINITY, f64::min);
-            if worst > best.1.iter().copied().fold(f64::INFINITY, f64::min) {
-                best = (t as usize, l);
+    /// smallest coordinate); `None` when no tetrahedron is near.
+    fn locate(&self, mesh: &TetMesh, p: DVec3) -> Option<(usize, [f64; 4])> {
+        let query = Aabb::new(p.as_vec3(), p.as_vec3());
+        let smallest = |l: &[f64; 4]| l.iter().copied().fold(f64::INFINITY, f64::min);
+        let mut best: Option<(usize, [f64; 4])> = None;
+        for leaf in self.bvh.intersect_aabb(&query) {
+            let l = barycentric(mesh, leaf as usize, p);
+            if best.is_none_or(|(_, b)| smallest(&l) > smallest(&b)) {
+                best = Some((leaf as usize, l));
             }
-            worst >= 0.0
-        };
-        let home = self.cell_of(p);
-        if self.tets[self.index(home)].iter().any(|&t| consider(t)) {
-            return best;
-        }
-        // Outside every tetrahedron of its cell: search the surrounding block.
-        for k in home[2].saturating_sub(1)..=(home[2] + 1).min(self.counts[2] - 1) {
-            for j in home[1].saturating_sub(1)..=(home[1] + 1).min(self.counts[1] - 1) {
-                for i in home[0].saturating_sub(1)..=(home[0] + 1).min(self.counts[0] - 1) {
-                    for &t in &self.tets[self.index([i, j, k])] {
-                        if consider(t) {
-                            return best;
-                        }
-                    }
-                }
+            if smallest(&l) >= 0.0 {
+                break;
             }
         }
         best

@@ -52,20 +52,6 @@ fn forces_under(
     (forces, interior, body)
 }
 
-/// The ratio of the largest interior to the largest boundary force.
-fn interior_ratio(forces: &[DVec3], interior: &[bool]) -> f64 {
-    let (mut inner, mut boundary) = (0.0f64, 0.0f64);
-    for (f, &is_inner) in forces.iter().zip(interior) {
-        if is_inner {
-            inner = inner.max(f.length());
-        } else {
-            boundary = boundary.max(f.length());
-        }
-    }
-    assert!(boundary > 0.0, "the deformation must load the boundary");
-    inner / boundary
-}
-
 /// Tolerance 1e-9 of the largest boundary force: the exact answer is zero (the 27-point rule
 /// integrates the constant-stress integrand exactly on parallelepipeds) and round-off is ~1e-14.
 #[test]
@@ -76,11 +62,11 @@ fn every_model_passes_the_patch_test_on_slanted_hexahedra() {
     for model in MODELS {
         let (elastic, interior, _) =
             forces_under(model, None, |p| f * p + DVec3::X, |_| DVec3::ZERO);
-        let ratio = interior_ratio(&elastic, &interior);
+        let ratio = common::interior_ratio(&elastic, &interior);
         println!("{model:?} hexahedral patch test: interior/boundary force = {ratio:.2e}");
         assert!(ratio < 1e-9, "{model:?}: {ratio:e}");
         let (damped, interior, _) = forces_under(model, Some(damping), |p| f * p, |p| f_dot * p);
-        let ratio = interior_ratio(&damped, &interior);
+        let ratio = common::interior_ratio(&damped, &interior);
         assert!(ratio < 1e-9, "{model:?} damped: {ratio:e}");
     }
 }

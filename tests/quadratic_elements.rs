@@ -61,16 +61,8 @@ fn forces_under(
 
 /// Largest interior force over largest boundary force.
 fn interior_ratio(mesh: &mesh::QuadraticTetMesh, forces: &[DVec3]) -> f64 {
-    let (mut interior, mut boundary) = (0.0f64, 0.0f64);
-    for (p, f) in mesh.positions().iter().zip(forces) {
-        if is_interior(*p) {
-            interior = interior.max(f.length());
-        } else {
-            boundary = boundary.max(f.length());
-        }
-    }
-    assert!(boundary > 0.0, "the deformation must load the boundary");
-    interior / boundary
+    let interior: Vec<bool> = mesh.positions().iter().map(|p| is_interior(*p)).collect();
+    common::interior_ratio(forces, &interior)
 }
 
 /// Tolerance 1e-9 of the largest boundary force: the exact answer is zero (the four-point rule

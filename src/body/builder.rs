@@ -4,7 +4,7 @@ use super::{SoftBody, lumped_masses};
 use crate::Error;
 use crate::contact::ContactSettings;
 use crate::damping::RayleighDamping;
-use crate::element::{ElementShape, Elements, QuadraticElements};
+use crate::element::{ElementShape, Elements, PressureBasis, QuadraticElements};
 use crate::embedding::Embedding;
 use crate::fvm::{FvmMesh, NodalAveraging, VolumetricTreatment};
 use crate::material::Material;
@@ -402,14 +402,9 @@ impl SoftBodyBuilder {
                     .iter()
                     .map(|volume| volume * self.material.density())
                     .collect();
-                let mean_dilatation = self.volumetric == VolumetricTreatment::ElementAverage;
-                (
-                    Elements::Quadratic {
-                        elements,
-                        mean_dilatation,
-                    },
-                    masses,
-                )
+                let pressure = (self.volumetric == VolumetricTreatment::ElementAverage)
+                    .then(|| PressureBasis::new(&elements));
+                (Elements::Quadratic { elements, pressure }, masses)
             }
         };
         let embedding = match self.embedded {

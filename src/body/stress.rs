@@ -5,7 +5,7 @@
 
 use super::SoftBody;
 use crate::element::{Elements, projected_measure};
-use crate::fvm::gather;
+use crate::fvm::{TetRest, gather};
 use crate::material::{HyperelasticModel, VolumetricTerm, with_hyperelastic_model};
 use rapier3d::glamx::{DMat3, DVec3};
 
@@ -38,7 +38,6 @@ impl SoftBody {
     /// elements with [`SoftBody::inverted_tet_count`].
     pub fn cauchy_stresses(&self) -> Vec<DMat3> {
         with_hyperelastic_model!(self.material, |model| {
-            let stress = cauchy_from_piola;
             match &self.elements {
                 Elements::Linear {
                     fvm,
@@ -58,13 +57,13 @@ impl SoftBody {
                                 piola += model.volume_measure_gradient(&f)
                                     * (bulk * measures.excess(tet, t));
                             }
-                            stress(&f, piola)
+                            cauchy_from_piola(&f, piola)
                         })
                         .collect()
                 }
                 Elements::Quadratic {
                     elements: quadratic,
-                    mean_dilatation,
+                    pressure,
                 } => {
                     let rest = self.mesh.positions();
                     let bulk = model.volumetric_modulus();
@@ -88,10 +87,11 @@ impl SoftBody {
                                 * 0.25;
                             let f = quadratic.gradient_at(element, rest, &self.positions, xi);
                             let mut piola = model.first_piola(&f);
-                            if *mean_dilatation {
+                            if let Some(basis) = pressure {
                                 let projected = projected_measure(
                                     &model,
                                     quadratic,
+                                    basis,
                                     element,
                                     xi,
                                     &self.positions,
@@ -99,7 +99,7 @@ impl SoftBody {
                                 piola += model.volume_measure_gradient(&f)
                                     * (bulk * (projected - model.volume_measure(&f)));
                             }
-                            stress(&f, piola)
+                            cauchy_from_piola(&f, piola)
                         })
                         .collect()
                 }
@@ -125,11 +125,7 @@ impl SoftBody {
                 .tets()
                 .iter()
                 .map(|tet| {
-                    let [p0, p1, p2, p3] = tet.map(|n| rest[n as usize]);
-                    let [x0, x1, x2, x3] = tet.map(|n| x[n as usize]);
-                    let rest_edges = DMat3::from_cols(p1 - p0, p2 - p0, p3 - p0);
-                    let edges = DMat3::from_cols(x1 - x0, x2 - x0, x3 - x0);
-                    let f = edges * rest_edges.inverse();
+                    let f = TetRest::new(gather(tet, rest)).gradient(&gather(tet, &x));
                     cauchy_from_piola(&f, model.first_piola(&f))
                 })
                 .collect()

@@ -179,17 +179,17 @@ pub enum BodyPoint {
 }
 
 impl BodyPoint {
-    /// The nodes the point moves with and their weights.
+    /// The nodes the point moves with and their weights; `embedding` is the body's, which every
+    /// embedded point comes from.
     fn stencil<'a>(&'a self, embedding: Option<&'a Embedding>) -> Stencil<'a> {
-        match (self, embedding) {
-            (Self::Embedded(vertex), Some(embedding)) => {
-                let (nodes, weights) = embedding.stencil(*vertex);
-                Stencil { nodes, weights }
-            }
-            (Self::Node(node), _) | (Self::Embedded(node), None) => Stencil {
+        match self {
+            Self::Node(node) => Stencil {
                 nodes: std::slice::from_ref(node),
                 weights: &[1.0],
             },
+            Self::Embedded(vertex) => embedding
+                .expect("embedded contact points are only made for a body with an embedding")
+                .point_stencil(*vertex),
         }
     }
 }
@@ -432,6 +432,7 @@ impl SoftBody {
         let (body_lo, body_hi) = self.position_bounds();
         let mut tree = None;
         let mut corners = Vec::new();
+        let contact_points = self.contact_points();
         for (handle, collider) in colliders.iter() {
             if collider.is_sensor() || !self.collision_groups.test(collider.collision_groups()) {
                 continue;
@@ -458,7 +459,7 @@ impl SoftBody {
             let coefficients = SurfaceCoefficients::of_body(self)
                 .combine(SurfaceCoefficients::of_collider(collider));
             let mut proxy = None;
-            for at in self.contact_points() {
+            for &at in &contact_points {
                 let stencil = at.stencil(self.embedding.as_ref());
                 // A point that cannot move, or moves with a node glued to the collider's body.
                 if stencil.nodes.iter().all(|&n| self.pinned[n as usize])

@@ -18,25 +18,119 @@
 //! `g_i = ∂b_i/∂x`, which stays inside the element's own stencil. Both sets of constraints
 //! need at least two elements across a bent section.
 
+use super::hex27;
 use super::quadratic::{ElementShape, QuadraticElements, deformation_gradient};
 use crate::material::VolumetricTerm;
 use rapier3d::glamx::{DMat3, DVec3};
+
+/// The most quadrature points of an element (quadratic hexahedra).
+const MAX_POINTS: usize = hex27::QUADRATURE.len();
+/// The most pressure functions of an element: `1, ξ1, ξ2, ξ3`.
+const MAX_FUNCTIONS: usize = 4;
+
+/// The pressure functions of every element, orthonormal for its rest quadrature weights: rest
+/// data, built once per body.
+#[derive(Debug, Clone)]
+pub(crate) struct PressureBasis {
+    /// Functions per element: 1 for tetrahedra, 4 for hexahedra.
+    functions: usize,
+    /// Per element and function, its coefficients on `1, ξ1, ξ2, ξ3`.
+    coefficients: Vec<[f64; MAX_FUNCTIONS]>,
+    /// Per element, function and quadrature point, the function's value there.
+    values: Vec<f64>,
+}
+
+impl PressureBasis {
+    /// The bases of `quadratic`'s elements (Gram–Schmidt on the monomials, per element).
+    pub(crate) fn new(quadratic: &QuadraticElements) -> Self {
+        let functions = match quadratic.shape() {
+            ElementShape::Tetrahedron => 1,
+            ElementShape::Hexahedron => MAX_FUNCTIONS,
+        };
+        let rule = quadratic.shape().quadrature();
+        let monomials: Vec<[f64; MAX_FUNCTIONS]> = rule
+            .iter()
+            .map(|(xi, _)| monomials_at(functions, *xi))
+            .collect();
+        let mut coefficients = Vec::with_capacity(functions * quadratic.element_count());
+        let mut values = Vec::with_capacity(functions * quadratic.point_count());
+        for element in 0..quadratic.element_count() {
+            let weights = quadratic
+                .element_points(element)
+                .map(|q| quadratic.point_weight(q));
+            let inner = |a: &[f64; MAX_FUNCTIONS], b: &[f64; MAX_FUNCTIONS]| -> f64 {
+                weights
+                    .clone()
+                    .zip(&monomials)
+                    .map(|(w, m)| w * dot(a, m) * dot(b, m))
+                    .sum()
+            };
+            let first = coefficients.len();
+            for k in 0..functions {
+                let mut c = [0.0; MAX_FUNCTIONS];
+                c[k] = 1.0;
+                for previous in &coefficients[first..] {
+                    let projection = inner(&c, previous);
+                    for (ci, pi) in c.iter_mut().zip(previous) {
+                        *ci -= projection * pi;
+                    }
+                }
+                let norm = inner(&c, &c).sqrt();
+                coefficients.push(c.map(|ci| ci / norm));
+            }
+            for c in &coefficients[first..] {
+                values.extend(monomials.iter().map(|m| dot(c, m)));
+            }
+        }
+        Self {
+            functions,
+            coefficients,
+            values,
+        }
+    }
+
+    /// Element `element`'s functions' values at its quadrature points, function after function.
+    fn values(&self, element: usize, points: usize) -> std::slice::ChunksExact<'_, f64> {
+        let per_element = self.functions * points;
+        self.values[per_element * element..per_element * (element + 1)].chunks_exact(points)
+    }
+
+    /// Element `element`'s functions' values at natural coordinates `xi`.
+    fn at(&self, element: usize, xi: DVec3) -> impl Iterator<Item = f64> + '_ {
+        let m = monomials_at(self.functions, xi);
+        self.coefficients[self.functions * element..self.functions * (element + 1)]
+            .iter()
+            .map(move |c| dot(c, &m))
+    }
+}
+
+/// The first `count` of the monomials `1, ξ1, ξ2, ξ3` at `xi`, the rest zero.
+fn monomials_at(count: usize, xi: DVec3) -> [f64; MAX_FUNCTIONS] {
+    let mut values = [1.0, xi.x, xi.y, xi.z];
+    values[count..].fill(0.0);
+    values
+}
+
+fn dot(a: &[f64; MAX_FUNCTIONS], b: &[f64; MAX_FUNCTIONS]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
 
 /// Per quadrature point, `Π m_q − m_q` at positions `x` (m): its share of the averaging.
 pub(crate) fn excesses<M: VolumetricTerm>(
     model: &M,
     quadratic: &QuadraticElements,
+    basis: &PressureBasis,
     x: &[DVec3],
 ) -> Vec<f64> {
     let mut out = Vec::with_capacity(quadratic.point_count());
     for element in 0..quadratic.element_count() {
-        let projection = Projection::of(model, quadratic, element, x);
+        let projection = Projection::of(model, quadratic, basis, element, x);
         out.extend(
             projection
-                .measures
+                .projected()
                 .iter()
-                .enumerate()
-                .map(|(q, m)| projection.projected_at_point(q) - m),
+                .zip(projection.measures())
+                .map(|(projected, m)| projected - m),
         );
     }
     out
@@ -46,18 +140,19 @@ pub(crate) fn excesses<M: VolumetricTerm>(
 pub(crate) fn energy_change<M: VolumetricTerm>(
     model: &M,
     quadratic: &QuadraticElements,
+    basis: &PressureBasis,
     x: &[DVec3],
 ) -> f64 {
     let bulk = model.volumetric_modulus();
     let mut change = 0.0;
     for element in 0..quadratic.element_count() {
-        let projection = Projection::of(model, quadratic, element, x);
+        let projection = Projection::of(model, quadratic, basis, element, x);
         let pointwise: f64 = quadratic
             .element_points(element)
-            .zip(&projection.measures)
+            .zip(projection.measures())
             .map(|(q, m)| quadratic.point_weight(q) * m * m)
             .sum();
-        let projected: f64 = projection.coefficients.iter().map(|b| b * b).sum();
+        let projected: f64 = projection.coefficients().iter().map(|b| b * b).sum();
         change += 0.5 * bulk * (projected - pointwise);
     }
     change
@@ -69,6 +164,7 @@ pub(crate) fn energy_change<M: VolumetricTerm>(
 pub(crate) fn for_each_coupling<M: VolumetricTerm>(
     model: &M,
     quadratic: &QuadraticElements,
+    basis: &PressureBasis,
     x: &[DVec3],
     mut add: impl FnMut(&[(u32, DVec3)], f64),
 ) {
@@ -83,7 +179,7 @@ pub(crate) fn for_each_coupling<M: VolumetricTerm>(
             let f = deformation_gradient(nodes, quadratic.point_gradients(point), x);
             model.volume_measure_gradient(&f) * quadratic.point_weight(point)
         }));
-        for function in &PressureBasis::values_at_points(quadratic, element) {
+        for function in basis.values(element, points.len()) {
             gradient.clear();
             gradient.extend(nodes.iter().map(|&n| (n, DVec3::ZERO)));
             for ((point, phi), dm) in points.clone().zip(function).zip(&measure_gradients) {
@@ -102,158 +198,80 @@ pub(crate) fn for_each_coupling<M: VolumetricTerm>(
 pub(crate) fn projected_measure<M: VolumetricTerm>(
     model: &M,
     quadratic: &QuadraticElements,
+    basis: &PressureBasis,
     element: usize,
     xi: DVec3,
     x: &[DVec3],
 ) -> f64 {
-    let projection = Projection::of(model, quadratic, element, x);
-    projection
-        .basis
-        .at(xi)
-        .iter()
-        .zip(&projection.coefficients)
+    let projection = Projection::of(model, quadratic, basis, element, x);
+    basis
+        .at(element, xi)
+        .zip(projection.coefficients())
         .map(|(phi, b)| phi * b)
         .sum()
 }
 
-/// The pressure functions of one element, orthonormal for its quadrature weights: per function
-/// its coefficients on `1, ξ1, ξ2, ξ3`.
-struct PressureBasis {
-    /// The monomials used: 1 for tetrahedra, 4 for hexahedra.
-    monomials: usize,
-    /// Per function, its coefficients (filled by [`PressureBasis::orthonormalize`]).
-    coefficients: Vec<[f64; 4]>,
-}
-
-impl PressureBasis {
-    /// The unnormalized monomials of the shape's pressure space.
-    fn of(shape: ElementShape) -> Self {
-        let monomials = match shape {
-            ElementShape::Tetrahedron => 1,
-            ElementShape::Hexahedron => 4,
-        };
-        Self {
-            monomials,
-            coefficients: Vec::new(),
-        }
-    }
-
-    /// The monomials `1, ξ1, ξ2, ξ3` (the first `monomials` of them) at `xi`.
-    fn monomials_at(&self, xi: DVec3) -> [f64; 4] {
-        let mut values = [1.0, xi.x, xi.y, xi.z];
-        values[self.monomials..].fill(0.0);
-        values
-    }
-
-    /// The basis made orthonormal for element `element`'s quadrature weights (Gram–Schmidt).
-    fn orthonormalize(mut self, quadratic: &QuadraticElements, element: usize) -> Self {
-        let rule = quadratic.shape().quadrature();
-        let weights: Vec<f64> = quadratic
-            .element_points(element)
-            .map(|q| quadratic.point_weight(q))
-            .collect();
-        let inner = |a: &[f64; 4], b: &[f64; 4]| -> f64 {
-            rule.iter()
-                .zip(&weights)
-                .map(|((xi, _), w)| {
-                    let m = self.monomials_at(*xi);
-                    let (fa, fb) = (dot(a, &m), dot(b, &m));
-                    w * fa * fb
-                })
-                .sum()
-        };
-        let mut functions: Vec<[f64; 4]> = Vec::with_capacity(self.monomials);
-        for k in 0..self.monomials {
-            let mut c = [0.0; 4];
-            c[k] = 1.0;
-            for previous in &functions {
-                let projection = inner(&c, previous);
-                for (ci, pi) in c.iter_mut().zip(previous) {
-                    *ci -= projection * pi;
-                }
-            }
-            let norm = inner(&c, &c).sqrt();
-            functions.push(c.map(|ci| ci / norm));
-        }
-        self.coefficients = functions;
-        self
-    }
-
-    /// The functions' values at `xi`.
-    fn at(&self, xi: DVec3) -> Vec<f64> {
-        let m = self.monomials_at(xi);
-        self.coefficients.iter().map(|c| dot(c, &m)).collect()
-    }
-
-    /// Per function of element `element`'s basis, its values at the element's quadrature points.
-    fn values_at_points(quadratic: &QuadraticElements, element: usize) -> Vec<Vec<f64>> {
-        let basis = Self::of(quadratic.shape()).orthonormalize(quadratic, element);
-        let rule = quadratic.shape().quadrature();
-        let at_points: Vec<Vec<f64>> = rule.iter().map(|(xi, _)| basis.at(*xi)).collect();
-        (0..basis.coefficients.len())
-            .map(|i| at_points.iter().map(|values| values[i]).collect())
-            .collect()
-    }
-}
-
-fn dot(a: &[f64; 4], b: &[f64; 4]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
-}
-
-/// One element's volume measures at its quadrature points and their projection.
+/// One element's volume measures at its quadrature points and their projection, in fixed
+/// storage (no allocation per element).
 struct Projection {
-    basis: PressureBasis,
+    points: usize,
+    functions: usize,
     /// `m(F_q)` per point.
-    measures: Vec<f64>,
+    measures: [f64; MAX_POINTS],
     /// `Π m` per point.
-    projected: Vec<f64>,
+    projected: [f64; MAX_POINTS],
     /// `b_i = Σ_q w_q φ_i m_q` per pressure function.
-    coefficients: Vec<f64>,
+    coefficients: [f64; MAX_FUNCTIONS],
 }
 
 impl Projection {
     fn of<M: VolumetricTerm>(
         model: &M,
         quadratic: &QuadraticElements,
+        basis: &PressureBasis,
         element: usize,
         x: &[DVec3],
     ) -> Self {
         let nodes = quadratic.element(element);
-        let basis = PressureBasis::of(quadratic.shape()).orthonormalize(quadratic, element);
-        let rule = quadratic.shape().quadrature();
-        let measures: Vec<f64> = quadratic
-            .element_points(element)
-            .map(|q| {
-                let f: DMat3 = deformation_gradient(nodes, quadratic.point_gradients(q), x);
-                model.volume_measure(&f)
-            })
-            .collect();
-        let values: Vec<Vec<f64>> = rule.iter().map(|(xi, _)| basis.at(*xi)).collect();
-        let mut coefficients = vec![0.0; basis.coefficients.len()];
-        for ((q, m), phi) in quadratic
-            .element_points(element)
-            .zip(&measures)
-            .zip(&values)
+        let points = quadratic.element_points(element);
+        let mut projection = Self {
+            points: points.len(),
+            functions: basis.functions,
+            measures: [0.0; MAX_POINTS],
+            projected: [0.0; MAX_POINTS],
+            coefficients: [0.0; MAX_FUNCTIONS],
+        };
+        for (m, q) in projection.measures.iter_mut().zip(points.clone()) {
+            let f = deformation_gradient(nodes, quadratic.point_gradients(q), x);
+            *m = model.volume_measure(&f);
+        }
+        for (b, phi) in projection
+            .coefficients
+            .iter_mut()
+            .zip(basis.values(element, points.len()))
         {
-            let w = quadratic.point_weight(q);
-            for (b, p) in coefficients.iter_mut().zip(phi) {
-                *b += w * p * m;
+            *b = points
+                .clone()
+                .zip(phi)
+                .zip(&projection.measures)
+                .map(|((q, p), m)| quadratic.point_weight(q) * p * m)
+                .sum();
+            for (projected, p) in projection.projected.iter_mut().zip(phi) {
+                *projected += *b * p;
             }
         }
-        let projected = values
-            .iter()
-            .map(|phi| phi.iter().zip(&coefficients).map(|(p, b)| p * b).sum())
-            .collect();
-        Self {
-            basis,
-            measures,
-            projected,
-            coefficients,
-        }
+        projection
     }
 
-    /// `Π m` at the element's quadrature point `q` (local index).
-    fn projected_at_point(&self, q: usize) -> f64 {
-        self.projected[q]
+    fn measures(&self) -> &[f64] {
+        &self.measures[..self.points]
+    }
+
+    fn projected(&self) -> &[f64] {
+        &self.projected[..self.points]
+    }
+
+    fn coefficients(&self) -> &[f64] {
+        &self.coefficients[..self.functions]
     }
 }

@@ -19,7 +19,7 @@ pub mod tet10;
 use crate::damping::RayleighDamping;
 use crate::fvm::{FvmMesh, NodalAveraging, VolumetricTreatment};
 use crate::material::VolumetricTerm;
-pub(crate) use mean_dilatation::projected_measure;
+pub(crate) use mean_dilatation::{PressureBasis, projected_measure};
 pub(crate) use quadratic::deformation_gradient;
 pub use quadratic::{ElementShape, QuadraticElements};
 use rapier3d::glamx::{DMat3, DVec3};
@@ -48,8 +48,9 @@ pub(crate) enum Elements {
     },
     Quadratic {
         elements: QuadraticElements,
-        /// Whether the volumetric term is averaged per element ([`mean_dilatation`]).
-        mean_dilatation: bool,
+        /// The pressure functions the volumetric term is projected on, when it is
+        /// ([`mean_dilatation`]).
+        pressure: Option<PressureBasis>,
     },
 }
 
@@ -78,8 +79,7 @@ impl Elements {
                 ..
             } => VolumetricTreatment::NodalAverage,
             Self::Quadratic {
-                mean_dilatation: true,
-                ..
+                pressure: Some(_), ..
             } => VolumetricTreatment::ElementAverage,
             _ => VolumetricTreatment::PerElement,
         }
@@ -150,7 +150,7 @@ impl Elements {
         out
     }
 
-    /// Per integration point, its share `m̄_e − m_q` of the element-averaged volumetric term
+    /// Per integration point, its share `Π m_q − m_q` of the element-projected volumetric term
     /// at positions `x` (m), when the elements average it ([`mean_dilatation`]).
     pub(crate) fn volumetric_excesses<M: VolumetricTerm>(
         &self,
@@ -160,8 +160,8 @@ impl Elements {
         match self {
             Self::Quadratic {
                 elements,
-                mean_dilatation: true,
-            } => Some(mean_dilatation::excesses(model, elements, x)),
+                pressure: Some(basis),
+            } => Some(mean_dilatation::excesses(model, elements, basis, x)),
             _ => None,
         }
     }
@@ -213,8 +213,8 @@ impl Elements {
             Self::Linear { fvm, .. } => return fvm.elastic_energy(model, x),
             Self::Quadratic {
                 elements,
-                mean_dilatation: true,
-            } => mean_dilatation::energy_change(model, elements, x),
+                pressure: Some(basis),
+            } => mean_dilatation::energy_change(model, elements, basis, x),
             Self::Quadratic { .. } => 0.0,
         };
         self.for_each_point(|_, nodes, gradients, weight| {
@@ -233,10 +233,10 @@ impl Elements {
     ) {
         if let Self::Quadratic {
             elements,
-            mean_dilatation: true,
+            pressure: Some(basis),
         } = self
         {
-            mean_dilatation::for_each_coupling(model, elements, x, add);
+            mean_dilatation::for_each_coupling(model, elements, basis, x, add);
         }
     }
 

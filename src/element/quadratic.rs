@@ -26,13 +26,10 @@ impl ElementShape {
 
     /// The quadrature rule: natural coordinates and weights (their sum is the reference
     /// element's volume).
-    pub(crate) fn quadrature(self) -> Vec<(DVec3, f64)> {
+    pub(crate) fn quadrature(self) -> &'static [(DVec3, f64)] {
         match self {
-            Self::Tetrahedron => tet10::QUADRATURE
-                .iter()
-                .map(|l| (DVec3::new(l[1], l[2], l[3]), 1.0 / 24.0))
-                .collect(),
-            Self::Hexahedron => hex27::QUADRATURE.to_vec(),
+            Self::Tetrahedron => &TETRAHEDRON_QUADRATURE,
+            Self::Hexahedron => &hex27::QUADRATURE,
         }
     }
 
@@ -84,6 +81,19 @@ impl ElementShape {
         }
     }
 }
+
+/// [`tet10::QUADRATURE`] in natural coordinates `ξ = (L1, L2, L3)`, each point standing for a
+/// quarter of the reference tetrahedron's volume 1/6.
+const TETRAHEDRON_QUADRATURE: [(DVec3, f64); 4] = {
+    let mut rule = [(DVec3::ZERO, 0.0); 4];
+    let mut q = 0;
+    while q < 4 {
+        let l = tet10::QUADRATURE[q];
+        rule[q] = (DVec3::new(l[1], l[2], l[3]), 1.0 / 24.0);
+        q += 1;
+    }
+    rule
+};
 
 /// The barycentric coordinates `(1 − ξ1 − ξ2 − ξ3, ξ1, ξ2, ξ3)` of a tetrahedron's natural
 /// coordinates.
@@ -161,7 +171,7 @@ impl QuadraticElements {
             for corner in &corners {
                 rest_gradients(shape, &p, *corner).map_err(inverted)?;
             }
-            for (xi, weight) in &rule {
+            for (xi, weight) in rule {
                 let (point_gradients, determinant) =
                     rest_gradients(shape, &p, *xi).map_err(inverted)?;
                 gradients.extend(point_gradients);
@@ -170,22 +180,19 @@ impl QuadraticElements {
         }
         let mut lumped_volumes = vec![0.0; positions.len()];
         for (element, element_nodes) in nodes.chunks_exact(per_element).enumerate() {
-            let volume: f64 = weights[rule.len() * element..rule.len() * (element + 1)]
-                .iter()
-                .sum();
+            let volume: f64 = weights[rule.len() * element..][..rule.len()].iter().sum();
             for (&n, fraction) in element_nodes.iter().zip(shape.lumped_mass_fractions()) {
                 lumped_volumes[n as usize] += fraction * volume;
             }
         }
-        let elements = Self {
+        Ok(Self {
             shape,
             nodes: nodes.to_vec(),
             gradients,
             weights,
             points_per_element: rule.len(),
             lumped_volumes,
-        };
-        Ok(elements)
+        })
     }
 
     /// The elements' shape.
@@ -210,11 +217,6 @@ impl QuadraticElements {
     /// The elements' node lists, in order.
     pub fn elements(&self) -> std::slice::ChunksExact<'_, u32> {
         self.nodes.chunks_exact(self.shape.node_count())
-    }
-
-    /// Quadrature points per element.
-    pub fn points_per_element(&self) -> usize {
-        self.points_per_element
     }
 
     /// The indices of element `element`'s quadrature points.
@@ -245,8 +247,7 @@ impl QuadraticElements {
     /// # Panics
     /// If the element does not exist.
     pub fn volume(&self, element: usize) -> f64 {
-        let q = self.points_per_element;
-        self.weights[q * element..q * (element + 1)].iter().sum()
+        self.weights[self.element_points(element)].iter().sum()
     }
 
     /// The rest volume (m³) lumped on each node: HRZ fractions of each element's volume; times
@@ -272,15 +273,14 @@ impl QuadraticElements {
     }
 
     /// The natural coordinates of rest point `point` (m) in element `element`, found by Newton's
-    /// method on the isoparametric map from `guess`, and the distance (m) between `point` and the
-    /// map's value there (zero when it converged).
+    /// method on the isoparametric map from `guess`.
     pub(crate) fn natural_coordinates(
         &self,
         element: usize,
         rest: &[DVec3],
         point: DVec3,
         guess: DVec3,
-    ) -> (DVec3, f64) {
+    ) -> DVec3 {
         let p: Vec<DVec3> = self
             .element(element)
             .iter()
@@ -303,7 +303,7 @@ impl QuadraticElements {
             }
             xi += jacobian.inverse() * residual;
         }
-        (xi, point.distance(map(xi)))
+        xi
     }
 }
 
@@ -382,8 +382,8 @@ mod tests {
             .zip(&rest)
             .map(|(n, p)| *p * *n)
             .sum();
-        let (found, distance) = elements.natural_coordinates(0, &rest, point, DVec3::ZERO);
-        assert!(found.distance(xi) < 1e-12 && distance < 1e-12);
+        let found = elements.natural_coordinates(0, &rest, point, DVec3::ZERO);
+        assert!(found.distance(xi) < 1e-12);
     }
 
     #[test]

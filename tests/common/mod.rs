@@ -287,3 +287,17 @@ pub fn free_momentum_change(body: &mut SoftBody, seed: u64, implicit: bool) -> (
         .sum();
     (change, scale.max(before.length()))
 }
+
+/// The ratio of the largest force on an `interior` node to the largest on a boundary node.
+pub fn interior_ratio(forces: &[DVec3], interior: &[bool]) -> f64 {
+    let (mut inner, mut boundary) = (0.0f64, 0.0f64);
+    for (f, &is_inner) in forces.iter().zip(interior) {
+        if is_inner {
+            inner = inner.max(f.length());
+        } else {
+            boundary = boundary.max(f.length());
+        }
+    }
+    assert!(boundary > 0.0, "the deformation must load the boundary");
+    inner / boundary
+}
