@@ -136,24 +136,7 @@ fn a_cage_carrying_a_fine_mesh_rests_on_a_rapier_ground() {
         .unwrap();
         assert_eq!(cube.element_shape(), ElementShape::Hexahedron);
         let cube = world.soft_bodies.insert(cube);
-        let h =
-            f64::from(world.physics.integration_parameters.dt) / f64::from(world.coupling_substeps);
-        for _ in 0..150 {
-            for (_, outcome) in world.step() {
-                outcome.unwrap();
-            }
-        }
-        let (mut reaction, frames) = (0.0, 60);
-        for _ in 0..frames {
-            for (_, outcome) in world.step() {
-                outcome.unwrap();
-            }
-            reaction += -world.soft_bodies[cube]
-                .contact_force_on(ground, h)
-                .unwrap()
-                .0
-                .y;
-        }
+        let reaction = common::settled_reaction(&mut world, cube, ground);
         let body = &world.soft_bodies[cube];
         let touching = body
             .contacts()
@@ -166,7 +149,6 @@ fn a_cage_carrying_a_fine_mesh_rests_on_a_rapier_ground() {
             "contacts act on the fine mesh"
         );
         let weight = body.total_mass() * 9.81;
-        let reaction = reaction / f64::from(frames);
         let lowest = body
             .embedded_positions()
             .unwrap()

@@ -338,26 +338,9 @@ fn a_quadratic_cube_rests_on_a_rapier_ground() {
     .build()
     .unwrap();
     let cube = world.soft_bodies.insert(cube);
-    let h = f64::from(world.physics.integration_parameters.dt) / f64::from(world.coupling_substeps);
-    for _ in 0..150 {
-        for (_, outcome) in world.step() {
-            outcome.unwrap();
-        }
-    }
-    let (mut reaction, frames) = (0.0, 60);
-    for _ in 0..frames {
-        for (_, outcome) in world.step() {
-            outcome.unwrap();
-        }
-        reaction += -world.soft_bodies[cube]
-            .contact_force_on(ground, h)
-            .unwrap()
-            .0
-            .y;
-    }
+    let reaction = common::settled_reaction(&mut world, cube, ground);
     let body = &world.soft_bodies[cube];
     let weight = body.total_mass() * 9.81;
-    let reaction = reaction / f64::from(frames);
     let lowest = body
         .positions()
         .iter()

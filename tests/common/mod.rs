@@ -301,3 +301,32 @@ pub fn interior_ratio(forces: &[DVec3], interior: &[bool]) -> f64 {
     assert!(boundary > 0.0, "the deformation must load the boundary");
     inner / boundary
 }
+
+/// Steps `world` 150 frames for `body` to settle on `ground`, then 60 more, and returns the
+/// ground's mean upward reaction on the body over those 60 (N).
+pub fn settled_reaction(
+    world: &mut rapier_fvm::world::FvmWorld,
+    body: SoftBodyHandle,
+    ground: rapier3d::prelude::ColliderHandle,
+) -> f64 {
+    let h = f64::from(world.physics.integration_parameters.dt) / f64::from(world.coupling_substeps);
+    let step = |world: &mut rapier_fvm::world::FvmWorld| {
+        for (_, outcome) in world.step() {
+            outcome.unwrap();
+        }
+    };
+    for _ in 0..150 {
+        step(world);
+    }
+    let frames = 60;
+    let mut reaction = 0.0;
+    for _ in 0..frames {
+        step(world);
+        reaction -= world.soft_bodies[body]
+            .contact_force_on(ground, h)
+            .unwrap()
+            .0
+            .y;
+    }
+    reaction / f64::from(frames)
+}
