@@ -9,9 +9,12 @@
 //!    pressure on hexahedra), from ν = 0 to the nearly incompressible 0.499.
 //! 3. Dynamics: released from rest with stiffness-proportional damping `β = 2/ω₁` (the first mode
 //!    critically damped; the equilibrium does not depend on it), 1.5 s, tip averaged over the
-//!    last 0.25 s; wall time per step of 1/240 s and 1/60 s, per implicit scheme. (Explicit
-//!    steps are not offered: this heavy stiffness-proportional damping makes the explicit
-//!    stability limit tiny.)
+//!    last 0.25 s; wall time per step of 1/240 s and 1/60 s, per implicit scheme, with Newton
+//!    iterations and tangent factorizations per step. Newton reuses earlier factorizations (the
+//!    chord method, `ImplicitIntegrator::reuse_factorization`) except in the rows marked `off`,
+//!    which measure the same setting with a fresh tangent at every iteration, side by side.
+//!    (Explicit steps are not offered: this heavy stiffness-proportional damping makes the
+//!    explicit stability limit tiny.)
 //!
 //! The tip deflection is the mean vertical displacement of the free face's nodes.
 //! Run with `cargo run --release --example cantilever_quadratic`. The last line is a JSON object
@@ -179,22 +182,30 @@ struct Dynamic {
     ms_per_step: f64,
     dofs: usize,
     /// Newton iterations per step, on average.
-    work_per_step: f64,
+    newton_per_step: f64,
+    /// Tangent assemblies and factorizations per step, on average (Newton iterations that did
+    /// not reuse an earlier factorization).
+    factorizations_per_step: f64,
 }
 
-fn dynamic_case(beam: &Beam, stepper: Stepper, dt: f64) -> Result<Dynamic, Error> {
+fn dynamic_case(beam: &Beam, stepper: Stepper, dt: f64, reuse: bool) -> Result<Dynamic, Error> {
     let (mut body, tip) = beam.build(Some(2.0 / euler_bernoulli_omega()))?;
     let rest = tip_height(&body, &tip);
     let steps = (1.5 / dt).round() as usize;
     let averaged = (0.25 / dt).round() as usize;
-    let mut implicit = ImplicitIntegrator::default();
+    let mut implicit = ImplicitIntegrator {
+        reuse_factorization: reuse,
+        ..Default::default()
+    };
     if let Stepper::Bdf2 = stepper {
         implicit.scheme = ImplicitScheme::Bdf2;
     }
-    let (mut sum, mut work) = (0.0, 0usize);
+    let (mut sum, mut newton, mut reused) = (0.0, 0usize, 0usize);
     let start = Instant::now();
     for step in 0..steps {
-        work += implicit.step(&mut body, dt, GRAVITY)?.newton_iterations;
+        let report = implicit.step(&mut body, dt, GRAVITY)?;
+        newton += report.newton_iterations;
+        reused += report.reused_factorizations;
         if step >= steps - averaged {
             sum += rest - tip_height(&body, &tip);
         }
@@ -204,7 +215,8 @@ fn dynamic_case(beam: &Beam, stepper: Stepper, dt: f64) -> Result<Dynamic, Error
         error: sum / averaged as f64 / timoshenko_tip(beam.nu) - 1.0,
         ms_per_step: seconds * 1e3 / steps as f64,
         dofs: dofs(&body),
-        work_per_step: work as f64 / steps as f64,
+        newton_per_step: newton as f64 / steps as f64,
+        factorizations_per_step: (newton - reused) as f64 / steps as f64,
     })
 }
 
@@ -355,16 +367,18 @@ fn main() -> Result<(), Error> {
 
     println!("\n3. Dynamics to rest (nu = 0.3), error of the settled tip vs Timoshenko");
     println!(
-        "{:<18} {:<12} {:<14} {:<10} {:>8} {:>6} {:>9} {:>9} {:>10}",
+        "{:<18} {:<12} {:<14} {:<10} {:<6} {:>8} {:>6} {:>9} {:>9} {:>11} {:>13}",
         "elements",
         "model",
         "integrator",
         "volumetric",
+        "reuse",
         "dt",
         "dofs",
         "error",
         "ms/step",
-        "work/step"
+        "newton/step",
+        "factors/step"
     );
     let mut best: Option<(Beam, &str, f64, Dynamic)> = None;
     let per_element = VolumetricTreatment::PerElement;
@@ -375,65 +389,95 @@ fn main() -> Result<(), Error> {
             [20, 2, 2],
             Stepper::BackwardEuler,
             per_element,
+            true,
         ),
         (
             Kind::LinearTet,
             [40, 4, 4],
             Stepper::BackwardEuler,
             per_element,
+            true,
         ),
         (
             Kind::QuadraticTet,
             [5, 1, 1],
             Stepper::BackwardEuler,
             per_element,
+            true,
         ),
         (
             Kind::QuadraticTet,
             [10, 1, 1],
             Stepper::BackwardEuler,
             per_element,
+            true,
         ),
-        (Kind::QuadraticTet, [10, 1, 1], Stepper::Bdf2, per_element),
+        (
+            Kind::QuadraticTet,
+            [10, 1, 1],
+            Stepper::BackwardEuler,
+            per_element,
+            false,
+        ),
+        (
+            Kind::QuadraticTet,
+            [10, 1, 1],
+            Stepper::Bdf2,
+            per_element,
+            true,
+        ),
         (
             Kind::QuadraticTet,
             [20, 2, 2],
             Stepper::BackwardEuler,
             per_element,
+            true,
         ),
         (
             Kind::QuadraticTet,
             [20, 1, 1],
             Stepper::BackwardEuler,
             per_element,
+            true,
         ),
         (
             Kind::QuadraticHex,
             [4, 1, 1],
             Stepper::BackwardEuler,
             averaged,
+            true,
         ),
         (
             Kind::QuadraticHex,
             [5, 1, 1],
             Stepper::BackwardEuler,
             per_element,
+            true,
         ),
         (
             Kind::QuadraticHex,
             [5, 1, 1],
             Stepper::BackwardEuler,
             averaged,
+            true,
         ),
-        (Kind::QuadraticHex, [5, 1, 1], Stepper::Bdf2, averaged),
+        (
+            Kind::QuadraticHex,
+            [5, 1, 1],
+            Stepper::BackwardEuler,
+            averaged,
+            false,
+        ),
+        (Kind::QuadraticHex, [5, 1, 1], Stepper::Bdf2, averaged, true),
         (
             Kind::QuadraticHex,
             [10, 1, 1],
             Stepper::BackwardEuler,
             averaged,
+            true,
         ),
     ];
-    for (kind, cells, stepper, volumetric) in dynamic_cases {
+    for (kind, cells, stepper, volumetric, reuse) in dynamic_cases {
         for model in [MaterialModel::Linear, MaterialModel::Corotated] {
             for dt in [1.0 / 240.0, 1.0 / 60.0] {
                 let beam = Beam {
@@ -443,18 +487,20 @@ fn main() -> Result<(), Error> {
                     nu: POISSON,
                     volumetric,
                 };
-                let outcome = dynamic_case(&beam, stepper, dt)?;
+                let outcome = dynamic_case(&beam, stepper, dt, reuse)?;
                 println!(
-                    "{:<18} {:<12} {:<14} {:<10} {:>8} {:>6} {:>8.2}% {:>9.3} {:>10.1}",
+                    "{:<18} {:<12} {:<14} {:<10} {:<6} {:>8} {:>6} {:>8.2}% {:>9.3} {:>11.2} {:>13.2}",
                     beam.label(),
                     format!("{model:?}"),
                     stepper.label(),
                     volumetric_label(volumetric),
+                    if reuse { "on" } else { "off" },
                     format!("1/{:.0}", 1.0 / dt),
                     outcome.dofs,
                     100.0 * outcome.error,
                     outcome.ms_per_step,
-                    outcome.work_per_step
+                    outcome.newton_per_step,
+                    outcome.factorizations_per_step
                 );
                 let better = match &best {
                     None => true,

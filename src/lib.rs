@@ -44,6 +44,7 @@
 mod assembly;
 pub mod attachment;
 pub mod body;
+pub mod chord;
 pub mod contact;
 pub mod damping;
 pub mod element;

@@ -3,8 +3,9 @@
 //! the step (m).
 //!
 //! Two methods:
-//! - a sparse direct solve, faer's supernodal Cholesky factorization (the fill-reducing ordering
-//!   and symbolic analysis are computed once per body and reused);
+//! - a sparse direct solve, faer's Cholesky factorization (the fill-reducing ordering and
+//!   symbolic analysis, in which faer picks a simplicial or supernodal factorization from the
+//!   fill, are computed once per body and reused);
 //! - the preconditioned conjugate gradient on the assembled matrix, with a 3 x 3 block-Jacobi
 //!   preconditioner (each node's diagonal block inverted), started from zero.
 //!
@@ -30,6 +31,7 @@ use crate::Error;
 use crate::assembly::{Stiffness, factorize, solve};
 use crate::body::SoftBody;
 use crate::material::is_positive_definite;
+use faer::sparse::linalg::solvers::Llt;
 use rapier3d::glamx::{DMat3, DVec3};
 
 /// How the Newton system of each implicit iteration is solved.
@@ -234,6 +236,8 @@ pub(crate) struct Solution {
     /// Whether the conjugate gradient fell back to the direct method (the caller keeps it for
     /// the rest of the frame).
     pub(crate) fell_back: bool,
+    /// The Cholesky factorization solved with, when the direct method was used.
+    pub(crate) factor: Option<Llt<usize, f64>>,
 }
 
 /// Assembles the tangent with `assemble(stiffness, project)` and solves `K u = rhs` by `method`,
@@ -255,12 +259,13 @@ pub(crate) fn solve_newton_system(
     assemble(stiffness, false);
     let (tolerance, max_iterations, fallback) = match method {
         Method::Direct => {
-            let (direction, projected) = solve_direct(stiffness, rhs, iteration, assemble, false)?;
+            let (factor, projected) = factorize_direct(stiffness, iteration, assemble, false)?;
             return Ok(Solution {
-                direction,
+                direction: solve(&factor, rhs),
                 cg_iterations: 0,
                 projected,
                 fell_back: false,
+                factor: Some(factor),
             });
         }
         Method::ConjugateGradient {
@@ -293,6 +298,7 @@ pub(crate) fn solve_newton_system(
                         cg_iterations,
                         projected,
                         fell_back: false,
+                        factor: None,
                     });
                 }
                 break;
@@ -309,34 +315,34 @@ pub(crate) fn solve_newton_system(
             }
         }
     }
-    let (direction, projected) = solve_direct(stiffness, rhs, iteration, assemble, projected)?;
+    let (factor, projected) = factorize_direct(stiffness, iteration, assemble, projected)?;
     Ok(Solution {
-        direction,
+        direction: solve(&factor, rhs),
         cg_iterations,
         projected,
         fell_back: true,
+        factor: Some(factor),
     })
 }
 
-/// Solves `K u = rhs` by Cholesky factorization of the assembled `stiffness`; if that fails and
-/// the tangent is not already `projected`, reassembles with projection and factorizes again.
-/// Returns the solution and whether the tangent solved was the projected one.
+/// The Cholesky factorization of the assembled `stiffness`; if that fails and the tangent is not
+/// already `projected`, reassembles with projection and factorizes again. Returns the
+/// factorization and whether the tangent factored was the projected one.
 ///
 /// # Errors
 /// [`Error::IndefiniteStiffness`] if the (projected) tangent cannot be factored.
-pub(crate) fn solve_direct(
+fn factorize_direct(
     stiffness: &mut Stiffness,
-    rhs: &[DVec3],
     iteration: usize,
     mut assemble: impl FnMut(&mut Stiffness, bool),
     projected: bool,
-) -> Result<(Vec<DVec3>, bool), Error> {
+) -> Result<(Llt<usize, f64>, bool), Error> {
     match factorize(stiffness, iteration) {
-        Ok(factor) => Ok((solve(&factor, rhs), projected)),
+        Ok(factor) => Ok((factor, projected)),
         Err(error) if projected => Err(error),
         Err(_) => {
             assemble(stiffness, true);
-            Ok((solve(&factorize(stiffness, iteration)?, rhs), true))
+            Ok((factorize(stiffness, iteration)?, true))
         }
     }
 }

@@ -450,3 +450,79 @@ fn invalid_conjugate_gradient_settings_are_typed_errors() {
     }
     assert_eq!(body.positions(), &before[..]);
 }
+
+/// `frames` steps of `dt` (s) from `body`, asserting that each converged; the final body and
+/// the Newton iterations that reused a factorization, of all Newton iterations.
+fn run_frames(
+    integrator: &ImplicitIntegrator,
+    body: &SoftBody,
+    frames: usize,
+    dt: f64,
+) -> (SoftBody, usize, usize) {
+    let mut body = body.clone();
+    let (mut reused, mut iterations) = (0, 0);
+    for _ in 0..frames {
+        let report = integrator.step(&mut body, dt, gravity()).unwrap();
+        assert!(report.converged);
+        reused += report.reused_factorizations;
+        iterations += report.newton_iterations;
+    }
+    (body, reused, iterations)
+}
+
+#[test]
+fn reusing_factorizations_meets_the_same_tolerance() {
+    // Newton with the exact tangent at every iteration against Newton reusing earlier
+    // factorizations (the chord method), both to the default tolerance 1e-6: each run stops
+    // within 1e-6 of the force scale of the same minimum, so the positions agree to about 1e-6
+    // of the motion per step; 1e-5 of the motion is allowed after the run.
+    // - Linear model with stiffness-proportional damping (first mode critically damped), 120
+    //   steps of 1/240 s: the tangent barely changes, so most iterations reuse.
+    // - Stable Neo-Hookean beam (E = 1 MPa) swinging far, 10 steps of 1/60 s, then 10 of
+    //   1/120 s: strongly nonlinear, and the step length changes.
+    let linear = Material::new(MaterialModel::Linear, 1e8, 0.3, common::DENSITY).unwrap();
+    let omega = 2.0 * PI * 5.07;
+    let damping = RayleighDamping::stiffness_proportional(2.0 / omega, linear.lame()).unwrap();
+    let (stiff, _) = common::damped_cantilever([10, 1, 1], linear, Some(damping));
+    let rubber = Material::new(MaterialModel::StableNeoHookean, 1e6, 0.3, common::DENSITY).unwrap();
+    let (soft, _) = cantilever([20, 2, 2], rubber);
+    let exact = ImplicitIntegrator {
+        reuse_factorization: false,
+        linear_solver: LinearSolver::Direct,
+        ..Default::default()
+    };
+    let chord = ImplicitIntegrator {
+        reuse_factorization: true,
+        ..exact
+    };
+    let cases = [
+        ("linear, damped", &stiff, &[(120, 1.0 / 240.0)][..]),
+        (
+            "Neo-Hookean",
+            &soft,
+            &[(10, 1.0 / 60.0), (10, 1.0 / 120.0)][..],
+        ),
+    ];
+    for (label, start, schedule) in cases {
+        let (mut with_exact, mut with_chord) = (start.clone(), start.clone());
+        let (mut reused, mut chord_iterations, mut exact_iterations) = (0, 0, 0);
+        for &(frames, dt) in schedule {
+            let (body, none, iterations) = run_frames(&exact, &with_exact, frames, dt);
+            assert_eq!(none, 0);
+            exact_iterations += iterations;
+            with_exact = body;
+            let (body, some, iterations) = run_frames(&chord, &with_chord, frames, dt);
+            reused += some;
+            chord_iterations += iterations;
+            with_chord = body;
+        }
+        let gap = largest_gap(with_exact.positions(), with_chord.positions());
+        let motion = largest_gap(with_exact.positions(), start.positions());
+        let factored = chord_iterations - reused;
+        println!(
+            "{label}: gap {gap:.3e} m of {motion:.4} m of motion; exact Newton {exact_iterations} factorizations, chord {factored} factorizations and {reused} reuses"
+        );
+        assert!(gap < 1e-5 * motion, "{label}: gap {gap} m");
+        assert!(reused > 0, "{label}");
+    }
+}

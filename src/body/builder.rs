@@ -2,6 +2,7 @@
 
 use super::{SoftBody, lumped_masses};
 use crate::Error;
+use crate::chord::Chord;
 use crate::contact::ContactSettings;
 use crate::damping::RayleighDamping;
 use crate::element::{ElementShape, Elements, PressureBasis, QuadraticElements};
@@ -440,6 +441,7 @@ impl SoftBodyBuilder {
             ),
             previous_step: None,
             tangent: None,
+            chord: Chord::default(),
             mesh: self.mesh,
             subdivision_parents,
             material: self.material,

@@ -10,6 +10,7 @@ pub use set::{SoftBodyHandle, SoftBodySet};
 
 use crate::assembly::Stiffness;
 use crate::attachment::Attachment;
+use crate::chord::Chord;
 use crate::contact::{ContactSettings, CornerContact, NodeContact, RigidProxy};
 use crate::damping::RayleighDamping;
 use crate::element::{ElementOrder, ElementShape, Elements};
@@ -50,6 +51,8 @@ pub struct SoftBody {
     /// The sparse tangent's pattern and symbolic factorization, built by the first implicit or
     /// static solve and kept for the next.
     pub(crate) tangent: Option<Stiffness>,
+    /// The implicit integrator's last factorization, kept for reuse by the chord method.
+    pub(crate) chord: Chord,
     /// The nodes on the mesh's boundary, which contacts are detected for (unless the body has an
     /// embedded mesh).
     pub(crate) surface_nodes: Vec<u32>,

@@ -14,13 +14,15 @@
 //! iteration solves the Newton system with the exact tangent (or, where that is not positive
 //! definite, with element stress tangents projected to be positive semi-definite) by the chosen
 //! [`LinearSolver`] (a sparse Cholesky factorization or a preconditioned conjugate gradient),
-//! then a backtracking line search makes `E` decrease. Both schemes are stable at any step
-//! length.
+//! then a backtracking line search makes `E` decrease. While an earlier factorization keeps
+//! cutting the out-of-balance force tenfold per iteration, iterations solve with it instead of
+//! assembling and factoring anew ([`crate::chord`]). Both schemes are stable at any step length.
 
 use super::check_step;
 use crate::Error;
-use crate::assembly::Stiffness;
+use crate::assembly::{Stiffness, solve};
 use crate::body::{PreviousStep, SoftBody};
+use crate::chord::Chord;
 use crate::damping::RayleighDamping;
 use crate::element::add_point_forces;
 use crate::element::deformation_gradient;
@@ -69,6 +71,14 @@ pub struct ImplicitIntegrator {
     pub substeps: u32,
     /// How each Newton iteration's linear system is solved.
     pub linear_solver: LinearSolver,
+    /// Whether Newton iterations solved by the direct method may reuse the Cholesky
+    /// factorization of an earlier iteration or step (the chord method) while it keeps cutting
+    /// the out-of-balance force tenfold per iteration: the same tolerance is met, and where the
+    /// tangent changes little (the linear model, small strains, a fixed step) most iterations
+    /// skip the assembly and the factorization. See [`crate::chord`] for the rule. The body
+    /// then keeps its last factorization between steps (8 bytes per nonzero of the Cholesky
+    /// factor); `false` frees it after each solve.
+    pub reuse_factorization: bool,
 }
 
 impl Default for ImplicitIntegrator {
@@ -79,6 +89,7 @@ impl Default for ImplicitIntegrator {
             max_newton_iterations: 20,
             substeps: 1,
             linear_solver: LinearSolver::Automatic,
+            reuse_factorization: true,
         }
     }
 }
@@ -93,6 +104,9 @@ pub struct ImplicitReport {
     /// Conjugate gradient iterations over all substeps (zero when every system was solved by
     /// the direct method).
     pub linear_iterations: usize,
+    /// Newton iterations that solved with an earlier factorization instead of assembling and
+    /// factoring the tangent (see [`ImplicitIntegrator::reuse_factorization`]).
+    pub reused_factorizations: usize,
     /// Newton iterations whose exact tangent was not positive definite (the Cholesky
     /// factorization failed or the conjugate gradient met negative curvature), so that the
     /// tangent with element stress tangents projected to be positive semi-definite was solved.
@@ -111,6 +125,8 @@ struct Outcome {
     iterations: usize,
     /// Conjugate gradient iterations.
     linear_iterations: usize,
+    /// Iterations that reused an earlier factorization.
+    reused_factorizations: usize,
     /// Iterations that solved the projected tangent.
     projected_tangents: usize,
     /// Final relative residual.
@@ -175,24 +191,35 @@ impl ImplicitIntegrator {
             substeps: self.substeps,
             newton_iterations: 0,
             linear_iterations: 0,
+            reused_factorizations: 0,
             projected_tangents: 0,
             relative_residual: 0.0,
             converged: true,
             inverted_tets: 0,
         };
-        let mut stiffness = body.take_tangent();
-        let mut method = self.linear_solver.method(body, h);
+        let mut solver = Solver {
+            stiffness: body.take_tangent(),
+            // Without reuse, a factorization kept by earlier steps is dropped.
+            chord: if self.reuse_factorization {
+                std::mem::take(&mut body.chord)
+            } else {
+                Chord::default()
+            },
+            method: self.linear_solver.method(body, h),
+        };
         for _ in 0..self.substeps {
-            match self.substep(body, &mut stiffness, &mut method, h, gravity) {
+            match self.substep(body, &mut solver, h, gravity) {
                 Ok(Outcome {
                     iterations,
                     linear_iterations,
+                    reused_factorizations,
                     projected_tangents,
                     residual,
                     converged,
                 }) => {
                     report.newton_iterations += iterations;
                     report.linear_iterations += linear_iterations;
+                    report.reused_factorizations += reused_factorizations;
                     report.projected_tangents += projected_tangents;
                     report.relative_residual = report.relative_residual.max(residual);
                     report.converged &= converged;
@@ -200,12 +227,12 @@ impl ImplicitIntegrator {
                 Err(error) => {
                     body.restore_state();
                     body.previous_step = history;
-                    body.tangent = Some(stiffness);
+                    solver.give_back(body);
                     return Err(error);
                 }
             }
         }
-        body.tangent = Some(stiffness);
+        solver.give_back(body);
         if let Some(node) = body.first_non_finite_node() {
             body.restore_state();
             body.previous_step = history;
@@ -219,8 +246,7 @@ impl ImplicitIntegrator {
     fn substep(
         &self,
         body: &mut SoftBody,
-        stiffness: &mut Stiffness,
-        method: &mut Method,
+        solver: &mut Solver,
         h: f64,
         gravity: DVec3,
     ) -> Result<Outcome, Error> {
@@ -237,7 +263,7 @@ impl ImplicitIntegrator {
         if predicted.is_nan() || predicted > here {
             body.positions.clone_from(&start.positions);
         }
-        let outcome = self.minimize(body, stiffness, method, &start)?;
+        let outcome = self.minimize(body, solver, &start)?;
         contact::record_penalty_impulses(body, start.h, h);
         attachment::record_spring_impulses(body, start.h, h);
         for n in 0..body.positions.len() {
@@ -256,12 +282,12 @@ impl ImplicitIntegrator {
     }
 
     /// Newton's method on the step's incremental potential, from the body's current positions.
-    /// A conjugate gradient that falls back to the direct solve switches `method` to it.
+    /// A conjugate gradient that falls back to the direct solve switches the solver's method to
+    /// it.
     fn minimize(
         &self,
         body: &mut SoftBody,
-        stiffness: &mut Stiffness,
-        method: &mut Method,
+        solver: &mut Solver,
         start: &StepStart,
     ) -> Result<Outcome, Error> {
         let inertia: Vec<f64> = body
@@ -277,9 +303,15 @@ impl ImplicitIntegrator {
         let mut outcome = Outcome {
             iterations: 0,
             linear_iterations: 0,
+            reused_factorizations: 0,
             projected_tangents: 0,
             residual: f64::NAN,
             converged: false,
+        };
+        solver.chord.start_step();
+        let finish = |solver: &mut Solver, outcome: Outcome| -> Result<Outcome, Error> {
+            solver.chord.end_step(outcome.reused_factorizations > 0);
+            Ok(outcome)
         };
         loop {
             let relative = norm(&residual) / reference;
@@ -290,7 +322,7 @@ impl ImplicitIntegrator {
             }
             if relative <= self.tolerance {
                 outcome.converged = true;
-                return Ok(outcome);
+                return finish(solver, outcome);
             }
             // A small residual that three iterations could not cut by 10 % sits on its round-off
             // floor (very stiff or nearly incompressible material against a small load).
@@ -298,34 +330,88 @@ impl ImplicitIntegrator {
                 && history.len() >= 3
                 && relative > 0.9 * history[history.len() - 3];
             if outcome.iterations == self.max_newton_iterations || stalled {
-                return Ok(outcome);
+                return finish(solver, outcome);
             }
             history.push(relative);
-            // The exact Hessian converges fastest; where it is indefinite (compressed elements)
-            // the per-element projection restores a descent direction.
-            let solution = solve_newton_system(
-                *method,
-                self.tolerance / relative,
-                stiffness,
-                &residual,
-                outcome.iterations,
-                |stiffness, project| start.assemble(body, stiffness, &inertia, project),
-            )?;
-            outcome.linear_iterations += solution.cg_iterations;
-            outcome.projected_tangents += usize::from(solution.projected);
-            if solution.fell_back {
-                *method = Method::Direct;
-            }
-            let direction = solution.direction;
+            let last_iteration = outcome.iterations + 1 == self.max_newton_iterations;
+            let reusable = (self.reuse_factorization && solver.method == Method::Direct)
+                .then(|| solver.chord.factor_for(start.h, last_iteration))
+                .flatten();
+            let (direction, reused) = match reusable {
+                Some(factor) => (solve(factor, &residual), true),
+                None => (
+                    self.exact_direction(body, solver, start, &inertia, &residual, &mut outcome)?,
+                    false,
+                ),
+            };
             let energy = |body: &SoftBody| start.energy(body);
-            match descend(body, &residual, &direction, energy, |body| {
+            let next = descend(body, &residual, &direction, energy, |body| {
                 start.residual(body)
-            }) {
-                Some(next) => residual = next,
-                None => return Ok(outcome),
-            }
+            });
             outcome.iterations += 1;
+            if reused {
+                outcome.reused_factorizations += 1;
+                // No descent at all counts as no contraction.
+                let after = next.as_deref().map_or(f64::INFINITY, norm);
+                solver.chord.record(norm(&residual), after);
+            }
+            match next {
+                Some(next) => residual = next,
+                // The exact tangent may still descend where an earlier one does not.
+                None if reused => {}
+                None => return finish(solver, outcome),
+            }
         }
+    }
+
+    /// The Newton direction (m per node) of the exact tangent, which the chord keeps for reuse
+    /// when it was factored.
+    fn exact_direction(
+        &self,
+        body: &SoftBody,
+        solver: &mut Solver,
+        start: &StepStart,
+        inertia: &[f64],
+        residual: &[DVec3],
+        outcome: &mut Outcome,
+    ) -> Result<Vec<DVec3>, Error> {
+        // The exact Hessian converges fastest; where it is indefinite (compressed elements)
+        // the per-element projection restores a descent direction.
+        let solution = solve_newton_system(
+            solver.method,
+            self.tolerance / outcome.residual,
+            &mut solver.stiffness,
+            residual,
+            outcome.iterations,
+            |stiffness, project| start.assemble(body, stiffness, inertia, project),
+        )?;
+        outcome.linear_iterations += solution.cg_iterations;
+        outcome.projected_tangents += usize::from(solution.projected);
+        if solution.fell_back {
+            solver.method = Method::Direct;
+        }
+        if let Some(factor) = solution.factor
+            && self.reuse_factorization
+        {
+            solver.chord.keep(factor, start.h);
+        }
+        Ok(solution.direction)
+    }
+}
+
+/// The implicit step's linear algebra, carried across substeps: the tangent workspace, the
+/// factorization kept for reuse and the solve method.
+struct Solver {
+    stiffness: Stiffness,
+    chord: Chord,
+    method: Method,
+}
+
+impl Solver {
+    /// Returns the workspace and the kept factorization to the body for its next step.
+    fn give_back(self, body: &mut SoftBody) {
+        body.tangent = Some(self.stiffness);
+        body.chord = self.chord;
     }
 }
 

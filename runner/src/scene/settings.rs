@@ -17,6 +17,7 @@
 //! scheme = "backward_euler"  # implicit: or "bdf2"
 //! tolerance = 1e-6           # implicit: Newton's relative tolerance
 //! max_newton_iterations = 20
+//! reuse_factorization = true # implicit: reuse earlier factorizations while they converge fast
 //!
 //! [output]
 //! save_every = 3             # frames between saved ParaView/OBJ frames (frame 0 always saved)
@@ -123,6 +124,8 @@ pub struct IntegratorSpec {
     pub tolerance: Option<f64>,
     /// Implicit: Newton iterations per substep at most.
     pub max_newton_iterations: Option<usize>,
+    /// Implicit: whether Newton may reuse earlier factorizations (the chord method).
+    pub reuse_factorization: Option<bool>,
 }
 
 impl IntegratorSpec {
@@ -146,6 +149,9 @@ impl IntegratorSpec {
                     .max_newton_iterations
                     .unwrap_or(implicit.max_newton_iterations),
                 substeps: self.implicit_substeps.unwrap_or(implicit.substeps),
+                reuse_factorization: self
+                    .reuse_factorization
+                    .unwrap_or(implicit.reuse_factorization),
                 ..implicit
             },
             force: match self.kind {
