@@ -23,19 +23,21 @@ pub(crate) fn norm(v: &[DVec3]) -> f64 {
     v.iter().map(|x| x.length_squared()).sum::<f64>().sqrt()
 }
 
-/// One Newton update of `body`'s positions along `direction`: the line search below, or, when
-/// the energy's decrease is lost in its round-off (close to the solution), the largest step of
-/// the same sequence that lowers the out-of-balance force. Returns the new residual, or `None`
-/// (positions unchanged) if neither descends.
+/// One Newton update of `body`'s positions along `direction` from where the minimized energy
+/// is `energy_now` (J): the line search below, or, when the energy's decrease is lost in its
+/// round-off (close to the solution), the largest step of the same sequence that lowers the
+/// out-of-balance force. Returns the new residual and energy, or `None` (positions unchanged) if
+/// neither descends.
 pub(crate) fn descend(
     body: &mut SoftBody,
     residual: &[DVec3],
+    energy_now: f64,
     direction: &[DVec3],
     energy: impl Fn(&SoftBody) -> f64,
     mut residual_at: impl FnMut(&mut SoftBody) -> Vec<DVec3>,
-) -> Option<Vec<DVec3>> {
-    if line_search(body, residual, direction, energy) {
-        return Some(residual_at(body));
+) -> Option<(Vec<DVec3>, f64)> {
+    if let Some(accepted) = line_search(body, residual, energy_now, direction, &energy) {
+        return Some((residual_at(body), accepted));
     }
     let start = body.positions.clone();
     let current = norm(residual);
@@ -46,7 +48,7 @@ pub(crate) fn descend(
         }
         let next = residual_at(body);
         if norm(&next) < current {
-            return Some(next);
+            return Some((next, energy(body)));
         }
         alpha *= 0.5;
     }
@@ -57,19 +59,20 @@ pub(crate) fn descend(
 /// The smallest step fraction the searches try.
 const MIN_STEP: f64 = 1.0 / 1024.0;
 
-/// Moves `body` along `direction` from its current positions by the largest step `α` in
-/// `1, 1/2, 1/4, …, 1/1024` that satisfies the Armijo condition on `energy` (J), whose gradient
-/// is `-residual` (N), so that the energy decreases. Returns `false`, with the positions put
-/// back, if no such step exists (the direction no longer descends above round-off).
+/// Moves `body` along `direction` from its current positions, where `energy` (J) is `initial`
+/// and its gradient is `-residual` (N), by the largest step `α` in `1, 1/2, 1/4, …, 1/1024` that
+/// satisfies the Armijo condition, so that the energy decreases. Returns the energy there, or
+/// `None`, with the positions put back, if no such step exists (the direction no longer descends
+/// above round-off).
 fn line_search(
     body: &mut SoftBody,
     residual: &[DVec3],
+    initial: f64,
     direction: &[DVec3],
     energy: impl Fn(&SoftBody) -> f64,
-) -> bool {
+) -> Option<f64> {
     const ARMIJO: f64 = 1e-4;
     let start = body.positions.clone();
-    let initial = energy(body);
     let slope: f64 = -residual
         .iter()
         .zip(direction)
@@ -84,11 +87,12 @@ fn line_search(
         for ((x, x0), s) in body.positions.iter_mut().zip(&start).zip(direction) {
             *x = *x0 + *s * alpha;
         }
-        if energy(body) <= initial + ARMIJO * alpha * slope + round_off {
-            return true;
+        let value = energy(body);
+        if value <= initial + ARMIJO * alpha * slope + round_off {
+            return Some(value);
         }
         alpha *= 0.5;
     }
     body.positions.copy_from_slice(&start);
-    false
+    None
 }

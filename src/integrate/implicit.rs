@@ -258,12 +258,13 @@ impl ImplicitIntegrator {
         body.velocities.fill(DVec3::ZERO);
         let here = start.energy(body);
         body.positions.clone_from(&start.target);
-        let predicted = start.energy(body);
+        let mut potential = start.energy(body);
         // A NaN prediction is not lower either.
-        if predicted.is_nan() || predicted > here {
+        if potential.is_nan() || potential > here {
             body.positions.clone_from(&start.positions);
+            potential = here;
         }
-        let outcome = self.minimize(body, solver, &start)?;
+        let outcome = self.minimize(body, solver, &start, potential)?;
         contact::record_penalty_impulses(body, start.h, h);
         attachment::record_spring_impulses(body, start.h, h);
         for n in 0..body.positions.len() {
@@ -281,14 +282,15 @@ impl ImplicitIntegrator {
         Ok(outcome)
     }
 
-    /// Newton's method on the step's incremental potential, from the body's current positions.
-    /// A conjugate gradient that falls back to the direct solve switches the solver's method to
-    /// it.
+    /// Newton's method on the step's incremental potential, from the body's current positions,
+    /// where it is `potential` (J). A conjugate gradient that falls back to the direct solve
+    /// switches the solver's method to it.
     fn minimize(
         &self,
         body: &mut SoftBody,
         solver: &mut Solver,
         start: &StepStart,
+        mut potential: f64,
     ) -> Result<Outcome, Error> {
         let inertia: Vec<f64> = body
             .masses
@@ -345,18 +347,18 @@ impl ImplicitIntegrator {
                 ),
             };
             let energy = |body: &SoftBody| start.energy(body);
-            let next = descend(body, &residual, &direction, energy, |body| {
+            let next = descend(body, &residual, potential, &direction, energy, |body| {
                 start.residual(body)
             });
             outcome.iterations += 1;
             if reused {
                 outcome.reused_factorizations += 1;
                 // No descent at all counts as no contraction.
-                let after = next.as_deref().map_or(f64::INFINITY, norm);
+                let after = next.as_ref().map_or(f64::INFINITY, |(next, _)| norm(next));
                 solver.chord.record(norm(&residual), after);
             }
             match next {
-                Some(next) => residual = next,
+                Some((next, energy)) => (residual, potential) = (next, energy),
                 // The exact tangent may still descend where an earlier one does not.
                 None if reused => {}
                 None => return finish(solver, outcome),

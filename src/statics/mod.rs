@@ -97,6 +97,7 @@ fn newton(
         });
     }
     let mut history: Vec<f64> = Vec::new();
+    let mut potential = potential_energy(body, &load);
     for iteration in 0..settings.max_iterations {
         let relative = norm(&residual) / reference;
         // Newton more than halves the residual each iteration until round-off in the force sum
@@ -126,10 +127,10 @@ fn newton(
         )?
         .direction;
         let energy = |body: &SoftBody| potential_energy(body, &load);
-        match descend(body, &residual, &step, energy, |body| {
+        match descend(body, &residual, potential, &step, energy, |body| {
             out_of_balance(body, &load)
         }) {
-            Some(next) => residual = next,
+            Some((next, energy)) => (residual, potential) = (next, energy),
             // No descent left above round-off: accept a tiny residual, refuse anything else.
             None if relative <= ROUND_OFF_CEILING => {
                 return Ok(StaticReport {
