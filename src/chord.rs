@@ -9,13 +9,14 @@
 //! out-of-balance force and two triangular solves instead of an assembly and a factorization. It
 //! converges linearly, cutting the out-of-balance force by about `‖I - K̃⁻¹ K‖` per iteration.
 //!
-//! The rule ([`Chord::factor_for`]): an iteration reuses the last factorization when it was made
-//! for the same effective step `ĥ` (the inertia `M/ĥ²` dominates the matrix), reuse has not failed
-//! in this step, and it is not the last iteration Newton is allowed (which always gets the exact
-//! tangent). A reused iteration fails when it does not cut the out-of-balance force below
-//! [`MAX_CONTRACTION`] times its value; the rest of the step then uses exact tangents, and reuse
-//! pauses for 1, 2, 4, … up to [`MAX_PAUSE`] steps (doubling with each consecutive failing step),
-//! so a strongly nonlinear motion wastes at most one solve every few steps.
+//! The rule, for systems solved by the direct method: an iteration reuses the last factorization
+//! when it was made for the same effective step `ĥ` (the inertia `M/ĥ²` dominates the matrix),
+//! reuse has not failed in this step, and it is not the last iteration Newton is allowed (which
+//! always gets the exact tangent). A reused iteration fails when it does not cut the
+//! out-of-balance force below [`MAX_CONTRACTION`] times its value; the rest of the step then uses
+//! exact tangents, and reuse pauses for 1, 2, 4, … up to [`MAX_PAUSE`] steps (doubling with each
+//! consecutive failing step), so a strongly nonlinear motion wastes at most one solve every few
+//! steps.
 
 use faer::sparse::linalg::solvers::Llt;
 
