@@ -330,3 +330,39 @@ pub fn settled_reaction(
     }
     reaction / f64::from(frames)
 }
+
+/// `ω_max` (rad/s) of `M⁻¹K` at rest by power iteration, using the linear model's forces
+/// (`K u = -f(x0 + u)` exactly for the linear model), pinned nodes excluded.
+pub fn highest_angular_frequency(body: &mut SoftBody) -> f64 {
+    let rest = body.positions().to_vec();
+    let masses = body.masses().to_vec();
+    let mut rng = Lcg(1);
+    let mut u: Vec<DVec3> = (0..rest.len()).map(|_| rng.vector()).collect();
+    let mut eigenvalue: f64 = 0.0;
+    for _ in 0..50_000 {
+        let norm = u.iter().map(|a| a.length_squared()).sum::<f64>().sqrt();
+        let scale = 1e-6 / norm;
+        for (n, x) in body.positions_mut().iter_mut().enumerate() {
+            *x = rest[n] + u[n] * scale;
+        }
+        let forces = body.internal_forces().to_vec();
+        let next: Vec<DVec3> = (0..rest.len())
+            .map(|n| {
+                if body.is_pinned(n) {
+                    DVec3::ZERO
+                } else {
+                    -forces[n] / masses[n] / scale
+                }
+            })
+            .collect();
+        eigenvalue = next.iter().zip(&u).map(|(a, b)| a.dot(*b)).sum::<f64>() / norm.powi(2);
+        let next_norm = next.iter().map(|a| a.length_squared()).sum::<f64>().sqrt();
+        u = next.iter().map(|a| *a / next_norm).collect();
+        // The Rayleigh quotient rises monotonically to ω²; stop once it has settled.
+        if (next_norm / norm - eigenvalue).abs() <= 1e-9 * eigenvalue {
+            break;
+        }
+    }
+    body.positions_mut().copy_from_slice(&rest);
+    eigenvalue.sqrt()
+}
