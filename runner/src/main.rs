@@ -133,10 +133,14 @@ fn run(scene: PathBuf, out: PathBuf, duration: Option<f64>, progress: bool) -> R
         report.speed_vs_real_time
     );
     for body in &report.soft_bodies {
+        let embedded = body
+            .embedded_tets
+            .map_or(String::new(), |tets| format!(", carrying {tets} tets"));
         println!(
-            "  soft {:<16} {:>6} tets {:>5} nodes; {} explicit / {} implicit frames; {} failed; max inverted {}",
+            "  soft {:<16} {:>6} {} {:>5} nodes{embedded}; {} explicit / {} implicit frames; {} failed; max inverted {}",
             body.name,
-            body.tets,
+            body.elements,
+            body.element_kind,
             body.nodes,
             body.explicit_frames,
             body.implicit_frames,

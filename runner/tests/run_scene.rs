@@ -87,8 +87,10 @@ fn a_short_drop_writes_every_output_and_the_vtu_matches_the_body() {
     };
     let report = sim::run(&scene, &options).unwrap();
     assert_eq!(report.frames, 6);
-    assert_eq!(report.soft_bodies[0].tets, 1080);
+    assert_eq!(report.soft_bodies[0].element_kind, "linear tetrahedra");
+    assert_eq!(report.soft_bodies[0].elements, 1080);
     assert_eq!(report.soft_bodies[0].nodes, 343);
+    assert_eq!(report.soft_bodies[0].embedded_tets, None);
     assert!(!report.stability.any_error && report.stability.final_state_finite);
     // report.json holds the same.
     let json: serde_json::Value =
@@ -138,4 +140,23 @@ fn a_short_drop_writes_every_output_and_the_vtu_matches_the_body() {
             assert!((points[i] - rest[axis] - displacement[i]).abs() < 1e-12);
         }
     }
+}
+
+#[test]
+fn a_cage_reports_its_hexahedra_and_the_fine_mesh_it_carries() {
+    // cage_beam.toml: 5 x 1 x 1 quadratic hexahedra (11 x 3 x 3 nodes) carrying 40 x 4 x 4
+    // cells of five tetrahedra.
+    let scene = Scene::load(scene_path("cage_beam.toml")).unwrap();
+    let options = RunOptions {
+        out: out_dir("short_cage"),
+        duration: Some(0.05),
+        progress: false,
+    };
+    let report = sim::run(&scene, &options).unwrap();
+    let beam = &report.soft_bodies[0];
+    assert_eq!(beam.element_kind, "quadratic hexahedra");
+    assert_eq!(beam.elements, 5);
+    assert_eq!(beam.nodes, 99);
+    assert_eq!(beam.embedded_tets, Some(3200));
+    assert!(!report.stability.any_error && report.stability.final_state_finite);
 }

@@ -137,6 +137,16 @@ impl SoftBody {
         self.elements.shape()
     }
 
+    /// The number of elements the body is simulated with: the mesh's tetrahedra for linear
+    /// elements, the quadratic tetrahedra or hexahedra otherwise (each subdivided in
+    /// [`SoftBody::mesh`]).
+    pub fn element_count(&self) -> usize {
+        match &self.elements {
+            Elements::Linear { .. } => self.mesh.tet_count(),
+            Elements::Quadratic { elements, .. } => elements.element_count(),
+        }
+    }
+
     /// The material.
     pub fn material(&self) -> &Material {
         &self.material

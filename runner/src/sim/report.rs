@@ -2,6 +2,8 @@
 //! energies in J.
 
 use rapier_fvm::Error;
+use rapier_fvm::body::SoftBody;
+use rapier_fvm::element::{ElementOrder, ElementShape};
 use rapier_fvm::integrate::{AutomaticReport, IntegratorKind};
 use serde::Serialize;
 
@@ -70,10 +72,15 @@ pub struct SoftBodyReport {
     pub name: String,
     /// Its material label.
     pub material: String,
-    /// Tetrahedra.
-    pub tets: usize,
+    /// The elements it is simulated with: "linear tetrahedra", "quadratic tetrahedra" or
+    /// "quadratic hexahedra".
+    pub element_kind: String,
+    /// How many of them.
+    pub elements: usize,
     /// Nodes.
     pub nodes: usize,
+    /// Tetrahedra of the fine mesh it carries for contact and output, if any.
+    pub embedded_tets: Option<usize>,
     /// Mass (kg).
     pub mass: f64,
     /// Frames its last substep stepped explicitly.
@@ -156,19 +163,20 @@ pub struct Files {
 
 impl SoftBodyReport {
     /// An empty record for a body.
-    pub(crate) fn new(
-        name: String,
-        material: String,
-        tets: usize,
-        nodes: usize,
-        mass: f64,
-    ) -> Self {
+    pub(crate) fn new(name: String, material: String, body: &SoftBody) -> Self {
+        let element_kind = match (body.element_order(), body.element_shape()) {
+            (ElementOrder::Linear, _) => "linear tetrahedra",
+            (ElementOrder::Quadratic, ElementShape::Tetrahedron) => "quadratic tetrahedra",
+            (ElementOrder::Quadratic, ElementShape::Hexahedron) => "quadratic hexahedra",
+        };
         Self {
             name,
             material,
-            tets,
-            nodes,
-            mass,
+            element_kind: element_kind.to_owned(),
+            elements: body.element_count(),
+            nodes: body.node_count(),
+            embedded_tets: body.embedding().map(|e| e.mesh().tet_count()),
+            mass: body.total_mass(),
             ..Self::default()
         }
     }

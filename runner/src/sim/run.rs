@@ -59,13 +59,7 @@ pub fn run(scene: &Scene, options: &RunOptions) -> Result<Report, RunError> {
     let mut bodies: Vec<SoftBodyReport> = (sim.soft.iter())
         .map(|entry| {
             let body = &sim.world.soft_bodies[entry.handle];
-            SoftBodyReport::new(
-                entry.name.clone(),
-                entry.label.clone(),
-                body.mesh().tet_count(),
-                body.node_count(),
-                body.total_mass(),
-            )
+            SoftBodyReport::new(entry.name.clone(), entry.label.clone(), body)
         })
         .collect();
     let mut stability = Stability::default();
