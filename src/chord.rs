@@ -7,26 +7,38 @@
 //! only by another route. Where the tangent changes little between iterations and steps (the
 //! linear model, small strains, a fixed step length, no new contact) such an iteration costs an
 //! out-of-balance force and two triangular solves instead of an assembly and a factorization. It
-//! converges linearly, cutting the out-of-balance force by about `‖I - K̃⁻¹ K‖` per iteration.
+//! converges linearly, cutting the out-of-balance force by about `‖I - K K̃⁻¹‖` per iteration.
 //!
 //! The rule, for systems solved by the direct method: an iteration reuses the last factorization
 //! when it was made for the same effective step `ĥ` (the inertia `M/ĥ²` dominates the matrix),
-//! reuse has not failed in this step, and it is not the last iteration Newton is allowed (which
-//! always gets the exact tangent). A reused iteration fails when it does not cut the
-//! out-of-balance force below [`MAX_CONTRACTION`] times its value; the rest of the step then uses
-//! exact tangents, and reuse pauses for 1, 2, 4, … up to [`MAX_PAUSE`] steps (doubling with each
-//! consecutive failing step), so a strongly nonlinear motion wastes at most one solve every few
-//! steps.
+//! reuse has not failed in this step, and the iterations Newton has left could still reach the
+//! tolerance at the contraction [`MAX_CONTRACTION`] with one exact iteration to spare (so a
+//! small `max_newton_iterations` keeps exact Newton). A reused iteration only takes the full
+//! step or half of it; it fails when neither lowers the potential or when it does not bring the
+//! out-of-balance force to the tolerance or below [`MAX_CONTRACTION`] times its value. The rest
+//! of the step then uses exact tangents, and reuse pauses for the body's next 1, 2, 4, … up to
+//! [`MAX_PAUSE`] implicit substeps (doubling with each consecutive failing substep), so a
+//! strongly nonlinear motion wastes at most one solve every few substeps.
 
 use faer::sparse::linalg::solvers::Llt;
 
-/// A reused factorization must cut the out-of-balance force at least by this factor per
-/// iteration (dimensionless). At 0.1, a tolerance of 1e-6 is reached within about six reused
-/// iterations, each a small fraction of the cost of an exact one.
+/// A reused factorization must bring the out-of-balance force to at most this fraction of its
+/// previous value per iteration (dimensionless). At 0.1, a tolerance of 1e-6 is reached within
+/// about six reused iterations, each a small fraction of the cost of an exact one.
 pub const MAX_CONTRACTION: f64 = 0.1;
 
-/// The longest pause, in steps, of reuse after failures.
+/// The longest pause of reuse after failures, in implicit substeps of the body.
 pub const MAX_PAUSE: u32 = 16;
+
+/// Whether `remaining` Newton iterations leave room for reuse when the out-of-balance force must
+/// still fall by the factor `reduction` (its value over the tolerance's): enough iterations at
+/// [`MAX_CONTRACTION`] to get there, and one more.
+pub(crate) fn within_budget(reduction: f64, remaining: usize) -> bool {
+    let needed = (reduction.ln() / MAX_CONTRACTION.recip().ln())
+        .ceil()
+        .max(1.0);
+    (remaining as f64) > needed
+}
 
 /// The factorization kept for reuse and the pause after failures; one per body.
 #[derive(Debug, Clone, Default)]
@@ -53,9 +65,9 @@ impl Chord {
     }
 
     /// The factorization an iteration of a step of effective length `h` (s) may reuse, if the
-    /// rule allows one (`last_iteration`: the last iteration Newton is allowed).
-    pub(crate) fn factor_for(&self, h: f64, last_iteration: bool) -> Option<&Llt<usize, f64>> {
-        if self.paused || self.failed_this_step || last_iteration {
+    /// rule allows one (`within_budget`: see [`within_budget`]).
+    pub(crate) fn factor_for(&self, h: f64, within_budget: bool) -> Option<&Llt<usize, f64>> {
+        if self.paused || self.failed_this_step || !within_budget {
             return None;
         }
         self.factor
@@ -70,7 +82,8 @@ impl Chord {
     }
 
     /// Records a reused iteration that cut the out-of-balance force from `before` to `after`
-    /// (N): a failure if not by [`MAX_CONTRACTION`].
+    /// (N; zero when it met the tolerance): a failure if not to [`MAX_CONTRACTION`] times
+    /// `before`.
     pub(crate) fn record(&mut self, before: f64, after: f64) {
         if after <= MAX_CONTRACTION * before {
             return;
@@ -109,15 +122,28 @@ mod tests {
         Llt::try_new_with_symbolic(symbolic, matrix.as_ref(), Side::Lower).unwrap()
     }
 
+    /// Within the iteration budget.
+    const ALLOWED: bool = true;
+
     #[test]
-    fn a_factorization_is_reused_only_for_its_own_step_and_never_last() {
+    fn a_factorization_is_reused_only_for_its_own_step_and_within_budget() {
         let mut chord = Chord::default();
         chord.start_step();
-        assert!(chord.factor_for(0.01, false).is_none());
+        assert!(chord.factor_for(0.01, ALLOWED).is_none());
         chord.keep(factor(), 0.01);
-        assert!(chord.factor_for(0.01, false).is_some());
-        assert!(chord.factor_for(0.02, false).is_none());
-        assert!(chord.factor_for(0.01, true).is_none());
+        assert!(chord.factor_for(0.01, ALLOWED).is_some());
+        assert!(chord.factor_for(0.02, ALLOWED).is_none());
+        assert!(chord.factor_for(0.01, !ALLOWED).is_none());
+    }
+
+    #[test]
+    fn the_budget_leaves_room_for_contraction_and_one_exact_iteration() {
+        // A reduction of 5e3 takes four iterations at 0.1: five are needed, four are not enough.
+        assert!(within_budget(5e3, 5));
+        assert!(!within_budget(5e3, 4));
+        // The last iteration (or a single one) is always exact.
+        assert!(!within_budget(2.0, 1));
+        assert!(within_budget(2.0, 2));
     }
 
     #[test]
@@ -128,11 +154,11 @@ mod tests {
         let mut offered = Vec::new();
         for step in 0..40 {
             chord.start_step();
-            let reused = chord.factor_for(0.01, false).is_some();
+            let reused = chord.factor_for(0.01, ALLOWED).is_some();
             if reused {
                 offered.push(step);
                 chord.record(1.0, 0.5);
-                assert!(chord.factor_for(0.01, false).is_none());
+                assert!(chord.factor_for(0.01, ALLOWED).is_none());
             }
             chord.end_step(reused);
         }
@@ -144,7 +170,7 @@ mod tests {
         let mut offered = Vec::new();
         for (step, after) in [0.5, 0.5, 0.01, 0.5, 0.5, 0.5].into_iter().enumerate() {
             chord.start_step();
-            let reused = chord.factor_for(0.01, false).is_some();
+            let reused = chord.factor_for(0.01, ALLOWED).is_some();
             if reused {
                 offered.push(step);
                 chord.record(1.0, after);

@@ -238,6 +238,9 @@ pub(crate) struct Solution {
     pub(crate) fell_back: bool,
     /// The Cholesky factorization solved with, when the direct method was used.
     pub(crate) factor: Option<Llt<usize, f64>>,
+    /// Numeric Cholesky factorizations attempted (two when the exact tangent failed and the
+    /// projected one was factored).
+    pub(crate) factorizations: usize,
 }
 
 /// Assembles the tangent with `assemble(stiffness, project)` and solves `K u = rhs` by `method`,
@@ -259,13 +262,14 @@ pub(crate) fn solve_newton_system(
     assemble(stiffness, false);
     let (tolerance, max_iterations, fallback) = match method {
         Method::Direct => {
-            let (factor, projected) = factorize_direct(stiffness, iteration, assemble, false)?;
+            let direct = factorize_direct(stiffness, iteration, assemble, false)?;
             return Ok(Solution {
-                direction: solve(&factor, rhs),
+                direction: solve(&direct.factor, rhs),
                 cg_iterations: 0,
-                projected,
+                projected: direct.projected,
                 fell_back: false,
-                factor: Some(factor),
+                factorizations: direct.attempts,
+                factor: Some(direct.factor),
             });
         }
         Method::ConjugateGradient {
@@ -299,6 +303,7 @@ pub(crate) fn solve_newton_system(
                         projected,
                         fell_back: false,
                         factor: None,
+                        factorizations: 0,
                     });
                 }
                 break;
@@ -315,19 +320,28 @@ pub(crate) fn solve_newton_system(
             }
         }
     }
-    let (factor, projected) = factorize_direct(stiffness, iteration, assemble, projected)?;
+    let direct = factorize_direct(stiffness, iteration, assemble, projected)?;
     Ok(Solution {
-        direction: solve(&factor, rhs),
+        direction: solve(&direct.factor, rhs),
         cg_iterations,
-        projected,
+        projected: direct.projected,
         fell_back: true,
-        factor: Some(factor),
+        factorizations: direct.attempts,
+        factor: Some(direct.factor),
     })
 }
 
+/// A successful Cholesky factorization of the Newton system.
+struct DirectFactorization {
+    factor: Llt<usize, f64>,
+    /// Whether the tangent factored is the projected one.
+    projected: bool,
+    /// Factorizations attempted: 1, or 2 when the exact tangent failed first.
+    attempts: usize,
+}
+
 /// The Cholesky factorization of the assembled `stiffness`; if that fails and the tangent is not
-/// already `projected`, reassembles with projection and factorizes again. Returns the
-/// factorization and whether the tangent factored was the projected one.
+/// already `projected`, reassembles with projection and factorizes again.
 ///
 /// # Errors
 /// [`Error::IndefiniteStiffness`] if the (projected) tangent cannot be factored.
@@ -336,13 +350,21 @@ fn factorize_direct(
     iteration: usize,
     mut assemble: impl FnMut(&mut Stiffness, bool),
     projected: bool,
-) -> Result<(Llt<usize, f64>, bool), Error> {
+) -> Result<DirectFactorization, Error> {
     match factorize(stiffness, iteration) {
-        Ok(factor) => Ok((factor, projected)),
+        Ok(factor) => Ok(DirectFactorization {
+            factor,
+            projected,
+            attempts: 1,
+        }),
         Err(error) if projected => Err(error),
         Err(_) => {
             assemble(stiffness, true);
-            Ok((factorize(stiffness, iteration)?, true))
+            Ok(DirectFactorization {
+                factor: factorize(stiffness, iteration)?,
+                projected: true,
+                attempts: 2,
+            })
         }
     }
 }

@@ -36,7 +36,7 @@ pub(crate) fn descend(
     energy: impl Fn(&SoftBody) -> f64,
     mut residual_at: impl FnMut(&mut SoftBody) -> Vec<DVec3>,
 ) -> Option<(Vec<DVec3>, f64)> {
-    if let Some(accepted) = line_search(body, residual, energy_now, direction, &energy) {
+    if let Some(accepted) = line_search(body, residual, energy_now, direction, &energy, MIN_STEP) {
         return Some((residual_at(body), accepted));
     }
     let start = body.positions.clone();
@@ -59,17 +59,34 @@ pub(crate) fn descend(
 /// The smallest step fraction the searches try.
 const MIN_STEP: f64 = 1.0 / 1024.0;
 
+/// A Newton update along a direction expected to be nearly the Newton step (from an earlier
+/// tangent's factorization): the full step or half of it, whichever first satisfies the Armijo
+/// condition on `energy` from `energy_now` (J). Returns the new residual and energy, or `None`
+/// (positions unchanged) if neither does.
+pub(crate) fn step_along(
+    body: &mut SoftBody,
+    residual: &[DVec3],
+    energy_now: f64,
+    direction: &[DVec3],
+    energy: impl Fn(&SoftBody) -> f64,
+    mut residual_at: impl FnMut(&mut SoftBody) -> Vec<DVec3>,
+) -> Option<(Vec<DVec3>, f64)> {
+    let accepted = line_search(body, residual, energy_now, direction, energy, 0.5)?;
+    Some((residual_at(body), accepted))
+}
+
 /// Moves `body` along `direction` from its current positions, where `energy` (J) is `initial`
-/// and its gradient is `-residual` (N), by the largest step `α` in `1, 1/2, 1/4, …, 1/1024` that
-/// satisfies the Armijo condition, so that the energy decreases. Returns the energy there, or
-/// `None`, with the positions put back, if no such step exists (the direction no longer descends
-/// above round-off).
+/// and its gradient is `-residual` (N), by the largest step `α` in `1, 1/2, 1/4, …` down to
+/// `smallest` that satisfies the Armijo condition, so that the energy decreases. Returns the
+/// energy there, or `None`, with the positions put back, if no such step exists (the direction
+/// no longer descends above round-off).
 fn line_search(
     body: &mut SoftBody,
     residual: &[DVec3],
     initial: f64,
     direction: &[DVec3],
     energy: impl Fn(&SoftBody) -> f64,
+    smallest: f64,
 ) -> Option<f64> {
     const ARMIJO: f64 = 1e-4;
     let start = body.positions.clone();
@@ -83,7 +100,7 @@ fn line_search(
     // depend on where the coordinate origin is.)
     let round_off = 1e-12 * initial.abs();
     let mut alpha = 1.0;
-    while alpha >= MIN_STEP {
+    while alpha >= smallest {
         for ((x, x0), s) in body.positions.iter_mut().zip(&start).zip(direction) {
             *x = *x0 + *s * alpha;
         }

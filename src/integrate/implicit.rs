@@ -22,13 +22,13 @@ use super::check_step;
 use crate::Error;
 use crate::assembly::{Stiffness, solve};
 use crate::body::{PreviousStep, SoftBody};
-use crate::chord::Chord;
+use crate::chord::{self, Chord};
 use crate::damping::RayleighDamping;
 use crate::element::add_point_forces;
 use crate::element::deformation_gradient;
 use crate::linear_solver::{LinearSolver, Method, solve_newton_system};
 use crate::material::green_strain;
-use crate::newton::{check_tolerance, descend, norm};
+use crate::newton::{check_tolerance, descend, norm, step_along};
 use crate::{attachment, contact};
 use rapier3d::glamx::{DMat3, DVec3};
 
@@ -99,14 +99,19 @@ impl Default for ImplicitIntegrator {
 pub struct ImplicitReport {
     /// Substeps taken.
     pub substeps: u32,
-    /// Newton iterations over all substeps.
+    /// Newton iterations over all substeps, those that reused a factorization included.
     pub newton_iterations: usize,
     /// Conjugate gradient iterations over all substeps (zero when every system was solved by
     /// the direct method).
     pub linear_iterations: usize,
     /// Newton iterations that solved with an earlier factorization instead of assembling and
-    /// factoring the tangent (see [`ImplicitIntegrator::reuse_factorization`]).
+    /// factoring the tangent (see [`ImplicitIntegrator::reuse_factorization`]); included in
+    /// `newton_iterations`.
     pub reused_factorizations: usize,
+    /// Numeric Cholesky factorizations of the Newton system (two in an iteration whose exact
+    /// tangent failed to factor and whose projected tangent was factored; none for systems
+    /// solved by the conjugate gradient or with a reused factorization).
+    pub factorizations: usize,
     /// Newton iterations whose exact tangent was not positive definite (the Cholesky
     /// factorization failed or the conjugate gradient met negative curvature), so that the
     /// tangent with element stress tangents projected to be positive semi-definite was solved.
@@ -127,6 +132,8 @@ struct Outcome {
     linear_iterations: usize,
     /// Iterations that reused an earlier factorization.
     reused_factorizations: usize,
+    /// Numeric Cholesky factorizations.
+    factorizations: usize,
     /// Iterations that solved the projected tangent.
     projected_tangents: usize,
     /// Final relative residual.
@@ -192,6 +199,7 @@ impl ImplicitIntegrator {
             newton_iterations: 0,
             linear_iterations: 0,
             reused_factorizations: 0,
+            factorizations: 0,
             projected_tangents: 0,
             relative_residual: 0.0,
             converged: true,
@@ -213,6 +221,7 @@ impl ImplicitIntegrator {
                     iterations,
                     linear_iterations,
                     reused_factorizations,
+                    factorizations,
                     projected_tangents,
                     residual,
                     converged,
@@ -220,6 +229,7 @@ impl ImplicitIntegrator {
                     report.newton_iterations += iterations;
                     report.linear_iterations += linear_iterations;
                     report.reused_factorizations += reused_factorizations;
+                    report.factorizations += factorizations;
                     report.projected_tangents += projected_tangents;
                     report.relative_residual = report.relative_residual.max(residual);
                     report.converged &= converged;
@@ -306,6 +316,7 @@ impl ImplicitIntegrator {
             iterations: 0,
             linear_iterations: 0,
             reused_factorizations: 0,
+            factorizations: 0,
             projected_tangents: 0,
             residual: f64::NAN,
             converged: false,
@@ -335,32 +346,53 @@ impl ImplicitIntegrator {
                 return finish(solver, outcome);
             }
             history.push(relative);
-            let last_iteration = outcome.iterations + 1 == self.max_newton_iterations;
+            let remaining = self.max_newton_iterations - outcome.iterations;
             let reusable = (self.reuse_factorization && solver.method == Method::Direct)
-                .then(|| solver.chord.factor_for(start.h, last_iteration))
+                .then(|| {
+                    let budget = chord::within_budget(relative / self.tolerance, remaining);
+                    solver.chord.factor_for(start.h, budget)
+                })
                 .flatten();
-            let (direction, reused) = match reusable {
-                Some(factor) => (solve(factor, &residual), true),
-                None => (
-                    self.exact_direction(body, solver, start, &inertia, &residual, &mut outcome)?,
-                    false,
-                ),
-            };
             let energy = |body: &SoftBody| start.energy(body);
-            let next = descend(body, &residual, potential, &direction, energy, |body| {
-                start.residual(body)
-            });
+            let residual_at = |body: &mut SoftBody| start.residual(body);
+            let next = match reusable {
+                Some(factor) => {
+                    let direction = solve(factor, &residual);
+                    let next =
+                        step_along(body, &residual, potential, &direction, energy, residual_at);
+                    outcome.reused_factorizations += 1;
+                    // Converged counts as enough contraction; no descent as none.
+                    let after = next.as_ref().map_or(f64::INFINITY, |(next, _)| {
+                        let after = norm(next);
+                        if after <= self.tolerance * reference {
+                            0.0
+                        } else {
+                            after
+                        }
+                    });
+                    solver.chord.record(norm(&residual), after);
+                    if next.is_none() {
+                        // The exact tangent may still descend where an earlier one does not;
+                        // this iteration did not move, so it is not in the stall history.
+                        history.pop();
+                    }
+                    next.or(Some((residual.clone(), potential)))
+                }
+                None => {
+                    let direction = self.exact_direction(
+                        body,
+                        solver,
+                        start,
+                        &inertia,
+                        &residual,
+                        &mut outcome,
+                    )?;
+                    descend(body, &residual, potential, &direction, energy, residual_at)
+                }
+            };
             outcome.iterations += 1;
-            if reused {
-                outcome.reused_factorizations += 1;
-                // No descent at all counts as no contraction.
-                let after = next.as_ref().map_or(f64::INFINITY, |(next, _)| norm(next));
-                solver.chord.record(norm(&residual), after);
-            }
             match next {
                 Some((next, energy)) => (residual, potential) = (next, energy),
-                // The exact tangent may still descend where an earlier one does not.
-                None if reused => {}
                 None => return finish(solver, outcome),
             }
         }
@@ -388,6 +420,7 @@ impl ImplicitIntegrator {
             |stiffness, project| start.assemble(body, stiffness, inertia, project),
         )?;
         outcome.linear_iterations += solution.cg_iterations;
+        outcome.factorizations += solution.factorizations;
         outcome.projected_tangents += usize::from(solution.projected);
         if solution.fell_back {
             solver.method = Method::Direct;
