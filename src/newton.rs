@@ -23,21 +23,39 @@ pub(crate) fn norm(v: &[DVec3]) -> f64 {
     v.iter().map(|x| x.length_squared()).sum::<f64>().sqrt()
 }
 
+/// How far a Newton update searches along its direction.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Search {
+    /// Steps `1, 1/2, …, 1/1024` on the energy; then, when the energy's decrease is lost in its
+    /// round-off (close to the solution), the largest step of the same sequence that lowers the
+    /// out-of-balance force.
+    Thorough,
+    /// The full step or half of it, on the energy only: for a direction expected to be nearly
+    /// the Newton step (from an earlier tangent's factorization).
+    Short,
+}
+
 /// One Newton update of `body`'s positions along `direction` from where the minimized energy
-/// is `energy_now` (J): the line search below, or, when the energy's decrease is lost in its
-/// round-off (close to the solution), the largest step of the same sequence that lowers the
-/// out-of-balance force. Returns the new residual and energy, or `None` (positions unchanged) if
-/// neither descends.
+/// is `energy_now` (J), searching as `search` says. Returns the new residual and energy, or
+/// `None` (positions unchanged) if no step descends.
 pub(crate) fn descend(
     body: &mut SoftBody,
     residual: &[DVec3],
     energy_now: f64,
     direction: &[DVec3],
+    search: Search,
     energy: impl Fn(&SoftBody) -> f64,
     mut residual_at: impl FnMut(&mut SoftBody) -> Vec<DVec3>,
 ) -> Option<(Vec<DVec3>, f64)> {
-    if let Some(accepted) = line_search(body, residual, energy_now, direction, &energy, MIN_STEP) {
+    let smallest = match search {
+        Search::Thorough => MIN_STEP,
+        Search::Short => 0.5,
+    };
+    if let Some(accepted) = line_search(body, residual, energy_now, direction, &energy, smallest) {
         return Some((residual_at(body), accepted));
+    }
+    if search == Search::Short {
+        return None;
     }
     let start = body.positions.clone();
     let current = norm(residual);
@@ -56,24 +74,8 @@ pub(crate) fn descend(
     None
 }
 
-/// The smallest step fraction the searches try.
+/// The smallest step fraction the thorough search tries.
 const MIN_STEP: f64 = 1.0 / 1024.0;
-
-/// A Newton update along a direction expected to be nearly the Newton step (from an earlier
-/// tangent's factorization): the full step or half of it, whichever first satisfies the Armijo
-/// condition on `energy` from `energy_now` (J). Returns the new residual and energy, or `None`
-/// (positions unchanged) if neither does.
-pub(crate) fn step_along(
-    body: &mut SoftBody,
-    residual: &[DVec3],
-    energy_now: f64,
-    direction: &[DVec3],
-    energy: impl Fn(&SoftBody) -> f64,
-    mut residual_at: impl FnMut(&mut SoftBody) -> Vec<DVec3>,
-) -> Option<(Vec<DVec3>, f64)> {
-    let accepted = line_search(body, residual, energy_now, direction, energy, 0.5)?;
-    Some((residual_at(body), accepted))
-}
 
 /// Moves `body` along `direction` from its current positions, where `energy` (J) is `initial`
 /// and its gradient is `-residual` (N), by the largest step `α` in `1, 1/2, 1/4, …` down to

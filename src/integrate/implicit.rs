@@ -28,7 +28,7 @@ use crate::element::add_point_forces;
 use crate::element::deformation_gradient;
 use crate::linear_solver::{LinearSolver, Method, solve_newton_system};
 use crate::material::green_strain;
-use crate::newton::{check_tolerance, descend, norm, step_along};
+use crate::newton::{Search, check_tolerance, descend, norm};
 use crate::{attachment, contact};
 use rapier3d::glamx::{DMat3, DVec3};
 
@@ -353,43 +353,42 @@ impl ImplicitIntegrator {
                     solver.chord.factor_for(start.h, budget)
                 })
                 .flatten();
-            let energy = |body: &SoftBody| start.energy(body);
-            let residual_at = |body: &mut SoftBody| start.residual(body);
-            let next = match reusable {
-                Some(factor) => {
-                    let direction = solve(factor, &residual);
-                    let next =
-                        step_along(body, &residual, potential, &direction, energy, residual_at);
-                    outcome.reused_factorizations += 1;
-                    // Converged counts as enough contraction; no descent as none.
-                    let after = next.as_ref().map_or(f64::INFINITY, |(next, _)| {
-                        let after = norm(next);
-                        if after <= self.tolerance * reference {
-                            0.0
-                        } else {
-                            after
-                        }
-                    });
-                    solver.chord.record(norm(&residual), after);
-                    if next.is_none() {
-                        // The exact tangent may still descend where an earlier one does not;
-                        // this iteration did not move, so it is not in the stall history.
-                        history.pop();
-                    }
-                    next.or(Some((residual.clone(), potential)))
-                }
-                None => {
-                    let direction = self.exact_direction(
-                        body,
-                        solver,
-                        start,
-                        &inertia,
-                        &residual,
-                        &mut outcome,
-                    )?;
-                    descend(body, &residual, potential, &direction, energy, residual_at)
-                }
+            let (direction, search) = match reusable {
+                Some(factor) => (solve(factor, &residual), Search::Short),
+                None => (
+                    self.exact_direction(body, solver, start, &inertia, &residual, &mut outcome)?,
+                    Search::Thorough,
+                ),
             };
+            let energy = |body: &SoftBody| start.energy(body);
+            let mut next = descend(
+                body,
+                &residual,
+                potential,
+                &direction,
+                search,
+                energy,
+                |body| start.residual(body),
+            );
+            if search == Search::Short {
+                outcome.reused_factorizations += 1;
+                // Converged counts as enough contraction; no descent as none.
+                let after = next.as_ref().map_or(f64::INFINITY, |(next, _)| {
+                    let after = norm(next);
+                    if after <= self.tolerance * reference {
+                        0.0
+                    } else {
+                        after
+                    }
+                });
+                solver.chord.record(norm(&residual), after);
+                if next.is_none() {
+                    // The exact tangent may still descend where an earlier one does not; this
+                    // iteration did not move, so it leaves the stall history.
+                    history.pop();
+                    next = Some((residual.clone(), potential));
+                }
+            }
             outcome.iterations += 1;
             match next {
                 Some((next, energy)) => (residual, potential) = (next, energy),

@@ -10,7 +10,7 @@ use crate::Error;
 use crate::assembly::{Stiffness, factorize, solve};
 use crate::body::SoftBody;
 use crate::linear_solver::{Method, solve_newton_system};
-use crate::newton::{check_tolerance, descend, norm};
+use crate::newton::{Search, check_tolerance, descend, norm};
 use rapier3d::glamx::{DMat3, DVec3};
 
 /// The largest relative residual accepted as round-off when Newton stops reducing it.
@@ -127,9 +127,15 @@ fn newton(
         )?
         .direction;
         let energy = |body: &SoftBody| potential_energy(body, &load);
-        match descend(body, &residual, potential, &step, energy, |body| {
-            out_of_balance(body, &load)
-        }) {
+        match descend(
+            body,
+            &residual,
+            potential,
+            &step,
+            Search::Thorough,
+            energy,
+            |body| out_of_balance(body, &load),
+        ) {
             Some((next, energy)) => (residual, potential) = (next, energy),
             // No descent left above round-off: accept a tiny residual, refuse anything else.
             None if relative <= ROUND_OFF_CEILING => {
