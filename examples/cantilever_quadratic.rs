@@ -438,99 +438,23 @@ fn main() -> Result<(), Error> {
     let mut best: Option<(Beam, &str, f64, Dynamic)> = None;
     let per_element = VolumetricTreatment::PerElement;
     let averaged = VolumetricTreatment::ElementAverage;
+    // One row per case: elements, cells, scheme, volumetric treatment, factorization reuse.
+    #[rustfmt::skip]
     let dynamic_cases = [
-        (
-            Kind::LinearTet,
-            [20, 2, 2],
-            Stepper::BackwardEuler,
-            per_element,
-            true,
-        ),
-        (
-            Kind::LinearTet,
-            [40, 4, 4],
-            Stepper::BackwardEuler,
-            per_element,
-            true,
-        ),
-        (
-            Kind::QuadraticTet,
-            [5, 1, 1],
-            Stepper::BackwardEuler,
-            per_element,
-            true,
-        ),
-        (
-            Kind::QuadraticTet,
-            [10, 1, 1],
-            Stepper::BackwardEuler,
-            per_element,
-            true,
-        ),
-        (
-            Kind::QuadraticTet,
-            [10, 1, 1],
-            Stepper::BackwardEuler,
-            per_element,
-            false,
-        ),
-        (
-            Kind::QuadraticTet,
-            [10, 1, 1],
-            Stepper::Bdf2,
-            per_element,
-            true,
-        ),
-        (
-            Kind::QuadraticTet,
-            [20, 2, 2],
-            Stepper::BackwardEuler,
-            per_element,
-            true,
-        ),
-        (
-            Kind::QuadraticTet,
-            [20, 1, 1],
-            Stepper::BackwardEuler,
-            per_element,
-            true,
-        ),
-        (
-            Kind::QuadraticHex,
-            [4, 1, 1],
-            Stepper::BackwardEuler,
-            averaged,
-            true,
-        ),
-        (
-            Kind::QuadraticHex,
-            [5, 1, 1],
-            Stepper::BackwardEuler,
-            per_element,
-            true,
-        ),
-        (
-            Kind::QuadraticHex,
-            [5, 1, 1],
-            Stepper::BackwardEuler,
-            averaged,
-            true,
-        ),
-        (
-            Kind::QuadraticHex,
-            [5, 1, 1],
-            Stepper::BackwardEuler,
-            averaged,
-            false,
-        ),
+        (Kind::LinearTet, [20, 2, 2], Stepper::BackwardEuler, per_element, true),
+        (Kind::LinearTet, [40, 4, 4], Stepper::BackwardEuler, per_element, true),
+        (Kind::QuadraticTet, [5, 1, 1], Stepper::BackwardEuler, per_element, true),
+        (Kind::QuadraticTet, [10, 1, 1], Stepper::BackwardEuler, per_element, true),
+        (Kind::QuadraticTet, [10, 1, 1], Stepper::BackwardEuler, per_element, false),
+        (Kind::QuadraticTet, [10, 1, 1], Stepper::Bdf2, per_element, true),
+        (Kind::QuadraticTet, [20, 2, 2], Stepper::BackwardEuler, per_element, true),
+        (Kind::QuadraticTet, [20, 1, 1], Stepper::BackwardEuler, per_element, true),
+        (Kind::QuadraticHex, [4, 1, 1], Stepper::BackwardEuler, averaged, true),
+        (Kind::QuadraticHex, [5, 1, 1], Stepper::BackwardEuler, per_element, true),
+        (Kind::QuadraticHex, [5, 1, 1], Stepper::BackwardEuler, averaged, true),
+        (Kind::QuadraticHex, [5, 1, 1], Stepper::BackwardEuler, averaged, false),
         (Kind::QuadraticHex, [5, 1, 1], Stepper::Bdf2, averaged, true),
-        (
-            Kind::QuadraticHex,
-            [10, 1, 1],
-            Stepper::BackwardEuler,
-            averaged,
-            true,
-        ),
+        (Kind::QuadraticHex, [10, 1, 1], Stepper::BackwardEuler, averaged, true),
     ];
     for (kind, cells, stepper, volumetric, reuse) in dynamic_cases {
         for model in [MaterialModel::Linear, MaterialModel::Corotated] {
