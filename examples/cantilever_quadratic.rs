@@ -330,74 +330,25 @@ fn main() -> Result<(), Error> {
         "{:<18} {:<15} {:>6} {:>9} {:>9} {:>9} {:>9} {:>9}",
         "elements", "volumetric", "dofs", "nu=0", "nu=0.3", "nu=0.45", "nu=0.49", "nu=0.499"
     );
-    for (kind, cells, volumetric) in [
+    // One row per case: elements, cells, volumetric treatment.
+    #[rustfmt::skip]
+    let volumetric_cases = [
         (Kind::LinearTet, [40, 4, 4], VolumetricTreatment::PerElement),
-        (
-            Kind::LinearTet,
-            [40, 4, 4],
-            VolumetricTreatment::NodalAverage,
-        ),
-        (
-            Kind::QuadraticTet,
-            [10, 1, 1],
-            VolumetricTreatment::PerElement,
-        ),
-        (
-            Kind::QuadraticTet,
-            [10, 1, 1],
-            VolumetricTreatment::ElementAverage,
-        ),
-        (
-            Kind::QuadraticTet,
-            [20, 1, 1],
-            VolumetricTreatment::PerElement,
-        ),
-        (
-            Kind::QuadraticTet,
-            [20, 1, 1],
-            VolumetricTreatment::ElementAverage,
-        ),
-        (
-            Kind::QuadraticTet,
-            [10, 2, 2],
-            VolumetricTreatment::PerElement,
-        ),
-        (
-            Kind::QuadraticTet,
-            [10, 2, 2],
-            VolumetricTreatment::ElementAverage,
-        ),
-        (
-            Kind::QuadraticTet,
-            [20, 2, 2],
-            VolumetricTreatment::PerElement,
-        ),
-        (
-            Kind::QuadraticTet,
-            [20, 2, 2],
-            VolumetricTreatment::ElementAverage,
-        ),
-        (
-            Kind::QuadraticHex,
-            [5, 1, 1],
-            VolumetricTreatment::PerElement,
-        ),
-        (
-            Kind::QuadraticHex,
-            [5, 1, 1],
-            VolumetricTreatment::ElementAverage,
-        ),
-        (
-            Kind::QuadraticHex,
-            [10, 1, 1],
-            VolumetricTreatment::ElementAverage,
-        ),
-        (
-            Kind::QuadraticHex,
-            [20, 2, 2],
-            VolumetricTreatment::ElementAverage,
-        ),
-    ] {
+        (Kind::LinearTet, [40, 4, 4], VolumetricTreatment::NodalAverage),
+        (Kind::QuadraticTet, [10, 1, 1], VolumetricTreatment::PerElement),
+        (Kind::QuadraticTet, [10, 1, 1], VolumetricTreatment::ElementAverage),
+        (Kind::QuadraticTet, [20, 1, 1], VolumetricTreatment::PerElement),
+        (Kind::QuadraticTet, [20, 1, 1], VolumetricTreatment::ElementAverage),
+        (Kind::QuadraticTet, [10, 2, 2], VolumetricTreatment::PerElement),
+        (Kind::QuadraticTet, [10, 2, 2], VolumetricTreatment::ElementAverage),
+        (Kind::QuadraticTet, [20, 2, 2], VolumetricTreatment::PerElement),
+        (Kind::QuadraticTet, [20, 2, 2], VolumetricTreatment::ElementAverage),
+        (Kind::QuadraticHex, [5, 1, 1], VolumetricTreatment::PerElement),
+        (Kind::QuadraticHex, [5, 1, 1], VolumetricTreatment::ElementAverage),
+        (Kind::QuadraticHex, [10, 1, 1], VolumetricTreatment::ElementAverage),
+        (Kind::QuadraticHex, [20, 2, 2], VolumetricTreatment::ElementAverage),
+    ];
+    for (kind, cells, volumetric) in volumetric_cases {
         let beam = |nu| Beam {
             kind,
             cells,

@@ -13,7 +13,7 @@
 
 mod common;
 
-use common::{Lcg, MODELS, OBJECTIVE_MODELS, highest_angular_frequency};
+use common::{MODELS, OBJECTIVE_MODELS, highest_angular_frequency};
 use rapier_fvm::element::ElementShape;
 use rapier_fvm::prelude::*;
 use rapier_fvm::statics::{self, StaticSettings};
@@ -270,20 +270,7 @@ fn explicit_steps_of_hexahedra_are_stable() {
     };
     let omega_max = highest_angular_frequency(&mut build(MaterialModel::Linear));
     let mut body = build(MaterialModel::Corotated);
-    let mut rng = Lcg(5);
-    for x in body.positions_mut() {
-        *x += rng.vector() * 0.005;
-    }
-    let initial = body.elastic_energy() + body.kinetic_energy();
-    let (mut worst, mut longest): (f64, f64) = (0.0, 0.0);
-    for _ in 0..120 {
-        let report = SymplecticEuler::default()
-            .step(&mut body, 1.0 / 60.0, DVec3::ZERO)
-            .unwrap();
-        longest = longest.max(1.0 / 60.0 / f64::from(report.substeps));
-        let energy = body.elastic_energy() + body.kinetic_energy();
-        worst = worst.max((energy / initial - 1.0).abs());
-    }
+    let (worst, longest) = common::explicit_energy_change(&mut body, 5, 0.005, 120);
     let bound = omega_max * longest / 2.0;
     println!(
         "explicit hex cage: worst energy change {:.2}% over 2 s, bound ω_max h/2 = {:.2}%",

@@ -191,19 +191,7 @@ fn explicit_steps_of_quadratic_elements_are_stable() {
     let mut body = SoftBodyBuilder::quadratic(quadratic, material)
         .build()
         .unwrap();
-    let mut rng = Lcg(9);
-    for x in body.positions_mut() {
-        *x += rng.vector() * 0.005;
-    }
-    let initial = body.elastic_energy() + body.kinetic_energy();
-    let mut worst: f64 = 0.0;
-    for _ in 0..30 {
-        SymplecticEuler::default()
-            .step(&mut body, 1.0 / 60.0, DVec3::ZERO)
-            .unwrap();
-        let energy = body.elastic_energy() + body.kinetic_energy();
-        worst = worst.max((energy / initial - 1.0).abs());
-    }
+    let (worst, _) = common::explicit_energy_change(&mut body, 9, 0.005, 30);
     println!(
         "explicit quadratic: worst energy drift {:.2}%",
         100.0 * worst
