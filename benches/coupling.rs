@@ -2,7 +2,7 @@
 //!
 //! - (a) `soft_cube_alone`: the drop scene's soft cube (10 cm, stable Neo-Hookean, E = 1e5 Pa,
 //!   ν = 0.3, 1000 kg/m³, 6 x 6 x 6 cells, Rayleigh damping 2e-3 s, as in `examples/drop.rs`)
-//!   falling freely, stepped by the world's automatic integrator `coupling_substeps` times per
+//!   falling freely, stepped by the world's automatic integrator `coupling.substeps` times per
 //!   frame at the coupling substep length: the soft step alone, without contacts or rapier.
 //! - (b) `soft_cube_on_ground`: the same cube resting on a fixed half-space ground (friction 0.5)
 //!   in an [`FvmWorld`]: contact detection, contacts enforced, and rapier's sub-cycled step.
@@ -35,11 +35,11 @@ const SETTLING_FRAMES: usize = 60;
 
 /// A damped rubber cube of side `side` (m), `cells` cubes a side, Young's modulus `young` (Pa),
 /// its centre at `centre` (m).
-fn soft_cube(side: f64, cells: usize, young: f64, centre: DVec3) -> SoftBody {
+fn soft_cube(side: f64, cells: usize, young: f64, centre: DVec3) -> DeformableBody {
     let rubber =
         Material::new(MaterialModel::StableNeoHookean, young, 0.3, 1000.0).expect("valid material");
     let mesh = mesh::cuboid(DVec3::splat(side / 2.0), [cells; 3]).expect("valid generator input");
-    SoftBodyBuilder::new(mesh, rubber)
+    DeformableBodyBuilder::new(mesh, rubber)
         .damping(
             RayleighDamping::stiffness_proportional(2e-3, rubber.lame()).expect("valid damping"),
         )
@@ -49,7 +49,7 @@ fn soft_cube(side: f64, cells: usize, young: f64, centre: DVec3) -> SoftBody {
 }
 
 /// The drop scene's cube with its centre at height `y` (m).
-fn drop_cube(y: f64) -> SoftBody {
+fn drop_cube(y: f64) -> DeformableBody {
     soft_cube(0.1, 6, 1e5, DVec3::new(0.0, y, 0.0))
 }
 
@@ -70,7 +70,7 @@ fn step(world: &mut FvmWorld) {
 }
 
 /// `examples/grasp.rs`'s cube (5 cm) with its centre at height `y` (m).
-fn grasp_cube(y: f64) -> SoftBody {
+fn grasp_cube(y: f64) -> DeformableBody {
     let mut cube = soft_cube(0.05, 4, 1e5, DVec3::new(0.0, y, 0.0));
     cube.friction = 1.0;
     cube
@@ -147,11 +147,11 @@ fn coupling_frame(c: &mut Criterion) {
     // (a) The cube alone, stepped as the world steps its soft bodies; and the grasp's cube.
     let mut alone = drop_cube(0.55);
     let mut grasp_alone = grasp_cube(0.5);
-    let integrator = on_ground.integrator;
-    let substeps = on_ground.coupling_substeps;
+    let integrator = on_ground.coupling.integrator;
+    let substeps = on_ground.coupling.substeps;
     let h = f64::from(on_ground.physics.integration_parameters.dt) / f64::from(substeps);
     let gravity = on_ground.physics.gravity.as_dvec3();
-    let frame_alone = |body: &mut SoftBody| {
+    let frame_alone = |body: &mut DeformableBody| {
         for _ in 0..substeps {
             integrator.step(body, h, gravity).expect("soft step");
         }

@@ -10,12 +10,12 @@ use rapier_fvm::prelude::*;
 use std::hint::black_box;
 
 /// A deformed, moving 40^3-cube box so every branch of the kernel does real work.
-fn box_body(model: MaterialModel, treatment: VolumetricTreatment) -> SoftBody {
+fn box_body(model: MaterialModel, treatment: VolumetricTreatment) -> DeformableBody {
     let mesh = mesh::cuboid(DVec3::splat(0.2), [40, 40, 40]).expect("valid generator input");
     let material = Material::new(model, 1e6, 0.3, 1000.0).expect("valid material");
     let damping =
         RayleighDamping::stiffness_proportional(1e-3, material.lame()).expect("valid damping");
-    let mut body = SoftBodyBuilder::new(mesh, material)
+    let mut body = DeformableBodyBuilder::new(mesh, material)
         .damping(damping)
         .volumetric(treatment)
         .build()
@@ -70,7 +70,7 @@ fn quadratic_kernel(c: &mut Criterion) {
         let material = Material::new(model, 1e6, 0.3, 1000.0).expect("valid material");
         let damping =
             RayleighDamping::stiffness_proportional(1e-3, material.lame()).expect("valid damping");
-        let mut body = SoftBodyBuilder::quadratic(quadratic.clone(), material)
+        let mut body = DeformableBodyBuilder::quadratic(quadratic.clone(), material)
             .damping(damping)
             .build()
             .expect("valid body");

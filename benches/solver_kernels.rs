@@ -23,13 +23,13 @@ use std::hint::black_box;
 const GRAVITY: DVec3 = DVec3::new(0.0, -9.81, 0.0);
 
 /// The reference beam at rest, its sparsity pattern and symbolic factorization already built.
-fn beam() -> SoftBody {
+fn beam() -> DeformableBody {
     let half = DVec3::new(0.5, 0.05, 0.05);
     let mesh = mesh::cuboid(half, [20, 4, 4]).expect("valid generator input");
     let clamped = mesh.nodes_where(|p| p.x <= -half.x + 1e-9);
     let material =
         Material::new(MaterialModel::StableNeoHookean, 1e9, 0.3, 1000.0).expect("valid material");
-    let mut body = SoftBodyBuilder::new(mesh, material)
+    let mut body = DeformableBodyBuilder::new(mesh, material)
         .translation(DVec3::new(half.x, 0.0, 0.0))
         .pinned_nodes(clamped)
         .build()
@@ -111,7 +111,7 @@ fn contact_detection(c: &mut Criterion) {
         .flatten()
         .collect::<std::collections::BTreeSet<_>>()
         .len();
-    let mut body = SoftBodyBuilder::new(mesh, material)
+    let mut body = DeformableBodyBuilder::new(mesh, material)
         .translation(DVec3::new(0.0, 0.1, 0.0))
         .build()
         .expect("valid body");

@@ -29,13 +29,13 @@ fn timoshenko() -> f64 {
 }
 
 /// The clamped beam along +x with `cells` cubes, and the node nearest the free end's centre.
-fn beam(cells: [usize; 3], model: MaterialModel) -> Result<(SoftBody, usize), Error> {
+fn beam(cells: [usize; 3], model: MaterialModel) -> Result<(DeformableBody, usize), Error> {
     let half = DVec3::new(LENGTH / 2.0, SIDE / 2.0, SIDE / 2.0);
     let mesh = mesh::cuboid(half, cells)?;
     let clamped = mesh.nodes_where(|p| p.x <= -half.x + 1e-9);
     let tip = mesh.nearest_node(DVec3::new(half.x, 0.0, 0.0)) as usize;
     let material = Material::new(model, YOUNG, POISSON, DENSITY)?;
-    let body = SoftBodyBuilder::new(mesh, material)
+    let body = DeformableBodyBuilder::new(mesh, material)
         .translation(DVec3::new(half.x, 0.0, 0.0))
         .pinned_nodes(clamped)
         .build()?;

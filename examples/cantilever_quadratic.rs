@@ -91,7 +91,7 @@ impl Beam {
     }
 
     /// The clamped beam along +x and the nodes of its free face.
-    fn build(&self, damping: Option<f64>) -> Result<(SoftBody, Vec<usize>), Error> {
+    fn build(&self, damping: Option<f64>) -> Result<(DeformableBody, Vec<usize>), Error> {
         let half = DVec3::new(LENGTH / 2.0, SIDE / 2.0, SIDE / 2.0);
         let linear = mesh::cuboid(half, self.cells)?;
         let material = Material::new(self.model, YOUNG, self.nu, DENSITY)?;
@@ -99,17 +99,17 @@ impl Beam {
         let mut builder = match self.kind {
             Kind::LinearTet => {
                 let pins = linear.nodes_where(clamped);
-                SoftBodyBuilder::new(linear, material).pinned_nodes(pins)
+                DeformableBodyBuilder::new(linear, material).pinned_nodes(pins)
             }
             Kind::QuadraticTet => {
                 let quadratic = mesh::QuadraticTetMesh::from_linear(&linear)?;
                 let pins = quadratic.nodes_where(clamped);
-                SoftBodyBuilder::quadratic(quadratic, material).pinned_nodes(pins)
+                DeformableBodyBuilder::quadratic(quadratic, material).pinned_nodes(pins)
             }
             Kind::QuadraticHex => {
                 let cage = mesh::QuadraticHexMesh::cuboid(half, self.cells)?;
                 let pins = cage.nodes_where(clamped);
-                SoftBodyBuilder::quadratic_hex(cage, material).pinned_nodes(pins)
+                DeformableBodyBuilder::quadratic_hex(cage, material).pinned_nodes(pins)
             }
         };
         if let Some(beta) = damping {
@@ -139,12 +139,12 @@ fn volumetric_label(treatment: VolumetricTreatment) -> &'static str {
 }
 
 /// Mean height of the tip nodes (m).
-fn tip_height(body: &SoftBody, tip: &[usize]) -> f64 {
+fn tip_height(body: &DeformableBody, tip: &[usize]) -> f64 {
     tip.iter().map(|&n| body.positions()[n].y).sum::<f64>() / tip.len() as f64
 }
 
 /// Free degrees of freedom.
-fn dofs(body: &SoftBody) -> usize {
+fn dofs(body: &DeformableBody) -> usize {
     3 * (0..body.node_count())
         .filter(|&n| !body.is_pinned(n))
         .count()

@@ -16,9 +16,9 @@ use std::time::Instant;
 
 const FRAMES: usize = 120;
 
-fn cube() -> Result<SoftBody, Error> {
+fn cube() -> Result<DeformableBody, Error> {
     let rubber = Material::new(MaterialModel::StableNeoHookean, 1e5, 0.3, 1000.0)?;
-    SoftBodyBuilder::new(mesh::cuboid(DVec3::splat(0.05), [6, 6, 6])?, rubber)
+    DeformableBodyBuilder::new(mesh::cuboid(DVec3::splat(0.05), [6, 6, 6])?, rubber)
         .damping(RayleighDamping::stiffness_proportional(
             2e-3,
             rubber.lame(),
@@ -73,10 +73,10 @@ fn main() -> Result<(), Error> {
     // The same body, same frames and integrator, falling freely: the soft step alone.
     let mut alone = cube()?;
     let gravity = DVec3::new(0.0, -9.81, 0.0);
-    let h = 1.0 / 60.0 / f64::from(world.coupling_substeps);
+    let h = 1.0 / 60.0 / f64::from(world.coupling.substeps);
     let start = Instant::now();
-    for _ in 0..FRAMES * world.coupling_substeps as usize {
-        world.integrator.step(&mut alone, h, gravity)?;
+    for _ in 0..FRAMES * world.coupling.substeps as usize {
+        world.coupling.integrator.step(&mut alone, h, gravity)?;
     }
     let alone_ms = start.elapsed().as_secs_f64() * 1e3 / FRAMES as f64;
     let body = &world.soft_bodies[handle];
@@ -84,7 +84,7 @@ fn main() -> Result<(), Error> {
     println!(
         "deepest {:.3} mm (margin {} mm); rests with its centre at {:.3} mm; {:.2} ms/frame coupled, {:.2} ms/frame alone ({:.2}x)",
         deepest * 1e3,
-        world.contact.margin * 1e3,
+        world.coupling.contact.margin * 1e3,
         rest * 1e3,
         coupled_ms,
         alone_ms,

@@ -86,7 +86,7 @@ fn timoshenko(young: f64, poisson: f64) -> f64 {
 }
 
 /// The body of `scene`, and the node whose deflection beam theory predicts (cantilever only).
-fn build(scene: Scene, young: f64, poisson: f64) -> Result<(SoftBody, Option<usize>), Error> {
+fn build(scene: Scene, young: f64, poisson: f64) -> Result<(DeformableBody, Option<usize>), Error> {
     let material = Material::new(MaterialModel::StableNeoHookean, young, poisson, 1000.0)?;
     match scene {
         Scene::Cantilever => {
@@ -94,7 +94,7 @@ fn build(scene: Scene, young: f64, poisson: f64) -> Result<(SoftBody, Option<usi
             let mesh = mesh::cuboid(half, [20, 2, 2])?;
             let clamped = mesh.nodes_where(|p| p.x <= -half.x + 1e-9);
             let tip = mesh.nearest_node(DVec3::new(half.x, 0.0, 0.0)) as usize;
-            let body = SoftBodyBuilder::new(mesh, material)
+            let body = DeformableBodyBuilder::new(mesh, material)
                 .translation(DVec3::new(half.x, 0.0, 0.0))
                 .pinned_nodes(clamped)
                 .build()?;
@@ -102,7 +102,7 @@ fn build(scene: Scene, young: f64, poisson: f64) -> Result<(SoftBody, Option<usi
         }
         Scene::DroppedCube => {
             let mesh = mesh::cuboid(DVec3::splat(0.05), [4, 4, 4])?;
-            let body = SoftBodyBuilder::new(mesh, material)
+            let body = DeformableBodyBuilder::new(mesh, material)
                 .translation(DVec3::new(0.0, 0.051, 0.0))
                 .linvel(DVec3::new(0.0, -(2.0 * 9.81 * 0.5f64).sqrt(), 0.0))
                 .build()?;
@@ -146,7 +146,7 @@ pub fn run_case(scene: Scene, young: f64, poisson: f64, frame_dt: f64, frames: u
         Scene::Cantilever => ColliderSet::new(),
         Scene::DroppedCube => ground(),
     };
-    let energy = |b: &SoftBody| {
+    let energy = |b: &DeformableBody| {
         b.kinetic_energy() + b.elastic_energy() + b.gravity_potential_energy(gravity)
     };
     let initial = energy(&body);

@@ -102,7 +102,7 @@ fn main() -> Result<(), Error> {
         None,
     );
     let rubber = Material::new(MaterialModel::StableNeoHookean, 1e5, 0.3, 1000.0)?;
-    let cube = SoftBodyBuilder::new(mesh::cuboid(DVec3::splat(HALF), [4; 3])?, rubber)
+    let cube = DeformableBodyBuilder::new(mesh::cuboid(DVec3::splat(HALF), [4; 3])?, rubber)
         .damping(RayleighDamping::stiffness_proportional(
             2e-3,
             rubber.lame(),
@@ -128,7 +128,7 @@ fn main() -> Result<(), Error> {
     let dt = f64::from(world.physics.integration_parameters.dt);
     let g = world.physics.gravity.as_dvec3().length();
     let weight = world.soft_bodies[cube].total_mass() * g;
-    let margin = world.contact.margin;
+    let margin = world.coupling.contact.margin;
 
     println!(
         "{:>6} {:>7} {:>12} {:>12} {:>13} {:>12} {:>9} {:>10}",

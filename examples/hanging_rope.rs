@@ -1,6 +1,6 @@
 //! A ball hanging from a soft rope, swinging: a 0.5 m rope (1 x 1 cm, 2 x 40 x 2 cells, stable
 //! Neo-Hookean, E = 1e6 Pa, ν = 0.3, 1000 kg/m³, Rayleigh damping 0.01 s) clamped at the top,
-//! with a 1 kg rigid ball (r = 5 cm) glued 1 cm below its end by [`SoftBody::attach`], released
+//! with a 1 kg rigid ball (r = 5 cm) glued 1 cm below its end by [`DeformableBody::attach`], released
 //! 5° from the vertical in an [`FvmWorld`] at 60 frames per second: how to hang a rigid body from
 //! a soft one, and whether the pair swings as the compound pendulum it is.
 //!
@@ -36,7 +36,7 @@ fn main() -> Result<(), Error> {
     let mesh = mesh::cuboid(DVec3::new(0.005, LENGTH / 2.0, 0.005), [2, 40, 2])?;
     let top = mesh.nodes_where(|p| p.y >= LENGTH / 2.0 - 1e-9);
     let bottom = mesh.nodes_where(|p| p.y <= -LENGTH / 2.0 + 1e-9);
-    let rope = SoftBodyBuilder::new(mesh, material)
+    let rope = DeformableBodyBuilder::new(mesh, material)
         .damping(RayleighDamping::stiffness_proportional(
             0.01,
             material.lame(),

@@ -9,12 +9,12 @@
 use rapier_fvm::prelude::*;
 use std::time::Instant;
 
-fn beam(cells: [usize; 3], young: f64) -> Result<SoftBody, Error> {
+fn beam(cells: [usize; 3], young: f64) -> Result<DeformableBody, Error> {
     let half = DVec3::new(0.5, 0.05, 0.05);
     let mesh = mesh::cuboid(half, cells)?;
     let clamped = mesh.nodes_where(|p| p.x <= -half.x + 1e-9);
     let material = Material::new(MaterialModel::StableNeoHookean, young, 0.3, 1000.0)?;
-    SoftBodyBuilder::new(mesh, material)
+    DeformableBodyBuilder::new(mesh, material)
         .translation(DVec3::new(half.x, 0.0, 0.0))
         .pinned_nodes(clamped)
         .build()

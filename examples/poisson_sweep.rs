@@ -41,7 +41,7 @@ fn tip_error(
     let clamped = mesh.nodes_where(|p| p.x <= -half.x + 1e-9);
     let tip = mesh.nearest_node(DVec3::new(half.x, 0.0, 0.0)) as usize;
     let material = Material::new(model, YOUNG, poisson, 1000.0)?;
-    let mut body = SoftBodyBuilder::new(mesh, material)
+    let mut body = DeformableBodyBuilder::new(mesh, material)
         .translation(DVec3::new(half.x, 0.0, 0.0))
         .pinned_nodes(clamped)
         .volumetric(treatment)

@@ -45,7 +45,7 @@ fn main() -> Result<(), Error> {
         None,
     );
     let rubber = Material::new(MaterialModel::StableNeoHookean, 1e6, 0.3, 1000.0)?;
-    let block = SoftBodyBuilder::new(
+    let block = DeformableBodyBuilder::new(
         mesh::cuboid(DVec3::splat(BLOCK_SIDE / 2.0), [4; 3])?,
         rubber,
     )
@@ -70,7 +70,7 @@ fn main() -> Result<(), Error> {
             .friction(0.8),
     );
     // The contacts' impulses are those of the frame's last soft step, one coupling substep long.
-    let h = f64::from(world.physics.integration_parameters.dt) / f64::from(world.coupling_substeps);
+    let h = f64::from(world.physics.integration_parameters.dt) / f64::from(world.coupling.substeps);
     let g = world.physics.gravity.as_dvec3().length();
     let box_mass = f64::from(world.physics.bodies[rigid_box].mass());
     let weight = (world.soft_bodies[block].total_mass() + box_mass) * g;

@@ -49,7 +49,7 @@ const BLOCKS: [Block; 3] = [
 ];
 
 /// The mean height (m) of the nodes of `body` whose rest height is `rest_y` (m).
-fn layer_height(body: &SoftBody, rest_y: f64) -> f64 {
+fn layer_height(body: &DeformableBody, rest_y: f64) -> f64 {
     let layer = body.mesh().nodes_where(|p| (p.y - rest_y).abs() < 1e-9);
     layer
         .iter()
@@ -72,18 +72,19 @@ fn main() -> Result<(), Error> {
             block.poisson,
             block.density,
         )?;
-        let body = SoftBodyBuilder::new(mesh::cuboid(DVec3::splat(SIDE / 2.0), [4; 3])?, material)
-            .damping(RayleighDamping::stiffness_proportional(
-                2e-3,
-                material.lame(),
-            )?)
-            .translation(DVec3::new(
-                0.0,
-                (level as f64 + 0.5) * SIDE + 1e-3 * level as f64,
-                0.0,
-            ))
-            .friction(0.8)
-            .build()?;
+        let body =
+            DeformableBodyBuilder::new(mesh::cuboid(DVec3::splat(SIDE / 2.0), [4; 3])?, material)
+                .damping(RayleighDamping::stiffness_proportional(
+                    2e-3,
+                    material.lame(),
+                )?)
+                .translation(DVec3::new(
+                    0.0,
+                    (level as f64 + 0.5) * SIDE + 1e-3 * level as f64,
+                    0.0,
+                ))
+                .friction(0.8)
+                .build()?;
         handles.push(world.soft_bodies.insert(body));
     }
     let half = (SIDE / 2.0 * 0.8) as f32;
@@ -99,7 +100,7 @@ fn main() -> Result<(), Error> {
     );
     let frames = 120;
     let substep =
-        f64::from(world.physics.integration_parameters.dt) / f64::from(world.coupling_substeps);
+        f64::from(world.physics.integration_parameters.dt) / f64::from(world.coupling.substeps);
     let (mut deepest, mut reaction) = (0.0f64, 0.0);
     for frame in 0..frames {
         for (_, outcome) in world.step() {

@@ -28,13 +28,13 @@ fn gravity() -> DVec3 {
 }
 
 /// The reference beam along +x from x = 0 (clamped), and the node at the centre of its free end.
-fn beam(cells: [usize; 3], young: f64) -> Result<(SoftBody, usize), Error> {
+fn beam(cells: [usize; 3], young: f64) -> Result<(DeformableBody, usize), Error> {
     let half = DVec3::new(0.5, 0.05, 0.05);
     let mesh = mesh::cuboid(half, cells)?;
     let clamped = mesh.nodes_where(|p| p.x <= -half.x + 1e-9);
     let tip = mesh.nearest_node(DVec3::new(half.x, 0.0, 0.0)) as usize;
     let material = Material::new(MaterialModel::StableNeoHookean, young, 0.3, 1000.0)?;
-    let body = SoftBodyBuilder::new(mesh, material)
+    let body = DeformableBodyBuilder::new(mesh, material)
         .translation(DVec3::new(half.x, 0.0, 0.0))
         .pinned_nodes(clamped)
         .build()?;
@@ -42,11 +42,11 @@ fn beam(cells: [usize; 3], young: f64) -> Result<(SoftBody, usize), Error> {
 }
 
 /// A soft 0.2 m cube of `n³` cells hanging from its top face.
-fn soft_cube(n: usize) -> Result<SoftBody, Error> {
+fn soft_cube(n: usize) -> Result<DeformableBody, Error> {
     let mesh = mesh::cuboid(DVec3::splat(0.1), [n, n, n])?;
     let top = mesh.nodes_where(|p| p.y >= 0.1 - 1e-9);
     let material = Material::new(MaterialModel::StableNeoHookean, 1e5, 0.3, 1000.0)?;
-    SoftBodyBuilder::new(mesh, material)
+    DeformableBodyBuilder::new(mesh, material)
         .pinned_nodes(top)
         .build()
 }
@@ -65,7 +65,7 @@ struct Run {
 /// Times `frames` frames of `dt` after `warm_up` untimed ones (the first builds the sparsity
 /// pattern and, for the direct solve, the symbolic factorization).
 fn run(
-    body: &mut SoftBody,
+    body: &mut DeformableBody,
     integrator: &ImplicitIntegrator,
     dt: f64,
     warm_up: usize,
@@ -127,7 +127,7 @@ fn sizes(json: &mut Vec<String>) -> Result<(), Error> {
         "auto",
         "pred CG"
     );
-    let cases: Vec<(String, SoftBody, f64, usize, usize)> = vec![
+    let cases: Vec<(String, DeformableBody, f64, usize, usize)> = vec![
         (
             "small step".into(),
             beam([10, 2, 2], 1e8)?.0,
@@ -239,7 +239,7 @@ fn calibrate(json: &mut Vec<String>) -> Result<(), Error> {
         linear_solver,
         ..Default::default()
     };
-    let cases: Vec<(String, SoftBody, f64)> = vec![
+    let cases: Vec<(String, DeformableBody, f64)> = vec![
         ("beam 1.6k".into(), beam([20, 4, 4], 1e9)?.0, 1.0 / 60.0),
         ("beam 13k".into(), beam([40, 8, 8], 1e9)?.0, 1.0 / 60.0),
         ("cube 5k".into(), soft_cube(10)?, 1.0 / 240.0),

@@ -10,7 +10,7 @@
 //! the rotational directions of a stressed element, so exact tangents are used where they exist.
 
 use crate::Error;
-use crate::body::SoftBody;
+use crate::body::DeformableBody;
 use crate::contact::Stencil;
 use crate::element::deformation_gradient;
 use crate::fvm::NodalAveraging;
@@ -51,7 +51,7 @@ pub(crate) struct Stiffness {
 impl Stiffness {
     /// The pattern of `body`'s mesh, values zero: nodes sharing a tetrahedron, and with nodal
     /// averaging also nodes sharing a neighbour (the patches' coupling).
-    pub(crate) fn new(body: &SoftBody) -> Self {
+    pub(crate) fn new(body: &DeformableBody) -> Self {
         let n = body.node_count();
         let mut lower_neighbours: Vec<Vec<u32>> = (0..n as u32).map(|b| vec![b]).collect();
         couple_all_pairs(&mut lower_neighbours, body.elements.element_nodes());
@@ -111,7 +111,7 @@ impl Stiffness {
     /// `diagonal[n] I` on each free node.
     pub(crate) fn assemble(
         &mut self,
-        body: &SoftBody,
+        body: &DeformableBody,
         diagonal: Option<&[f64]>,
         project: bool,
         extra: impl Fn(usize, &DMat3, &DMat3) -> DMat3,
@@ -448,8 +448,8 @@ pub(crate) fn project_positive(a: StressTangent) -> StressTangent {
 /// A step of 1e-6 m on metre-sized bodies keeps truncation (~1e-12) and round-off (~1e-10)
 /// well inside these bounds while any missing term fails them.
 #[cfg(test)]
-pub(crate) fn assert_forces_and_tangent_match_energy(body: &mut SoftBody, label: &str) {
-    let shift = |body: &mut SoftBody, direction: &[DVec3], step: f64| {
+pub(crate) fn assert_forces_and_tangent_match_energy(body: &mut DeformableBody, label: &str) {
+    let shift = |body: &mut DeformableBody, direction: &[DVec3], step: f64| {
         for (x, d) in body.positions_mut().iter_mut().zip(direction) {
             *x += *d * step;
         }
@@ -489,7 +489,7 @@ pub(crate) fn assert_forces_and_tangent_match_energy(body: &mut SoftBody, label:
 /// Moves every node of `body` by a pseudo-random offset of up to `amplitude` (m) per axis, the
 /// same for the same `seed`.
 #[cfg(test)]
-pub(crate) fn perturb_positions(body: &mut SoftBody, mut seed: u64, amplitude: f64) {
+pub(crate) fn perturb_positions(body: &mut DeformableBody, mut seed: u64, amplitude: f64) {
     for x in body.positions_mut() {
         for i in 0..3 {
             seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1);

@@ -10,7 +10,7 @@
 //! for contacts.
 
 use crate::Error;
-use crate::body::SoftBody;
+use crate::body::DeformableBody;
 use crate::contact::RigidProxy;
 use rapier3d::dynamics::{RigidBodyHandle, RigidBodySet};
 use rapier3d::glamx::{DMat3, DVec3};
@@ -38,11 +38,11 @@ pub struct Attachment {
     effective_mass: DMat3,
 }
 
-impl SoftBody {
+impl DeformableBody {
     /// Glues `nodes` to the rigid body `body` of `bodies` where they are now: each node keeps
     /// following the body's material point it sits at, and the body feels it (two-way when the
     /// body is dynamic; a kinematic or fixed body drags the nodes along). The attachments act from
-    /// the next [`SoftBody::detect_contacts`], which readies them for the coming step.
+    /// the next [`DeformableBody::detect_contacts`], which readies them for the coming step.
     ///
     /// # Errors
     /// [`Error::NodeOutOfRange`] for a node that does not exist, [`Error::UnknownRigidBody`] if
@@ -115,7 +115,7 @@ pub(crate) fn ready(
 
 /// Readies the attachments' velocity constraints for an explicit substep of `h` (s), before the
 /// sweeps of [`solve_velocities`].
-pub(crate) fn prepare_velocities(body: &mut SoftBody, h: f64) {
+pub(crate) fn prepare_velocities(body: &mut DeformableBody, h: f64) {
     for attachment in &mut body.attachments {
         let n = attachment.node as usize;
         let x = body.positions[n];
@@ -128,8 +128,8 @@ pub(crate) fn prepare_velocities(body: &mut SoftBody, h: f64) {
 
 /// One sweep over the attachments' velocity constraints, after the contacts': each node's
 /// velocity is set to its anchor's plus the drift correction by an impulse shared with the body.
-pub(crate) fn solve_velocities(body: &mut SoftBody) {
-    let SoftBody {
+pub(crate) fn solve_velocities(body: &mut DeformableBody) {
+    let DeformableBody {
         attachments,
         rigid_proxies,
         positions,
@@ -152,7 +152,7 @@ pub(crate) fn solve_velocities(body: &mut SoftBody) {
 }
 
 /// Carries the anchors with their bodies over an explicit substep of `h` (s), after the sweeps.
-pub(crate) fn advance_anchors(body: &mut SoftBody, h: f64) {
+pub(crate) fn advance_anchors(body: &mut DeformableBody, h: f64) {
     for attachment in &mut body.attachments {
         let proxy = &body.rigid_proxies[attachment.proxy];
         attachment.anchor += proxy.velocity_at(attachment.anchor) * h;
@@ -170,7 +170,11 @@ impl Attachment {
 /// Calls `each(node, stiffness k (N/m), target (m))` for every attachment in an implicit step of
 /// effective length `h` (s): the node is pulled toward the anchor's predicted end position with
 /// the energy `k/2 |x - target|²`.
-pub(crate) fn for_each_spring(body: &SoftBody, h: f64, mut each: impl FnMut(usize, f64, DVec3)) {
+pub(crate) fn for_each_spring(
+    body: &DeformableBody,
+    h: f64,
+    mut each: impl FnMut(usize, f64, DVec3),
+) {
     for attachment in &body.attachments {
         let n = attachment.node as usize;
         if !body.pinned[n] {
@@ -187,13 +191,13 @@ pub(crate) fn for_each_spring(body: &SoftBody, h: f64, mut each: impl FnMut(usiz
 /// Records the impulses (N s) the implicit springs gave the nodes over a substep of length `h`
 /// (s), hands their opposite to the bodies, and moves the anchors with them. The targets are
 /// taken before any impulse is handed over, as the step's solve saw them.
-pub(crate) fn record_spring_impulses(body: &mut SoftBody, effective_h: f64, h: f64) {
+pub(crate) fn record_spring_impulses(body: &mut DeformableBody, effective_h: f64, h: f64) {
     let targets: Vec<DVec3> = body
         .attachments
         .iter()
         .map(|a| a.spring_target(&body.rigid_proxies, effective_h))
         .collect();
-    let SoftBody {
+    let DeformableBody {
         attachments,
         rigid_proxies,
         positions,

@@ -19,7 +19,7 @@ use rapier3d::parry::bounding_volume::Aabb;
 use rapier3d::parry::partitioning::{Bvh, BvhBuildStrategy};
 
 /// A fine mesh embedded in a body's simulation mesh (see the [module](self) documentation).
-/// Made by [`SoftBodyBuilder::embedded`](crate::body::SoftBodyBuilder::embedded).
+/// Made by [`DeformableBodyBuilder::embedded`](crate::body::DeformableBodyBuilder::embedded).
 #[derive(Debug, Clone)]
 pub struct Embedding {
     mesh: TetMesh,

@@ -28,7 +28,7 @@
 //! let mesh = mesh::cuboid(DVec3::new(0.5, 0.05, 0.05), [10, 1, 1])?;
 //! let clamped = mesh.nodes_where(|p| p.x <= -0.5 + 1e-9);
 //! let rubber = Material::new(MaterialModel::StableNeoHookean, 1e6, 0.45, 1100.0)?;
-//! let mut beam = SoftBodyBuilder::new(mesh, rubber)
+//! let mut beam = DeformableBodyBuilder::new(mesh, rubber)
 //!     .damping(RayleighDamping::stiffness_proportional(0.01, rubber.lame())?)
 //!     .pinned_nodes(clamped)
 //!     .build()?;
@@ -46,6 +46,7 @@ pub mod attachment;
 pub mod body;
 pub mod chord;
 pub mod contact;
+pub mod coupling;
 pub mod damping;
 pub mod element;
 pub mod embedding;
@@ -74,8 +75,11 @@ pub use rapier3d::glamx;
 /// The types most programs need.
 pub mod prelude {
     pub use crate::Error;
-    pub use crate::body::{SoftBody, SoftBodyBuilder, SoftBodyHandle, SoftBodySet};
+    pub use crate::body::{
+        DeformableBody, DeformableBodyBuilder, DeformableBodyHandle, DeformableBodySet,
+    };
     pub use crate::contact::{BodyPoint, ContactSettings, ContactTarget, NodeContact};
+    pub use crate::coupling::{RapierSets, RigidLoad, RigidSets, SoftCoupling};
     pub use crate::damping::RayleighDamping;
     pub use crate::fvm::VolumetricTreatment;
     pub use crate::integrate::{
@@ -85,5 +89,6 @@ pub mod prelude {
     pub use crate::linear_solver::LinearSolver;
     pub use crate::material::{LameParameters, Material, MaterialModel, YoungPoisson};
     pub use crate::mesh::{self, TetMesh};
+    pub use crate::world::FvmWorld;
     pub use rapier3d::glamx::{DMat3, DQuat, DVec3};
 }

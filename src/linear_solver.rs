@@ -29,7 +29,7 @@
 
 use crate::Error;
 use crate::assembly::{Stiffness, factorize, solve};
-use crate::body::SoftBody;
+use crate::body::DeformableBody;
 use crate::material::is_positive_definite;
 use faer::sparse::linalg::solvers::Llt;
 use rapier3d::glamx::{DMat3, DVec3};
@@ -44,7 +44,7 @@ pub enum LinearSolver {
     ///   `tol` = [`AUTOMATIC_CG_TOLERANCE`], `C` = [`CG_ITERATION_FACTOR`], with the condition
     ///   number of `M/ĥ² + K` estimated from the highest and lowest wave modes,
     ///   `κ = (1 + ω_max² w) / (1 + ω_min² w)`, `w = ĥ (ĥ + β)`: `ω_max = 2 c_p / ℓ` (rad/s) from
-    ///   [`SoftBody::wave_length_scale`] `ℓ` and the material's
+    ///   [`DeformableBody::wave_length_scale`] `ℓ` and the material's
     ///   [`dilatational_wave_speed`](crate::material::Material::dilatational_wave_speed) `c_p`,
     ///   `ω_min = c_p / D` with `D` the diagonal of the body's bounding box, `ĥ` the substep (s),
     ///   `β = (φ + 2ψ)/(λ + 2μ)` the damping's stiffness-proportional time (s, zero undamped).
@@ -135,7 +135,7 @@ impl LinearSolver {
     }
 
     /// The method for substeps of `h` (s) on `body` in its current shape.
-    pub(crate) fn method(&self, body: &SoftBody, h: f64) -> Method {
+    pub(crate) fn method(&self, body: &DeformableBody, h: f64) -> Method {
         match *self {
             LinearSolver::Direct => Method::Direct,
             LinearSolver::ConjugateGradient {
@@ -176,7 +176,7 @@ pub struct SolverPrediction {
 
 /// The prediction [`LinearSolver::Automatic`] makes for substeps of `h` (s) on `body` in its
 /// current shape, for a conjugate gradient of relative tolerance `tolerance`.
-pub fn predict(body: &SoftBody, h: f64, tolerance: f64) -> SolverPrediction {
+pub fn predict(body: &DeformableBody, h: f64, tolerance: f64) -> SolverPrediction {
     let material = body.material();
     let speed = material.dilatational_wave_speed();
     let highest = 2.0 * speed / body.wave_length_scale();

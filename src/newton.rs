@@ -2,7 +2,7 @@
 //! norm and a backtracking line search that guarantees the minimized energy decreases.
 
 use crate::Error;
-use crate::body::SoftBody;
+use crate::body::DeformableBody;
 use rapier3d::glamx::DVec3;
 
 /// Refuses a Newton tolerance that is not positive and finite.
@@ -39,13 +39,13 @@ pub(crate) enum Search {
 /// is `energy_now` (J), searching as `search` says. Returns the new residual and energy, or
 /// `None` (positions unchanged) if no step descends.
 pub(crate) fn descend(
-    body: &mut SoftBody,
+    body: &mut DeformableBody,
     residual: &[DVec3],
     energy_now: f64,
     direction: &[DVec3],
     search: Search,
-    energy: impl Fn(&SoftBody) -> f64,
-    mut residual_at: impl FnMut(&mut SoftBody) -> Vec<DVec3>,
+    energy: impl Fn(&DeformableBody) -> f64,
+    mut residual_at: impl FnMut(&mut DeformableBody) -> Vec<DVec3>,
 ) -> Option<(Vec<DVec3>, f64)> {
     let smallest = match search {
         Search::Thorough => MIN_STEP,
@@ -83,11 +83,11 @@ const MIN_STEP: f64 = 1.0 / 1024.0;
 /// energy there, or `None`, with the positions put back, if no such step exists (the direction
 /// no longer descends above round-off).
 fn line_search(
-    body: &mut SoftBody,
+    body: &mut DeformableBody,
     residual: &[DVec3],
     initial: f64,
     direction: &[DVec3],
-    energy: impl Fn(&SoftBody) -> f64,
+    energy: impl Fn(&DeformableBody) -> f64,
     smallest: f64,
 ) -> Option<f64> {
     const ARMIJO: f64 = 1e-4;

@@ -3,16 +3,16 @@
 
 use rapier_fvm::prelude::*;
 
-fn ball(young: f64) -> SoftBody {
+fn ball(young: f64) -> DeformableBody {
     let material = Material::new(MaterialModel::StableNeoHookean, young, 0.4, 1000.0).unwrap();
-    SoftBodyBuilder::new(mesh::sphere(0.1, 4).unwrap(), material)
+    DeformableBodyBuilder::new(mesh::sphere(0.1, 4).unwrap(), material)
         .build()
         .unwrap()
 }
 
 #[test]
 fn handles_stay_valid_until_removal_and_never_alias_a_reused_slot() {
-    let mut set = SoftBodySet::new();
+    let mut set = DeformableBodySet::new();
     let a = set.insert(ball(1e5));
     let b = set.insert(ball(2e5));
     assert_eq!(set.len(), 2);
@@ -26,13 +26,13 @@ fn handles_stay_valid_until_removal_and_never_alias_a_reused_slot() {
         "the free slot is reused"
     );
     assert!(set.get(a).is_none() && set.contains(c) && set.contains(b));
-    let handles: Vec<SoftBodyHandle> = set.iter().map(|(h, _)| h).collect();
+    let handles: Vec<DeformableBodyHandle> = set.iter().map(|(h, _)| h).collect();
     assert_eq!(handles, vec![c, b]);
 }
 
 #[test]
 fn stepping_a_set_reports_each_body_and_keeps_a_failed_one_unchanged() {
-    let mut set = SoftBodySet::new();
+    let mut set = DeformableBodySet::new();
     let good = set.insert(ball(1e5));
     let bad = set.insert(ball(1e5));
     set[bad].velocities_mut()[0].x = f64::NAN;

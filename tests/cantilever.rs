@@ -14,7 +14,11 @@ fn static_tip_deflection(cells: [usize; 3], material: Material) -> f64 {
 }
 
 /// Static tip deflection (m, positive down) of `body` at equilibrium.
-fn equilibrium_tip_deflection(mut body: SoftBody, tip: usize, settings: &StaticSettings) -> f64 {
+fn equilibrium_tip_deflection(
+    mut body: DeformableBody,
+    tip: usize,
+    settings: &StaticSettings,
+) -> f64 {
     let rest = body.positions()[tip].y;
     statics::solve_equilibrium(&mut body, gravity(), settings).unwrap();
     rest - body.positions()[tip].y
@@ -110,19 +114,23 @@ fn nonlinear_models_agree_with_linear_at_small_deflection() {
 
 /// Stiffness-proportional damping time (s) giving the first mode of `body` the damping ratio
 /// `zeta`.
-fn damping_for(body: &SoftBody, zeta: f64) -> RayleighDamping {
+fn damping_for(body: &DeformableBody, zeta: f64) -> RayleighDamping {
     let omega = 2.0 * std::f64::consts::PI * statics::fundamental_frequency(body).unwrap();
     RayleighDamping::stiffness_proportional(2.0 * zeta / omega, body.material().lame()).unwrap()
 }
 
 /// The cantilever with its first mode damped at the ratio `zeta`.
-fn cantilever_damped_at(cells: [usize; 3], material: Material, zeta: f64) -> (SoftBody, usize) {
+fn cantilever_damped_at(
+    cells: [usize; 3],
+    material: Material,
+    zeta: f64,
+) -> (DeformableBody, usize) {
     let (undamped, _) = cantilever(cells, material);
     common::damped_cantilever(cells, material, Some(damping_for(&undamped, zeta)))
 }
 
 /// Runs `seconds` of frames of 1/60 s; returns the largest node speed (m/s) at the end.
-fn settle(body: &mut SoftBody, seconds: f64) -> f64 {
+fn settle(body: &mut DeformableBody, seconds: f64) -> f64 {
     let integrator = SymplecticEuler::default();
     for _ in 0..(seconds * 60.0).round() as usize {
         integrator.step(body, 1.0 / 60.0, gravity()).unwrap();
@@ -220,7 +228,7 @@ fn static_solver_errors_leave_the_body_untouched() {
     ));
     let mesh = body.mesh().clone();
     let all = 0..mesh.node_count() as u32;
-    let mut frozen = SoftBodyBuilder::new(mesh, material)
+    let mut frozen = DeformableBodyBuilder::new(mesh, material)
         .pinned_nodes(all)
         .build()
         .unwrap();
@@ -233,7 +241,7 @@ fn static_solver_errors_leave_the_body_untouched() {
         Err(Error::NoFreeNode)
     );
     // A body with no pinned node has rigid motions: its stiffness is singular.
-    let free = SoftBodyBuilder::new(body.mesh().clone(), material)
+    let free = DeformableBodyBuilder::new(body.mesh().clone(), material)
         .build()
         .unwrap();
     let mut free_body = free.clone();

@@ -42,10 +42,10 @@ fn ground(normal: DVec3, friction: f64) -> ColliderSet {
 
 /// A 10 cm rubber cube (E = 1e5 Pa, ν = 0.3, 1000 kg/m³, 4 x 4 x 4 cells, damped) whose centre
 /// is at `centre`.
-fn rubber_cube(centre: DVec3, rotation: DVec3) -> SoftBody {
+fn rubber_cube(centre: DVec3, rotation: DVec3) -> DeformableBody {
     let material = Material::new(MaterialModel::StableNeoHookean, 1e5, 0.3, 1000.0).unwrap();
     let mesh = mesh::cuboid(DVec3::splat(0.05), [4, 4, 4]).unwrap();
-    SoftBodyBuilder::new(mesh, material)
+    DeformableBodyBuilder::new(mesh, material)
         .damping(RayleighDamping::stiffness_proportional(2e-3, material.lame()).unwrap())
         .translation(centre)
         .rotation(rotation)
@@ -53,14 +53,14 @@ fn rubber_cube(centre: DVec3, rotation: DVec3) -> SoftBody {
         .unwrap()
 }
 
-fn lowest(body: &SoftBody) -> f64 {
+fn lowest(body: &DeformableBody) -> f64 {
     body.positions()
         .iter()
         .map(|x| x.y)
         .fold(f64::INFINITY, f64::min)
 }
 
-fn fastest(body: &SoftBody) -> f64 {
+fn fastest(body: &DeformableBody) -> f64 {
     body.velocities()
         .iter()
         .map(|v| v.length())
@@ -244,7 +244,7 @@ fn an_elastic_bar_striking_a_wall_end_on_rebounds_at_its_impact_speed() {
     let material = Material::new(MaterialModel::StableNeoHookean, 1e6, 0.0, 1000.0).unwrap();
     let length = 0.5;
     let mesh = mesh::cuboid(DVec3::new(length / 2.0, 0.025, 0.025), [20, 2, 2]).unwrap();
-    let mut bar = SoftBodyBuilder::new(mesh, material)
+    let mut bar = DeformableBodyBuilder::new(mesh, material)
         .translation(DVec3::new(length / 2.0 + 1e-3, 0.0, 0.0))
         .linvel(DVec3::new(-1.0, 0.0, 0.0))
         .friction(0.0)

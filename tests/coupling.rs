@@ -13,15 +13,15 @@ fn rubber(young: f64) -> Material {
 }
 
 /// `body` with surface friction coefficient `friction`.
-fn with_friction(mut body: SoftBody, friction: f64) -> SoftBody {
+fn with_friction(mut body: DeformableBody, friction: f64) -> DeformableBody {
     body.friction = friction;
     body
 }
 
 /// A soft cube of side `side` (m) centred at `centre`, with damping time 2e-3 s.
-fn soft_cube(side: f64, cells: usize, centre: DVec3, young: f64) -> SoftBody {
+fn soft_cube(side: f64, cells: usize, centre: DVec3, young: f64) -> DeformableBody {
     let material = rubber(young);
-    SoftBodyBuilder::new(
+    DeformableBodyBuilder::new(
         mesh::cuboid(DVec3::splat(side / 2.0), [cells; 3]).unwrap(),
         material,
     )
@@ -101,7 +101,7 @@ fn a_box_resting_on_a_soft_block_is_supported_without_jitter_or_creep() {
             .friction(0.8),
     );
     // Contact impulses are those of the last soft step, one coupling substep long.
-    let h = f64::from(world.physics.integration_parameters.dt) / f64::from(world.coupling_substeps);
+    let h = f64::from(world.physics.integration_parameters.dt) / f64::from(world.coupling.substeps);
     for _ in 0..120 {
         step(&mut world);
     }
@@ -151,7 +151,7 @@ fn a_ball_hanging_from_a_soft_rope_swings_with_the_pendulum_period() {
     let mesh = mesh::cuboid(DVec3::new(0.005, length / 2.0, 0.005), [2, 40, 2]).unwrap();
     let top = mesh.nodes_where(|p| p.y >= length / 2.0 - 1e-9);
     let bottom = mesh.nodes_where(|p| p.y <= -length / 2.0 + 1e-9);
-    let rope = SoftBodyBuilder::new(mesh, material)
+    let rope = DeformableBodyBuilder::new(mesh, material)
         .damping(RayleighDamping::stiffness_proportional(0.01, material.lame()).unwrap())
         .orientation(tilt)
         .translation(tilt * DVec3::new(0.0, -length / 2.0, 0.0))
@@ -282,7 +282,7 @@ fn a_rigid_plate_on_a_soft_block_sinks_by_m_g_h_over_e_a() {
 /// deepest any node was inside a finger (m).
 fn grasp(squeeze: f64, integrator: Option<IntegratorKind>) -> (f64, f64, f64) {
     let mut world = FvmWorld::default();
-    world.integrator.force = integrator;
+    world.coupling.integrator.force = integrator;
     world.physics.insert_collider(
         ColliderBuilder::new(SharedShape::halfspace(Vec3::Y)).friction(0.5),
         None,
@@ -389,7 +389,7 @@ fn a_soft_beam_glued_to_a_box_on_the_ground_leaves_the_box_at_rest() {
     // with the automatic choice (implicit, for this heavily damped beam) and explicit.
     for integrator in [None, Some(IntegratorKind::Explicit)] {
         let mut world = FvmWorld::default();
-        world.integrator.force = integrator;
+        world.coupling.integrator.force = integrator;
         world.physics.insert_collider(
             ColliderBuilder::new(SharedShape::halfspace(Vec3::Y)).friction(0.8),
             None,
@@ -404,7 +404,7 @@ fn a_soft_beam_glued_to_a_box_on_the_ground_leaves_the_box_at_rest() {
         let material = rubber(1e6);
         let mesh = mesh::cuboid(DVec3::new(0.1, 0.02, 0.02), [10, 2, 2]).unwrap();
         let root = mesh.nodes_where(|p| p.x <= -0.1 + 1e-9);
-        let beam = SoftBodyBuilder::new(mesh, material)
+        let beam = DeformableBodyBuilder::new(mesh, material)
             .damping(RayleighDamping::stiffness_proportional(0.01, material.lame()).unwrap())
             .translation(DVec3::new(half as f64 + 0.1, half as f64, 0.0))
             .build()
@@ -453,7 +453,7 @@ fn nodes_glued_to_a_kinematic_body_follow_its_prescribed_path() {
         let material = rubber(1e6);
         let mesh = mesh::cuboid(DVec3::new(0.01, 0.1, 0.01), [1, 10, 1]).unwrap();
         let root = mesh.nodes_where(|p| p.y >= 0.1 - 1e-9);
-        let rod = SoftBodyBuilder::new(mesh, material)
+        let rod = DeformableBodyBuilder::new(mesh, material)
             .damping(RayleighDamping::stiffness_proportional(0.01, material.lame()).unwrap())
             .translation(DVec3::new(common::GLUED_PATH_RADIUS, 0.4, 0.0))
             .build()
@@ -479,7 +479,7 @@ fn a_small_box_rests_on_the_faces_of_a_coarse_soft_block() {
     // 1e5 N/m, over its mass): the default 4 coupling substeps a frame (240 Hz) cannot follow
     // it and leave it jittering at about 3 cm/s; 16 (960 Hz) do.
     let mut world = FvmWorld::default();
-    world.coupling_substeps = 16;
+    world.coupling.substeps = 16;
     world.physics.insert_collider(
         ColliderBuilder::new(SharedShape::halfspace(Vec3::Y)).friction(0.8),
         None,
@@ -522,7 +522,7 @@ fn a_small_box_rests_on_the_faces_of_a_coarse_soft_block() {
         face * 1e3,
         (face - bottom) * 1e3
     );
-    assert!(face - bottom < world.contact.margin + 1e-3);
+    assert!(face - bottom < world.coupling.contact.margin + 1e-3);
     assert!(fastest < 1e-3);
     assert!((support / weight - 1.0).abs() < 0.01);
 }

@@ -18,22 +18,25 @@ fn rubber() -> Material {
 
 /// Every element kind carrying a fine mesh: linear tetrahedra, curved quadratic tetrahedra (a
 /// sphere, whose fine surface pokes out between the coarse curved faces) and a hexahedral cage.
-fn carriers() -> Vec<(&'static str, SoftBodyBuilder, TetMesh)> {
+fn carriers() -> Vec<(&'static str, DeformableBodyBuilder, TetMesh)> {
     let half = DVec3::new(0.2, 0.1, 0.1);
     vec![
         (
             "linear tetrahedra",
-            SoftBodyBuilder::new(mesh::cuboid(half, [2, 1, 1]).unwrap(), rubber()),
+            DeformableBodyBuilder::new(mesh::cuboid(half, [2, 1, 1]).unwrap(), rubber()),
             mesh::cuboid(half, [12, 6, 6]).unwrap(),
         ),
         (
             "curved quadratic tetrahedra",
-            SoftBodyBuilder::quadratic(mesh::QuadraticTetMesh::sphere(0.1, 2).unwrap(), rubber()),
+            DeformableBodyBuilder::quadratic(
+                mesh::QuadraticTetMesh::sphere(0.1, 2).unwrap(),
+                rubber(),
+            ),
             mesh::sphere(0.1, 8).unwrap(),
         ),
         (
             "quadratic hexahedra",
-            SoftBodyBuilder::quadratic_hex(
+            DeformableBodyBuilder::quadratic_hex(
                 mesh::QuadraticHexMesh::cuboid(half, [2, 1, 1]).unwrap(),
                 rubber(),
             ),
@@ -96,7 +99,7 @@ fn a_vertex_outside_the_simulation_mesh_is_refused() {
         .to_vec();
     positions[26] = DVec3::splat(0.5);
     let fine = TetMesh::new(positions, tets).unwrap();
-    let error = SoftBodyBuilder::new(coarse, rubber())
+    let error = DeformableBodyBuilder::new(coarse, rubber())
         .embedded(fine)
         .build()
         .unwrap_err();
@@ -119,13 +122,13 @@ fn a_cage_carrying_a_fine_mesh_rests_on_a_rapier_ground() {
         Some(IntegratorKind::Implicit),
     ] {
         let mut world = FvmWorld::default();
-        world.integrator.force = force;
+        world.coupling.integrator.force = force;
         let ground = world
             .physics
             .insert_collider(ColliderBuilder::new(SharedShape::halfspace(Vec3::Y)), None);
         let material = rubber();
         let half = DVec3::splat(0.1);
-        let cube = SoftBodyBuilder::quadratic_hex(
+        let cube = DeformableBodyBuilder::quadratic_hex(
             mesh::QuadraticHexMesh::cuboid(half, [1, 1, 1]).unwrap(),
             material,
         )
@@ -183,12 +186,14 @@ fn an_embedded_surface_hitting_a_free_ball_conserves_momentum() {
         ColliderBuilder::ball(radius).density(density).friction(0.5),
     );
     let material = rubber();
-    let mut sphere =
-        SoftBodyBuilder::quadratic(mesh::QuadraticTetMesh::sphere(0.06, 2).unwrap(), material)
-            .embedded(mesh::sphere(0.06, 8).unwrap())
-            .damping(RayleighDamping::stiffness_proportional(2e-3, material.lame()).unwrap())
-            .build()
-            .unwrap();
+    let mut sphere = DeformableBodyBuilder::quadratic(
+        mesh::QuadraticTetMesh::sphere(0.06, 2).unwrap(),
+        material,
+    )
+    .embedded(mesh::sphere(0.06, 8).unwrap())
+    .damping(RayleighDamping::stiffness_proportional(2e-3, material.lame()).unwrap())
+    .build()
+    .unwrap();
     for v in sphere.velocities_mut() {
         *v = DVec3::X;
     }

@@ -41,7 +41,7 @@ fn computed_critical_step_is_below_and_close_to_the_true_limit() {
         for nu in [-0.5, 0.0, 0.3, 0.45, 0.49] {
             for (name, mesh) in meshes() {
                 let material = Material::new(MaterialModel::Linear, 1e6, nu, 1000.0).unwrap();
-                let mut body = SoftBodyBuilder::new(mesh, material)
+                let mut body = DeformableBodyBuilder::new(mesh, material)
                     .volumetric(treatment)
                     .build()
                     .unwrap();
@@ -72,10 +72,10 @@ fn computed_critical_step_is_below_and_close_to_the_true_limit() {
 }
 
 /// A beam with every mode excited by a random displacement.
-fn excited_beam(damping_time: f64) -> SoftBody {
+fn excited_beam(damping_time: f64) -> DeformableBody {
     let material = Material::new(MaterialModel::StVenantKirchhoff, 1e6, 0.3, 1000.0).unwrap();
     let mesh = mesh::cuboid(DVec3::new(0.25, 0.05, 0.05), [10, 2, 2]).unwrap();
-    let mut builder = SoftBodyBuilder::new(mesh, material);
+    let mut builder = DeformableBodyBuilder::new(mesh, material);
     if damping_time > 0.0 {
         builder = builder.damping(
             RayleighDamping::stiffness_proportional(damping_time, material.lame()).unwrap(),
@@ -89,12 +89,12 @@ fn excited_beam(damping_time: f64) -> SoftBody {
     body
 }
 
-fn mechanical_energy(body: &SoftBody) -> f64 {
+fn mechanical_energy(body: &DeformableBody) -> f64 {
     body.kinetic_energy() + body.elastic_energy()
 }
 
 /// Energy after `steps` single steps of `dt`, over the initial energy; infinite if it blew up.
-fn energy_growth(mut body: SoftBody, dt: f64, steps: usize) -> f64 {
+fn energy_growth(mut body: DeformableBody, dt: f64, steps: usize) -> f64 {
     let initial = mechanical_energy(&body);
     let integrator = SymplecticEuler {
         substeps: Substeps::Fixed(1),

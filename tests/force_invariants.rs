@@ -14,10 +14,10 @@ use rapier_fvm::prelude::*;
 
 /// A body of `mesh` (E = 1e6 Pa, ν = 0.35, damped) with its nodes moved randomly by up to
 /// `amplitude` (m) and random velocities up to 1 m/s per component.
-fn randomized(mesh: TetMesh, model: MaterialModel, seed: u64, amplitude: f64) -> SoftBody {
+fn randomized(mesh: TetMesh, model: MaterialModel, seed: u64, amplitude: f64) -> DeformableBody {
     let material = Material::new(model, 1e6, 0.35, 1000.0).unwrap();
     let damping = RayleighDamping::new(300.0, 200.0).unwrap();
-    let mut body = SoftBodyBuilder::new(mesh, material)
+    let mut body = DeformableBodyBuilder::new(mesh, material)
         .damping(damping)
         .build()
         .unwrap();
@@ -32,12 +32,12 @@ fn randomized(mesh: TetMesh, model: MaterialModel, seed: u64, amplitude: f64) ->
 }
 
 /// A 4 x 2 x 2-cell (80-tetrahedron) bar, randomized.
-fn random_body(model: MaterialModel, seed: u64, amplitude: f64) -> SoftBody {
+fn random_body(model: MaterialModel, seed: u64, amplitude: f64) -> DeformableBody {
     let mesh = mesh::cuboid(DVec3::new(0.2, 0.1, 0.1), [4, 2, 2]).unwrap();
     randomized(mesh, model, seed, amplitude)
 }
 
-fn sums(body: &mut SoftBody) -> (DVec3, DVec3, f64, f64) {
+fn sums(body: &mut DeformableBody) -> (DVec3, DVec3, f64, f64) {
     let positions = body.positions().to_vec();
     let forces = body.internal_forces().to_vec();
     let net: DVec3 = forces.iter().sum();
@@ -311,7 +311,7 @@ fn simd_mesh_loop_matches_the_scalar_kernel() {
 fn forces_are_bit_identical_whatever_the_thread_count() {
     let mesh = mesh::cuboid(DVec3::splat(0.2), [16, 16, 16]).unwrap();
     let mut body = randomized(mesh, MaterialModel::StableNeoHookean, 12, 1e-3);
-    let forces_with = |threads: usize, body: &mut SoftBody| {
+    let forces_with = |threads: usize, body: &mut DeformableBody| {
         rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build()

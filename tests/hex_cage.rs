@@ -42,10 +42,10 @@ fn forces_under(
     damping: Option<RayleighDamping>,
     map: impl Fn(DVec3) -> DVec3,
     rate: impl Fn(DVec3) -> DVec3,
-) -> (Vec<DVec3>, Vec<bool>, SoftBody) {
+) -> (Vec<DVec3>, Vec<bool>, DeformableBody) {
     let (cage, interior) = slanted_cage();
     let material = Material::new(model, 1e7, 0.3, 1000.0).unwrap();
-    let mut builder = SoftBodyBuilder::quadratic_hex(cage, material);
+    let mut builder = DeformableBodyBuilder::quadratic_hex(cage, material);
     if let Some(damping) = damping {
         builder = builder.damping(damping);
     }
@@ -129,7 +129,7 @@ fn rigid_motion_produces_no_force() {
 fn momentum_is_conserved_by_implicit_steps() {
     let material = Material::new(MaterialModel::StableNeoHookean, 1e5, 0.45, 1000.0).unwrap();
     let cage = mesh::QuadraticHexMesh::cuboid(DVec3::splat(0.1), [2, 1, 1]).unwrap();
-    let mut body = SoftBodyBuilder::quadratic_hex(cage, material)
+    let mut body = DeformableBodyBuilder::quadratic_hex(cage, material)
         .damping(RayleighDamping::new(5.0, 10.0).unwrap())
         .volumetric(VolumetricTreatment::ElementAverage)
         .build()
@@ -169,13 +169,17 @@ fn hex_cage_cantilever_matches_beam_theory_at_any_poisson_ratio() {
 }
 
 /// The clamped cage beam of `cells`, and its tip nodes.
-fn cage_beam(cells: [usize; 3], nu: f64, treatment: VolumetricTreatment) -> (SoftBody, Vec<u32>) {
+fn cage_beam(
+    cells: [usize; 3],
+    nu: f64,
+    treatment: VolumetricTreatment,
+) -> (DeformableBody, Vec<u32>) {
     let material = Material::new(MaterialModel::Linear, 1e8, nu, common::DENSITY).unwrap();
     let half = DVec3::new(0.5, 0.05, 0.05);
     let cage = mesh::QuadraticHexMesh::cuboid(half, cells).unwrap();
     let clamped = cage.nodes_where(|p| p.x <= -half.x + 1e-9);
     let tip = cage.nodes_where(|p| p.x >= half.x - 1e-9);
-    let body = SoftBodyBuilder::quadratic_hex(cage, material)
+    let body = DeformableBodyBuilder::quadratic_hex(cage, material)
         .pinned_nodes(clamped)
         .volumetric(treatment)
         .build()
@@ -188,9 +192,9 @@ fn static_cage_tip_error(
     cells: [usize; 3],
     nu: f64,
     treatment: VolumetricTreatment,
-) -> (SoftBody, f64) {
+) -> (DeformableBody, f64) {
     let (mut body, tip) = cage_beam(cells, nu, treatment);
-    let height = |b: &SoftBody| {
+    let height = |b: &DeformableBody| {
         tip.iter()
             .map(|&n| b.positions()[n as usize].y)
             .sum::<f64>()
@@ -233,7 +237,7 @@ fn the_explicit_stable_step_is_below_the_true_limit_of_hexahedra() {
         ] {
             for nu in [0.0, 0.3, 0.49] {
                 let material = Material::new(MaterialModel::Linear, 1e6, nu, 1000.0).unwrap();
-                let mut body = SoftBodyBuilder::quadratic_hex(cage.clone(), material)
+                let mut body = DeformableBodyBuilder::quadratic_hex(cage.clone(), material)
                     .volumetric(treatment)
                     .build()
                     .unwrap();
@@ -263,7 +267,7 @@ fn explicit_steps_of_hexahedra_are_stable() {
     let cage = mesh::QuadraticHexMesh::cuboid(DVec3::splat(0.1), [2, 2, 2]).unwrap();
     let build = |model| {
         let material = Material::new(model, 1e6, 0.45, 1000.0).unwrap();
-        SoftBodyBuilder::quadratic_hex(cage.clone(), material)
+        DeformableBodyBuilder::quadratic_hex(cage.clone(), material)
             .volumetric(VolumetricTreatment::ElementAverage)
             .build()
             .unwrap()

@@ -10,7 +10,7 @@ use rapier_fvm::statics::{self, StaticSettings};
 use std::f64::consts::PI;
 use std::time::Instant;
 
-fn total_energy(body: &SoftBody) -> f64 {
+fn total_energy(body: &DeformableBody) -> f64 {
     body.kinetic_energy() + body.elastic_energy() + body.gravity_potential_energy(gravity())
 }
 
@@ -246,7 +246,7 @@ fn momentum_is_conserved_by_implicit_steps() {
     for scheme in [ImplicitScheme::BackwardEuler, ImplicitScheme::Bdf2] {
         let material = Material::new(MaterialModel::StableNeoHookean, 1e6, 0.4, 1000.0).unwrap();
         let mesh = mesh::sphere(0.1, 5).unwrap();
-        let mut body = SoftBodyBuilder::new(mesh, material)
+        let mut body = DeformableBodyBuilder::new(mesh, material)
             .damping(RayleighDamping::stiffness_proportional(1e-3, material.lame()).unwrap())
             .build()
             .unwrap();
@@ -392,7 +392,7 @@ fn conjugate_gradient_falls_back_to_the_projected_tangent_on_negative_curvature(
     // (kinetic + elastic, no gravity) must not rise beyond round-off (1e-9 relative).
     let material = Material::new(MaterialModel::StableNeoHookean, 1e5, 0.3, 1000.0).unwrap();
     let mesh = mesh::cuboid(DVec3::splat(0.1), [4, 4, 4]).unwrap();
-    let mut body = SoftBodyBuilder::new(mesh, material).build().unwrap();
+    let mut body = DeformableBodyBuilder::new(mesh, material).build().unwrap();
     let mut rng = Lcg(7);
     for x in body.positions_mut() {
         x.y = 1e-3 * rng.next();
@@ -401,7 +401,7 @@ fn conjugate_gradient_falls_back_to_the_projected_tangent_on_negative_curvature(
         linear_solver: conjugate_gradient(1e-6, 2000),
         ..Default::default()
     };
-    let energy = |body: &SoftBody| body.kinetic_energy() + body.elastic_energy();
+    let energy = |body: &DeformableBody| body.kinetic_energy() + body.elastic_energy();
     let (inverted, mut last) = (body.inverted_tet_count(), energy(&body));
     let (mut projected, mut cg_iterations) = (0, 0);
     for _ in 0..30 {
@@ -455,10 +455,10 @@ fn invalid_conjugate_gradient_settings_are_typed_errors() {
 /// Newton iterations that reused a factorization and the factorizations.
 fn run_frames(
     integrator: &ImplicitIntegrator,
-    body: &SoftBody,
+    body: &DeformableBody,
     frames: usize,
     dt: f64,
-) -> (SoftBody, usize, usize) {
+) -> (DeformableBody, usize, usize) {
     let mut body = body.clone();
     let (mut reused, mut factorizations) = (0, 0);
     for _ in 0..frames {

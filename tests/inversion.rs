@@ -15,17 +15,17 @@ const ROBUST: [MaterialModel; 3] = [
     MaterialModel::StVenantKirchhoff,
 ];
 
-fn soft_cube(model: MaterialModel) -> SoftBody {
+fn soft_cube(model: MaterialModel) -> DeformableBody {
     let material = Material::new(model, 1e5, 0.3, 1000.0).unwrap();
     let mesh = mesh::cuboid(DVec3::splat(0.1), [4, 4, 4]).unwrap();
-    SoftBodyBuilder::new(mesh, material)
+    DeformableBodyBuilder::new(mesh, material)
         .damping(RayleighDamping::stiffness_proportional(0.01, material.lame()).unwrap())
         .build()
         .unwrap()
 }
 
 /// Runs backward Euler frames of 1/60 s without gravity; returns the inverted count per frame.
-fn recover(body: &mut SoftBody, frames: usize) -> Vec<usize> {
+fn recover(body: &mut DeformableBody, frames: usize) -> Vec<usize> {
     (0..frames)
         .map(|_| {
             ImplicitIntegrator::default()
@@ -96,7 +96,7 @@ fn a_tetrahedron_turned_inside_out_recovers_with_the_explicit_integrator_too() {
             vec![[0, 1, 2, 3]],
         )
         .unwrap();
-        let mut body = SoftBodyBuilder::new(mesh, material)
+        let mut body = DeformableBodyBuilder::new(mesh, material)
             .damping(RayleighDamping::stiffness_proportional(1e-3, material.lame()).unwrap())
             .build()
             .unwrap();

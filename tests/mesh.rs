@@ -216,7 +216,7 @@ fn lumped_masses_sum_to_density_times_volume() {
         mesh::sphere(0.25, 6).unwrap(),
     ] {
         let volume = mesh.volume();
-        let body = SoftBodyBuilder::new(mesh, material).build().unwrap();
+        let body = DeformableBodyBuilder::new(mesh, material).build().unwrap();
         let total = body.total_mass();
         assert!(
             (total - density * volume).abs() <= 1e-12 * total,
@@ -231,7 +231,7 @@ fn lumped_masses_sum_to_density_times_volume() {
 fn each_node_of_a_single_tet_gets_a_quarter_of_its_mass() {
     let mesh = TetMesh::new(unit_tet(), vec![[0, 1, 2, 3]]).unwrap();
     let material = Material::new(MaterialModel::Linear, 1e6, 0.3, 600.0).unwrap();
-    let body = SoftBodyBuilder::new(mesh, material).build().unwrap();
+    let body = DeformableBodyBuilder::new(mesh, material).build().unwrap();
     for &m in body.masses() {
         assert!((m - 600.0 / 6.0 / 4.0).abs() < 1e-12);
     }
@@ -241,7 +241,7 @@ fn each_node_of_a_single_tet_gets_a_quarter_of_its_mass() {
 fn builder_rejects_missing_pinned_node_and_non_finite_placement() {
     let material = Material::new(MaterialModel::Linear, 1e6, 0.3, 1000.0).unwrap();
     let mesh = mesh::cuboid(DVec3::ONE, [1, 1, 1]).unwrap();
-    let err = SoftBodyBuilder::new(mesh.clone(), material)
+    let err = DeformableBodyBuilder::new(mesh.clone(), material)
         .pinned_nodes([3, 8])
         .build()
         .unwrap_err();
@@ -252,7 +252,7 @@ fn builder_rejects_missing_pinned_node_and_non_finite_placement() {
             node_count: 8
         }
     );
-    let err = SoftBodyBuilder::new(mesh, material)
+    let err = DeformableBodyBuilder::new(mesh, material)
         .translation(DVec3::new(0.0, f64::NAN, 0.0))
         .build()
         .unwrap_err();
@@ -324,7 +324,7 @@ fn slivers_are_refused_before_stepping() {
     let (tet, quality) = mesh.worst_tet();
     assert!(tet == 0 && quality < 1e-4);
     let material = Material::new(MaterialModel::Linear, 1e6, 0.3, 1000.0).unwrap();
-    match SoftBodyBuilder::new(mesh.clone(), material).build() {
+    match DeformableBodyBuilder::new(mesh.clone(), material).build() {
         Err(Error::SliverTet {
             tet: 0, threshold, ..
         }) => {
@@ -334,7 +334,7 @@ fn slivers_are_refused_before_stepping() {
     }
     // The threshold is the user's to lower.
     assert!(
-        SoftBodyBuilder::new(mesh, material)
+        DeformableBodyBuilder::new(mesh, material)
             .min_element_quality(0.0)
             .build()
             .is_ok()

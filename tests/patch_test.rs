@@ -42,7 +42,7 @@ fn interior_force_ratio(
 ) -> f64 {
     let mesh = distorted_box();
     let material = Material::new(model, 1e7, 0.3, 1000.0).unwrap();
-    let mut builder = SoftBodyBuilder::new(mesh.clone(), material);
+    let mut builder = DeformableBodyBuilder::new(mesh.clone(), material);
     if let Some(damping) = damping {
         builder = builder.damping(damping);
     }

@@ -52,7 +52,7 @@ fn forces_under(
     rate: impl Fn(DVec3) -> DVec3,
 ) -> Vec<DVec3> {
     let material = Material::new(model, 1e7, 0.3, 1000.0).unwrap();
-    let mut builder = SoftBodyBuilder::quadratic(mesh.clone(), material);
+    let mut builder = DeformableBodyBuilder::quadratic(mesh.clone(), material);
     if let Some(damping) = damping {
         builder = builder.damping(damping);
     }
@@ -169,7 +169,7 @@ fn momentum_is_conserved_by_explicit_and_implicit_steps() {
     let linear = mesh::cuboid(DVec3::splat(0.1), [2, 2, 2]).unwrap();
     let quadratic = mesh::QuadraticTetMesh::from_linear(&linear).unwrap();
     for implicit in [false, true] {
-        let mut body = SoftBodyBuilder::quadratic(quadratic.clone(), material)
+        let mut body = DeformableBodyBuilder::quadratic(quadratic.clone(), material)
             .damping(RayleighDamping::new(5.0, 10.0).unwrap())
             .build()
             .unwrap();
@@ -188,7 +188,7 @@ fn explicit_steps_of_quadratic_elements_are_stable() {
     let material = Material::new(MaterialModel::Corotated, 1e6, 0.3, 1000.0).unwrap();
     let linear = mesh::cuboid(DVec3::splat(0.1), [3, 3, 3]).unwrap();
     let quadratic = mesh::QuadraticTetMesh::from_linear(&linear).unwrap();
-    let mut body = SoftBodyBuilder::quadratic(quadratic, material)
+    let mut body = DeformableBodyBuilder::quadratic(quadratic, material)
         .build()
         .unwrap();
     let (worst, _) = common::explicit_energy_change(&mut body, 9, 0.005, 30);
@@ -218,12 +218,12 @@ fn quadratic_cantilever_matches_beam_theory() {
             mesh::QuadraticTetMesh::from_linear(&mesh::cuboid(half, cells).unwrap()).unwrap();
         let clamped = quadratic.nodes_where(|p| p.x <= -half.x + 1e-9);
         let tip = quadratic.nodes_where(|p| p.x >= half.x - 1e-9);
-        let mut body = SoftBodyBuilder::quadratic(quadratic, material)
+        let mut body = DeformableBodyBuilder::quadratic(quadratic, material)
             .pinned_nodes(clamped)
             .build()
             .unwrap();
         assert_eq!(body.element_order(), ElementOrder::Quadratic);
-        let height = |b: &SoftBody| {
+        let height = |b: &DeformableBody| {
             tip.iter()
                 .map(|&n| b.positions()[n as usize].y)
                 .sum::<f64>()
@@ -252,7 +252,7 @@ fn quadratic_cantilever_first_frequency_matches_timoshenko() {
     let quadratic =
         mesh::QuadraticTetMesh::from_linear(&mesh::cuboid(half, [20, 1, 1]).unwrap()).unwrap();
     let clamped = quadratic.nodes_where(|p| p.x <= -half.x + 1e-9);
-    let body = SoftBodyBuilder::quadratic(quadratic, material)
+    let body = DeformableBodyBuilder::quadratic(quadratic, material)
         .pinned_nodes(clamped)
         .build()
         .unwrap();
@@ -317,7 +317,7 @@ fn a_quadratic_cube_rests_on_a_rapier_ground() {
         .insert_collider(ColliderBuilder::new(SharedShape::halfspace(Vec3::Y)), None);
     let material = Material::new(MaterialModel::StableNeoHookean, 1e5, 0.3, 1000.0).unwrap();
     let linear = mesh::cuboid(DVec3::splat(0.1), [2, 2, 2]).unwrap();
-    let cube = SoftBodyBuilder::quadratic(
+    let cube = DeformableBodyBuilder::quadratic(
         mesh::QuadraticTetMesh::from_linear(&linear).unwrap(),
         material,
     )
@@ -352,7 +352,7 @@ fn curved_quadratic_meshes_follow_the_round_shape() {
     let material = Material::new(MaterialModel::Corotated, 1e6, 0.3, 1000.0).unwrap();
     let flat = mesh::sphere(radius, 4).unwrap();
     let curved = mesh::QuadraticTetMesh::sphere(radius, 4).unwrap();
-    let body = SoftBodyBuilder::quadratic(curved.clone(), material)
+    let body = DeformableBodyBuilder::quadratic(curved.clone(), material)
         .build()
         .unwrap();
     let flat_error = flat.volume() / exact - 1.0;
@@ -390,7 +390,7 @@ fn glued_quadratic_nodes_follow_a_moving_kinematic_body() {
         let linear = mesh::cuboid(DVec3::new(0.01, 0.1, 0.01), [1, 5, 1]).unwrap();
         let quadratic = mesh::QuadraticTetMesh::from_linear(&linear).unwrap();
         let root = quadratic.nodes_where(|p| p.y >= 0.1 - 1e-9);
-        let rod = SoftBodyBuilder::quadratic(quadratic, material)
+        let rod = DeformableBodyBuilder::quadratic(quadratic, material)
             .damping(RayleighDamping::stiffness_proportional(1e-3, material.lame()).unwrap())
             .translation(DVec3::new(common::GLUED_PATH_RADIUS, 0.4, 0.0))
             .build()

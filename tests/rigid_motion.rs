@@ -10,18 +10,18 @@ use rapier_fvm::prelude::*;
 
 const YOUNG: f64 = 1e7;
 
-fn body(model: MaterialModel) -> SoftBody {
+fn body(model: MaterialModel) -> DeformableBody {
     let material = Material::new(model, YOUNG, 0.3, 1000.0).unwrap();
     let damping = RayleighDamping::stiffness_proportional(0.05, material.lame()).unwrap();
     let mesh = mesh::sphere(0.1, 5).unwrap();
-    SoftBodyBuilder::new(mesh, material)
+    DeformableBodyBuilder::new(mesh, material)
         .damping(damping)
         .build()
         .unwrap()
 }
 
 /// Places the body at `x = R p + t` with velocity `v = ω x (x - t) + v0`.
-fn move_rigidly(body: &mut SoftBody, rotation: DQuat, spin: DVec3, drift: DVec3) {
+fn move_rigidly(body: &mut DeformableBody, rotation: DQuat, spin: DVec3, drift: DVec3) {
     let translation = DVec3::new(1.0, -2.0, 0.5);
     let rest = body.mesh().positions().to_vec();
     for (n, p) in rest.iter().enumerate() {
@@ -32,7 +32,7 @@ fn move_rigidly(body: &mut SoftBody, rotation: DQuat, spin: DVec3, drift: DVec3)
 }
 
 /// The force scale of a 1 % strain on this mesh: E * 0.01 * (area of a typical face).
-fn force_scale(body: &SoftBody) -> f64 {
+fn force_scale(body: &DeformableBody) -> f64 {
     YOUNG * 0.01 * body.mesh().min_altitude().powi(2)
 }
 

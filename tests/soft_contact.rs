@@ -22,7 +22,7 @@ fn world_on_ground(friction: f32) -> (FvmWorld, ColliderHandle) {
     (world, ground)
 }
 
-fn step(world: &mut FvmWorld) -> Vec<(SoftBodyHandle, AutomaticReport)> {
+fn step(world: &mut FvmWorld) -> Vec<(DeformableBodyHandle, AutomaticReport)> {
     world
         .step()
         .into_iter()
@@ -37,9 +37,9 @@ fn step(world: &mut FvmWorld) -> Vec<(SoftBodyHandle, AutomaticReport)> {
 
 /// A damped cube of side `SIDE`, 4 cells a side, centred at `centre`, of Young's modulus
 /// `young` (Pa) and Poisson's ratio `poisson`, density 1000 kg/m³, friction 0.5.
-fn cube(young: f64, poisson: f64, centre: DVec3) -> SoftBody {
+fn cube(young: f64, poisson: f64, centre: DVec3) -> DeformableBody {
     let material = Material::new(MaterialModel::StableNeoHookean, young, poisson, 1000.0).unwrap();
-    SoftBodyBuilder::new(
+    DeformableBodyBuilder::new(
         mesh::cuboid(DVec3::splat(SIDE / 2.0), [4; 3]).unwrap(),
         material,
     )
@@ -83,7 +83,7 @@ fn a_stack_of_two_soft_cubes_compresses_as_uniaxial_elasticity_says() {
                     .iter()
                     .all(|(_, r)| r.choice == IntegratorKind::Explicit)
             );
-            let substep = frame / f64::from(world.coupling_substeps);
+            let substep = frame / f64::from(world.coupling.substeps);
             let (force, _) = world.soft_bodies[bottom]
                 .contact_force_on(ground, substep)
                 .unwrap();
@@ -98,7 +98,7 @@ fn a_stack_of_two_soft_cubes_compresses_as_uniaxial_elasticity_says() {
     }
     let reaction = reaction / f64::from(averaged);
     let weight = 9.81 * 1000.0 * SIDE.powi(3);
-    let shortening = |body: SoftBodyHandle| {
+    let shortening = |body: DeformableBodyHandle| {
         let b = &world.soft_bodies[body];
         SIDE - (mean_height_of_layer(b, SIDE / 2.0) - mean_height_of_layer(b, -SIDE / 2.0))
     };
@@ -127,7 +127,7 @@ fn a_stack_of_two_soft_cubes_compresses_as_uniaxial_elasticity_says() {
     assert!((reaction / (2.0 * weight) - 1.0).abs() < 0.01);
     assert!(fastest < 1e-3);
     // No more overlap than the contact margin plus 1 mm, the bound for the drop.
-    assert!(deepest < world.contact.margin + 1e-3);
+    assert!(deepest < world.coupling.contact.margin + 1e-3);
 }
 
 #[test]
@@ -174,18 +174,18 @@ fn two_soft_bodies_colliding_in_zero_gravity_conserve_momentum() {
         (p1 - p0).length(),
         p0.length(),
         (l1 - l0).length(),
-        world.contact.margin * struck_momentum.length(),
+        world.coupling.contact.margin * struck_momentum.length(),
         struck_momentum.length()
     );
     // The impact happened: the struck cube carries a good part of the momentum.
     assert!(struck_momentum.x > 0.2 * p0.x);
     assert!((p1 - p0).length() <= 1e-6 * p0.length());
-    assert!((l1 - l0).length() <= world.contact.margin * struck_momentum.length());
+    assert!((l1 - l0).length() <= world.coupling.contact.margin * struck_momentum.length());
 }
 
 /// The mean height (m) of the body's nodes whose rest height is `rest_y` (m, in the mesh's own
 /// frame).
-fn mean_height_of_layer(body: &SoftBody, rest_y: f64) -> f64 {
+fn mean_height_of_layer(body: &DeformableBody, rest_y: f64) -> f64 {
     let layer = body.mesh().nodes_where(|p| (p.y - rest_y).abs() < 1e-9);
     layer
         .iter()
@@ -218,7 +218,7 @@ fn a_body_of_two_separate_cubes_lands_on_itself_only_with_self_contact() {
     let material = rubber(young);
     for self_contact in [true, false] {
         let (mut world, ground) = world_on_ground(0.5);
-        let body = SoftBodyBuilder::new(
+        let body = DeformableBodyBuilder::new(
             two_cubes_one_mesh(DVec3::new(0.0, SIDE + 2e-3, 0.0)),
             material,
         )
@@ -235,7 +235,7 @@ fn a_body_of_two_separate_cubes_lands_on_itself_only_with_self_contact() {
         for index in 0..frames {
             step(&mut world);
             if index >= frames - 60 {
-                let substep = frame / f64::from(world.coupling_substeps);
+                let substep = frame / f64::from(world.coupling.substeps);
                 let (force, _) = world.soft_bodies[handle]
                     .contact_force_on(ground, substep)
                     .unwrap();
@@ -259,7 +259,7 @@ fn a_body_of_two_separate_cubes_lands_on_itself_only_with_self_contact() {
             lower_top * 1e3
         );
         if self_contact {
-            assert!(lower_top - upper_lowest < world.contact.margin + 1e-3);
+            assert!(lower_top - upper_lowest < world.coupling.contact.margin + 1e-3);
             assert!((reaction / weight - 1.0).abs() < 0.01);
         } else {
             assert!(upper_lowest < lower_top - SIDE / 2.0);
@@ -283,7 +283,7 @@ fn the_halves_of_a_body_colliding_in_zero_gravity_conserve_its_momentum() {
     let mesh = two_cubes_one_mesh(DVec3::new(SIDE + 2e-3, 0.03, 0.0));
     let material = rubber(1e5);
     let handle = world.soft_bodies.insert(
-        SoftBodyBuilder::new(mesh, material)
+        DeformableBodyBuilder::new(mesh, material)
             .damping(RayleighDamping::stiffness_proportional(2e-3, material.lame()).unwrap())
             .self_contact(true)
             .build()
@@ -293,7 +293,7 @@ fn the_halves_of_a_body_colliding_in_zero_gravity_conserve_its_momentum() {
     for v in &mut world.soft_bodies[handle].velocities_mut()[..left] {
         *v = DVec3::new(1.0, 0.0, 0.3);
     }
-    let momenta = |body: &SoftBody| {
+    let momenta = |body: &DeformableBody| {
         body.positions()
             .iter()
             .zip(body.velocities())
@@ -323,12 +323,12 @@ fn the_halves_of_a_body_colliding_in_zero_gravity_conserve_its_momentum() {
         (p1 - p0).length(),
         p0.length(),
         (l1 - l0).length(),
-        world.contact.margin * right_mass * right_speed,
+        world.coupling.contact.margin * right_mass * right_speed,
         right_speed
     );
     assert!(touched, "the halves never met");
     // The impact happened: the right cube was set moving.
     assert!(right_speed > 0.1);
     assert!((p1 - p0).length() <= 1e-6 * p0.length());
-    assert!((l1 - l0).length() <= world.contact.margin * right_mass * right_speed);
+    assert!((l1 - l0).length() <= world.coupling.contact.margin * right_mass * right_speed);
 }

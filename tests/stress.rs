@@ -6,14 +6,14 @@ use rapier_fvm::prelude::*;
 const E: f64 = 2e6;
 const NU: f64 = 0.3;
 
-fn cube(model: MaterialModel) -> SoftBody {
+fn cube(model: MaterialModel) -> DeformableBody {
     let material = Material::new(model, E, NU, 1000.0).unwrap();
     let mesh = mesh::cuboid(DVec3::splat(0.05), [3, 3, 3]).unwrap();
-    SoftBodyBuilder::new(mesh, material).build().unwrap()
+    DeformableBodyBuilder::new(mesh, material).build().unwrap()
 }
 
 /// Moves every node to `map(rest position)`.
-fn deform(body: &mut SoftBody, map: impl Fn(DVec3) -> DVec3) {
+fn deform(body: &mut DeformableBody, map: impl Fn(DVec3) -> DVec3) {
     let rest = body.mesh().positions().to_vec();
     for (x, p) in body.positions_mut().iter_mut().zip(rest) {
         *x = map(p);
@@ -49,7 +49,7 @@ fn uniaxial_stretch_of_a_linear_cube_gives_e_epsilon() {
                     .iter()
                     .all(|c| *c <= 1e-9 * axial.abs())
             );
-            let von_mises = SoftBody::von_mises(&sigma);
+            let von_mises = DeformableBody::von_mises(&sigma);
             assert!((von_mises - sigma.x_axis.x.abs()).abs() <= 1e-9 * axial.abs());
         }
     }
@@ -84,6 +84,10 @@ fn inverted_elements_give_finite_stress() {
         assert_eq!(body.inverted_tet_count(), body.mesh().tet_count());
         let stresses = body.cauchy_stresses();
         assert!(stresses.iter().all(|s| s.is_finite()));
-        assert!(stresses.iter().all(|s| SoftBody::von_mises(s).is_finite()));
+        assert!(
+            stresses
+                .iter()
+                .all(|s| DeformableBody::von_mises(s).is_finite())
+        );
     }
 }

@@ -15,7 +15,7 @@ const HALF: DVec3 = DVec3::new(0.3, 0.05, 0.05);
 const STRAIN: f64 = 1e-4;
 
 /// Nodal forces of the bar stretched by `STRAIN` along x and `lateral` along y and z.
-fn forces(body: &mut SoftBody, lateral: f64) -> Vec<DVec3> {
+fn forces(body: &mut DeformableBody, lateral: f64) -> Vec<DVec3> {
     let rest: Vec<DVec3> = body.mesh().positions().to_vec();
     let stretch = DVec3::new(1.0 + STRAIN, 1.0 + lateral, 1.0 + lateral);
     for (x, p) in body.positions_mut().iter_mut().zip(&rest) {
@@ -44,7 +44,7 @@ fn uniaxial_tension_gives_e_epsilon_and_minus_nu_epsilon() {
         let material = Material::new(MaterialModel::Linear, e, nu, 1000.0).unwrap();
         let mesh = mesh::cuboid(HALF, [6, 3, 2]).unwrap();
         let rest = mesh.positions().to_vec();
-        let mut body = SoftBodyBuilder::new(mesh, material).build().unwrap();
+        let mut body = DeformableBodyBuilder::new(mesh, material).build().unwrap();
 
         let r0 = lateral_face_force(&rest, &forces(&mut body, 0.0));
         let r1 = lateral_face_force(&rest, &forces(&mut body, -STRAIN));

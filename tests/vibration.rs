@@ -44,7 +44,7 @@ fn released_from_static_deflection(
     cells: [usize; 3],
     model: MaterialModel,
     damping: Option<RayleighDamping>,
-) -> (SoftBody, usize) {
+) -> (DeformableBody, usize) {
     let (mut body, tip) = cantilever(cells, material(model));
     statics::solve_equilibrium(&mut body, common::gravity(), &StaticSettings::default()).unwrap();
     let (mut released, _) = common::damped_cantilever(cells, material(model), damping);
@@ -53,7 +53,7 @@ fn released_from_static_deflection(
 }
 
 /// Tip height (m) sampled every `dt` (s) for `duration` (s), with automatic substeps.
-fn tip_history(body: &mut SoftBody, tip: usize, dt: f64, duration: f64) -> Vec<f64> {
+fn tip_history(body: &mut DeformableBody, tip: usize, dt: f64, duration: f64) -> Vec<f64> {
     let integrator = SymplecticEuler::default();
     (0..(duration / dt).round() as usize)
         .map(|_| {

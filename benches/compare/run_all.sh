@@ -38,7 +38,7 @@ start=$(date +%s)
 
 echo "== building" >&2
 bash benches/compare/setup.sh "$venv" >&2
-cargo build --release -p rapier_fvm_runner --bin compare_cases --bin compare_report >&2
+cargo build --release -p rapier_fvm_cases -p compare_report >&2
 (cd "$builtin_dir" && CARGO_TARGET_DIR="$builtin_target" cargo build --release) >&2
 
 mkdir -p "$log"

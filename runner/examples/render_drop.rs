@@ -33,7 +33,7 @@ fn main() -> Result<(), Box<dyn Error>> {
         ColliderBuilder::cuboid(0.03, 0.03, 0.03).density(500.0),
     );
     let rubber = Material::new(MaterialModel::StableNeoHookean, 1e5, 0.3, 1000.0)?;
-    let cube = SoftBodyBuilder::new(mesh::cuboid(DVec3::splat(0.05), [6, 6, 6])?, rubber)
+    let cube = DeformableBodyBuilder::new(mesh::cuboid(DVec3::splat(0.05), [6, 6, 6])?, rubber)
         .damping(RayleighDamping::stiffness_proportional(
             2e-3,
             rubber.lame(),

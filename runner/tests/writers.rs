@@ -25,7 +25,7 @@ fn folder(test: &str) -> PathBuf {
 fn scene(time: f64) -> Snapshot {
     let rubber = Material::new(MaterialModel::StableNeoHookean, 1e5, 0.3, 1000.0).unwrap();
     let mut body =
-        SoftBodyBuilder::new(mesh::cuboid(DVec3::splat(0.05), [2, 2, 2]).unwrap(), rubber)
+        DeformableBodyBuilder::new(mesh::cuboid(DVec3::splat(0.05), [2, 2, 2]).unwrap(), rubber)
             .translation(DVec3::new(0.0, 0.1, 0.0))
             .build()
             .unwrap();

@@ -1,6 +1,6 @@
-//! [`SoftBodyBuilder`]: the rapier-style way to describe a soft body before creating it.
+//! [`DeformableBodyBuilder`]: the rapier-style way to describe a soft body before creating it.
 
-use super::{SoftBody, lumped_masses};
+use super::{DeformableBody, lumped_masses};
 use crate::Error;
 use crate::chord::Chord;
 use crate::contact::ContactSettings;
@@ -24,7 +24,7 @@ use rapier3d::glamx::{DQuat, DVec3};
 /// let mesh = mesh::cuboid(DVec3::new(0.5, 0.05, 0.05), [10, 1, 1])?;
 /// let clamped = mesh.nodes_where(|p| p.x <= -0.5 + 1e-9);
 /// let steel = Material::new(MaterialModel::Corotated, 200e9, 0.3, 7850.0)?;
-/// let beam = SoftBodyBuilder::new(mesh, steel)
+/// let beam = DeformableBodyBuilder::new(mesh, steel)
 ///     .translation(DVec3::new(0.5, 1.0, 0.0))
 ///     .pinned_nodes(clamped)
 ///     .build()?;
@@ -33,7 +33,7 @@ use rapier3d::glamx::{DQuat, DVec3};
 /// ```
 #[derive(Debug, Clone)]
 #[must_use = "a builder does nothing until `build` is called"]
-pub struct SoftBodyBuilder {
+pub struct DeformableBodyBuilder {
     /// The linear tetrahedra: the body's elements, or the subdivision of its quadratic ones.
     mesh: TetMesh,
     /// The quadratic elements, for a body of them.
@@ -66,14 +66,14 @@ struct QuadraticSpec {
     parents: Vec<u32>,
 }
 
-/// Default [`SoftBodyBuilder::friction`]: rapier's default collider friction.
+/// Default [`DeformableBodyBuilder::friction`]: rapier's default collider friction.
 pub const DEFAULT_FRICTION: f64 = 0.5;
 
-/// Default [`SoftBodyBuilder::min_element_quality`]: a tetrahedron whose smallest altitude is a
+/// Default [`DeformableBodyBuilder::min_element_quality`]: a tetrahedron whose smallest altitude is a
 /// thousandth of its longest edge is refused.
 pub const DEFAULT_MIN_ELEMENT_QUALITY: f64 = 1e-3;
 
-impl SoftBodyBuilder {
+impl DeformableBodyBuilder {
     /// A body of `mesh` (rest positions in m) made of `material`, at rest where the mesh lies,
     /// undamped, with no pinned node.
     pub fn new(mesh: TetMesh, material: Material) -> Self {
@@ -101,7 +101,7 @@ impl SoftBodyBuilder {
 
     /// A body of quadratic (10-node) tetrahedra: far more accurate in bending per degree of
     /// freedom than linear ones (see [`crate::element::tet10`]). The body's
-    /// [`SoftBody::mesh`] is then `mesh`'s [subdivision](QuadraticTetMesh::subdivided), on the
+    /// [`DeformableBody::mesh`] is then `mesh`'s [subdivision](QuadraticTetMesh::subdivided), on the
     /// same nodes; node indices (pins, attachments, probes) are those of `mesh`.
     ///
     /// # Example
@@ -112,7 +112,7 @@ impl SoftBodyBuilder {
     /// let mesh = mesh::QuadraticTetMesh::from_linear(&linear)?;
     /// let clamped = mesh.nodes_where(|p| p.x <= -0.5 + 1e-9);
     /// let material = Material::new(MaterialModel::Corotated, 1e8, 0.3, 1000.0)?;
-    /// let beam = SoftBodyBuilder::quadratic(mesh, material)
+    /// let beam = DeformableBodyBuilder::quadratic(mesh, material)
     ///     .pinned_nodes(clamped)
     ///     .build()?;
     /// assert_eq!(beam.element_order(), rapier_fvm::element::ElementOrder::Quadratic);
@@ -135,7 +135,7 @@ impl SoftBodyBuilder {
 
     /// A body simulated on a coarse cage of quadratic (27-node) hexahedra: one element across a
     /// beam's section bends it as a continuum does (see [`crate::element::hex27`]), so bending
-    /// bodies need the fewest nodes this way. The body's [`SoftBody::mesh`] is the cage's
+    /// bodies need the fewest nodes this way. The body's [`DeformableBody::mesh`] is the cage's
     /// [subdivision](QuadraticHexMesh::subdivided), on the same nodes.
     ///
     /// # Example
@@ -145,7 +145,7 @@ impl SoftBodyBuilder {
     /// let cage = mesh::QuadraticHexMesh::cuboid(DVec3::new(0.5, 0.05, 0.05), [5, 1, 1])?;
     /// let clamped = cage.nodes_where(|p| p.x <= -0.5 + 1e-9);
     /// let material = Material::new(MaterialModel::Corotated, 1e8, 0.3, 1000.0)?;
-    /// let beam = SoftBodyBuilder::quadratic_hex(cage, material)
+    /// let beam = DeformableBodyBuilder::quadratic_hex(cage, material)
     ///     .pinned_nodes(clamped)
     ///     .build()?;
     /// assert_eq!(beam.element_shape(), rapier_fvm::element::ElementShape::Hexahedron);
@@ -210,7 +210,7 @@ impl SoftBodyBuilder {
     }
 
     /// The smallest tetrahedron quality (smallest altitude over longest edge, dimensionless)
-    /// accepted by [`SoftBodyBuilder::build`]; default [`DEFAULT_MIN_ELEMENT_QUALITY`], 0 accepts
+    /// accepted by [`DeformableBodyBuilder::build`]; default [`DEFAULT_MIN_ELEMENT_QUALITY`], 0 accepts
     /// every valid mesh.
     pub fn min_element_quality(mut self, quality: f64) -> Self {
         self.min_quality = quality;
@@ -240,7 +240,7 @@ impl SoftBodyBuilder {
     }
 
     /// The surface's restitution coefficient (non-negative, finite); default 0, as rapier's
-    /// colliders (see [`SoftBody::restitution`]).
+    /// colliders (see [`DeformableBody::restitution`]).
     pub fn restitution(mut self, restitution: f64) -> Self {
         self.restitution = restitution;
         self
@@ -254,7 +254,7 @@ impl SoftBodyBuilder {
     }
 
     /// Whether the surface collides with itself where the motion brings together parts far apart
-    /// in the rest shape; default off (see [`SoftBody::self_contact`]).
+    /// in the rest shape; default off (see [`DeformableBody::self_contact`]).
     pub fn self_contact(mut self, enabled: bool) -> Self {
         self.self_contact = enabled;
         self
@@ -265,7 +265,7 @@ impl SoftBodyBuilder {
     /// [`crate::embedding`]), and contacts with colliders act on its surface instead of the
     /// simulation mesh's. A coarse cage of quadratic elements then sets the cost and accuracy
     /// of the elasticity, and the fine mesh the resolution of contact and output
-    /// ([`SoftBody::embedded_positions`]). Self-contact, contacts between soft bodies and rigid
+    /// ([`DeformableBody::embedded_positions`]). Self-contact, contacts between soft bodies and rigid
     /// corners pressing on the body act on the simulation mesh's surface.
     ///
     /// # Example
@@ -277,7 +277,7 @@ impl SoftBodyBuilder {
     /// let cage = mesh::QuadraticHexMesh::cuboid(half, [4, 1, 1])?;
     /// let fine = mesh::cuboid(half, [32, 4, 4])?;
     /// let material = Material::new(MaterialModel::Corotated, 1e6, 0.3, 1000.0)?;
-    /// let beam = SoftBodyBuilder::quadratic_hex(cage, material)
+    /// let beam = DeformableBodyBuilder::quadratic_hex(cage, material)
     ///     .embedded(fine)
     ///     .build()?;
     /// let surface = beam.embedded_positions().expect("embedded");
@@ -309,7 +309,7 @@ impl SoftBodyBuilder {
     /// carries;
     /// [`Error::InvalidSetting`] for a minimum quality outside `[0, 1)` or a negative or
     /// non-finite friction or restitution.
-    pub fn build(self) -> Result<SoftBody, Error> {
+    pub fn build(self) -> Result<DeformableBody, Error> {
         for (parameter, value) in [
             ("friction", self.friction),
             ("restitution", self.restitution),
@@ -431,7 +431,7 @@ impl SoftBodyBuilder {
         let mut surface_nodes: Vec<u32> = surface_triangles.iter().flatten().copied().collect();
         surface_nodes.sort_unstable();
         surface_nodes.dedup();
-        Ok(SoftBody {
+        Ok(DeformableBody {
             elements,
             masses,
             forces: vec![DVec3::ZERO; node_count],

@@ -5,8 +5,8 @@ mod builder;
 mod set;
 mod stress;
 
-pub use builder::{DEFAULT_FRICTION, DEFAULT_MIN_ELEMENT_QUALITY, SoftBodyBuilder};
-pub use set::{SoftBodyHandle, SoftBodySet};
+pub use builder::{DEFAULT_FRICTION, DEFAULT_MIN_ELEMENT_QUALITY, DeformableBodyBuilder};
+pub use set::{DeformableBodyHandle, DeformableBodySet};
 
 use crate::assembly::Stiffness;
 use crate::attachment::Attachment;
@@ -25,11 +25,11 @@ use rapier3d::glamx::DVec3;
 /// A deformable body discretized by tetrahedra, linear (simulated by finite volumes) or
 /// quadratic.
 ///
-/// Built with [`SoftBodyBuilder`]. Mass is lumped on the nodes from their control volumes (a
+/// Built with [`DeformableBodyBuilder`]. Mass is lumped on the nodes from their control volumes (a
 /// quarter of each incident linear tetrahedron's rest volume times the density; HRZ fractions
 /// for quadratic ones), so the nodal masses sum to density times rest volume.
 #[derive(Debug, Clone)]
-pub struct SoftBody {
+pub struct DeformableBody {
     /// The linear tetrahedra: the elements, or the subdivision of the quadratic ones.
     pub(crate) mesh: TetMesh,
     pub(crate) elements: Elements,
@@ -84,15 +84,15 @@ pub struct SoftBody {
     /// The surface's Coulomb friction coefficient, combined with a collider's or another soft
     /// body's by the stronger of their combine rules, as rapier combines two colliders'.
     pub friction: f64,
-    /// How [`SoftBody::friction`] combines with the other side's.
+    /// How [`DeformableBody::friction`] combines with the other side's.
     pub friction_combine_rule: CoefficientCombineRule,
     /// The surface's restitution coefficient, combined with the other side's as
-    /// [`SoftBody::friction`] is: a node striking a surface faster than
+    /// [`DeformableBody::friction`] is: a node striking a surface faster than
     /// [`RESTITUTION_THRESHOLD`](crate::contact::RESTITUTION_THRESHOLD) leaves it at this fraction
     /// of its approach speed (explicit integration). The body's own elasticity makes it rebound
     /// too; with the default 0 that is the only rebound.
     pub restitution: f64,
-    /// How [`SoftBody::restitution`] combines with the other side's.
+    /// How [`DeformableBody::restitution`] combines with the other side's.
     pub restitution_combine_rule: CoefficientCombineRule,
     /// Whether the body's surface collides with itself (a body folding over itself, or made of
     /// separate parts): off by default, as it costs a bounding-volume query per surface node and
@@ -104,7 +104,7 @@ pub struct SoftBody {
     pub user_data: u128,
 }
 
-impl SoftBody {
+impl DeformableBody {
     /// The rest mesh (rest positions in the body's own frame, m): the elements for a body of
     /// linear tetrahedra; for quadratic ones their subdivision into linear tetrahedra on the same
     /// nodes (see [`QuadraticTetMesh::subdivided`](crate::mesh::QuadraticTetMesh::subdivided)),
@@ -119,7 +119,7 @@ impl SoftBody {
     }
 
     /// The fine mesh the body carries for contact and output, if it was built with one
-    /// ([`SoftBodyBuilder::embedded`]).
+    /// ([`DeformableBodyBuilder::embedded`]).
     pub fn embedding(&self) -> Option<&Embedding> {
         self.embedding.as_ref()
     }
@@ -139,7 +139,7 @@ impl SoftBody {
 
     /// The number of elements the body is simulated with: the mesh's tetrahedra for linear
     /// elements, the quadratic tetrahedra or hexahedra otherwise (each subdivided in
-    /// [`SoftBody::mesh`]).
+    /// [`DeformableBody::mesh`]).
     pub fn element_count(&self) -> usize {
         match &self.elements {
             Elements::Linear { .. } => self.mesh.tet_count(),
@@ -243,7 +243,7 @@ impl SoftBody {
             .extend(self.contacts.iter().map(|c| (c.point, c.normal)));
     }
 
-    /// Puts back the state saved by [`SoftBody::save_state`].
+    /// Puts back the state saved by [`DeformableBody::save_state`].
     pub(crate) fn restore_state(&mut self) {
         self.positions.clone_from(&self.saved_state.0);
         self.velocities.clone_from(&self.saved_state.1);

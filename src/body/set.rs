@@ -1,24 +1,24 @@
-//! [`SoftBodySet`]: the soft bodies of a world, addressed by [`SoftBodyHandle`]s, as rapier keeps
+//! [`DeformableBodySet`]: the soft bodies of a world, addressed by [`DeformableBodyHandle`]s, as rapier keeps
 //! rigid bodies in a `RigidBodySet`.
 
-use super::SoftBody;
+use super::DeformableBody;
 
-/// A stable reference to a body of a [`SoftBodySet`]. A handle whose body was removed stays
+/// A stable reference to a body of a [`DeformableBodySet`]. A handle whose body was removed stays
 /// invalid even if its slot is reused (the generation differs).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct SoftBodyHandle {
+pub struct DeformableBodyHandle {
     index: u32,
     generation: u32,
 }
 
-impl SoftBodyHandle {
+impl DeformableBodyHandle {
     /// The slot index and generation, e.g. for logging or serialization.
     pub fn into_raw_parts(self) -> (u32, u32) {
         (self.index, self.generation)
     }
 
     /// The handle of slot `index` at `generation`, as given by
-    /// [`SoftBodyHandle::into_raw_parts`].
+    /// [`DeformableBodyHandle::into_raw_parts`].
     pub fn from_raw_parts(index: u32, generation: u32) -> Self {
         Self { index, generation }
     }
@@ -27,7 +27,7 @@ impl SoftBodyHandle {
 #[derive(Debug, Clone)]
 struct Slot {
     generation: u32,
-    body: Option<SoftBody>,
+    body: Option<DeformableBody>,
 }
 
 /// A collection of soft bodies with generational handles.
@@ -36,9 +36,9 @@ struct Slot {
 /// ```
 /// use rapier_fvm::prelude::*;
 ///
-/// let mut bodies = SoftBodySet::new();
+/// let mut bodies = DeformableBodySet::new();
 /// let material = Material::new(MaterialModel::StableNeoHookean, 1e5, 0.4, 1000.0)?;
-/// let ball = SoftBodyBuilder::new(mesh::sphere(0.1, 4)?, material).build()?;
+/// let ball = DeformableBodyBuilder::new(mesh::sphere(0.1, 4)?, material).build()?;
 /// let handle = bodies.insert(ball);
 /// assert_eq!(bodies.len(), 1);
 /// let removed = bodies.remove(handle).expect("the body was there");
@@ -49,25 +49,25 @@ struct Slot {
 /// # Ok::<(), rapier_fvm::Error>(())
 /// ```
 #[derive(Debug, Clone, Default)]
-pub struct SoftBodySet {
+pub struct DeformableBodySet {
     slots: Vec<Slot>,
     free: Vec<u32>,
     len: usize,
 }
 
-impl SoftBodySet {
+impl DeformableBodySet {
     /// An empty set.
     pub fn new() -> Self {
         Self::default()
     }
 
     /// Adds a body and returns its handle.
-    pub fn insert(&mut self, body: SoftBody) -> SoftBodyHandle {
+    pub fn insert(&mut self, body: DeformableBody) -> DeformableBodyHandle {
         self.len += 1;
         if let Some(index) = self.free.pop() {
             let slot = &mut self.slots[index as usize];
             slot.body = Some(body);
-            return SoftBodyHandle {
+            return DeformableBodyHandle {
                 index,
                 generation: slot.generation,
             };
@@ -76,14 +76,14 @@ impl SoftBodySet {
             generation: 0,
             body: Some(body),
         });
-        SoftBodyHandle {
+        DeformableBodyHandle {
             index: (self.slots.len() - 1) as u32,
             generation: 0,
         }
     }
 
     /// Removes and returns the body of `handle`, or `None` if it is not in the set.
-    pub fn remove(&mut self, handle: SoftBodyHandle) -> Option<SoftBody> {
+    pub fn remove(&mut self, handle: DeformableBodyHandle) -> Option<DeformableBody> {
         let slot = self.slots.get_mut(handle.index as usize)?;
         if slot.generation != handle.generation {
             return None;
@@ -96,13 +96,13 @@ impl SoftBodySet {
     }
 
     /// The body of `handle`, if it is in the set.
-    pub fn get(&self, handle: SoftBodyHandle) -> Option<&SoftBody> {
+    pub fn get(&self, handle: DeformableBodyHandle) -> Option<&DeformableBody> {
         let slot = self.slots.get(handle.index as usize)?;
         (slot.generation == handle.generation).then_some(slot.body.as_ref()?)
     }
 
     /// The body of `handle`, mutably, if it is in the set.
-    pub fn get_mut(&mut self, handle: SoftBodyHandle) -> Option<&mut SoftBody> {
+    pub fn get_mut(&mut self, handle: DeformableBodyHandle) -> Option<&mut DeformableBody> {
         let slot = self.slots.get_mut(handle.index as usize)?;
         if slot.generation != handle.generation {
             return None;
@@ -112,8 +112,11 @@ impl SoftBodySet {
 
     /// The bodies of distinct `handles`, mutably, in the order given; handles not in the set
     /// are skipped.
-    pub(crate) fn get_many_mut(&mut self, handles: &[SoftBodyHandle]) -> Vec<&mut SoftBody> {
-        let mut found: Vec<Option<&mut SoftBody>> = handles.iter().map(|_| None).collect();
+    pub(crate) fn get_many_mut(
+        &mut self,
+        handles: &[DeformableBodyHandle],
+    ) -> Vec<&mut DeformableBody> {
+        let mut found: Vec<Option<&mut DeformableBody>> = handles.iter().map(|_| None).collect();
         for (handle, body) in self.iter_mut() {
             if let Some(i) = handles.iter().position(|h| *h == handle) {
                 found[i] = Some(body);
@@ -123,7 +126,7 @@ impl SoftBodySet {
     }
 
     /// Whether `handle` refers to a body of the set.
-    pub fn contains(&self, handle: SoftBodyHandle) -> bool {
+    pub fn contains(&self, handle: DeformableBodyHandle) -> bool {
         self.get(handle).is_some()
     }
 
@@ -138,9 +141,9 @@ impl SoftBodySet {
     }
 
     /// The bodies and their handles, in slot order.
-    pub fn iter(&self) -> impl Iterator<Item = (SoftBodyHandle, &SoftBody)> {
+    pub fn iter(&self) -> impl Iterator<Item = (DeformableBodyHandle, &DeformableBody)> {
         self.slots.iter().enumerate().filter_map(|(index, slot)| {
-            let handle = SoftBodyHandle {
+            let handle = DeformableBodyHandle {
                 index: index as u32,
                 generation: slot.generation,
             };
@@ -149,12 +152,14 @@ impl SoftBodySet {
     }
 
     /// The bodies and their handles, mutably, in slot order.
-    pub fn iter_mut(&mut self) -> impl Iterator<Item = (SoftBodyHandle, &mut SoftBody)> {
+    pub fn iter_mut(
+        &mut self,
+    ) -> impl Iterator<Item = (DeformableBodyHandle, &mut DeformableBody)> {
         self.slots
             .iter_mut()
             .enumerate()
             .filter_map(|(index, slot)| {
-                let handle = SoftBodyHandle {
+                let handle = DeformableBodyHandle {
                     index: index as u32,
                     generation: slot.generation,
                 };
@@ -163,18 +168,18 @@ impl SoftBodySet {
     }
 }
 
-impl std::ops::Index<SoftBodyHandle> for SoftBodySet {
-    type Output = SoftBody;
+impl std::ops::Index<DeformableBodyHandle> for DeformableBodySet {
+    type Output = DeformableBody;
 
     /// # Panics
     /// If `handle` is not in the set, as rapier's sets do.
-    fn index(&self, handle: SoftBodyHandle) -> &SoftBody {
+    fn index(&self, handle: DeformableBodyHandle) -> &DeformableBody {
         self.get(handle).expect("no soft body with this handle")
     }
 }
 
-impl std::ops::IndexMut<SoftBodyHandle> for SoftBodySet {
-    fn index_mut(&mut self, handle: SoftBodyHandle) -> &mut SoftBody {
+impl std::ops::IndexMut<DeformableBodyHandle> for DeformableBodySet {
+    fn index_mut(&mut self, handle: DeformableBodyHandle) -> &mut DeformableBody {
         self.get_mut(handle).expect("no soft body with this handle")
     }
 }

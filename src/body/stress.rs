@@ -3,7 +3,7 @@
 //! first Piola–Kirchhoff stress `P` of the body's material, and its von Mises equivalent
 //! `σ_vm = sqrt(3/2 s:s)`, `s = σ - tr(σ)/3 I`.
 
-use super::SoftBody;
+use super::DeformableBody;
 use crate::element::{Elements, projected_measure};
 use crate::fvm::{TetRest, gather};
 use crate::material::{HyperelasticModel, VolumetricTerm, with_hyperelastic_model};
@@ -21,8 +21,8 @@ fn cauchy_from_piola(f: &DMat3, piola: DMat3) -> DMat3 {
     }
 }
 
-impl SoftBody {
-    /// The Cauchy stress `σ = P Fᵀ / det F` (Pa) of every tetrahedron of [`SoftBody::mesh`] at
+impl DeformableBody {
+    /// The Cauchy stress `σ = P Fᵀ / det F` (Pa) of every tetrahedron of [`DeformableBody::mesh`] at
     /// the current positions, in mesh order and world axes; symmetric for every model. For
     /// quadratic elements, whose stress varies inside the element, each tetrahedron of the
     /// subdivision gets the stress at its centroid.
@@ -35,7 +35,7 @@ impl SoftBody {
     /// An inverted or flattened tetrahedron (`det F <= 0`) has no Cauchy stress; for it the
     /// Kirchhoff stress `τ = P Fᵀ` (Pa) is returned instead, the Cauchy stress it would have at
     /// its rest volume: finite and of the right sign, never NaN for finite positions. Count those
-    /// elements with [`SoftBody::inverted_tet_count`].
+    /// elements with [`DeformableBody::inverted_tet_count`].
     pub fn cauchy_stresses(&self) -> Vec<DMat3> {
         with_hyperelastic_model!(self.material, |model| {
             match &self.elements {
@@ -108,13 +108,13 @@ impl SoftBody {
     }
 
     /// The Cauchy stress (Pa) of every tetrahedron of the embedded mesh
-    /// ([`SoftBody::embedding`]) at the current positions, in its mesh order and world axes;
+    /// ([`DeformableBody::embedding`]) at the current positions, in its mesh order and world axes;
     /// `None` without one. Each is the material's stress at the fine tetrahedron's own
     /// deformation gradient, from its interpolated vertices: the simulated field's mean over
     /// the tetrahedron (exact for a fine tetrahedron inside one linear element). The
     /// volumetric projection of [`VolumetricTreatment::ElementAverage`](crate::fvm::VolumetricTreatment::ElementAverage)
     /// and the viscous stress are not included; inverted tetrahedra get the Kirchhoff stress,
-    /// as in [`SoftBody::cauchy_stresses`].
+    /// as in [`DeformableBody::cauchy_stresses`].
     pub fn embedded_cauchy_stresses(&self) -> Option<Vec<DMat3>> {
         let embedding = self.embedding.as_ref()?;
         let x = embedding.positions(&self.positions);

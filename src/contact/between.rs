@@ -13,7 +13,7 @@ use super::{
     Coefficients, ContactSettings, ContactSides, SoftPoint, SurfaceCoefficients,
     VelocityConstraint, node_inverse_mass,
 };
-use crate::body::SoftBody;
+use crate::body::DeformableBody;
 use rapier3d::glamx::DVec3;
 
 /// A surface node of one soft body touching a boundary triangle of another.
@@ -38,7 +38,7 @@ pub(crate) struct BetweenContact {
 /// bodies' fastest nodes can travel in the step) of a facing boundary triangle of another whose
 /// collision groups interact with its own. Indices in the contacts are positions in `bodies`.
 pub(crate) fn detect_between(
-    bodies: &[&SoftBody],
+    bodies: &[&DeformableBody],
     settings: &ContactSettings,
     dt: f64,
     gravity: DVec3,
@@ -98,10 +98,10 @@ pub(crate) fn detect_between(
 
 /// The two bodies `i` and `j` (distinct) of `bodies`, both mutable.
 fn two_bodies<'a>(
-    bodies: &'a mut [&mut SoftBody],
+    bodies: &'a mut [&mut DeformableBody],
     i: usize,
     j: usize,
-) -> (&'a mut SoftBody, &'a mut SoftBody) {
+) -> (&'a mut DeformableBody, &'a mut DeformableBody) {
     if i < j {
         let (low, high) = bodies.split_at_mut(j);
         (&mut *low[i], &mut *high[0])
@@ -114,7 +114,11 @@ fn two_bodies<'a>(
 /// Readies the contacts for an explicit substep of `h` (s): each plane moves to its triangle's
 /// contact point where the corners are now, and the velocity constraint is set from the node's
 /// distance to it.
-pub(crate) fn prepare_between(contacts: &mut [BetweenContact], bodies: &[&mut SoftBody], h: f64) {
+pub(crate) fn prepare_between(
+    contacts: &mut [BetweenContact],
+    bodies: &[&mut DeformableBody],
+    h: f64,
+) {
     for contact in contacts {
         let triangle_body = &bodies[contact.triangle_body];
         if let Some((point, normal)) = contact.on_triangle.plane(&triangle_body.positions) {
@@ -138,7 +142,7 @@ pub(crate) fn prepare_between(contacts: &mut [BetweenContact], bodies: &[&mut So
 }
 
 /// One sweep over the contacts between `bodies` (see [`VelocityConstraint`]).
-pub(crate) fn solve_between(contacts: &mut [BetweenContact], bodies: &mut [&mut SoftBody]) {
+pub(crate) fn solve_between(contacts: &mut [BetweenContact], bodies: &mut [&mut DeformableBody]) {
     for contact in contacts {
         let (node_body, triangle_body) =
             two_bodies(bodies, contact.node_body, contact.triangle_body);
@@ -156,9 +160,9 @@ pub(crate) fn solve_between(contacts: &mut [BetweenContact], bodies: &mut [&mut 
 
 /// A node of one body and a triangle of another, within a sweep.
 struct Between<'a> {
-    node_body: &'a mut SoftBody,
+    node_body: &'a mut DeformableBody,
     node: usize,
-    triangle_body: &'a mut SoftBody,
+    triangle_body: &'a mut DeformableBody,
     on_triangle: SoftPoint,
 }
 

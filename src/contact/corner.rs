@@ -11,7 +11,7 @@
 
 use super::surface_tree::SurfaceTree;
 use super::{Coefficients, ContactSides, RigidProxy, SoftPoint, VelocityConstraint};
-use crate::body::SoftBody;
+use crate::body::DeformableBody;
 use rapier3d::geometry::{ColliderHandle, Shape};
 use rapier3d::glamx::DVec3;
 use rapier3d::math::Pose;
@@ -83,7 +83,7 @@ fn for_each_vertex(shape: &dyn Shape, pose: &Pose, each: &mut impl FnMut(DVec3, 
     }
 }
 
-impl SoftBody {
+impl DeformableBody {
     /// The contacts of the vertices of `shape` at `pose` (collider `collider`, contact
     /// `coefficients`) within `reach` (m) of the body's boundary triangles in `tree`, skipping
     /// triangles with a node in `glued` (nodes attached to the collider's rigid body); their
@@ -126,7 +126,7 @@ impl SoftBody {
 
 /// Readies the corner contacts for an explicit substep of `h` (s): each plane moves to its
 /// triangle's contact point where the nodes are now.
-pub(crate) fn prepare_corners(body: &mut SoftBody, h: f64) {
+pub(crate) fn prepare_corners(body: &mut DeformableBody, h: f64) {
     let depenetration_speed = body.contact_settings.depenetration_speed;
     for contact in &mut body.corner_contacts {
         if let Some((point, normal)) = contact.on_triangle.plane(&body.positions) {
@@ -151,7 +151,7 @@ pub(crate) fn prepare_corners(body: &mut SoftBody, h: f64) {
 
 /// Moves the corners with their rigid bodies' velocities for `h` (s), as the body's nodes move
 /// at the end of an explicit substep: the gaps then follow both sides.
-pub(crate) fn advance_corners(body: &mut SoftBody, h: f64) {
+pub(crate) fn advance_corners(body: &mut DeformableBody, h: f64) {
     for contact in &mut body.corner_contacts {
         if let Some(p) = contact.proxy {
             contact.vertex += body.rigid_proxies[p].velocity_at(contact.vertex) * h;
@@ -160,8 +160,8 @@ pub(crate) fn advance_corners(body: &mut SoftBody, h: f64) {
 }
 
 /// One sweep over the corner contacts (see [`VelocityConstraint`]).
-pub(crate) fn solve_corners(body: &mut SoftBody) {
-    let SoftBody {
+pub(crate) fn solve_corners(body: &mut DeformableBody) {
+    let DeformableBody {
         corner_contacts,
         rigid_proxies,
         velocities,

@@ -1,7 +1,7 @@
 //! Contact of soft bodies with rapier colliders, with themselves (self-contact) and with each
 //! other.
 //!
-//! Detection ([`SoftBody::detect_contacts`]) projects every surface node onto every collider
+//! Detection ([`DeformableBody::detect_contacts`]) projects every surface node onto every collider
 //! (parry's point projection, which covers all of rapier's shapes) that the node can reach within
 //! the coming frame, and keeps the nearest surface point and its outward normal as a
 //! [`NodeContact`]: a plane the node must stay on the outer side of during the frame. The
@@ -31,7 +31,7 @@
 //! impulses; the total is handed to rapier when the step is accepted.
 
 //!
-//! A body with [`SoftBody::self_contact`] on also gets contacts of its surface nodes with its own
+//! A body with [`DeformableBody::self_contact`] on also gets contacts of its surface nodes with its own
 //! boundary triangles away from their neighbourhood, and an [`FvmWorld`](crate::world::FvmWorld)
 //! finds the contacts of each soft body's surface nodes with the boundary triangles of the
 //! others. Both are solved by the explicit sweeps with the triangle's nodes taking their share of
@@ -54,7 +54,7 @@ pub use velocity_constraint::RESTITUTION_THRESHOLD;
 pub(crate) use velocity_constraint::{ContactSides, VelocityConstraint};
 
 use crate::Error;
-use crate::body::SoftBody;
+use crate::body::DeformableBody;
 use crate::embedding::Embedding;
 use rapier3d::dynamics::{CoefficientCombineRule, RigidBodyHandle, RigidBodySet};
 use rapier3d::geometry::{ColliderHandle, ColliderSet, Shape, SharedShape};
@@ -107,7 +107,7 @@ pub(crate) struct SurfaceCoefficients {
 
 impl SurfaceCoefficients {
     /// A soft body's.
-    pub(crate) fn of_body(body: &SoftBody) -> Self {
+    pub(crate) fn of_body(body: &DeformableBody) -> Self {
         Self {
             friction: body.friction as f32,
             friction_rule: body.friction_combine_rule,
@@ -161,7 +161,7 @@ pub enum ContactTarget {
     /// A rapier collider.
     Collider(ColliderHandle),
     /// A triangle of the body's own boundary, far from the node in the rest shape
-    /// (self-contact; see [`SoftBody::self_contact`]).
+    /// (self-contact; see [`DeformableBody::self_contact`]).
     OwnSurface {
         /// The triangle's nodes.
         triangle: [u32; 3],
@@ -173,7 +173,7 @@ pub enum ContactTarget {
 pub enum BodyPoint {
     /// A simulation node.
     Node(u32),
-    /// A vertex of the body's embedded mesh ([`SoftBody::embedding`]), which moves with the nodes
+    /// A vertex of the body's embedded mesh ([`DeformableBody::embedding`]), which moves with the nodes
     /// of the element it lies in and shares its impulses among them by their weights.
     Embedded(u32),
 }
@@ -399,10 +399,10 @@ impl ContactSettings {
     }
 }
 
-impl SoftBody {
+impl DeformableBody {
     /// Finds the contacts of the body's surface nodes with `colliders` for a frame of `frame_dt`
     /// (s) under `gravity` (m/s²), replacing the previous ones: a node gets a contact with each
-    /// non-sensor collider its [`SoftBody::collision_groups`] interact with and it is within
+    /// non-sensor collider its [`DeformableBody::collision_groups`] interact with and it is within
     /// `margin` of, plus twice the distance the body's fastest
     /// node can travel in the frame (`2 (|v|max + |g| dt) dt`), plus twice the collider's own
     /// travel (at most 1 m), except the colliders of a rigid body the node is attached to. The
@@ -549,7 +549,7 @@ impl SoftBody {
         }
     }
 
-    /// The contacts found by the last [`SoftBody::detect_contacts`].
+    /// The contacts found by the last [`DeformableBody::detect_contacts`].
     pub fn contacts(&self) -> &[NodeContact] {
         &self.contacts
     }
@@ -563,7 +563,7 @@ impl SoftBody {
 
     /// The impulse (N s) and angular impulse about the centre of mass (N m s) the body gave each
     /// rigid body it touches or is attached to over the last step, not yet handed to rapier (see
-    /// [`SoftBody::transfer_contact_impulses`]).
+    /// [`DeformableBody::transfer_contact_impulses`]).
     pub fn rigid_impulses(&self) -> impl Iterator<Item = (RigidBodyHandle, DVec3, DVec3)> + '_ {
         self.rigid_proxies
             .iter()
@@ -713,14 +713,14 @@ impl Partners<'_> {
 /// Splits `body` into its contacts, its positions, its embedded mesh and what the contacts push
 /// against.
 fn contacts_and_partners(
-    body: &mut SoftBody,
+    body: &mut DeformableBody,
 ) -> (
     &mut [NodeContact],
     &[DVec3],
     Option<&Embedding>,
     Partners<'_>,
 ) {
-    let SoftBody {
+    let DeformableBody {
         contacts,
         rigid_proxies,
         positions,
@@ -746,11 +746,11 @@ fn contacts_and_partners(
 /// Whether the body's contact constraints are coupled to each other (through a dynamic rigid
 /// body's velocity or the nodes of a self-contact triangle), so that one sweep does not solve
 /// them.
-pub(crate) fn constraints_coupled(body: &SoftBody) -> bool {
+pub(crate) fn constraints_coupled(body: &DeformableBody) -> bool {
     body.rigid_proxies.iter().any(RigidProxy::is_dynamic) || body.needs_explicit_contacts()
 }
 
-impl SoftBody {
+impl DeformableBody {
     /// Whether the last detection found self-contacts or rigid corners against the surface,
     /// which only the explicit integrator solves.
     pub(crate) fn needs_explicit_contacts(&self) -> bool {
@@ -766,7 +766,7 @@ impl SoftBody {
 /// sweeps of [`solve_velocities`]: each plane moves to the collider's surface point nearest to its
 /// node, and the lowest normal velocity is set so that the node arrives at the plane but does not
 /// cross it within the substep, or, found inside, leaves at most at the depenetration speed.
-pub(crate) fn prepare_velocities(body: &mut SoftBody, h: f64) {
+pub(crate) fn prepare_velocities(body: &mut DeformableBody, h: f64) {
     let depenetration_speed = body.contact_settings.depenetration_speed;
     let (contacts, positions, embedding, mut partners) = contacts_and_partners(body);
     for contact in contacts.iter_mut() {
@@ -795,7 +795,7 @@ pub(crate) fn prepare_velocities(body: &mut SoftBody, h: f64) {
 /// positions move; see [`VelocityConstraint`]). Against a rigid body or an own triangle the
 /// velocities are relative, the obstacle's effective mass counts, and the obstacle receives the
 /// opposite impulse.
-pub(crate) fn solve_velocities(body: &mut SoftBody) {
+pub(crate) fn solve_velocities(body: &mut DeformableBody) {
     let (contacts, positions, embedding, mut partners) = contacts_and_partners(body);
     for contact in contacts.iter_mut() {
         let point = contact.at;
@@ -853,7 +853,7 @@ fn implicit_contacts(contacts: &mut [NodeContact]) -> impl Iterator<Item = &mut 
 
 /// Records the impulses (N s) the implicit penalty and friction gave the nodes over a substep of
 /// length `h` (s), at the positions that ended it, and hands their opposite to the rigid bodies.
-pub(crate) fn record_penalty_impulses(body: &mut SoftBody, effective_h: f64, h: f64) {
+pub(crate) fn record_penalty_impulses(body: &mut DeformableBody, effective_h: f64, h: f64) {
     let settings = body.contact_settings;
     let (contacts, positions, embedding, mut partners) = contacts_and_partners(body);
     for contact in implicit_contacts(contacts) {
@@ -875,7 +875,7 @@ pub(crate) fn record_penalty_impulses(body: &mut SoftBody, effective_h: f64, h: 
 
 /// Readies implicit friction for a step of effective length `h` (s) from the body's positions:
 /// each contact's friction limit is its penalty force there, and slip is measured from there.
-pub(crate) fn lag_friction(body: &mut SoftBody, h: f64) {
+pub(crate) fn lag_friction(body: &mut DeformableBody, h: f64) {
     let settings = body.contact_settings;
     let (contacts, positions, embedding, partners) = contacts_and_partners(body);
     for contact in implicit_contacts(contacts) {
@@ -902,7 +902,7 @@ fn effective_mass(at: &Stencil, masses: &[f64], pinned: &[bool]) -> f64 {
 /// limit (see [`lag_friction`]); the force acts on the contact point, so node `a` of its stencil
 /// takes `w_a f` and the tangent couples nodes `a, b` by `w_a w_b T`.
 pub(crate) fn for_each_friction(
-    body: &SoftBody,
+    body: &DeformableBody,
     h: f64,
     mut each: impl FnMut(Stencil, f64, DVec3, DMat3),
 ) {
@@ -921,7 +921,7 @@ pub(crate) fn for_each_friction(
 /// inside its plane (`g < 0`); the penalty energy is `Σ k g²/2`, its force on the point `-k g n`
 /// (on node `a` of its stencil, `w_a` of it) and its tangent `w_a w_b k n nᵀ`.
 pub(crate) fn for_each_active_penalty(
-    body: &SoftBody,
+    body: &DeformableBody,
     h: f64,
     mut each: impl FnMut(Stencil, f64, f64, DVec3),
 ) {

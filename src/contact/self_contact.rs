@@ -14,9 +14,9 @@
 
 use super::surface_tree::SurfaceTree;
 use super::{BodyPoint, ContactTarget, NodeContact, Obstacle, SurfaceCoefficients};
-use crate::body::SoftBody;
+use crate::body::DeformableBody;
 
-impl SoftBody {
+impl DeformableBody {
     /// Adds the self-contacts of the body's surface nodes within `reach` (m) of its own
     /// boundary triangles (see the module documentation).
     pub(crate) fn detect_self_contacts(&mut self, reach: f64) {

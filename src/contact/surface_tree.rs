@@ -2,7 +2,7 @@
 //! the nearest triangle facing a point, for self-contact and contact between soft bodies.
 
 use super::SoftPoint;
-use crate::body::SoftBody;
+use crate::body::DeformableBody;
 use rapier3d::glamx::{DVec3, Vec3};
 use rapier3d::parry::bounding_volume::{Aabb, BoundingVolume};
 use rapier3d::parry::partitioning::{Bvh, BvhBuildStrategy};
@@ -44,7 +44,7 @@ impl TrianglePoint {
 
 impl SurfaceTree {
     /// The tree of `body`'s boundary as it is now.
-    pub(crate) fn of(body: &SoftBody) -> Self {
+    pub(crate) fn of(body: &DeformableBody) -> Self {
         let leaves: Vec<Aabb> = body
             .surface_triangles
             .iter()
@@ -71,7 +71,7 @@ impl SurfaceTree {
     /// the side face beyond it, which it lies on.
     pub(crate) fn nearest_facing(
         &self,
-        body: &SoftBody,
+        body: &DeformableBody,
         x: DVec3,
         facing: DVec3,
         reach: f64,
@@ -125,7 +125,7 @@ fn nearest_point_on_triangle(corners: [DVec3; 3], x: DVec3) -> Option<([f64; 3],
     Some((weights, point))
 }
 
-impl SoftBody {
+impl DeformableBody {
     /// The outward normal of the body's surface at each node now: the sum of its boundary
     /// triangles' area vectors (zero for interior nodes).
     pub(crate) fn surface_node_normals(&self) -> Vec<DVec3> {

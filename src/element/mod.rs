@@ -303,11 +303,11 @@ mod tests {
         model: MaterialModel,
         nu: f64,
         treatment: VolumetricTreatment,
-    ) -> SoftBody {
+    ) -> DeformableBody {
         let material = Material::new(model, 1e6, nu, 1000.0).unwrap();
         let linear = mesh::cuboid(DVec3::splat(0.5), [2, 2, 2]).unwrap();
         let quadratic = mesh::QuadraticTetMesh::from_linear(&linear).unwrap();
-        let mut body = SoftBodyBuilder::quadratic(quadratic, material)
+        let mut body = DeformableBodyBuilder::quadratic(quadratic, material)
             .volumetric(treatment)
             .build()
             .unwrap();
@@ -322,10 +322,10 @@ mod tests {
         model: MaterialModel,
         nu: f64,
         treatment: VolumetricTreatment,
-    ) -> SoftBody {
+    ) -> DeformableBody {
         let material = Material::new(model, 1e6, nu, 1000.0).unwrap();
         let cage = mesh::QuadraticHexMesh::cuboid(DVec3::new(0.5, 0.25, 0.25), [2, 1, 1]).unwrap();
-        let mut body = SoftBodyBuilder::quadratic_hex(cage, material)
+        let mut body = DeformableBodyBuilder::quadratic_hex(cage, material)
             .volumetric(treatment)
             .build()
             .unwrap();

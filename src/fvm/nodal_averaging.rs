@@ -262,10 +262,10 @@ mod tests {
     use crate::prelude::*;
 
     /// A 2 x 2 x 2-cell cube with nodal averaging, its nodes moved by up to 15 % of a cell.
-    fn perturbed_cube(model: MaterialModel, poisson_ratio: f64) -> SoftBody {
+    fn perturbed_cube(model: MaterialModel, poisson_ratio: f64) -> DeformableBody {
         let material = Material::new(model, 1e6, poisson_ratio, 1000.0).unwrap();
         let mesh = mesh::cuboid(DVec3::splat(0.5), [2, 2, 2]).unwrap();
-        let mut body = SoftBodyBuilder::new(mesh, material)
+        let mut body = DeformableBodyBuilder::new(mesh, material)
             .volumetric(VolumetricTreatment::NodalAverage)
             .build()
             .unwrap();
@@ -273,7 +273,7 @@ mod tests {
         body
     }
 
-    fn forces(body: &mut SoftBody) -> Vec<DVec3> {
+    fn forces(body: &mut DeformableBody) -> Vec<DVec3> {
         body.internal_forces().to_vec()
     }
 
@@ -306,7 +306,7 @@ mod tests {
             VolumetricTreatment::NodalAverage,
         ]
         .map(|treatment| {
-            let mut body = SoftBodyBuilder::new(mesh.clone(), material)
+            let mut body = DeformableBodyBuilder::new(mesh.clone(), material)
                 .volumetric(treatment)
                 .build()
                 .unwrap();

@@ -11,7 +11,7 @@
 
 use super::{ImplicitIntegrator, ImplicitReport, StepReport, SymplecticEuler};
 use crate::Error;
-use crate::body::{SoftBody, SoftBodyHandle, SoftBodySet};
+use crate::body::{DeformableBody, DeformableBodyHandle, DeformableBodySet};
 use crate::contact::BetweenContact;
 use crate::material::MaterialModel;
 use rapier3d::glamx::DVec3;
@@ -97,7 +97,7 @@ pub struct AutomaticIntegrator {
 impl AutomaticIntegrator {
     /// The predicted cost of a frame of `frame_dt` (s) for `body` with each integrator; an
     /// invalid explicit setting predicts an infinite explicit cost.
-    pub fn predict(&self, body: &SoftBody, frame_dt: f64) -> CostPrediction {
+    pub fn predict(&self, body: &DeformableBody, frame_dt: f64) -> CostPrediction {
         let needed = self
             .explicit
             .needed_substeps(body, frame_dt)
@@ -106,7 +106,7 @@ impl AutomaticIntegrator {
     }
 
     /// The prediction for a frame whose explicit version takes `explicit_substeps`.
-    fn prediction(&self, body: &SoftBody, explicit_substeps: f64) -> CostPrediction {
+    fn prediction(&self, body: &DeformableBody, explicit_substeps: f64) -> CostPrediction {
         let tets = body.mesh().tet_count() as f64;
         let model = body.material().model();
         let implicit_frames = f64::from(self.implicit.substeps.max(1));
@@ -125,10 +125,10 @@ impl AutomaticIntegrator {
     /// failed keeps the state it had, the others are advanced.
     pub fn step_all(
         &self,
-        bodies: &mut SoftBodySet,
+        bodies: &mut DeformableBodySet,
         frame_dt: f64,
         gravity: DVec3,
-    ) -> Vec<(SoftBodyHandle, Result<AutomaticReport, Error>)> {
+    ) -> Vec<(DeformableBodyHandle, Result<AutomaticReport, Error>)> {
         bodies
             .iter_mut()
             .map(|(handle, body)| (handle, self.step(body, frame_dt, gravity)))
@@ -145,7 +145,7 @@ impl AutomaticIntegrator {
     /// [`SymplecticEuler::step`] or [`ImplicitIntegrator::step`], whichever ran.
     pub fn step(
         &self,
-        body: &mut SoftBody,
+        body: &mut DeformableBody,
         frame_dt: f64,
         gravity: DVec3,
     ) -> Result<AutomaticReport, Error> {
@@ -204,7 +204,7 @@ impl AutomaticIntegrator {
     /// Those of [`SymplecticEuler::step`]; every body is then left as it was.
     pub(crate) fn step_together(
         &self,
-        bodies: &mut [&mut SoftBody],
+        bodies: &mut [&mut DeformableBody],
         between: &mut [BetweenContact],
         frame_dt: f64,
         gravity: DVec3,

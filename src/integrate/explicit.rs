@@ -13,7 +13,7 @@
 
 use super::check_step;
 use crate::Error;
-use crate::body::SoftBody;
+use crate::body::DeformableBody;
 use crate::contact::BetweenContact;
 use crate::{attachment, contact};
 use rapier3d::glamx::DVec3;
@@ -79,7 +79,7 @@ pub struct StepReport {
 impl SymplecticEuler {
     /// Estimated critical time step (s) of the explicit scheme for `body` in its current shape:
     /// steps above it make the highest modes grow. Zero if an element is flat.
-    pub fn critical_time_step(body: &SoftBody) -> f64 {
+    pub fn critical_time_step(body: &DeformableBody) -> f64 {
         let undamped =
             COURANT_NUMBER * body.wave_length_scale() / body.material().dilatational_wave_speed();
         let Some(damping) = body.damping() else {
@@ -93,7 +93,7 @@ impl SymplecticEuler {
     }
 
     /// The substep (s) used by [`Substeps::Automatic`]: the critical step times the safety factor.
-    pub fn stable_time_step(&self, body: &SoftBody) -> f64 {
+    pub fn stable_time_step(&self, body: &DeformableBody) -> f64 {
         self.safety_factor * Self::critical_time_step(body)
     }
 
@@ -107,7 +107,7 @@ impl SymplecticEuler {
     /// produced a NaN or infinity. On error the body is left as it was before the call.
     pub fn step(
         &self,
-        body: &mut SoftBody,
+        body: &mut DeformableBody,
         frame_dt: f64,
         gravity: DVec3,
     ) -> Result<StepReport, Error> {
@@ -120,7 +120,7 @@ impl SymplecticEuler {
     /// refusing more than `max_substeps` when they are automatic.
     pub(crate) fn advance(
         &self,
-        body: &mut SoftBody,
+        body: &mut DeformableBody,
         frame_dt: f64,
         gravity: DVec3,
         needed: f64,
@@ -138,7 +138,7 @@ impl SymplecticEuler {
     /// as it was.
     pub(crate) fn step_together(
         &self,
-        bodies: &mut [&mut SoftBody],
+        bodies: &mut [&mut DeformableBody],
         between: &mut [BetweenContact],
         frame_dt: f64,
         gravity: DVec3,
@@ -154,7 +154,7 @@ impl SymplecticEuler {
     /// [`SymplecticEuler::step_together`] in `needed` substeps.
     fn advance_together(
         &self,
-        bodies: &mut [&mut SoftBody],
+        bodies: &mut [&mut DeformableBody],
         between: &mut [BetweenContact],
         frame_dt: f64,
         gravity: DVec3,
@@ -176,7 +176,7 @@ impl SymplecticEuler {
             body.save_state();
             histories.push(body.previous_step.take());
         }
-        let fail = |bodies: &mut [&mut SoftBody], histories: Vec<_>, error| {
+        let fail = |bodies: &mut [&mut DeformableBody], histories: Vec<_>, error| {
             for (body, history) in bodies.iter_mut().zip(histories) {
                 body.restore_state();
                 body.previous_step = history;
@@ -233,7 +233,11 @@ impl SymplecticEuler {
     /// The substeps a frame of `frame_dt` (s) takes: the fixed count, or as many as the
     /// stability limit of the body's current shape asks for (possibly infinite or more than
     /// `max_substeps`, which [`SymplecticEuler::step`] then refuses).
-    pub(crate) fn needed_substeps(&self, body: &SoftBody, frame_dt: f64) -> Result<f64, Error> {
+    pub(crate) fn needed_substeps(
+        &self,
+        body: &DeformableBody,
+        frame_dt: f64,
+    ) -> Result<f64, Error> {
         match self.substeps {
             Substeps::Fixed(0) => Err(Error::InvalidSetting {
                 parameter: "substeps",
@@ -256,7 +260,12 @@ impl SymplecticEuler {
 }
 
 /// One symplectic Euler substep of length `h` (s) of `bodies` and the contacts `between` them.
-fn substep(bodies: &mut [&mut SoftBody], between: &mut [BetweenContact], h: f64, gravity: DVec3) {
+fn substep(
+    bodies: &mut [&mut DeformableBody],
+    between: &mut [BetweenContact],
+    h: f64,
+    gravity: DVec3,
+) {
     for body in bodies.iter_mut() {
         update_velocities(body, h, gravity);
     }
@@ -286,9 +295,9 @@ fn substep(bodies: &mut [&mut SoftBody], between: &mut [BetweenContact], h: f64,
 
 /// The substep's velocity update `v ← v + h (f/m + g)`, then the constraints readied for the
 /// sweeps.
-fn update_velocities(body: &mut SoftBody, h: f64, gravity: DVec3) {
+fn update_velocities(body: &mut DeformableBody, h: f64, gravity: DVec3) {
     body.compute_internal_forces();
-    let SoftBody {
+    let DeformableBody {
         velocities,
         masses,
         pinned,
@@ -311,10 +320,10 @@ fn update_velocities(body: &mut SoftBody, h: f64, gravity: DVec3) {
 }
 
 /// The substep's position update `x ← x + h v`, after the sweeps.
-fn update_positions(body: &mut SoftBody, h: f64) {
+fn update_positions(body: &mut DeformableBody, h: f64) {
     attachment::advance_anchors(body, h);
     contact::advance_corners(body, h);
-    let SoftBody {
+    let DeformableBody {
         positions,
         velocities,
         pinned,

@@ -21,7 +21,7 @@
 use super::check_step;
 use crate::Error;
 use crate::assembly::{Stiffness, solve};
-use crate::body::{PreviousStep, SoftBody};
+use crate::body::{DeformableBody, PreviousStep};
 use crate::chord::{self, Chord};
 use crate::damping::RayleighDamping;
 use crate::element::add_point_forces;
@@ -170,7 +170,7 @@ impl ImplicitIntegrator {
     /// [`Error::NonFiniteState`] if the step produced a NaN. On error the body is left as it was.
     pub fn step(
         &self,
-        body: &mut SoftBody,
+        body: &mut DeformableBody,
         frame_dt: f64,
         gravity: DVec3,
     ) -> Result<ImplicitReport, Error> {
@@ -255,7 +255,7 @@ impl ImplicitIntegrator {
     /// One substep.
     fn substep(
         &self,
-        body: &mut SoftBody,
+        body: &mut DeformableBody,
         solver: &mut Solver,
         h: f64,
         gravity: DVec3,
@@ -297,7 +297,7 @@ impl ImplicitIntegrator {
     /// switches the solver's method to it.
     fn minimize(
         &self,
-        body: &mut SoftBody,
+        body: &mut DeformableBody,
         solver: &mut Solver,
         start: &StepStart,
         mut potential: f64,
@@ -360,7 +360,7 @@ impl ImplicitIntegrator {
                     Search::Thorough,
                 ),
             };
-            let energy = |body: &SoftBody| start.energy(body);
+            let energy = |body: &DeformableBody| start.energy(body);
             let mut next = descend(
                 body,
                 &residual,
@@ -401,7 +401,7 @@ impl ImplicitIntegrator {
     /// when it was factored.
     fn exact_direction(
         &self,
-        body: &SoftBody,
+        body: &DeformableBody,
         solver: &mut Solver,
         start: &StepStart,
         inertia: &[f64],
@@ -443,7 +443,7 @@ struct Solver {
 
 impl Solver {
     /// Returns the workspace and the kept factorization to the body for its next step.
-    fn give_back(self, body: &mut SoftBody) {
+    fn give_back(self, body: &mut DeformableBody) {
         body.tangent = Some(self.stiffness);
         body.chord = self.chord;
     }
@@ -452,7 +452,7 @@ impl Solver {
 impl StepStart {
     /// The potential of a step of length `h` from the body's state; BDF2 uses the previous
     /// step when it had the same length, backward Euler otherwise.
-    fn new(body: &SoftBody, h: f64, gravity: DVec3, scheme: ImplicitScheme) -> Self {
+    fn new(body: &DeformableBody, h: f64, gravity: DVec3, scheme: ImplicitScheme) -> Self {
         let positions = body.positions.clone();
         let previous = match scheme {
             ImplicitScheme::Bdf2 => body.previous_step.as_ref().filter(|p| p.h == h),
@@ -522,7 +522,7 @@ impl StepStart {
 
     /// `-∇E` (N): elastic and damping forces, gravity, contact penalties and the inertial pull
     /// toward `x̂`; zero on pinned nodes.
-    fn residual(&self, body: &mut SoftBody) -> Vec<DVec3> {
+    fn residual(&self, body: &mut DeformableBody) -> Vec<DVec3> {
         body.velocities.fill(DVec3::ZERO);
         body.compute_internal_forces();
         let mut residual: Vec<DVec3> = (0..body.positions.len())
@@ -556,7 +556,12 @@ impl StepStart {
         residual
     }
 
-    fn add_damping_forces(&self, body: &SoftBody, damping: &RayleighDamping, out: &mut [DVec3]) {
+    fn add_damping_forces(
+        &self,
+        body: &DeformableBody,
+        damping: &RayleighDamping,
+        out: &mut [DVec3],
+    ) {
         body.elements
             .for_each_point(|point, nodes, gradients, weight| {
                 let f = deformation_gradient(nodes, gradients, &body.positions);
@@ -567,7 +572,7 @@ impl StepStart {
 
     /// The force scale the tolerance is relative to (N): the largest of gravity, the inertial
     /// pull and the initial out-of-balance force.
-    fn force_scale(&self, body: &SoftBody, initial_residual: &[DVec3]) -> f64 {
+    fn force_scale(&self, body: &DeformableBody, initial_residual: &[DVec3]) -> f64 {
         let inertial: Vec<DVec3> = (0..body.positions.len())
             .map(|n| (self.target[n] - self.positions[n]) * (body.masses[n] / (self.h * self.h)))
             .collect();
@@ -578,7 +583,7 @@ impl StepStart {
     }
 
     /// The incremental potential `E(x)` (J) at the body's positions.
-    fn energy(&self, body: &SoftBody) -> f64 {
+    fn energy(&self, body: &DeformableBody) -> f64 {
         let inertia: f64 = (0..body.positions.len())
             .map(|n| 0.5 * body.masses[n] * (body.positions[n] - self.target[n]).length_squared())
             .sum::<f64>()
@@ -618,7 +623,13 @@ impl StepStart {
 
     /// `M/h² + K_elastic + K_damping + K_contact`, each element's stress tangent projected to be positive
     /// semi-definite if `project`.
-    fn assemble(&self, body: &SoftBody, stiffness: &mut Stiffness, inertia: &[f64], project: bool) {
+    fn assemble(
+        &self,
+        body: &DeformableBody,
+        stiffness: &mut Stiffness,
+        inertia: &[f64],
+        project: bool,
+    ) {
         let damping = body.damping;
         stiffness.assemble(body, Some(inertia), project, |t, f, df| match &damping {
             Some(d) => d.step_first_piola_differential(f, &self.green[t], self.h, df),

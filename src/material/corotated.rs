@@ -25,10 +25,10 @@ const NEWTON_MAX_ITERATIONS: usize = 20;
 /// The rotation `R` of the polar decomposition `F = R S`, with `det R = +1` even for inverted `F`.
 pub(crate) fn polar_rotation(f: &DMat3) -> DMat3 {
     let size = super::double_dot(f, f) / 3.0;
-    if f.determinant() > NEWTON_MIN_CONDITION * size * size.sqrt() {
-        if let Some(rotation) = polar_rotation_newton(f) {
-            return rotation;
-        }
+    if f.determinant() > NEWTON_MIN_CONDITION * size * size.sqrt()
+        && let Some(rotation) = polar_rotation_newton(f)
+    {
+        return rotation;
     }
     polar_rotation_svd(f)
 }

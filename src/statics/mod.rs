@@ -8,7 +8,7 @@
 
 use crate::Error;
 use crate::assembly::{Stiffness, factorize, solve};
-use crate::body::SoftBody;
+use crate::body::DeformableBody;
 use crate::linear_solver::{Method, solve_newton_system};
 use crate::newton::{Search, check_tolerance, descend, norm};
 use rapier3d::glamx::{DMat3, DVec3};
@@ -54,7 +54,7 @@ pub struct StaticReport {
 /// pinned nodes), [`Error::StaticSolveDidNotConverge`] if the tolerance is not met. On error the
 /// body is left as it was.
 pub fn solve_equilibrium(
-    body: &mut SoftBody,
+    body: &mut DeformableBody,
     gravity: DVec3,
     settings: &StaticSettings,
 ) -> Result<StaticReport, Error> {
@@ -81,7 +81,7 @@ pub fn solve_equilibrium(
 
 /// Newton's iterations of [`solve_equilibrium`].
 fn newton(
-    body: &mut SoftBody,
+    body: &mut DeformableBody,
     stiffness: &mut Stiffness,
     gravity: DVec3,
     settings: &StaticSettings,
@@ -126,7 +126,7 @@ fn newton(
             |stiffness, project| assemble_elastic(stiffness, body, project),
         )?
         .direction;
-        let energy = |body: &SoftBody| potential_energy(body, &load);
+        let energy = |body: &DeformableBody| potential_energy(body, &load);
         match descend(
             body,
             &residual,
@@ -175,7 +175,7 @@ fn newton(
 /// # Errors
 /// [`Error::NoFreeNode`] if every node is pinned; [`Error::IndefiniteStiffness`] if the tangent
 /// stiffness cannot be factored (e.g. no pinned node, so rigid modes have zero frequency).
-pub fn fundamental_frequency(body: &SoftBody) -> Result<f64, Error> {
+pub fn fundamental_frequency(body: &DeformableBody) -> Result<f64, Error> {
     if body.pinned.iter().all(|&p| p) {
         return Err(Error::NoFreeNode);
     }
@@ -230,12 +230,12 @@ pub fn fundamental_frequency(body: &SoftBody) -> Result<f64, Error> {
 
 /// The elastic tangent stiffness at the body's current positions, projected per element to be
 /// positive semi-definite if `project`.
-fn assemble_elastic(stiffness: &mut Stiffness, body: &SoftBody, project: bool) {
+fn assemble_elastic(stiffness: &mut Stiffness, body: &DeformableBody, project: bool) {
     stiffness.assemble(body, None, project, |_, _, _| DMat3::ZERO);
 }
 
 /// `f_int(x) + load`, zero on pinned nodes (N).
-fn out_of_balance(body: &mut SoftBody, load: &[DVec3]) -> Vec<DVec3> {
+fn out_of_balance(body: &mut DeformableBody, load: &[DVec3]) -> Vec<DVec3> {
     // The velocities are zero, so the damping adds nothing.
     body.compute_internal_forces();
     (0..load.len())
@@ -250,7 +250,7 @@ fn out_of_balance(body: &mut SoftBody, load: &[DVec3]) -> Vec<DVec3> {
 }
 
 /// Total potential energy (J): elastic energy minus the work of the constant load.
-fn potential_energy(body: &SoftBody, load: &[DVec3]) -> f64 {
+fn potential_energy(body: &DeformableBody, load: &[DVec3]) -> f64 {
     // The load's work is measured from the positions at the start of the solve.
     let load_work: f64 = load
         .iter()

@@ -12,7 +12,7 @@ pub const GRAVITY: f64 = 9.81;
 
 /// The reference cantilever along +x from x = 0 (clamped) to x = L, centred on the x axis, with
 /// `cells` cubes along x, y, z; returns the body and the node at the centre of the free end.
-pub fn cantilever(cells: [usize; 3], material: Material) -> (SoftBody, usize) {
+pub fn cantilever(cells: [usize; 3], material: Material) -> (DeformableBody, usize) {
     damped_cantilever(cells, material, None)
 }
 
@@ -21,7 +21,7 @@ pub fn damped_cantilever(
     cells: [usize; 3],
     material: Material,
     damping: Option<RayleighDamping>,
-) -> (SoftBody, usize) {
+) -> (DeformableBody, usize) {
     cantilever_with(cells, material, damping, VolumetricTreatment::PerElement)
 }
 
@@ -31,12 +31,12 @@ pub fn cantilever_with(
     material: Material,
     damping: Option<RayleighDamping>,
     treatment: VolumetricTreatment,
-) -> (SoftBody, usize) {
+) -> (DeformableBody, usize) {
     let half = DVec3::new(LENGTH / 2.0, SIDE / 2.0, SIDE / 2.0);
     let mesh = mesh::cuboid(half, cells).unwrap();
     let clamped = mesh.nodes_where(|p| p.x <= -half.x + 1e-9);
     let tip = mesh.nearest_node(DVec3::new(half.x, 0.0, 0.0)) as usize;
-    let mut builder = SoftBodyBuilder::new(mesh, material)
+    let mut builder = DeformableBodyBuilder::new(mesh, material)
         .translation(DVec3::new(half.x, 0.0, 0.0))
         .pinned_nodes(clamped)
         .volumetric(treatment);
@@ -152,7 +152,7 @@ pub fn elastica_tip_deflection(young_modulus: f64) -> f64 {
 /// Places every node of `body` at `map(p)` moving at `rate(p)`, `p` its rest position, and
 /// returns the internal forces (N per node) there.
 pub fn forces_under(
-    body: &mut SoftBody,
+    body: &mut DeformableBody,
     map: impl Fn(DVec3) -> DVec3,
     rate: impl Fn(DVec3) -> DVec3,
 ) -> Vec<DVec3> {
@@ -169,12 +169,16 @@ pub fn forces_under(
 /// second, for 120 frames of an [`FvmWorld`](rapier_fvm::world::FvmWorld) stepped by
 /// `integrator` (`None`: automatic). Returns the largest distance (m) of a glued node from where
 /// the path puts its anchor.
-pub fn glued_path_error(rod: SoftBody, root: &[u32], integrator: Option<IntegratorKind>) -> f64 {
+pub fn glued_path_error(
+    rod: DeformableBody,
+    root: &[u32],
+    integrator: Option<IntegratorKind>,
+) -> f64 {
     use rapier_fvm::glamx::Vec3;
     use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder};
 
     let mut world = rapier_fvm::world::FvmWorld::default();
-    world.integrator.force = integrator;
+    world.coupling.integrator.force = integrator;
     let (radius, period) = (GLUED_PATH_RADIUS as f32, 1.0f32);
     let start = Vec3::new(radius, 0.5, 0.0);
     let (driver, _) = world.physics.insert(
@@ -236,7 +240,7 @@ pub fn homogeneous_deformation_rate() -> DMat3 {
 /// body `soft` and the rigid ball `ball` of radius `radius` (m) in `world`.
 pub fn soft_and_ball_momenta(
     world: &rapier_fvm::world::FvmWorld,
-    soft: SoftBodyHandle,
+    soft: DeformableBodyHandle,
     ball: rapier3d::prelude::RigidBodyHandle,
     radius: f32,
 ) -> (DVec3, DVec3) {
@@ -261,7 +265,7 @@ pub fn soft_and_ball_momenta(
 /// takes ten free steps of 1/60 s without gravity (implicit or explicit), and returns the change
 /// of linear momentum and the scale it is measured against (kg m/s): the larger of the initial
 /// momentum and the sum of the nodes' momentum magnitudes at the end.
-pub fn free_momentum_change(body: &mut SoftBody, seed: u64, implicit: bool) -> (f64, f64) {
+pub fn free_momentum_change(body: &mut DeformableBody, seed: u64, implicit: bool) -> (f64, f64) {
     let mut rng = Lcg(seed);
     for v in body.velocities_mut() {
         *v = rng.vector();
@@ -306,10 +310,10 @@ pub fn interior_ratio(forces: &[DVec3], interior: &[bool]) -> f64 {
 /// ground's mean upward reaction on the body over those 60 (N).
 pub fn settled_reaction(
     world: &mut rapier_fvm::world::FvmWorld,
-    body: SoftBodyHandle,
+    body: DeformableBodyHandle,
     ground: rapier3d::prelude::ColliderHandle,
 ) -> f64 {
-    let h = f64::from(world.physics.integration_parameters.dt) / f64::from(world.coupling_substeps);
+    let h = f64::from(world.physics.integration_parameters.dt) / f64::from(world.coupling.substeps);
     let step = |world: &mut rapier_fvm::world::FvmWorld| {
         for (_, outcome) in world.step() {
             outcome.unwrap();
@@ -333,7 +337,7 @@ pub fn settled_reaction(
 
 /// `ω_max` (rad/s) of `M⁻¹K` at rest by power iteration, using the linear model's forces
 /// (`K u = -f(x0 + u)` exactly for the linear model), pinned nodes excluded.
-pub fn highest_angular_frequency(body: &mut SoftBody) -> f64 {
+pub fn highest_angular_frequency(body: &mut DeformableBody) -> f64 {
     let rest = body.positions().to_vec();
     let masses = body.masses().to_vec();
     let mut rng = Lcg(1);
@@ -372,7 +376,7 @@ pub fn highest_angular_frequency(body: &mut SoftBody) -> f64 {
 /// automatic substep. Returns the largest relative change of kinetic + elastic energy at the
 /// frames' ends and the longest substep taken (s).
 pub fn explicit_energy_change(
-    body: &mut SoftBody,
+    body: &mut DeformableBody,
     seed: u64,
     amplitude: f64,
     frames: usize,

@@ -2,7 +2,7 @@
 //! frame; the writers read nothing else.
 
 use super::rigid_mesh::collider_triangles;
-use rapier_fvm::body::SoftBody;
+use rapier_fvm::body::DeformableBody;
 use rapier_fvm::glamx::{DMat3, DVec3};
 use rapier3d::dynamics::RigidBodyHandle;
 use rapier3d::pipeline::PhysicsWorld;
@@ -36,7 +36,7 @@ pub struct SoftBodySnapshot {
     pub tets: Vec<[u32; 4]>,
     /// Boundary triangles (node indices), normals `(b - a) × (c - a)` pointing out of the body.
     pub surface: Vec<[u32; 3]>,
-    /// Cauchy stress per tetrahedron (Pa), world axes: see [`SoftBody::cauchy_stresses`].
+    /// Cauchy stress per tetrahedron (Pa), world axes: see [`DeformableBody::cauchy_stresses`].
     pub cauchy_stress: Vec<DMat3>,
 }
 
@@ -63,7 +63,7 @@ impl SoftBodySnapshot {
     pub fn capture(
         name: impl Into<String>,
         material: impl Into<String>,
-        body: &SoftBody,
+        body: &DeformableBody,
         rest_positions: &[DVec3],
     ) -> Self {
         assert_eq!(
@@ -107,7 +107,10 @@ impl SoftBodySnapshot {
 
     /// Von Mises equivalent stress per tetrahedron (Pa).
     pub fn von_mises(&self) -> Vec<f64> {
-        self.cauchy_stress.iter().map(SoftBody::von_mises).collect()
+        self.cauchy_stress
+            .iter()
+            .map(DeformableBody::von_mises)
+            .collect()
     }
 
     /// Von Mises stress per node (Pa): the mean over the node's tetrahedra, for smooth colouring.

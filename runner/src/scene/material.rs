@@ -2,7 +2,7 @@
 //!
 //! ```toml
 //! material = { model = "stable_neo_hookean", young = 1e5, poisson = 0.3, density = 1000.0 }
-//! damping = { stiffness_time = 2e-3 }    # s: phi and psi proportional to the Lamé constants
+//! damping = { stiffness_time = 2e-3 }    # s: phi = t λ and psi = t μ
 //! damping = { phi = 50.0, psi = 100.0 }  # Pa·s
 //! ```
 
@@ -94,13 +94,14 @@ impl MaterialSpec {
 }
 
 /// Rayleigh damping on the strain rate: `phi` and `psi` (Pa·s), or `stiffness_time` (s), the
-/// stiffness-proportional form `phi = t μ`, `psi = t λ`.
+/// stiffness-proportional form `phi = t λ`, `psi = t μ`, in the library's damping stress
+/// `σ = φ tr(ε̇) I + 2ψ ε̇`.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct DampingSpec {
-    /// Shear viscosity φ (Pa·s); default 0 when `psi` is given.
+    /// Volumetric coefficient φ (Pa·s), on `tr(ε̇) I`; default 0 when `psi` is given.
     pub phi: Option<f64>,
-    /// Bulk viscosity ψ (Pa·s); default 0 when `phi` is given.
+    /// Shear viscosity ψ (Pa·s), on `2 ε̇`; default 0 when `phi` is given.
     pub psi: Option<f64>,
     /// Stiffness-proportional time β (s), instead of `phi` and `psi`.
     pub stiffness_time: Option<f64>,

@@ -5,7 +5,7 @@ use super::probe::Probe;
 use crate::scene::rigid_body::{RigidBodySpec, RigidKind, ShapeSpec};
 use crate::scene::soft_body::{ElementsSpec, SoftBodySpec, VolumetricSpec};
 use crate::scene::{Scene, SceneError, SceneSource};
-use rapier_fvm::body::{SoftBodyBuilder, SoftBodyHandle};
+use rapier_fvm::body::{DeformableBodyBuilder, DeformableBodyHandle};
 use rapier_fvm::fvm::VolumetricTreatment;
 use rapier_fvm::glamx::{DVec3, Vec3};
 use rapier_fvm::mesh::import::surface;
@@ -20,7 +20,7 @@ pub struct SoftEntry {
     /// Its material label (colour in the pictures).
     pub label: String,
     /// Its handle in the world.
-    pub handle: SoftBodyHandle,
+    pub handle: DeformableBodyHandle,
     /// Its world positions before the first step (m): displacements are measured from them.
     pub rest: Vec<DVec3>,
 }
@@ -59,9 +59,9 @@ impl Simulation {
         let mut world = FvmWorld::default();
         world.physics.gravity = DVec3::from_array(scene.world.gravity).as_vec3();
         world.physics.integration_parameters.dt = scene.world.dt as f32;
-        world.coupling_substeps = scene.world.coupling_substeps;
-        world.contact = scene.contact.settings();
-        world.integrator = scene.integrator.integrator();
+        world.coupling.substeps = scene.world.coupling_substeps;
+        world.coupling.contact = scene.contact.settings();
+        world.coupling.integrator = scene.integrator.integrator();
         let mut rigid = Vec::new();
         for (i, spec) in scene.rigid_body.iter().enumerate() {
             let handle = insert_rigid(&mut world, spec, &format!("rigid_body[{i}]"), source)?;
@@ -241,9 +241,9 @@ fn insert_soft(
         attachments.push((nodes, body.handle, at));
     }
     let mut builder = match (quadratic, cage) {
-        (Some(quadratic), _) => SoftBodyBuilder::quadratic(quadratic, material),
-        (_, Some(cage)) => SoftBodyBuilder::quadratic_hex(cage, material),
-        _ => SoftBodyBuilder::new(mesh, material),
+        (Some(quadratic), _) => DeformableBodyBuilder::quadratic(quadratic, material),
+        (_, Some(cage)) => DeformableBodyBuilder::quadratic_hex(cage, material),
+        _ => DeformableBodyBuilder::new(mesh, material),
     };
     if let Some(embedded) = &spec.embedded {
         builder = builder.embedded(embedded.build(&format!("{key}.embedded"), source)?);

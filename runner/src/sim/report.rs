@@ -2,7 +2,7 @@
 //! energies in J.
 
 use rapier_fvm::Error;
-use rapier_fvm::body::SoftBody;
+use rapier_fvm::body::DeformableBody;
 use rapier_fvm::element::{ElementOrder, ElementShape};
 use rapier_fvm::integrate::{AutomaticReport, IntegratorKind};
 use serde::Serialize;
@@ -163,7 +163,7 @@ pub struct Files {
 
 impl SoftBodyReport {
     /// An empty record for a body.
-    pub(crate) fn new(name: String, material: String, body: &SoftBody) -> Self {
+    pub(crate) fn new(name: String, material: String, body: &DeformableBody) -> Self {
         let element_kind = match (body.element_order(), body.element_shape()) {
             (ElementOrder::Linear, _) => "linear tetrahedra",
             (ElementOrder::Quadratic, ElementShape::Tetrahedron) => "quadratic tetrahedra",

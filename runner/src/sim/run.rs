@@ -137,17 +137,17 @@ fn progress_bar(frames: usize, show: bool) -> ProgressBar {
 
 /// The settings used.
 fn settings(scene: &Scene, world: &WorldSpec, sim: &Simulation) -> Settings {
-    let integrator = &sim.world.integrator;
+    let integrator = &sim.world.coupling.integrator;
     Settings {
         dt: world.dt,
         duration: world.duration,
         gravity: world.gravity,
-        coupling_substeps: sim.world.coupling_substeps,
+        coupling_substeps: sim.world.coupling.substeps,
         integrator: format!("{:?}", scene.integrator.kind).to_lowercase(),
         explicit_safety_factor: integrator.explicit.safety_factor,
         implicit_substeps: integrator.implicit.substeps,
-        contact_margin: sim.world.contact.margin,
-        contact_velocity_iterations: sim.world.contact.velocity_iterations,
+        contact_margin: sim.world.coupling.contact.margin,
+        contact_velocity_iterations: sim.world.coupling.contact.velocity_iterations,
         save_every: scene.output.save_every,
     }
 }

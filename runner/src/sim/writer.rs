@@ -73,7 +73,7 @@ impl Writer {
 
     /// Saves frame `frame` of `sim` if it is a saved or pictured frame.
     pub(crate) fn frame(&mut self, sim: &Simulation, frame: usize) -> Result<(), OutputError> {
-        let saved = frame % self.save_every == 0 || frame == self.frames;
+        let saved = frame.is_multiple_of(self.save_every) || frame == self.frames;
         let pictured = self.picture_frames.contains(&frame);
         if !(saved || pictured) {
             return Ok(());

@@ -2,7 +2,7 @@
 //! and the explicit stability limit, for a `check` command to print.
 
 use super::RawMesh;
-use crate::body::SoftBodyBuilder;
+use crate::body::DeformableBodyBuilder;
 use crate::integrate::SymplecticEuler;
 use crate::material::Material;
 use crate::mesh::{DEGENERATE_RELATIVE_VOLUME, signed_volume};
@@ -117,7 +117,7 @@ pub fn check(positions: &[DVec3], tets: &[[u32; 4]], material: &Material) -> Qua
         };
         if let Ok(body) = raw
             .into_mesh()
-            .and_then(|mesh| SoftBodyBuilder::new(mesh, *material).build())
+            .and_then(|mesh| DeformableBodyBuilder::new(mesh, *material).build())
         {
             report.critical_time_step = Some(SymplecticEuler::critical_time_step(&body));
             report.stable_time_step = Some(SymplecticEuler::default().stable_time_step(&body));

@@ -31,7 +31,7 @@ pub struct Contact {
     pub body: Body,
     /// The integrator forced on every frame, or `None` for [`AutomaticIntegrator`]'s choice.
     pub force: Option<IntegratorKind>,
-    /// [`FvmWorld::coupling_substeps`].
+    /// [`SoftCoupling::substeps`].
     pub coupling_substeps: u32,
 }
 
@@ -85,8 +85,8 @@ impl Contact {
         let mut world = FvmWorld::default();
         world.physics.integration_parameters.dt = DT as f32;
         world.physics.gravity = GRAVITY.as_vec3();
-        world.coupling_substeps = self.coupling_substeps;
-        world.integrator.force = self.force;
+        world.coupling.substeps = self.coupling_substeps;
+        world.coupling.integrator.force = self.force;
         world
     }
 
@@ -105,7 +105,7 @@ impl Contact {
             "coupling_substeps": self.coupling_substeps,
             "dt": DT,
             "E": SOFT_E, "nu": SOFT_NU, "damping_beta": SOFT_BETA, "friction": FRICTION,
-            "contact_margin": world.contact.margin,
+            "contact_margin": world.coupling.contact.margin,
             "contact_margin_is": "detection reach only: contacts act at the surface, no rest gap",
             "gravity": "-y",
             "time_clock": CpuClock::Thread.name(),

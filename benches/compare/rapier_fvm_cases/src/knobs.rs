@@ -44,7 +44,7 @@ impl Stepper {
 
     /// Advances `body` by `dt` (s) under `gravity` (m/s²); returns the Newton iterations (implicit)
     /// or substeps (explicit) the step took and whether it converged.
-    pub fn step(self, body: &mut SoftBody, dt: f64, gravity: DVec3) -> Result<Work, Error> {
+    pub fn step(self, body: &mut DeformableBody, dt: f64, gravity: DVec3) -> Result<Work, Error> {
         match self {
             Stepper::Implicit(scheme, tolerance) => {
                 let integrator = ImplicitIntegrator {
@@ -179,18 +179,18 @@ impl Body {
         material: Material,
         beta: Option<f64>,
         pinned: impl Fn(DVec3) -> bool,
-    ) -> Result<SoftBodyBuilder, Error> {
+    ) -> Result<DeformableBodyBuilder, Error> {
         let linear = mesh::cuboid(half, self.cells)?;
         let pin = |p: DVec3| pinned(p + translation);
         let builder = match self.order {
             ElementOrder::Linear => {
                 let pins = linear.nodes_where(pin);
-                SoftBodyBuilder::new(linear, material).pinned_nodes(pins)
+                DeformableBodyBuilder::new(linear, material).pinned_nodes(pins)
             }
             ElementOrder::Quadratic => {
                 let quadratic = mesh::QuadraticTetMesh::from_linear(&linear)?;
                 let pins = quadratic.nodes_where(pin);
-                SoftBodyBuilder::quadratic(quadratic, material).pinned_nodes(pins)
+                DeformableBodyBuilder::quadratic(quadratic, material).pinned_nodes(pins)
             }
         };
         let builder = match beta {
@@ -205,21 +205,21 @@ impl Body {
 }
 
 /// The nodes of `body` whose current position satisfies `select`.
-pub fn nodes_where(body: &SoftBody, select: impl Fn(DVec3) -> bool) -> Vec<usize> {
+pub fn nodes_where(body: &DeformableBody, select: impl Fn(DVec3) -> bool) -> Vec<usize> {
     (0..body.node_count())
         .filter(|&n| select(body.positions()[n]))
         .collect()
 }
 
 /// Free degrees of freedom of `body`.
-pub fn dofs(body: &SoftBody) -> usize {
+pub fn dofs(body: &DeformableBody) -> usize {
     3 * (0..body.node_count())
         .filter(|&n| !body.is_pinned(n))
         .count()
 }
 
 /// Whether every node is finite and within 100 m of the origin.
-pub fn body_ok(body: &SoftBody) -> bool {
+pub fn body_ok(body: &DeformableBody) -> bool {
     body.positions()
         .iter()
         .all(|x| x.is_finite() && x.length() < 100.0)

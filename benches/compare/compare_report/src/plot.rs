@@ -8,8 +8,8 @@ use plotters::drawing::DrawingAreaErrorKind;
 use plotters::prelude::*;
 use std::path::Path;
 
-/// The bundled font (DejaVu Sans, as the runner's plots use), registered as `sans-serif`.
-static FONT: &[u8] = include_bytes!("../../../assets/fonts/DejaVuSans.ttf");
+/// The bundled font (`DejaVu` Sans, as the runner's plots use), registered as `sans-serif`.
+static FONT: &[u8] = include_bytes!("../../../../runner/assets/fonts/DejaVuSans.ttf");
 /// Pixel size of one panel.
 const PANEL: (u32, u32) = (560, 420);
 /// Width of the legend column (px).

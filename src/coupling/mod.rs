@@ -1,0 +1,335 @@
+//! The coupling layer between rapier's rigid bodies and the deformable bodies, run between rapier
+//! steps on the caller's own sets.
+//!
+//! rapier offers no callback inside its step, so a frame of `dt` is cut into
+//! [`SoftCoupling::substeps`] rapier steps of `h = dt / substeps`, and the deformable bodies step
+//! between them. One coupling substep, in order:
+//!
+//! 1. **Kinematic paths.** Each position-based kinematic body told where to be at the end of the
+//!    frame is told the part of its straight path it reaches by the end of this substep.
+//! 2. **Contacts.** Each deformable body finds the colliders its surface can reach within `h`
+//!    ([`DeformableBody::detect_contacts`](crate::body::DeformableBody::detect_contacts)), and
+//!    the bodies find each other's surfaces.
+//! 3. **Support.** Rigid bodies that rapier's narrow phase finds touching something are held in
+//!    place within the soft step: otherwise they would fall freely there, the ground that holds
+//!    them acting only in rapier's step.
+//! 4. **Soft step.** Bodies touching each other step together, explicitly, so that their
+//!    contacts are solved in the same sweeps with both bodies' nodes; the others step alone by
+//!    [`SoftCoupling::integrator`].
+//! 5. **Exchange.** The impulses the soft step gave dynamic rigid bodies are handed to rapier at
+//!    the nodes, and summed into the frame's [`RigidLoad`]s.
+//! 6. **Rigid step.** rapier steps the rigid bodies over `h`, with the frame's
+//!    `num_solver_iterations` divided among the substeps (rounded up), so that its solver cost
+//!    per frame is about unchanged.
+//!
+//! Sub-cycling keeps the rigid bodies' view of the deformable bodies one short substep old, which
+//! removes the friction ratchet and the rocking that a single rapier step per frame shows.
+//! [`SoftCoupling::step`] runs a whole frame, calling the caller's [`PhysicsPipeline`];
+//! [`SoftCoupling::substep`] runs stages 2 to 5 alone, for a program that steps rapier itself.
+//! [`FvmWorld`](crate::world::FvmWorld) is the same over a [`PhysicsWorld`](rapier3d::pipeline::PhysicsWorld).
+
+mod groups;
+mod kinematic;
+mod loads;
+
+pub use loads::RigidLoad;
+
+use crate::Error;
+use crate::body::{DeformableBody, DeformableBodyHandle, DeformableBodySet};
+use crate::contact::{self, ContactSettings};
+use crate::integrate::{AutomaticIntegrator, AutomaticReport};
+use groups::touching_groups;
+use kinematic::KinematicPath;
+use loads::FrameLoads;
+use rapier3d::dynamics::{
+    CCDSolver, ImpulseJointSet, IntegrationParameters, IslandManager, MultibodyJointSet,
+    RigidBodyHandle, RigidBodySet,
+};
+use rapier3d::geometry::{BroadPhaseBvh, ColliderSet, NarrowPhase};
+use rapier3d::glamx::DVec3;
+use rapier3d::math::Vector;
+use rapier3d::pipeline::{EventHandler, PhysicsHooks, PhysicsPipeline};
+
+/// Each deformable body's result over a frame: the report of its last substep, or the first
+/// error it met (a body whose step failed keeps the state it had before that substep and skips
+/// the rest of the frame).
+pub type SoftStepResults = Vec<(DeformableBodyHandle, Result<AutomaticReport, Error>)>;
+
+/// What stepping a body gave over a frame so far: nothing yet, its last report, or the error that
+/// stopped it.
+type Outcome = Option<Result<AutomaticReport, Error>>;
+
+/// The part of a rapier world a soft substep reads and writes: the rigid bodies (their poses
+/// and velocities read, contact impulses applied), the colliders the surfaces touch, and the
+/// narrow phase (which rigid bodies rest on something).
+pub struct RigidSets<'a> {
+    /// The rigid bodies.
+    pub bodies: &'a mut RigidBodySet,
+    /// The colliders.
+    pub colliders: &'a ColliderSet,
+    /// The narrow phase of the last rapier step.
+    pub narrow_phase: &'a NarrowPhase,
+}
+
+/// Everything rapier's [`PhysicsPipeline::step`] takes, borrowed from the caller's own sets, so
+/// that [`SoftCoupling::step`] can run rapier's substeps between its soft ones.
+pub struct RapierSets<'a> {
+    /// Gravity (m/s²), acting on the deformable bodies too.
+    pub gravity: Vector,
+    /// The frame's parameters: `dt` (s) is the frame step; the substeps use a copy with `dt`
+    /// and `num_solver_iterations` divided.
+    pub integration_parameters: &'a IntegrationParameters,
+    /// rapier's island manager.
+    pub islands: &'a mut IslandManager,
+    /// rapier's broad phase.
+    pub broad_phase: &'a mut BroadPhaseBvh,
+    /// rapier's narrow phase.
+    pub narrow_phase: &'a mut NarrowPhase,
+    /// The rigid bodies.
+    pub bodies: &'a mut RigidBodySet,
+    /// The colliders.
+    pub colliders: &'a mut ColliderSet,
+    /// The impulse joints.
+    pub impulse_joints: &'a mut ImpulseJointSet,
+    /// The multibody joints.
+    pub multibody_joints: &'a mut MultibodyJointSet,
+    /// rapier's own (built-in) soft bodies, which its step takes; an empty set if unused.
+    pub rapier_soft_bodies: &'a mut rapier3d::dynamics::SoftBodySet,
+    /// rapier's continuous collision detection solver.
+    pub ccd_solver: &'a mut CCDSolver,
+}
+
+impl RapierSets<'_> {
+    /// One rapier step with `parameters` (a substep's).
+    fn step_rapier(
+        &mut self,
+        pipeline: &mut PhysicsPipeline,
+        parameters: &IntegrationParameters,
+        hooks: &dyn PhysicsHooks,
+        events: &dyn EventHandler,
+    ) {
+        pipeline.step(
+            self.gravity,
+            parameters,
+            self.islands,
+            self.broad_phase,
+            self.narrow_phase,
+            self.bodies,
+            self.colliders,
+            self.impulse_joints,
+            self.multibody_joints,
+            self.rapier_soft_bodies,
+            self.ccd_solver,
+            hooks,
+            events,
+        );
+    }
+}
+
+/// How deformable bodies are stepped beside rapier's rigid bodies, and what they exerted on them
+/// over the last frame.
+#[derive(Debug, Clone)]
+pub struct SoftCoupling {
+    /// How the deformable bodies are stepped.
+    pub integrator: AutomaticIntegrator,
+    /// How their contacts are detected and enforced.
+    pub contact: ContactSettings,
+    /// rapier steps per frame, with the deformable bodies stepped between them (at least 1).
+    pub substeps: u32,
+    /// What each deformable body exerted on each rigid body over the last frame or substep.
+    loads: FrameLoads,
+}
+
+impl Default for SoftCoupling {
+    fn default() -> Self {
+        Self {
+            integrator: AutomaticIntegrator::default(),
+            contact: ContactSettings::default(),
+            substeps: 4,
+            loads: FrameLoads::default(),
+        }
+    }
+}
+
+impl SoftCoupling {
+    /// Advances rigid and deformable bodies by one frame (`integration_parameters.dt`, s): the
+    /// [`SoftCoupling::substeps`] coupling substeps of the module's documentation, each a soft
+    /// step then one `pipeline` step on the caller's `rapier` sets with `hooks` and `events`.
+    /// A frame of `dt = 0` (a pause) only lets rapier apply changes, and steps no deformable
+    /// body.
+    pub fn step(
+        &mut self,
+        pipeline: &mut PhysicsPipeline,
+        mut rapier: RapierSets<'_>,
+        soft_bodies: &mut DeformableBodySet,
+        hooks: &dyn PhysicsHooks,
+        events: &dyn EventHandler,
+    ) -> SoftStepResults {
+        let frame = *rapier.integration_parameters;
+        self.loads.clear();
+        if frame.dt <= 0.0 {
+            rapier.step_rapier(pipeline, &frame, hooks, events);
+            return Vec::new();
+        }
+        let substeps = self.substeps.max(1);
+        let h = f64::from(frame.dt) / f64::from(substeps);
+        let gravity = rapier.gravity.as_dvec3();
+        let mut substep_parameters = frame;
+        substep_parameters.dt = frame.dt / substeps as f32;
+        substep_parameters.num_solver_iterations = frame
+            .num_solver_iterations
+            .div_ceil(substeps as usize)
+            .max(1);
+        let mut outcomes: Vec<(DeformableBodyHandle, Outcome)> = soft_bodies
+            .iter()
+            .map(|(handle, _)| (handle, None))
+            .collect();
+        let paths = KinematicPath::all(rapier.bodies);
+        for substep in 1..=substeps {
+            for path in &paths {
+                path.advance(rapier.bodies, substep as f32 / substeps as f32);
+            }
+            let rigid = RigidSets {
+                bodies: rapier.bodies,
+                colliders: rapier.colliders,
+                narrow_phase: rapier.narrow_phase,
+            };
+            self.step_soft_bodies(soft_bodies, rigid, &mut outcomes, h, gravity);
+            rapier.step_rapier(pipeline, &substep_parameters, hooks, events);
+        }
+        self.loads.finish(f64::from(frame.dt));
+        outcomes
+            .into_iter()
+            .filter_map(|(handle, outcome)| outcome.map(|outcome| (handle, outcome)))
+            .collect()
+    }
+
+    /// Steps every deformable body by `h` (s) under `gravity` (m/s²) against the rigid world as
+    /// it is (stages 2 to 5 of the module's documentation), for a program that runs its own
+    /// rapier step of `h` right after. [`SoftCoupling::rigid_loads`] then holds this substep's
+    /// loads.
+    pub fn substep(
+        &mut self,
+        soft_bodies: &mut DeformableBodySet,
+        rigid: RigidSets<'_>,
+        h: f64,
+        gravity: DVec3,
+    ) -> SoftStepResults {
+        self.loads.clear();
+        let mut outcomes: Vec<(DeformableBodyHandle, Outcome)> = soft_bodies
+            .iter()
+            .map(|(handle, _)| (handle, None))
+            .collect();
+        self.step_soft_bodies(soft_bodies, rigid, &mut outcomes, h, gravity);
+        if h > 0.0 {
+            self.loads.finish(h);
+        }
+        outcomes
+            .into_iter()
+            .filter_map(|(handle, outcome)| outcome.map(|outcome| (handle, outcome)))
+            .collect()
+    }
+
+    /// The mean force and torque each deformable body exerted on each rigid body it touched or
+    /// is attached to, over the last frame of [`SoftCoupling::step`] (or the last
+    /// [`SoftCoupling::substep`]): the impulses it handed over divided by the time. Colliders
+    /// without a rigid body (fixed ground) are not listed: see
+    /// [`DeformableBody::contact_force_on`](crate::body::DeformableBody::contact_force_on).
+    pub fn rigid_loads(&self) -> &[RigidLoad] {
+        self.loads.all()
+    }
+
+    /// The mean force (N) and torque about its centre of mass (N m) deformable body `soft`
+    /// exerted on rigid body `rigid` over the last frame; zero if they did not interact.
+    pub fn load_on(&self, soft: DeformableBodyHandle, rigid: RigidBodyHandle) -> (DVec3, DVec3) {
+        self.loads.on(soft, rigid)
+    }
+
+    /// One coupling substep of `h` (s) of the bodies whose `outcomes` are not yet an error: each
+    /// finds its contacts with the colliders, bodies touching each other are grouped and stepped
+    /// together, the others alone, and the impulses they gave rigid bodies go to rapier and to
+    /// the loads. Each body's outcome becomes its last report or its error.
+    fn step_soft_bodies(
+        &mut self,
+        soft_bodies: &mut DeformableBodySet,
+        rigid: RigidSets<'_>,
+        outcomes: &mut [(DeformableBodyHandle, Outcome)],
+        h: f64,
+        gravity: DVec3,
+    ) {
+        for (handle, outcome) in outcomes.iter_mut() {
+            if matches!(outcome, Some(Err(_))) {
+                continue;
+            }
+            if let Err(error) = soft_bodies[*handle].detect_contacts(
+                rigid.colliders,
+                rigid.bodies,
+                h,
+                gravity,
+                &self.contact,
+            ) {
+                *outcome = Some(Err(error));
+            }
+        }
+        let live: Vec<DeformableBodyHandle> = outcomes
+            .iter()
+            .filter(|(_, outcome)| !matches!(outcome, Some(Err(_))))
+            .map(|(handle, _)| *handle)
+            .collect();
+        let between = {
+            let bodies: Vec<&DeformableBody> = live.iter().map(|&h| &soft_bodies[h]).collect();
+            contact::detect_between(&bodies, &self.contact, h, gravity)
+        };
+        for (group, mut contacts) in touching_groups(live.len(), between) {
+            let handles: Vec<DeformableBodyHandle> = group.iter().map(|&i| live[i]).collect();
+            let mut bodies = soft_bodies.get_many_mut(&handles);
+            for body in bodies.iter_mut() {
+                hold_supported_bodies(body, rigid.bodies, rigid.narrow_phase);
+            }
+            let stepped: Vec<Result<AutomaticReport, Error>> = if let [body] = &mut bodies[..] {
+                vec![self.integrator.step(body, h, gravity)]
+            } else {
+                match self
+                    .integrator
+                    .step_together(&mut bodies, &mut contacts, h, gravity)
+                {
+                    Ok(reports) => reports.into_iter().map(Ok).collect(),
+                    Err(error) => vec![Err(error); bodies.len()],
+                }
+            };
+            for ((handle, body), result) in handles.iter().zip(bodies).zip(stepped) {
+                if result.is_ok() {
+                    for (rigid_body, impulse, angular_impulse) in body.rigid_impulses() {
+                        self.loads
+                            .add(*handle, rigid_body, impulse, angular_impulse);
+                    }
+                    body.transfer_contact_impulses(rigid.bodies);
+                }
+                if let Some((_, outcome)) = outcomes.iter_mut().find(|(h, _)| h == handle) {
+                    *outcome = Some(result);
+                }
+            }
+        }
+    }
+}
+
+/// Holds the rigid bodies `body` touches that rigid contacts support: within the soft step they
+/// would otherwise fall freely, the ground that holds them acting only in rapier's step.
+fn hold_supported_bodies(
+    body: &mut DeformableBody,
+    bodies: &RigidBodySet,
+    narrow_phase: &NarrowPhase,
+) {
+    for proxy in &mut body.rigid_proxies {
+        let supported = bodies.get(proxy.handle).is_some_and(|rigid| {
+            rigid.colliders().iter().any(|&collider| {
+                narrow_phase
+                    .contact_pairs_with(collider)
+                    .any(|pair| pair.has_any_active_contact())
+            })
+        });
+        if supported {
+            proxy.hold();
+        }
+    }
+}
