@@ -80,6 +80,18 @@ struct Beam {
 }
 
 impl Beam {
+    /// A beam of linear elasticity.
+    fn linear(kind: Kind, cells: [usize; 3], nu: f64, volumetric: VolumetricTreatment) -> Self {
+        Self {
+            kind,
+            cells,
+            model: MaterialModel::Linear,
+            nu,
+            volumetric,
+        }
+    }
+
+    /// The elements' order and the cells per axis, for the tables.
     fn label(&self) -> String {
         let order = match self.kind {
             Kind::LinearTet => "linear",
@@ -275,7 +287,8 @@ fn vibration_frequency(beam: &Beam, stepper: Stepper, dt: f64) -> Result<f64, Er
     }
 }
 
-fn main() -> Result<(), Error> {
+/// Prints the beam and its Timoshenko references.
+fn print_intro() {
     println!(
         "Cantilever L = {LENGTH} m, {SIDE} x {SIDE} m, E = {YOUNG:e} Pa, rho = {DENSITY} kg/m^3, clamped face pinned"
     );
@@ -284,7 +297,10 @@ fn main() -> Result<(), Error> {
         timoshenko_tip(POISSON) * 1e3,
         timoshenko_tip(0.0) * 1e3
     );
+}
 
+/// Table 1: static tip error at ν = 0.3 and ν = 0 and the first frequency per resolution.
+fn static_table() -> Result<(), Error> {
     println!("1. Static equilibrium (linear elasticity) and first frequency");
     println!(
         "{:<18} {:>6} {:>14} {:>14} {:>11} {:>10}",
@@ -305,13 +321,7 @@ fn main() -> Result<(), Error> {
         (Kind::QuadraticHex, [20, 2, 2]),
     ];
     for (kind, cells) in resolutions {
-        let beam = |nu| Beam {
-            kind,
-            cells,
-            model: MaterialModel::Linear,
-            nu,
-            volumetric: VolumetricTreatment::PerElement,
-        };
+        let beam = |nu| Beam::linear(kind, cells, nu, VolumetricTreatment::PerElement);
         let (error, frequency, dofs) = static_case(&beam(POISSON))?;
         let (error_nu0, _, _) = static_case(&beam(0.0))?;
         println!(
@@ -324,7 +334,11 @@ fn main() -> Result<(), Error> {
             100.0 * (frequency / TIMOSHENKO_FREQUENCY_HZ - 1.0)
         );
     }
+    Ok(())
+}
 
+/// Table 2: static tip error per volumetric treatment, from ν = 0 to 0.499.
+fn volumetric_table() -> Result<(), Error> {
     println!("\n2. Volumetric treatment (static, linear elasticity): tip error vs Timoshenko");
     println!(
         "{:<18} {:<15} {:>6} {:>9} {:>9} {:>9} {:>9} {:>9}",
@@ -349,13 +363,7 @@ fn main() -> Result<(), Error> {
         (Kind::QuadraticHex, [20, 2, 2], VolumetricTreatment::ElementAverage),
     ];
     for (kind, cells, volumetric) in volumetric_cases {
-        let beam = |nu| Beam {
-            kind,
-            cells,
-            model: MaterialModel::Linear,
-            nu,
-            volumetric,
-        };
+        let beam = |nu| Beam::linear(kind, cells, nu, volumetric);
         let errors =
             [0.0, 0.3, 0.45, 0.49, 0.499].map(|nu| static_case(&beam(nu)).map(|(e, _, _)| e));
         let (_, _, dofs) = static_case(&beam(0.45))?;
@@ -370,7 +378,30 @@ fn main() -> Result<(), Error> {
         }
         println!();
     }
+    Ok(())
+}
 
+/// The best dynamic case so far: its beam, scheme label, step (s) and outcome.
+type Best = (Beam, &'static str, f64, Dynamic);
+
+/// Whether `outcome` beats `best`: within [`TARGET_MS`] first, then smaller error or faster.
+fn is_better(outcome: &Dynamic, best: Option<&Best>) -> bool {
+    match best {
+        None => true,
+        Some((_, _, _, b)) => {
+            let fits = |d: &Dynamic| d.ms_per_step <= TARGET_MS;
+            match (fits(outcome), fits(b)) {
+                (true, false) => true,
+                (false, true) => false,
+                (true, true) => outcome.error.abs() < b.error.abs(),
+                (false, false) => outcome.ms_per_step < b.ms_per_step,
+            }
+        }
+    }
+}
+
+/// Prints the header of table 3.
+fn print_dynamic_header() {
     println!("\n3. Dynamics to rest (nu = 0.3), error of the settled tip vs Timoshenko");
     println!(
         "{:<18} {:<12} {:<14} {:<10} {:<6} {:>8} {:>6} {:>9} {:>9} {:>11} {:>13}",
@@ -386,7 +417,30 @@ fn main() -> Result<(), Error> {
         "newton/step",
         "factors/step"
     );
-    let mut best: Option<(Beam, &str, f64, Dynamic)> = None;
+}
+
+/// Prints the row of table 3 for one dynamic case.
+fn print_dynamic_row(beam: &Beam, stepper: Stepper, dt: f64, reuse: bool, outcome: &Dynamic) {
+    println!(
+        "{:<18} {:<12} {:<14} {:<10} {:<6} {:>8} {:>6} {:>8.2}% {:>9.3} {:>11.2} {:>13.2}",
+        beam.label(),
+        format!("{:?}", beam.model),
+        stepper.label(),
+        volumetric_label(beam.volumetric),
+        if reuse { "on" } else { "off" },
+        format!("1/{:.0}", 1.0 / dt),
+        outcome.dofs,
+        100.0 * outcome.error,
+        outcome.ms_per_step,
+        outcome.newton_per_step,
+        outcome.factorizations_per_step
+    );
+}
+
+/// Table 3: the dynamic cases, each with both models at 1/240 s and 1/60 s; returns the best.
+fn dynamic_table() -> Result<Option<Best>, Error> {
+    print_dynamic_header();
+    let mut best: Option<Best> = None;
     let per_element = VolumetricTreatment::PerElement;
     let averaged = VolumetricTreatment::ElementAverage;
     // One row per case: elements, cells, scheme, volumetric treatment, factorization reuse.
@@ -411,45 +465,22 @@ fn main() -> Result<(), Error> {
         for model in [MaterialModel::Linear, MaterialModel::Corotated] {
             for dt in [1.0 / 240.0, 1.0 / 60.0] {
                 let beam = Beam {
-                    kind,
-                    cells,
                     model,
-                    nu: POISSON,
-                    volumetric,
+                    ..Beam::linear(kind, cells, POISSON, volumetric)
                 };
                 let outcome = dynamic_case(&beam, stepper, dt, reuse)?;
-                println!(
-                    "{:<18} {:<12} {:<14} {:<10} {:<6} {:>8} {:>6} {:>8.2}% {:>9.3} {:>11.2} {:>13.2}",
-                    beam.label(),
-                    format!("{model:?}"),
-                    stepper.label(),
-                    volumetric_label(volumetric),
-                    if reuse { "on" } else { "off" },
-                    format!("1/{:.0}", 1.0 / dt),
-                    outcome.dofs,
-                    100.0 * outcome.error,
-                    outcome.ms_per_step,
-                    outcome.newton_per_step,
-                    outcome.factorizations_per_step
-                );
-                let better = match &best {
-                    None => true,
-                    Some((_, _, _, b)) => {
-                        let fits = |d: &Dynamic| d.ms_per_step <= TARGET_MS;
-                        match (fits(&outcome), fits(b)) {
-                            (true, false) => true,
-                            (false, true) => false,
-                            (true, true) => outcome.error.abs() < b.error.abs(),
-                            (false, false) => outcome.ms_per_step < b.ms_per_step,
-                        }
-                    }
-                };
-                if better {
+                print_dynamic_row(&beam, stepper, dt, reuse, &outcome);
+                if is_better(&outcome, best.as_ref()) {
                     best = Some((beam, stepper.label(), dt, outcome));
                 }
             }
         }
     }
+    Ok(best)
+}
+
+/// Table 4: the modal first frequency and the one measured from free vibration per scheme.
+fn frequency_table() -> Result<(), Error> {
     println!(
         "\n4. First bending frequency (nu = 0.3): modal, and from 1 s of free vibration (undamped, released from the static deflection)"
     );
@@ -466,16 +497,18 @@ fn main() -> Result<(), Error> {
         "scheme on modal"
     );
     for (kind, cells, volumetric) in [
-        (Kind::QuadraticTet, [10, 1, 1], per_element),
-        (Kind::QuadraticHex, [5, 1, 1], averaged),
+        (
+            Kind::QuadraticTet,
+            [10, 1, 1],
+            VolumetricTreatment::PerElement,
+        ),
+        (
+            Kind::QuadraticHex,
+            [5, 1, 1],
+            VolumetricTreatment::ElementAverage,
+        ),
     ] {
-        let beam = Beam {
-            kind,
-            cells,
-            model: MaterialModel::Linear,
-            nu: POISSON,
-            volumetric,
-        };
+        let beam = Beam::linear(kind, cells, POISSON, volumetric);
         let (_, modal, _) = static_case(&beam)?;
         for stepper in [Stepper::BackwardEuler, Stepper::Bdf2] {
             for dt in [1.0 / 240.0, 1.0 / 60.0] {
@@ -495,7 +528,15 @@ fn main() -> Result<(), Error> {
             }
         }
     }
+    Ok(())
+}
 
+fn main() -> Result<(), Error> {
+    print_intro();
+    static_table()?;
+    volumetric_table()?;
+    let best = dynamic_table()?;
+    frequency_table()?;
     let (beam, stepper, dt, outcome) = best.expect("at least one case ran");
     println!(
         "{{\"setting\": \"{} {:?} {stepper} {} dt=1/{:.0}\", \"rel_error\": {:.5}, \"ms_per_step\": {:.4}, \"dofs\": {}}}",

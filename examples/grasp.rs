@@ -22,7 +22,9 @@
 use rapier_fvm::glamx::Vec3;
 use rapier_fvm::prelude::*;
 use rapier_fvm::world::FvmWorld;
-use rapier3d::prelude::{ColliderBuilder, ColliderHandle, RigidBodyBuilder, SharedShape};
+use rapier3d::prelude::{
+    ColliderBuilder, ColliderHandle, RigidBodyBuilder, RigidBodyHandle, SharedShape,
+};
 
 /// The cube's half side and the fingers' half thickness (m).
 const HALF: f64 = 0.025;
@@ -95,7 +97,18 @@ fn depth_inside(world: &FvmWorld, collider: ColliderHandle, positions: &[DVec3])
         .fold(0.0, f64::max)
 }
 
-fn main() -> Result<(), Error> {
+/// The scene: the world, the cube's handle and the fingers' body and collider handles.
+struct Scene {
+    world: FvmWorld,
+    cube: DeformableBodyHandle,
+    fingers: [(RigidBodyHandle, ColliderHandle); 2],
+}
+
+/// Left (x < 0) then right.
+const SIDES: [f64; 2] = [-1.0, 1.0];
+
+/// The ground, the soft cube on it and the two kinematic fingers beside it.
+fn build_scene() -> Result<Scene, Error> {
     let mut world = FvmWorld::default();
     world.physics.insert_collider(
         ColliderBuilder::new(SharedShape::halfspace(Vec3::Y)).friction(0.5),
@@ -111,9 +124,7 @@ fn main() -> Result<(), Error> {
         .friction(1.0)
         .build()?;
     let cube = world.soft_bodies.insert(cube);
-    // Left (x < 0) then right.
-    let sides = [-1.0, 1.0];
-    let fingers = sides.map(|side| {
+    let fingers = SIDES.map(|side| {
         let x = side * (HALF + FINGER_HALF + GAP);
         world.physics.insert(
             RigidBodyBuilder::kinematic_position_based().translation(Vec3::new(
@@ -125,11 +136,83 @@ fn main() -> Result<(), Error> {
                 .friction(1.0),
         )
     });
-    let dt = f64::from(world.physics.integration_parameters.dt);
-    let g = world.physics.gravity.as_dvec3().length();
-    let weight = world.soft_bodies[cube].total_mass() * g;
-    let margin = world.coupling.contact.margin;
+    Ok(Scene {
+        world,
+        cube,
+        fingers,
+    })
+}
 
+/// What the run measured, frame by frame and at its end.
+#[derive(Debug, Default)]
+struct Tally {
+    /// The cube's centre of mass and the fingers' heights (m) when the lift starts.
+    lift_start: (f64, f64),
+    /// The deepest (m) any node was inside a finger.
+    deepest: f64,
+    /// The lift and squeeze (N) summed over the hold's frames, and their count.
+    hold_lift: f64,
+    hold_squeeze: f64,
+    hold_frames: usize,
+    /// Frames the automatic integrator stepped explicitly and implicitly.
+    explicit_frames: usize,
+    implicit_frames: usize,
+    /// The lift (N) of the last frame.
+    end_lift: f64,
+}
+
+impl Scene {
+    /// The fingers' height (m).
+    fn finger_height(&self) -> f64 {
+        f64::from(self.world.physics.bodies[self.fingers[0].0].translation().y)
+    }
+
+    /// The cube's centre of mass and the fingers' heights (m).
+    fn heights(&self) -> (f64, f64) {
+        (
+            self.world.soft_bodies[self.cube].center_of_mass().y,
+            self.finger_height(),
+        )
+    }
+
+    /// Tells the fingers their pose at `t` (s) after the settling.
+    fn move_fingers(&mut self, t: f64) {
+        let closing = (t / CLOSE).clamp(0.0, 1.0);
+        let lifting = ((t - CLOSE) / LIFT).clamp(0.0, 1.0);
+        for ((finger, _), side) in self.fingers.iter().zip(SIDES) {
+            let x = side * (HALF + FINGER_HALF + GAP - (GAP + SQUEEZE) * closing);
+            let y = HALF + LIFT_HEIGHT * lifting;
+            self.world.physics.bodies[*finger]
+                .set_next_kinematic_translation(Vec3::new(x as f32, y as f32, 0.0));
+        }
+    }
+
+    /// The frame's lift and squeeze (N) on the fingers; notes the deepest node inside one.
+    fn measure(&self, tally: &mut Tally) -> (f64, f64) {
+        let body = &self.world.soft_bodies[self.cube];
+        let mut lift = 0.0;
+        for (finger, collider) in &self.fingers {
+            tally.deepest =
+                tally
+                    .deepest
+                    .max(depth_inside(&self.world, *collider, body.positions()));
+            lift -= self.world.load_on(self.cube, *finger).0.y;
+        }
+        let squeeze = self.world.load_on(self.cube, self.fingers[1].0).0.x;
+        (lift, squeeze)
+    }
+}
+
+/// The lowest node height (m) of `body`.
+fn lowest_node(body: &DeformableBody) -> f64 {
+    body.positions()
+        .iter()
+        .map(|x| x.y)
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Prints the table's header.
+fn print_header() {
     println!(
         "{:>6} {:>7} {:>12} {:>12} {:>13} {:>12} {:>9} {:>10}",
         "t (s)",
@@ -141,84 +224,89 @@ fn main() -> Result<(), Error> {
         "lift (N)",
         "integrator"
     );
-    let frames = ((SETTLE + CLOSE + LIFT + HOLD) / dt).round() as usize;
-    // The cube's centre of mass and the fingers' heights (m) when the lift starts.
-    let mut lift_start = (
-        world.soft_bodies[cube].center_of_mass().y,
-        f64::from(world.physics.bodies[fingers[0].0].translation().y),
+}
+
+/// Prints the table row of `frame`.
+fn print_row(
+    scene: &Scene,
+    frame: usize,
+    phase: Phase,
+    (lift, squeeze): (f64, f64),
+    choice: Option<IntegratorKind>,
+) {
+    let dt = f64::from(scene.world.physics.integration_parameters.dt);
+    let body = &scene.world.soft_bodies[scene.cube];
+    let choice = choice.map_or_else(|| "-".to_owned(), |kind| format!("{kind:?}"));
+    println!(
+        "{:>6.2} {:>7} {:>12.3} {:>12.3} {:>13.3} {:>12.3} {:>9.4} {:>10}",
+        frame as f64 * dt,
+        format!("{phase:?}"),
+        scene.world.physics.bodies[scene.fingers[0].0]
+            .translation()
+            .y
+            * 1e3,
+        body.center_of_mass().y * 1e3,
+        lowest_node(body) * 1e3,
+        squeeze,
+        lift,
+        choice
     );
-    let mut deepest = 0.0f64;
-    let (mut hold_lift, mut hold_squeeze, mut hold_frames) = (0.0, 0.0, 0usize);
-    let (mut explicit_frames, mut implicit_frames) = (0usize, 0usize);
-    let mut end_lift = 0.0;
+}
+
+/// Runs the settling, closing, lift and hold, printing a table row every [`ROW_FRAMES`] frames.
+fn run(scene: &mut Scene) -> Result<Tally, Error> {
+    let dt = f64::from(scene.world.physics.integration_parameters.dt);
+    let frames = ((SETTLE + CLOSE + LIFT + HOLD) / dt).round() as usize;
+    let mut tally = Tally {
+        lift_start: scene.heights(),
+        ..Tally::default()
+    };
     for frame in 1..=frames {
         let t = frame as f64 * dt - SETTLE;
         // The frame's phase, going by its middle.
         let phase = Phase::at(t - dt / 2.0);
-        let closing = (t / CLOSE).clamp(0.0, 1.0);
-        let lifting = ((t - CLOSE) / LIFT).clamp(0.0, 1.0);
-        for ((finger, _), side) in fingers.iter().zip(sides) {
-            let x = side * (HALF + FINGER_HALF + GAP - (GAP + SQUEEZE) * closing);
-            let y = HALF + LIFT_HEIGHT * lifting;
-            world.physics.bodies[*finger]
-                .set_next_kinematic_translation(Vec3::new(x as f32, y as f32, 0.0));
-        }
-        let choice = step(&mut world)?;
+        scene.move_fingers(t);
+        let choice = step(&mut scene.world)?;
         match choice {
-            Some(IntegratorKind::Explicit) => explicit_frames += 1,
-            Some(IntegratorKind::Implicit) => implicit_frames += 1,
+            Some(IntegratorKind::Explicit) => tally.explicit_frames += 1,
+            Some(IntegratorKind::Implicit) => tally.implicit_frames += 1,
             None => {}
         }
-        let body = &world.soft_bodies[cube];
-        let mut lift = 0.0;
-        for (finger, collider) in &fingers {
-            deepest = deepest.max(depth_inside(&world, *collider, body.positions()));
-            lift -= world.load_on(cube, *finger).0.y;
-        }
-        let squeeze = world.load_on(cube, fingers[1].0).0.x;
-        end_lift = lift;
+        let (lift, squeeze) = scene.measure(&mut tally);
+        tally.end_lift = lift;
         if phase == Phase::Close {
-            lift_start = (
-                body.center_of_mass().y,
-                f64::from(world.physics.bodies[fingers[0].0].translation().y),
-            );
+            tally.lift_start = scene.heights();
         }
         if phase == Phase::Hold {
-            hold_lift += lift;
-            hold_squeeze += squeeze;
-            hold_frames += 1;
+            tally.hold_lift += lift;
+            tally.hold_squeeze += squeeze;
+            tally.hold_frames += 1;
         }
         if frame % ROW_FRAMES == 0 {
-            let lowest = body
-                .positions()
-                .iter()
-                .map(|x| x.y)
-                .fold(f64::INFINITY, f64::min);
-            let choice = choice.map_or_else(|| "-".to_owned(), |kind| format!("{kind:?}"));
-            println!(
-                "{:>6.2} {:>7} {:>12.3} {:>12.3} {:>13.3} {:>12.3} {:>9.4} {:>10}",
-                frame as f64 * dt,
-                format!("{phase:?}"),
-                world.physics.bodies[fingers[0].0].translation().y * 1e3,
-                body.center_of_mass().y * 1e3,
-                lowest * 1e3,
-                squeeze,
-                lift,
-                choice
-            );
+            print_row(scene, frame, phase, (lift, squeeze), choice);
         }
     }
-    let (cube_start, finger_start) = lift_start;
-    let body = &world.soft_bodies[cube];
-    let finger_rise = f64::from(world.physics.bodies[fingers[0].0].translation().y) - finger_start;
+    Ok(tally)
+}
+
+/// Prints the slip, lowest and deepest nodes, lift against the weight, then the JSON line.
+fn print_summary(scene: &Scene, tally: &Tally) {
+    let body = &scene.world.soft_bodies[scene.cube];
+    let g = scene.world.physics.gravity.as_dvec3().length();
+    let weight = body.total_mass() * g;
+    let margin = scene.world.coupling.contact.margin;
+    let (cube_start, finger_start) = tally.lift_start;
+    let finger_rise = scene.finger_height() - finger_start;
     let slip = finger_rise - (body.center_of_mass().y - cube_start);
-    let lowest = body
-        .positions()
-        .iter()
-        .map(|x| x.y)
-        .fold(f64::INFINITY, f64::min);
-    let hold_frames = hold_frames.max(1) as f64;
-    let (lift, squeeze) = (hold_lift / hold_frames, hold_squeeze / hold_frames);
+    let lowest = lowest_node(body);
+    let deepest = tally.deepest;
+    let hold_frames = tally.hold_frames.max(1) as f64;
+    let (lift, squeeze) = (
+        tally.hold_lift / hold_frames,
+        tally.hold_squeeze / hold_frames,
+    );
+    let (end_lift, explicit_frames, implicit_frames) =
+        (tally.end_lift, tally.explicit_frames, tally.implicit_frames);
     println!(
         "slip {:.3} mm down the fingers over a {:.1} mm lift; lowest node {:.2} mm; deepest in a finger {:.3} mm (margin {:.1} mm); lift over the hold {lift:.4} N and at the end {end_lift:.4} N vs weight {weight:.4} N ({:+.2} %, {:+.3} %), squeeze {squeeze:.3} N; {explicit_frames} explicit and {implicit_frames} implicit frames",
         slip * 1e3,
@@ -237,5 +325,12 @@ fn main() -> Result<(), Error> {
         margin * 1e3,
         lift / weight - 1.0
     );
+}
+
+fn main() -> Result<(), Error> {
+    let mut scene = build_scene()?;
+    print_header();
+    let tally = run(&mut scene)?;
+    print_summary(&scene, &tally);
     Ok(())
 }

@@ -14,7 +14,7 @@
 
 use rapier_fvm::prelude::*;
 use rapier_fvm::world::FvmWorld;
-use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder};
+use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder, RigidBodyHandle};
 use std::f64::consts::PI;
 
 /// Frames per second (`FvmWorld`'s default frame step) and frames run (7 s).
@@ -29,7 +29,16 @@ const GAP: f64 = 0.01;
 /// The ball's mass (kg).
 const BALL_MASS: f64 = 1.0;
 
-fn main() -> Result<(), Error> {
+/// The world, the rope's and the ball's handles, and the ball's starting x (m).
+struct Scene {
+    world: FvmWorld,
+    rope: DeformableBodyHandle,
+    ball: RigidBodyHandle,
+    start_x: f64,
+}
+
+/// The rope clamped at the top, tilted 5°, with the ball glued below its end.
+fn build_scene() -> Result<Scene, Error> {
     let mut world = FvmWorld::default();
     let tilt = DQuat::from_rotation_z(5f64.to_radians());
     let material = Material::new(MaterialModel::StableNeoHookean, 1e6, 0.3, 1000.0)?;
@@ -53,16 +62,26 @@ fn main() -> Result<(), Error> {
     );
     let rope = world.soft_bodies.insert(rope);
     world.soft_bodies[rope].attach(bottom, ball, &world.physics.bodies)?;
+    Ok(Scene {
+        world,
+        rope,
+        ball,
+        start_x: centre.x,
+    })
+}
 
+/// Swings, printing the table; returns the downward crossing times (s) and the mean arm (m).
+fn swing(scene: &mut Scene) -> Result<(Vec<f64>, f64), Error> {
+    let world = &mut scene.world;
     let dt = f64::from(world.physics.integration_parameters.dt);
     println!("{:>6} {:>12} {:>14}", "t (s)", "angle (°)", "distance (m)");
-    let (mut crossings, mut previous_x, mut distance_sum) = (Vec::new(), centre.x, 0.0);
+    let (mut crossings, mut previous_x, mut distance_sum) = (Vec::new(), scene.start_x, 0.0);
     for frame in 1..=FRAMES {
         for (_, outcome) in world.step() {
             outcome?;
         }
         // The clamp's centre is the world origin.
-        let x = world.physics.bodies[ball].translation().as_dvec3();
+        let x = world.physics.bodies[scene.ball].translation().as_dvec3();
         distance_sum += x.length();
         if previous_x > 0.0 && x.x <= 0.0 {
             // Linear interpolation of the downward crossing of x = 0.
@@ -78,14 +97,18 @@ fn main() -> Result<(), Error> {
             );
         }
     }
+    Ok((crossings, distance_sum / FRAMES as f64))
+}
+
+/// Prints the measured period against the compound pendulum's, then the JSON line.
+fn print_summary(scene: &Scene, crossings: &[f64], arm: f64) {
     // The compound pendulum: the ball on its arm plus the rope as a uniform rod.
-    let arm = distance_sum / FRAMES as f64;
-    let rope_mass = world.soft_bodies[rope].total_mass();
+    let rope_mass = scene.world.soft_bodies[scene.rope].total_mass();
     let rope_length = arm - GAP - RADIUS;
     let inertia = BALL_MASS * (arm * arm + 0.4 * RADIUS * RADIUS)
         + rope_mass * rope_length * rope_length / 3.0;
     let moment = BALL_MASS * arm + rope_mass * rope_length / 2.0;
-    let g = world.physics.gravity.as_dvec3().length();
+    let g = scene.world.physics.gravity.as_dvec3().length();
     let expected = 2.0 * PI * (inertia / (moment * g)).sqrt();
     // Whole periods between the first and the last downward crossing.
     let period = match (crossings.first(), crossings.last()) {
@@ -115,5 +138,11 @@ fn main() -> Result<(), Error> {
         crossings.len().saturating_sub(1),
         (rope_length - LENGTH) * 1e3
     );
+}
+
+fn main() -> Result<(), Error> {
+    let mut scene = build_scene()?;
+    let (crossings, arm) = swing(&mut scene)?;
+    print_summary(&scene, &crossings, arm);
     Ok(())
 }

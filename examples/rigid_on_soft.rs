@@ -17,7 +17,9 @@
 use rapier_fvm::glamx::Vec3;
 use rapier_fvm::prelude::*;
 use rapier_fvm::world::FvmWorld;
-use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder, SharedShape};
+use rapier3d::prelude::{
+    ColliderBuilder, ColliderHandle, RigidBodyBuilder, RigidBodyHandle, SharedShape,
+};
 
 /// Frames per second (`FvmWorld`'s default frame step).
 const FPS: usize = 60;
@@ -38,7 +40,19 @@ fn step(world: &mut FvmWorld) -> Result<(), Error> {
     Ok(())
 }
 
-fn main() -> Result<(), Error> {
+/// The world, the ground's collider, the soft block's and the rigid box's handles.
+struct Scene {
+    world: FvmWorld,
+    ground: ColliderHandle,
+    block: DeformableBodyHandle,
+    rigid_box: RigidBodyHandle,
+}
+
+/// The half side of the box (m).
+const BOX_HALF: f32 = BOX_SIDE as f32 / 2.0;
+
+/// The ground, the soft block on it and the rigid box placed off-centre on the block.
+fn build_scene() -> Result<Scene, Error> {
     let mut world = FvmWorld::default();
     let ground = world.physics.insert_collider(
         ColliderBuilder::new(SharedShape::halfspace(Vec3::Y)).friction(0.8),
@@ -58,7 +72,7 @@ fn main() -> Result<(), Error> {
     .build()?;
     let block = world.soft_bodies.insert(block);
     // Placed 0.5 mm above the block's top.
-    let half = BOX_SIDE as f32 / 2.0;
+    let half = BOX_HALF;
     let (rigid_box, _) = world.physics.insert(
         RigidBodyBuilder::dynamic().translation(Vec3::new(
             0.04,
@@ -69,17 +83,40 @@ fn main() -> Result<(), Error> {
             .density(2000.0)
             .friction(0.8),
     );
-    // The contacts' impulses are those of the frame's last soft step, one coupling substep long.
-    let h = f64::from(world.physics.integration_parameters.dt) / f64::from(world.coupling.substeps);
-    let g = world.physics.gravity.as_dvec3().length();
-    let box_mass = f64::from(world.physics.bodies[rigid_box].mass());
-    let weight = (world.soft_bodies[block].total_mass() + box_mass) * g;
+    Ok(Scene {
+        world,
+        ground,
+        block,
+        rigid_box,
+    })
+}
 
+/// What the measuring time found.
+struct Measured {
+    /// The box's position (m) when the measuring started.
+    start: DVec3,
+    /// The ground's reaction averaged over the measuring frames (N).
+    reaction: f64,
+    /// The box's largest vertical speed (m/s).
+    fastest: f64,
+}
+
+/// The box's sideways distance (m) from `start`.
+fn creep_from(start: DVec3, x: DVec3) -> f64 {
+    DVec3::new(x.x - start.x, 0.0, x.z - start.z).length()
+}
+
+/// Settles, prints the header and first row, then measures, printing every [`ROW_FRAMES`].
+fn run(scene: &mut Scene) -> Result<Measured, Error> {
+    // The contacts' impulses are those of the frame's last soft step, one coupling substep long.
+    let world = &mut scene.world;
+    let h = f64::from(world.physics.integration_parameters.dt) / f64::from(world.coupling.substeps);
     for _ in 0..SETTLE_S * FPS {
-        step(&mut world)?;
+        step(world)?;
     }
-    let start = world.physics.bodies[rigid_box].translation().as_dvec3();
-    let creep_from = |x: DVec3| DVec3::new(x.x - start.x, 0.0, x.z - start.z).length();
+    let start = world.physics.bodies[scene.rigid_box]
+        .translation()
+        .as_dvec3();
     println!(
         "{:>6} {:>12} {:>16} {:>11} {:>14}",
         "t (s)", "box y (mm)", "box v_y (m/s)", "creep (µm)", "reaction (N)"
@@ -88,17 +125,20 @@ fn main() -> Result<(), Error> {
         "{:>6.2} {:>12.4} {:>16.3e} {:>11.3} {:>14}",
         SETTLE_S as f64,
         start.y * 1e3,
-        world.physics.bodies[rigid_box].linvel().y,
+        world.physics.bodies[scene.rigid_box].linvel().y,
         0.0,
         "-"
     );
     let (mut reaction_sum, mut row_sum, mut fastest) = (0.0, 0.0, 0.0f64);
     for frame in 1..=MEASURE_S * FPS {
-        step(&mut world)?;
-        let reaction = -world.soft_bodies[block].contact_force_on(ground, h)?.0.y;
+        step(world)?;
+        let reaction = -world.soft_bodies[scene.block]
+            .contact_force_on(scene.ground, h)?
+            .0
+            .y;
         reaction_sum += reaction;
         row_sum += reaction;
-        let rigid = &world.physics.bodies[rigid_box];
+        let rigid = &world.physics.bodies[scene.rigid_box];
         let vertical_speed = f64::from(rigid.linvel().y);
         fastest = fastest.max(vertical_speed.abs());
         if frame % ROW_FRAMES == 0 {
@@ -108,17 +148,32 @@ fn main() -> Result<(), Error> {
                 (SETTLE_S * FPS + frame) as f64 / FPS as f64,
                 x.y * 1e3,
                 vertical_speed,
-                creep_from(x) * 1e6,
+                creep_from(start, x) * 1e6,
                 row_sum / ROW_FRAMES as f64
             );
             row_sum = 0.0;
         }
     }
-    let reaction = reaction_sum / (MEASURE_S * FPS) as f64;
-    let pose = world.physics.bodies[rigid_box].position();
-    let creep = creep_from(pose.translation.as_dvec3());
+    Ok(Measured {
+        start,
+        reaction: reaction_sum / (MEASURE_S * FPS) as f64,
+        fastest,
+    })
+}
+
+/// Prints the reaction against the weight, the speed, creep, sink and tilt, then the JSON line.
+fn print_summary(scene: &Scene, measured: &Measured) {
+    let world = &scene.world;
+    let g = world.physics.gravity.as_dvec3().length();
+    let box_mass = f64::from(world.physics.bodies[scene.rigid_box].mass());
+    let weight = (world.soft_bodies[scene.block].total_mass() + box_mass) * g;
+    let (reaction, fastest) = (measured.reaction, measured.fastest);
+    let pose = world.physics.bodies[scene.rigid_box].position();
+    let creep = creep_from(measured.start, pose.translation.as_dvec3());
     // The centre of the box's bottom face, below the block's rest top.
-    let bottom = pose.transform_point(Vec3::new(0.0, -half, 0.0)).as_dvec3();
+    let bottom = pose
+        .transform_point(Vec3::new(0.0, -BOX_HALF, 0.0))
+        .as_dvec3();
     let sink = BLOCK_SIDE - bottom.y;
     let tilt = (pose.rotation * Vec3::Y).as_dvec3().angle_between(DVec3::Y);
     println!(
@@ -135,5 +190,11 @@ fn main() -> Result<(), Error> {
         sink * 1e3,
         tilt.to_degrees()
     );
+}
+
+fn main() -> Result<(), Error> {
+    let mut scene = build_scene()?;
+    let measured = run(&mut scene)?;
+    print_summary(&scene, &measured);
     Ok(())
 }

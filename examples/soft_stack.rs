@@ -12,7 +12,7 @@
 use rapier_fvm::glamx::Vec3;
 use rapier_fvm::prelude::*;
 use rapier_fvm::world::FvmWorld;
-use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder, SharedShape};
+use rapier3d::prelude::{ColliderBuilder, ColliderHandle, RigidBodyBuilder, SharedShape};
 
 /// Side of every block (m).
 const SIDE: f64 = 0.1;
@@ -58,7 +58,15 @@ fn layer_height(body: &DeformableBody, rest_y: f64) -> f64 {
         / layer.len() as f64
 }
 
-fn main() -> Result<(), Error> {
+/// The world, the ground's collider and the blocks' handles, bottom first.
+struct Scene {
+    world: FvmWorld,
+    ground: ColliderHandle,
+    handles: Vec<DeformableBodyHandle>,
+}
+
+/// The ground, the three blocks stacked on it (1 mm apart) and the rigid box on top.
+fn build_scene() -> Result<Scene, Error> {
     let mut world = FvmWorld::default();
     let ground = world.physics.insert_collider(
         ColliderBuilder::new(SharedShape::halfspace(Vec3::Y)).friction(0.8),
@@ -98,7 +106,17 @@ fn main() -> Result<(), Error> {
             .mass(BOX_MASS as f32)
             .friction(0.8),
     );
+    Ok(Scene {
+        world,
+        ground,
+        handles,
+    })
+}
+
+/// Runs 2 s; returns the deepest overlap between blocks (m) and the last second's reaction (N).
+fn run(scene: &mut Scene) -> Result<(f64, f64), Error> {
     let frames = 120;
+    let world = &mut scene.world;
     let substep =
         f64::from(world.physics.integration_parameters.dt) / f64::from(world.coupling.substeps);
     let (mut deepest, mut reaction) = (0.0f64, 0.0);
@@ -107,10 +125,11 @@ fn main() -> Result<(), Error> {
             outcome?;
         }
         if frame >= frames - 60 {
-            let (force, _) = world.soft_bodies[handles[0]].contact_force_on(ground, substep)?;
+            let (force, _) =
+                world.soft_bodies[scene.handles[0]].contact_force_on(scene.ground, substep)?;
             reaction -= force.y / 60.0;
         }
-        for pair in handles.windows(2) {
+        for pair in scene.handles.windows(2) {
             let below = layer_height(&world.soft_bodies[pair[0]], SIDE / 2.0);
             let above = world.soft_bodies[pair[1]]
                 .positions()
@@ -120,14 +139,19 @@ fn main() -> Result<(), Error> {
             deepest = deepest.max(below - above);
         }
     }
+    Ok((deepest, reaction))
+}
+
+/// Prints each block's shortening and estimate; returns the total weight (N) and JSON rows.
+fn print_blocks(scene: &Scene) -> (f64, Vec<String>) {
     println!(
         "{:<14} {:>10} {:>16} {:>16}",
         "block", "E (Pa)", "shortening (mm)", "uniaxial (mm)"
     );
     let mut load_above = BOX_MASS * GRAVITY;
     let mut rows = Vec::new();
-    for (block, handle) in BLOCKS.iter().zip(&handles).rev() {
-        let body = &world.soft_bodies[*handle];
+    for (block, handle) in BLOCKS.iter().zip(&scene.handles).rev() {
+        let body = &scene.world.soft_bodies[*handle];
         let weight = body.total_mass() * GRAVITY;
         let shortening = SIDE - (layer_height(body, SIDE / 2.0) - layer_height(body, -SIDE / 2.0));
         let estimate = (load_above + weight / 2.0) * SIDE / (block.young * SIDE * SIDE);
@@ -146,16 +170,23 @@ fn main() -> Result<(), Error> {
         ));
         load_above += weight;
     }
+    (load_above, rows)
+}
+
+fn main() -> Result<(), Error> {
+    let mut scene = build_scene()?;
+    let (deepest, reaction) = run(&mut scene)?;
+    let (total_weight, rows) = print_blocks(&scene);
     println!(
         "ground reaction (mean of the last second) {:.4} N for a total weight of {:.4} N; deepest overlap between blocks {:.4} mm",
         reaction,
-        load_above,
+        total_weight,
         deepest * 1e3
     );
     println!(
         "{{\"ground_reaction_n\": {:.5}, \"total_weight_n\": {:.5}, \"deepest_overlap_mm\": {:.5}, \"blocks\": [{}]}}",
         reaction,
-        load_above,
+        total_weight,
         deepest * 1e3,
         rows.join(", ")
     );

@@ -109,7 +109,25 @@ fn cg(tolerance: f64, max_iterations: usize) -> LinearSolver {
     }
 }
 
-fn sizes(json: &mut Vec<String>) -> Result<(), Error> {
+/// Free degrees of freedom of `body`.
+fn free_dofs(body: &DeformableBody) -> usize {
+    3 * (0..body.node_count())
+        .filter(|&n| !body.is_pinned(n))
+        .count()
+}
+
+/// [`run`] on a copy of `body`, after one untimed frame.
+fn run_copy(
+    body: &DeformableBody,
+    integrator: &ImplicitIntegrator,
+    dt: f64,
+    frames: usize,
+) -> Result<Run, Error> {
+    run(&mut body.clone(), integrator, dt, 1, frames)
+}
+
+/// Prints the header of the `sizes` table.
+fn print_sizes_header() {
     println!("== direct vs conjugate gradient (CG tolerance {AUTOMATIC_CG_TOLERANCE:e})");
     println!(
         "{:>12} {:>7} {:>6} {:>6} | {:>10} {:>7} | {:>10} {:>7} {:>9} {:>5} | {:>10} {:>6} {:>8}",
@@ -127,7 +145,14 @@ fn sizes(json: &mut Vec<String>) -> Result<(), Error> {
         "auto",
         "pred CG"
     );
-    let cases: Vec<(String, DeformableBody, f64, usize, usize)> = vec![
+}
+
+/// A `sizes` case: name, body, frame step (s), timed frames, conjugate gradient iteration limit.
+type SizeCase = (String, DeformableBody, f64, usize, usize);
+
+/// The cases of the `sizes` table.
+fn size_cases() -> Result<Vec<SizeCase>, Error> {
+    Ok(vec![
         (
             "small step".into(),
             beam([10, 2, 2], 1e8)?.0,
@@ -160,65 +185,55 @@ fn sizes(json: &mut Vec<String>) -> Result<(), Error> {
         ("cube 20k".into(), soft_cube(16)?, 1.0 / 240.0, 5, 5000),
         ("cube 53k".into(), soft_cube(22)?, 1.0 / 240.0, 3, 5000),
         ("cube 98k".into(), soft_cube(27)?, 1.0 / 240.0, 3, 5000),
-    ];
-    for (name, body, dt, frames, max_cg) in cases {
-        let prediction = predict(&body, dt, AUTOMATIC_CG_TOLERANCE);
-        let free = 3
-            * (0..body.node_count())
-                .filter(|&n| !body.is_pinned(n))
-                .count();
-        let direct = run(
-            &mut body.clone(),
-            &with_solver(LinearSolver::Direct),
-            dt,
-            1,
-            frames,
-        )?;
-        let iterative = run(
-            &mut body.clone(),
-            &with_solver(cg(AUTOMATIC_CG_TOLERANCE, max_cg)),
-            dt,
-            1,
-            frames,
-        )?;
-        let automatic = run(
-            &mut body.clone(),
-            &with_solver(LinearSolver::Automatic),
-            dt,
-            1,
-            frames,
-        )?;
-        let choice = if automatic.cg > 0.0 { "CG" } else { "direct" };
-        println!(
-            "{name:>12} {:>7} {free:>6} {:>6.0} | {:>10.1} {:>7.2} | {:>10.1} {:>7.2} {:>9.0} {:>5} | {:>10.1} {choice:>6} {:>8.0}",
-            body.mesh().tet_count(),
-            prediction.condition.sqrt(),
-            direct.ms,
-            direct.newton,
-            iterative.ms,
-            iterative.newton,
-            iterative.cg,
-            iterative.converged,
-            automatic.ms,
-            prediction.cg_iterations,
-        );
-        json.push(format!(
-            "{{\"case\": \"{name}\", \"tets\": {}, \"free_dofs\": {free}, \"sqrt_kappa\": {:.1}, \"direct_ms\": {:.2}, \"direct_newton\": {:.2}, \"cg_ms\": {:.2}, \"cg_newton\": {:.2}, \"cg_iterations_per_frame\": {:.1}, \"cg_converged\": {}, \"automatic_ms\": {:.2}, \"automatic\": \"{choice}\"}}",
-            body.mesh().tet_count(),
-            prediction.condition.sqrt(),
-            direct.ms,
-            direct.newton,
-            iterative.ms,
-            iterative.newton,
-            iterative.cg,
-            iterative.converged,
-            automatic.ms,
-        ));
+    ])
+}
+
+/// Times one `sizes` case with each solver; prints its row and pushes its JSON object.
+fn size_case(case: SizeCase, json: &mut Vec<String>) -> Result<(), Error> {
+    let (name, body, dt, frames, max_cg) = case;
+    let prediction = predict(&body, dt, AUTOMATIC_CG_TOLERANCE);
+    let free = free_dofs(&body);
+    let direct = run_copy(&body, &with_solver(LinearSolver::Direct), dt, frames)?;
+    let iterative = run_copy(
+        &body,
+        &with_solver(cg(AUTOMATIC_CG_TOLERANCE, max_cg)),
+        dt,
+        frames,
+    )?;
+    let automatic = run_copy(&body, &with_solver(LinearSolver::Automatic), dt, frames)?;
+    let choice = if automatic.cg > 0.0 { "CG" } else { "direct" };
+    let (tets, sqrt_kappa, predicted) = (
+        body.mesh().tet_count(),
+        prediction.condition.sqrt(),
+        prediction.cg_iterations,
+    );
+    let (direct_ms, direct_newton, automatic_ms) = (direct.ms, direct.newton, automatic.ms);
+    let (cg_ms, cg_newton, cg_its, cg_converged) = (
+        iterative.ms,
+        iterative.newton,
+        iterative.cg,
+        iterative.converged,
+    );
+    println!(
+        "{name:>12} {tets:>7} {free:>6} {sqrt_kappa:>6.0} | {direct_ms:>10.1} {direct_newton:>7.2} | {cg_ms:>10.1} {cg_newton:>7.2} {cg_its:>9.0} {cg_converged:>5} | {automatic_ms:>10.1} {choice:>6} {predicted:>8.0}"
+    );
+    json.push(format!(
+        "{{\"case\": \"{name}\", \"tets\": {tets}, \"free_dofs\": {free}, \"sqrt_kappa\": {sqrt_kappa:.1}, \"direct_ms\": {direct_ms:.2}, \"direct_newton\": {direct_newton:.2}, \"cg_ms\": {cg_ms:.2}, \"cg_newton\": {cg_newton:.2}, \"cg_iterations_per_frame\": {cg_its:.1}, \"cg_converged\": {cg_converged}, \"automatic_ms\": {automatic_ms:.2}, \"automatic\": \"{choice}\"}}"
+    ));
+    Ok(())
+}
+
+/// Part 1: the direct solve against the conjugate gradient and the automatic choice, by size.
+fn sizes(json: &mut Vec<String>) -> Result<(), Error> {
+    print_sizes_header();
+    for case in size_cases()? {
+        size_case(case, json)?;
     }
     Ok(())
 }
 
-fn calibrate(json: &mut Vec<String>) -> Result<(), Error> {
+/// Prints the header of the `calibrate` table.
+fn print_calibrate_header() {
     println!("== calibration: one Newton iteration per frame");
     println!(
         "{:>12} {:>6} | {:>11} {:>11} {:>12} {:>8} | {:>9} {:>6} {:>8} {:>7}",
@@ -233,12 +248,64 @@ fn calibrate(json: &mut Vec<String>) -> Result<(), Error> {
         "bound",
         "C"
     );
-    let one_iteration = |linear_solver| ImplicitIntegrator {
+}
+
+/// An integrator that stops after one Newton iteration, with `linear_solver`.
+fn one_iteration(linear_solver: LinearSolver) -> ImplicitIntegrator {
+    ImplicitIntegrator {
         tolerance: 1e-14,
         max_newton_iterations: 1,
         linear_solver,
         ..Default::default()
-    };
+    }
+}
+
+/// Measures one `calibrate` case; prints its row and pushes its JSON object.
+fn calibrate_case(
+    name: &str,
+    body: &DeformableBody,
+    dt: f64,
+    json: &mut Vec<String>,
+) -> Result<(), Error> {
+    let free = free_dofs(body);
+    let frames = 6;
+    let (few, many) = (10, 210);
+    let direct = run_copy(body, &one_iteration(LinearSolver::Direct), dt, frames)?;
+    let short = run_copy(body, &one_iteration(cg(1e-30, few)), dt, frames)?;
+    let long = run_copy(body, &one_iteration(cg(1e-30, many)), dt, frames)?;
+    // Each frame does the same work: the fastest is the least disturbed.
+    let product = (long.fastest - short.fastest) / (many - few) as f64;
+    let rest = short.fastest - few as f64 * product;
+    let cholesky = direct.fastest - rest;
+    // Iterations of a converged solve at the automatic tolerance, against the bound.
+    let mut probe = body.clone();
+    let solved = run(
+        &mut probe,
+        &with_solver(cg(AUTOMATIC_CG_TOLERANCE, 20_000)),
+        dt,
+        0,
+        1,
+    )?;
+    let per_solve = solved.cg / solved.newton.max(1.0);
+    let prediction = predict(body, dt, AUTOMATIC_CG_TOLERANCE);
+    let bound = prediction.condition.sqrt() * (2.0 / AUTOMATIC_CG_TOLERANCE).ln() / 2.0;
+    println!(
+        "{name:>12} {free:>6} | {cholesky:>11.2} {product:>11.4} {:>12.1} {:>8.2} | {per_solve:>9.0} {:>6.0} {bound:>8.0} {:>7.3}",
+        cholesky / product,
+        cholesky / product / (free as f64).sqrt(),
+        prediction.condition.sqrt(),
+        per_solve / bound
+    );
+    json.push(format!(
+        "{{\"case\": \"{name}\", \"free_dofs\": {free}, \"cholesky_ms\": {cholesky:.3}, \"matvec_ms\": {product:.5}, \"ratio\": {:.2}, \"cg_per_solve\": {per_solve:.1}, \"bound\": {bound:.1}}}",
+        cholesky / product
+    ));
+    Ok(())
+}
+
+/// Part 2: the constants of `LinearSolver::Automatic`, measured.
+fn calibrate(json: &mut Vec<String>) -> Result<(), Error> {
+    print_calibrate_header();
     let cases: Vec<(String, DeformableBody, f64)> = vec![
         ("beam 1.6k".into(), beam([20, 4, 4], 1e9)?.0, 1.0 / 60.0),
         ("beam 13k".into(), beam([40, 8, 8], 1e9)?.0, 1.0 / 60.0),
@@ -249,60 +316,7 @@ fn calibrate(json: &mut Vec<String>) -> Result<(), Error> {
         ("beam 100k".into(), beam([80, 16, 16], 1e9)?.0, 1.0 / 60.0),
     ];
     for (name, body, dt) in cases {
-        let free = 3
-            * (0..body.node_count())
-                .filter(|&n| !body.is_pinned(n))
-                .count();
-        let frames = 6;
-        let (few, many) = (10, 210);
-        let direct = run(
-            &mut body.clone(),
-            &one_iteration(LinearSolver::Direct),
-            dt,
-            1,
-            frames,
-        )?;
-        let short = run(
-            &mut body.clone(),
-            &one_iteration(cg(1e-30, few)),
-            dt,
-            1,
-            frames,
-        )?;
-        let long = run(
-            &mut body.clone(),
-            &one_iteration(cg(1e-30, many)),
-            dt,
-            1,
-            frames,
-        )?;
-        // Each frame does the same work: the fastest is the least disturbed.
-        let product = (long.fastest - short.fastest) / (many - few) as f64;
-        let rest = short.fastest - few as f64 * product;
-        let cholesky = direct.fastest - rest;
-        // Iterations of a converged solve at the automatic tolerance, against the bound.
-        let mut probe = body.clone();
-        let solved = run(
-            &mut probe,
-            &with_solver(cg(AUTOMATIC_CG_TOLERANCE, 20_000)),
-            dt,
-            0,
-            1,
-        )?;
-        let per_solve = solved.cg / solved.newton.max(1.0);
-        let prediction = predict(&body, dt, AUTOMATIC_CG_TOLERANCE);
-        let bound = prediction.condition.sqrt() * (2.0 / AUTOMATIC_CG_TOLERANCE).ln() / 2.0;
-        println!(
-            "{name:>12} {free:>6} | {cholesky:>11.2} {product:>11.4} {:>12.1} {:>8.2} | {per_solve:>9.0} {:>6.0} {bound:>8.0} {:>7.3}",
-            cholesky / product,
-            cholesky / product / (free as f64).sqrt(),
-            prediction.condition.sqrt(),
-            per_solve / bound
-        );
-        json.push(format!(
-            "{{\"case\": \"{name}\", \"free_dofs\": {free}, \"cholesky_ms\": {cholesky:.3}, \"matvec_ms\": {product:.5}, \"ratio\": {:.2}, \"cg_per_solve\": {per_solve:.1}, \"bound\": {bound:.1}}}",
-            cholesky / product
-        ));
+        calibrate_case(&name, &body, dt, json)?;
     }
     Ok(())
 }

@@ -167,16 +167,6 @@ impl Stiffness {
         }
     }
 
-    /// Adds the 3 x 3 block `block` (N/m) to the diagonal block of a free node.
-    pub(crate) fn add_node_block(&mut self, node: usize, block: &DMat3) {
-        for j in 0..3 {
-            for i in j..3 {
-                let e = self.entry(node, i, node, j);
-                self.values[e] += block.col(j)[i];
-            }
-        }
-    }
-
     /// Adds the tangent `w_a w_b block` (N/m) of a term acting on a point that moves with the
     /// nodes of `at` (a node, or an embedded vertex with its element's nodes), skipping pinned
     /// nodes.

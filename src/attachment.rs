@@ -10,6 +10,7 @@
 //! for contacts.
 
 use crate::Error;
+use crate::body::BodyConstraints;
 use crate::body::DeformableBody;
 use crate::contact::RigidProxy;
 use rapier3d::dynamics::{RigidBodyHandle, RigidBodySet};
@@ -76,18 +77,18 @@ impl DeformableBody {
                 effective_mass: DMat3::ZERO,
             });
         }
-        self.attachments.extend(added);
+        self.constraints.attachments.extend(added);
         Ok(())
     }
 
     /// The attachments.
     pub fn attachments(&self) -> &[Attachment] {
-        &self.attachments
+        &self.constraints.attachments
     }
 
     /// Removes every attachment to `body`.
     pub fn detach(&mut self, body: RigidBodyHandle) {
-        self.attachments.retain(|a| a.body != body);
+        self.constraints.attachments.retain(|a| a.body != body);
     }
 }
 
@@ -116,12 +117,12 @@ pub(crate) fn ready(
 /// Readies the attachments' velocity constraints for an explicit substep of `h` (s), before the
 /// sweeps of [`solve_velocities`].
 pub(crate) fn prepare_velocities(body: &mut DeformableBody, h: f64) {
-    for attachment in &mut body.attachments {
+    for attachment in &mut body.constraints.attachments {
         let n = attachment.node as usize;
         let x = body.positions[n];
         attachment.drift_velocity = (attachment.anchor - x) * (DRIFT_CORRECTION / h);
         attachment.effective_mass = (DMat3::IDENTITY * (1.0 / body.masses[n])
-            + body.rigid_proxies[attachment.proxy].inverse_mass_matrix(x))
+            + body.constraints.rigid_proxies[attachment.proxy].inverse_mass_matrix(x))
         .inverse();
     }
 }
@@ -130,8 +131,12 @@ pub(crate) fn prepare_velocities(body: &mut DeformableBody, h: f64) {
 /// velocity is set to its anchor's plus the drift correction by an impulse shared with the body.
 pub(crate) fn solve_velocities(body: &mut DeformableBody) {
     let DeformableBody {
-        attachments,
-        rigid_proxies,
+        constraints:
+            BodyConstraints {
+                attachments,
+                rigid_proxies,
+                ..
+            },
         positions,
         velocities,
         masses,
@@ -153,8 +158,8 @@ pub(crate) fn solve_velocities(body: &mut DeformableBody) {
 
 /// Carries the anchors with their bodies over an explicit substep of `h` (s), after the sweeps.
 pub(crate) fn advance_anchors(body: &mut DeformableBody, h: f64) {
-    for attachment in &mut body.attachments {
-        let proxy = &body.rigid_proxies[attachment.proxy];
+    for attachment in &mut body.constraints.attachments {
+        let proxy = &body.constraints.rigid_proxies[attachment.proxy];
         attachment.anchor += proxy.velocity_at(attachment.anchor) * h;
     }
 }
@@ -173,16 +178,19 @@ impl Attachment {
 pub(crate) fn for_each_spring(
     body: &DeformableBody,
     h: f64,
-    mut each: impl FnMut(usize, f64, DVec3),
+    mut each: impl FnMut(&Attachment, f64, DVec3),
 ) {
-    for attachment in &body.attachments {
+    for attachment in &body.constraints.attachments {
         let n = attachment.node as usize;
         if !body.pinned[n] {
-            let stiffness = body.contact_settings.penalty_stiffness(body.masses[n], h);
+            let stiffness = body
+                .constraints
+                .settings
+                .penalty_stiffness(body.masses[n], h);
             each(
-                n,
+                attachment,
                 stiffness,
-                attachment.spring_target(&body.rigid_proxies, h),
+                attachment.spring_target(&body.constraints.rigid_proxies, h),
             );
         }
     }
@@ -193,17 +201,22 @@ pub(crate) fn for_each_spring(
 /// taken before any impulse is handed over, as the step's solve saw them.
 pub(crate) fn record_spring_impulses(body: &mut DeformableBody, effective_h: f64, h: f64) {
     let targets: Vec<DVec3> = body
+        .constraints
         .attachments
         .iter()
-        .map(|a| a.spring_target(&body.rigid_proxies, effective_h))
+        .map(|a| a.spring_target(&body.constraints.rigid_proxies, effective_h))
         .collect();
     let DeformableBody {
-        attachments,
-        rigid_proxies,
+        constraints:
+            BodyConstraints {
+                attachments,
+                rigid_proxies,
+                settings: contact_settings,
+                ..
+            },
         positions,
         masses,
         pinned,
-        contact_settings,
         ..
     } = body;
     for (attachment, target) in attachments.iter_mut().zip(targets) {

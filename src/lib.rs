@@ -44,7 +44,8 @@
 mod assembly;
 pub mod attachment;
 pub mod body;
-pub mod chord;
+mod chord;
+mod constraint;
 pub mod contact;
 pub mod coupling;
 pub mod damping;
@@ -53,11 +54,12 @@ pub mod embedding;
 mod error;
 pub mod fvm;
 pub mod integrate;
-pub mod lanes;
+mod lanes;
 pub mod linear_solver;
 pub mod material;
 pub mod mesh;
 mod newton;
+pub mod query;
 pub mod statics;
 pub mod world;
 
@@ -79,7 +81,7 @@ pub mod prelude {
         DeformableBody, DeformableBodyBuilder, DeformableBodyHandle, DeformableBodySet,
     };
     pub use crate::contact::{BodyPoint, ContactSettings, ContactTarget, NodeContact};
-    pub use crate::coupling::{RapierSets, RigidLoad, RigidSets, SoftCoupling};
+    pub use crate::coupling::{ColliderLoad, RapierSets, RigidLoad, RigidSets, SoftCoupling};
     pub use crate::damping::RayleighDamping;
     pub use crate::fvm::VolumetricTreatment;
     pub use crate::integrate::{

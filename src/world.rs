@@ -5,7 +5,7 @@
 //! and sets calls [`SoftCoupling::step`] with them instead, and gets the same motion.
 
 use crate::body::{DeformableBodyHandle, DeformableBodySet};
-use crate::coupling::{RapierSets, RigidLoad, SoftCoupling, SoftStepResults};
+use crate::coupling::{ColliderLoad, RapierSets, RigidLoad, SoftCoupling, SoftStepResults};
 use rapier3d::dynamics::RigidBodyHandle;
 use rapier3d::glamx::DVec3;
 use rapier3d::pipeline::{EventHandler, PhysicsHooks, PhysicsWorld};
@@ -62,6 +62,13 @@ impl FvmWorld {
     /// is attached to, over the last frame; see [`SoftCoupling::rigid_loads`].
     pub fn rigid_loads(&self) -> &[RigidLoad] {
         self.coupling.rigid_loads()
+    }
+
+    /// The mean force and torque (about the world origin) each deformable body's contacts
+    /// exerted on each collider over the last frame, the ground included; see
+    /// [`SoftCoupling::collider_loads`].
+    pub fn collider_loads(&self) -> &[ColliderLoad] {
+        self.coupling.collider_loads()
     }
 
     /// The mean force (N) and torque about its centre of mass (N m) deformable body `soft`

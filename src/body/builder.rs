@@ -1,9 +1,7 @@
 //! [`DeformableBodyBuilder`]: the rapier-style way to describe a soft body before creating it.
 
-use super::{DeformableBody, lumped_masses};
+use super::{BodyConstraints, BodySurface, DeformableBody, SolverWorkspace, lumped_masses};
 use crate::Error;
-use crate::chord::Chord;
-use crate::contact::ContactSettings;
 use crate::damping::RayleighDamping;
 use crate::element::{ElementShape, Elements, PressureBasis, QuadraticElements};
 use crate::embedding::Embedding;
@@ -310,6 +308,51 @@ impl DeformableBodyBuilder {
     /// [`Error::InvalidSetting`] for a minimum quality outside `[0, 1)` or a negative or
     /// non-finite friction or restitution.
     pub fn build(self) -> Result<DeformableBody, Error> {
+        self.check_settings()?;
+        let pinned = self.pinned_flags()?;
+        let (positions, velocities) = self.initial_state(&pinned)?;
+        let subdivision_parents = self
+            .quadratic
+            .as_ref()
+            .map_or_else(Vec::new, |quadratic| quadratic.parents.clone());
+        let (elements, masses) = self.elements_and_masses()?;
+        let embedding = match self.embedded {
+            Some(fine) => Some(Embedding::new(
+                fine,
+                &self.mesh,
+                &elements,
+                &subdivision_parents,
+            )?),
+            None => None,
+        };
+        let node_count = self.mesh.node_count();
+        Ok(DeformableBody {
+            elements,
+            masses,
+            surface: BodySurface::of(&self.mesh),
+            workspace: SolverWorkspace::new(node_count),
+            constraints: BodyConstraints::default(),
+            mesh: self.mesh,
+            subdivision_parents,
+            material: self.material,
+            damping: self.damping,
+            positions,
+            velocities,
+            pinned,
+            embedding,
+            collision_groups: self.collision_groups,
+            friction: self.friction,
+            friction_combine_rule: self.friction_combine_rule,
+            restitution: self.restitution,
+            restitution_combine_rule: self.restitution_combine_rule,
+            self_contact: self.self_contact,
+            user_data: self.user_data,
+        })
+    }
+
+    /// Refuses contact coefficients and a minimum quality out of range, and a mesh with an
+    /// element below the minimum quality.
+    fn check_settings(&self) -> Result<(), Error> {
         for (parameter, value) in [
             ("friction", self.friction),
             ("restitution", self.restitution),
@@ -337,6 +380,11 @@ impl DeformableBodyBuilder {
                 threshold: self.min_quality,
             });
         }
+        Ok(())
+    }
+
+    /// Per node, whether it is pinned.
+    fn pinned_flags(&self) -> Result<Vec<bool>, Error> {
         let node_count = self.mesh.node_count();
         let mut pinned = vec![false; node_count];
         for &node in &self.pinned {
@@ -346,6 +394,12 @@ impl DeformableBodyBuilder {
             })?;
             *flag = true;
         }
+        Ok(pinned)
+    }
+
+    /// The nodes' world positions (m), the rest mesh rotated then translated, and velocities
+    /// (m/s), the initial one on every free node.
+    fn initial_state(&self, pinned: &[bool]) -> Result<(Vec<DVec3>, Vec<DVec3>), Error> {
         for (parameter, finite) in [
             ("translation", self.translation.is_finite()),
             (
@@ -365,109 +419,44 @@ impl DeformableBodyBuilder {
             .iter()
             .map(|p| rotation * *p + self.translation)
             .collect();
-        let velocities = (0..node_count)
-            .map(|n| if pinned[n] { DVec3::ZERO } else { self.linvel })
+        let velocities = pinned
+            .iter()
+            .map(|&pinned| if pinned { DVec3::ZERO } else { self.linvel })
             .collect();
-        let subdivision_parents = self
-            .quadratic
-            .as_ref()
-            .map_or_else(Vec::new, |quadratic| quadratic.parents.clone());
-        let (elements, masses) = match &self.quadratic {
-            None => {
-                let fvm = FvmMesh::new(&self.mesh);
-                let nodal_averaging = (self.volumetric == VolumetricTreatment::NodalAverage)
-                    .then(|| NodalAveraging::new(&fvm));
-                (
-                    Elements::Linear {
-                        fvm,
-                        nodal_averaging,
-                    },
-                    lumped_masses(&self.mesh, self.material.density()),
-                )
-            }
-            Some(quadratic) => {
-                if self.volumetric == VolumetricTreatment::NodalAverage {
-                    return Err(Error::UnsupportedOption {
-                        option: "VolumetricTreatment::NodalAverage",
-                        reason: "nodal averaging applies to linear tetrahedra; quadratic ones \
-                                 average per element (VolumetricTreatment::ElementAverage)",
-                    });
-                }
-                let elements = QuadraticElements::new(
-                    quadratic.shape,
-                    self.mesh.positions(),
-                    &quadratic.nodes,
-                )?;
-                let masses = elements
-                    .lumped_volumes()
-                    .iter()
-                    .map(|volume| volume * self.material.density())
-                    .collect();
-                let pressure = (self.volumetric == VolumetricTreatment::ElementAverage)
-                    .then(|| PressureBasis::new(&elements));
-                (Elements::Quadratic { elements, pressure }, masses)
-            }
+        Ok((positions, velocities))
+    }
+
+    /// The elements (linear, with nodal averaging if asked; or quadratic, with the projected
+    /// pressure if asked) and the nodes' lumped masses (kg).
+    fn elements_and_masses(&self) -> Result<(Elements, Vec<f64>), Error> {
+        let Some(quadratic) = &self.quadratic else {
+            let fvm = FvmMesh::new(&self.mesh);
+            let nodal_averaging = (self.volumetric == VolumetricTreatment::NodalAverage)
+                .then(|| NodalAveraging::new(&fvm));
+            return Ok((
+                Elements::Linear {
+                    fvm,
+                    nodal_averaging,
+                },
+                lumped_masses(&self.mesh, self.material.density()),
+            ));
         };
-        let embedding = match self.embedded {
-            Some(fine) => Some(Embedding::new(
-                fine,
-                &self.mesh,
-                &elements,
-                &subdivision_parents,
-            )?),
-            None => None,
-        };
-        let surface_triangles = self.mesh.surface_triangles();
-        let mut surface_rings = vec![Vec::new(); node_count];
-        for triangle in &surface_triangles {
-            for &n in triangle {
-                surface_rings[n as usize].extend(triangle);
-            }
+        if self.volumetric == VolumetricTreatment::NodalAverage {
+            return Err(Error::UnsupportedOption {
+                option: "VolumetricTreatment::NodalAverage",
+                reason: "nodal averaging applies to linear tetrahedra; quadratic ones \
+                         average per element (VolumetricTreatment::ElementAverage)",
+            });
         }
-        for ring in &mut surface_rings {
-            ring.sort_unstable();
-            ring.dedup();
-        }
-        let mut surface_nodes: Vec<u32> = surface_triangles.iter().flatten().copied().collect();
-        surface_nodes.sort_unstable();
-        surface_nodes.dedup();
-        Ok(DeformableBody {
-            elements,
-            masses,
-            forces: vec![DVec3::ZERO; node_count],
-            saved_state: (
-                Vec::with_capacity(node_count),
-                Vec::with_capacity(node_count),
-            ),
-            previous_step: None,
-            tangent: None,
-            chord: Chord::default(),
-            mesh: self.mesh,
-            subdivision_parents,
-            material: self.material,
-            damping: self.damping,
-            positions,
-            velocities,
-            pinned,
-            surface_nodes,
-            embedding,
-            surface_triangles,
-            surface_rings,
-            contacts: Vec::new(),
-            corner_contacts: Vec::new(),
-            attachments: Vec::new(),
-            rigid_proxies: Vec::new(),
-            saved_proxies: Vec::new(),
-            saved_anchors: Vec::new(),
-            saved_planes: Vec::new(),
-            contact_settings: ContactSettings::default(),
-            collision_groups: self.collision_groups,
-            friction: self.friction,
-            friction_combine_rule: self.friction_combine_rule,
-            restitution: self.restitution,
-            restitution_combine_rule: self.restitution_combine_rule,
-            self_contact: self.self_contact,
-            user_data: self.user_data,
-        })
+        let elements =
+            QuadraticElements::new(quadratic.shape, self.mesh.positions(), &quadratic.nodes)?;
+        let masses = elements
+            .lumped_volumes()
+            .iter()
+            .map(|volume| volume * self.material.density())
+            .collect();
+        let pressure = (self.volumetric == VolumetricTreatment::ElementAverage)
+            .then(|| PressureBasis::new(&elements));
+        Ok((Elements::Quadratic { elements, pressure }, masses))
     }
 }

@@ -2,16 +2,19 @@
 //! (m/s) and lumped masses (kg), plus pinned (Dirichlet) nodes.
 
 mod builder;
+mod constraints;
 mod set;
 mod stress;
+mod surface;
+mod workspace;
 
 pub use builder::{DEFAULT_FRICTION, DEFAULT_MIN_ELEMENT_QUALITY, DeformableBodyBuilder};
+pub(crate) use constraints::BodyConstraints;
 pub use set::{DeformableBodyHandle, DeformableBodySet};
+pub(crate) use surface::BodySurface;
+pub(crate) use workspace::SolverWorkspace;
 
 use crate::assembly::Stiffness;
-use crate::attachment::Attachment;
-use crate::chord::Chord;
-use crate::contact::{ContactSettings, CornerContact, NodeContact, RigidProxy};
 use crate::damping::RayleighDamping;
 use crate::element::{ElementOrder, ElementShape, Elements};
 use crate::embedding::Embedding;
@@ -41,43 +44,15 @@ pub struct DeformableBody {
     pub(crate) velocities: Vec<DVec3>,
     pub(crate) masses: Vec<f64>,
     pub(crate) pinned: Vec<bool>,
-    /// Scratch: the last internal forces computed (N per node).
-    pub(crate) forces: Vec<DVec3>,
-    /// Positions and velocities saved before a step, restored if the step fails.
-    pub(crate) saved_state: (Vec<DVec3>, Vec<DVec3>),
-    /// The state at the start of the last implicit substep, for two-step schemes; cleared by any
-    /// other change of the state.
-    pub(crate) previous_step: Option<PreviousStep>,
-    /// The sparse tangent's pattern and symbolic factorization, built by the first implicit or
-    /// static solve and kept for the next.
-    pub(crate) tangent: Option<Stiffness>,
-    /// The implicit integrator's last factorization, kept for reuse by the chord method.
-    pub(crate) chord: Chord,
-    /// The nodes on the mesh's boundary, which contacts are detected for (unless the body has an
-    /// embedded mesh).
-    pub(crate) surface_nodes: Vec<u32>,
+    /// The mesh's boundary: the nodes contacts are detected for (unless the body has an
+    /// embedded mesh), the triangles self-contact pushes against, each node's ring.
+    pub(crate) surface: BodySurface,
     /// A fine mesh carried by the nodes, whose surface contacts with colliders act on.
     pub(crate) embedding: Option<Embedding>,
-    /// The mesh's boundary triangles, outward-oriented, which self-contact pushes against.
-    pub(crate) surface_triangles: Vec<[u32; 3]>,
-    /// Per node, the boundary nodes sharing a boundary triangle with it, itself included, sorted
-    /// (empty for interior nodes): self-contact's neighbourhood.
-    pub(crate) surface_rings: Vec<Vec<u32>>,
-    /// The contacts the integrators enforce, from the last detection.
-    pub(crate) contacts: Vec<NodeContact>,
-    /// Rigid vertices against the body's boundary triangles, from the last detection.
-    pub(crate) corner_contacts: Vec<CornerContact>,
-    /// The nodes glued to rigid bodies.
-    pub(crate) attachments: Vec<Attachment>,
-    /// The rigid bodies the contacts and attachments touch, as the soft step sees them.
-    pub(crate) rigid_proxies: Vec<RigidProxy>,
-    /// The proxies and attachment anchors saved with the state, restored with it.
-    pub(crate) saved_proxies: Vec<RigidProxy>,
-    pub(crate) saved_anchors: Vec<DVec3>,
-    /// The contact planes saved with the state (explicit substeps move them).
-    pub(crate) saved_planes: Vec<(DVec3, DVec3)>,
-    /// The settings of the last contact detection.
-    pub(crate) contact_settings: ContactSettings,
+    /// The integrators' caches.
+    pub(crate) workspace: SolverWorkspace,
+    /// The contacts, rigid corners, attachments and rigid proxies of the coming step.
+    pub(crate) constraints: BodyConstraints,
     /// The collision groups of the surface: the body touches only the colliders whose groups
     /// pass `InteractionGroups::test` with these, as rapier's colliders do.
     pub collision_groups: InteractionGroups,
@@ -176,7 +151,7 @@ impl DeformableBody {
 
     /// Mutable world positions of the nodes (m). Editing the state restarts two-step integrators.
     pub fn positions_mut(&mut self) -> &mut [DVec3] {
-        self.previous_step = None;
+        self.workspace.previous_step = None;
         &mut self.positions
     }
 
@@ -187,7 +162,7 @@ impl DeformableBody {
 
     /// Mutable node velocities (m/s). Editing the state restarts two-step integrators.
     pub fn velocities_mut(&mut self) -> &mut [DVec3] {
-        self.previous_step = None;
+        self.workspace.previous_step = None;
         &mut self.velocities
     }
 
@@ -220,52 +195,31 @@ impl DeformableBody {
     /// Internal forces (N per node): elastic plus damping, at the current positions and velocities.
     pub fn internal_forces(&mut self) -> &[DVec3] {
         self.compute_internal_forces();
-        &self.forces
+        &self.workspace.forces
     }
 
     /// Copies positions, velocities and the touched rigid bodies aside (no allocation after the
     /// first call), and starts counting the contact impulses of a new step.
     pub(crate) fn save_state(&mut self) {
-        self.saved_state.0.clone_from(&self.positions);
-        self.saved_state.1.clone_from(&self.velocities);
-        for contact in &mut self.contacts {
-            contact.impulse = DVec3::ZERO;
-        }
-        for contact in &mut self.corner_contacts {
-            contact.impulse = DVec3::ZERO;
-        }
-        self.saved_proxies.clone_from(&self.rigid_proxies);
-        self.saved_anchors.clear();
-        self.saved_anchors
-            .extend(self.attachments.iter().map(|a| a.anchor));
-        self.saved_planes.clear();
-        self.saved_planes
-            .extend(self.contacts.iter().map(|c| (c.point, c.normal)));
+        self.workspace.saved_positions.clone_from(&self.positions);
+        self.workspace.saved_velocities.clone_from(&self.velocities);
+        self.constraints.save();
     }
 
     /// Puts back the state saved by [`DeformableBody::save_state`].
     pub(crate) fn restore_state(&mut self) {
-        self.positions.clone_from(&self.saved_state.0);
-        self.velocities.clone_from(&self.saved_state.1);
-        for contact in &mut self.contacts {
-            contact.impulse = DVec3::ZERO;
-        }
-        for contact in &mut self.corner_contacts {
-            contact.impulse = DVec3::ZERO;
-        }
-        self.rigid_proxies.clone_from(&self.saved_proxies);
-        for (attachment, anchor) in self.attachments.iter_mut().zip(&self.saved_anchors) {
-            attachment.anchor = *anchor;
-        }
-        for (contact, (point, normal)) in self.contacts.iter_mut().zip(&self.saved_planes) {
-            contact.point = *point;
-            contact.normal = *normal;
-        }
+        self.positions.clone_from(&self.workspace.saved_positions);
+        self.velocities.clone_from(&self.workspace.saved_velocities);
+        self.constraints.restore();
     }
 
-    /// The tangent workspace, built on first use; give it back with `self.tangent = Some(..)`.
+    /// The tangent workspace, built on first use; give it back with
+    /// `self.workspace.tangent = Some(..)`.
     pub(crate) fn take_tangent(&mut self) -> Stiffness {
-        self.tangent.take().unwrap_or_else(|| Stiffness::new(self))
+        self.workspace
+            .tangent
+            .take()
+            .unwrap_or_else(|| Stiffness::new(self))
     }
 
     /// The weight of every free node, `m g` (N); zero on pinned nodes.
@@ -285,11 +239,17 @@ impl DeformableBody {
             damping,
             positions,
             velocities,
-            forces,
+            workspace,
             ..
         } = self;
         with_hyperelastic_model!(material, |model| {
-            elements.internal_forces(&model, damping.as_ref(), positions, velocities, forces);
+            elements.internal_forces(
+                &model,
+                damping.as_ref(),
+                positions,
+                velocities,
+                &mut workspace.forces,
+            );
         });
     }
 

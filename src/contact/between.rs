@@ -71,7 +71,7 @@ pub(crate) fn detect_between(
             let normals = normals.get_or_insert_with(|| body.surface_node_normals());
             let coefficients =
                 SurfaceCoefficients::of_body(body).combine(SurfaceCoefficients::of_body(other));
-            for &node in &body.surface_nodes {
+            for &node in &body.surface.nodes {
                 let n = node as usize;
                 if body.pinned[n] {
                     continue;
@@ -132,12 +132,9 @@ pub(crate) fn prepare_between(
             (node_body.velocities[n] - contact.on_triangle.velocity(&triangle_body.velocities))
                 .dot(contact.normal)
         };
-        contact.constraint = VelocityConstraint::new(
-            gap,
-            h,
-            node_body.contact_settings.depenetration_speed,
-        )
-        .bounce(gap, h, normal_speed, contact.coefficients.restitution);
+        contact.constraint =
+            VelocityConstraint::new(gap, h, node_body.constraints.settings.depenetration_speed)
+                .bounce(gap, h, normal_speed, contact.coefficients.restitution);
     }
 }
 

@@ -9,8 +9,10 @@
 //! the impulse, the triangle's nodes its opposite by the contact point's barycentric weights,
 //! and the plane follows the triangle through the step.
 
+use super::detect::NearCollider;
 use super::surface_tree::SurfaceTree;
 use super::{Coefficients, ContactSides, RigidProxy, SoftPoint, VelocityConstraint};
+use crate::body::BodyConstraints;
 use crate::body::DeformableBody;
 use rapier3d::geometry::{ColliderHandle, Shape};
 use rapier3d::glamx::DVec3;
@@ -84,24 +86,26 @@ fn for_each_vertex(shape: &dyn Shape, pose: &Pose, each: &mut impl FnMut(DVec3, 
 }
 
 impl DeformableBody {
-    /// The contacts of the vertices of `shape` at `pose` (collider `collider`, contact
-    /// `coefficients`) within `reach` (m) of the body's boundary triangles in `tree`, skipping
-    /// triangles with a node in `glued` (nodes attached to the collider's rigid body); their
-    /// proxy is left for the caller to set.
-    #[allow(clippy::too_many_arguments)]
-    pub(crate) fn find_corner_contacts(
+    /// The contacts of the vertices of `near`'s shape within its reach (m) of the body's boundary
+    /// triangles in `tree`, skipping triangles with a node glued to the collider's rigid body;
+    /// their proxy is left for the caller to set.
+    pub(super) fn find_corner_contacts(
         &self,
         tree: &SurfaceTree,
-        collider: ColliderHandle,
-        shape: &dyn Shape,
-        pose: &Pose,
-        coefficients: Coefficients,
-        reach: f64,
-        glued: &[u32],
+        near: &NearCollider<'_>,
     ) -> Vec<CornerContact> {
+        let NearCollider {
+            handle: collider,
+            shape,
+            pose,
+            reach,
+            coefficients,
+            ref glued,
+            ..
+        } = *near;
         let bounds = tree.bounds.loosened(reach as f32);
         let mut found = Vec::new();
-        for_each_vertex(shape, pose, &mut |vertex, outward| {
+        for_each_vertex(shape.as_ref(), pose, &mut |vertex, outward| {
             if !bounds.contains_local_point(vertex.as_vec3()) {
                 return;
             }
@@ -127,8 +131,8 @@ impl DeformableBody {
 /// Readies the corner contacts for an explicit substep of `h` (s): each plane moves to its
 /// triangle's contact point where the nodes are now.
 pub(crate) fn prepare_corners(body: &mut DeformableBody, h: f64) {
-    let depenetration_speed = body.contact_settings.depenetration_speed;
-    for contact in &mut body.corner_contacts {
+    let depenetration_speed = body.constraints.settings.depenetration_speed;
+    for contact in &mut body.constraints.corner_contacts {
         if let Some((point, normal)) = contact.on_triangle.plane(&body.positions) {
             contact.point = point;
             contact.normal = normal;
@@ -136,7 +140,7 @@ pub(crate) fn prepare_corners(body: &mut DeformableBody, h: f64) {
         let gap = (contact.vertex - contact.point).dot(contact.normal);
         let normal_speed = || {
             let vertex_velocity = contact.proxy.map_or(DVec3::ZERO, |p| {
-                body.rigid_proxies[p].velocity_at(contact.vertex)
+                body.constraints.rigid_proxies[p].velocity_at(contact.vertex)
             });
             (vertex_velocity - contact.on_triangle.velocity(&body.velocities)).dot(contact.normal)
         };
@@ -152,9 +156,9 @@ pub(crate) fn prepare_corners(body: &mut DeformableBody, h: f64) {
 /// Moves the corners with their rigid bodies' velocities for `h` (s), as the body's nodes move
 /// at the end of an explicit substep: the gaps then follow both sides.
 pub(crate) fn advance_corners(body: &mut DeformableBody, h: f64) {
-    for contact in &mut body.corner_contacts {
+    for contact in &mut body.constraints.corner_contacts {
         if let Some(p) = contact.proxy {
-            contact.vertex += body.rigid_proxies[p].velocity_at(contact.vertex) * h;
+            contact.vertex += body.constraints.rigid_proxies[p].velocity_at(contact.vertex) * h;
         }
     }
 }
@@ -162,8 +166,12 @@ pub(crate) fn advance_corners(body: &mut DeformableBody, h: f64) {
 /// One sweep over the corner contacts (see [`VelocityConstraint`]).
 pub(crate) fn solve_corners(body: &mut DeformableBody) {
     let DeformableBody {
-        corner_contacts,
-        rigid_proxies,
+        constraints:
+            BodyConstraints {
+                corner_contacts,
+                rigid_proxies,
+                ..
+            },
         velocities,
         masses,
         pinned,

@@ -25,12 +25,12 @@ impl DeformableBody {
         let own = SurfaceCoefficients::of_body(self);
         let coefficients = own.combine(own);
         let mut found = Vec::new();
-        for &node in &self.surface_nodes {
+        for &node in &self.surface.nodes {
             let n = node as usize;
             if self.pinned[n] {
                 continue;
             }
-            let ring = &self.surface_rings[n];
+            let ring = &self.surface.rings[n];
             let near = |triangle: &[u32; 3]| triangle.iter().any(|c| ring.binary_search(c).is_ok());
             if let Some(hit) =
                 tree.nearest_facing(self, self.positions[n], node_normals[n], reach, near)
@@ -47,6 +47,6 @@ impl DeformableBody {
                 ));
             }
         }
-        self.contacts.extend(found);
+        self.constraints.contacts.extend(found);
     }
 }

@@ -46,7 +46,8 @@ impl SurfaceTree {
     /// The tree of `body`'s boundary as it is now.
     pub(crate) fn of(body: &DeformableBody) -> Self {
         let leaves: Vec<Aabb> = body
-            .surface_triangles
+            .surface
+            .triangles
             .iter()
             .map(|triangle| {
                 let [a, b, c] = triangle.map(|n| body.positions[n as usize]);
@@ -84,7 +85,7 @@ impl SurfaceTree {
         let mut nearest = None;
         let mut nearest_distance = reach;
         for leaf in self.bvh.intersect_aabb(&query) {
-            let triangle = body.surface_triangles[leaf as usize];
+            let triangle = body.surface.triangles[leaf as usize];
             if skipped(&triangle) {
                 continue;
             }
@@ -130,7 +131,7 @@ impl DeformableBody {
     /// triangles' area vectors (zero for interior nodes).
     pub(crate) fn surface_node_normals(&self) -> Vec<DVec3> {
         let mut normals = vec![DVec3::ZERO; self.positions.len()];
-        for triangle in &self.surface_triangles {
+        for triangle in &self.surface.triangles {
             let [a, b, c] = triangle.map(|n| self.positions[n as usize]);
             let area = (b - a).cross(c - a);
             for &n in triangle {

@@ -32,7 +32,7 @@ mod groups;
 mod kinematic;
 mod loads;
 
-pub use loads::RigidLoad;
+pub use loads::{ColliderLoad, RigidLoad};
 
 use crate::Error;
 use crate::body::{DeformableBody, DeformableBodyHandle, DeformableBodySet};
@@ -233,10 +233,17 @@ impl SoftCoupling {
     /// The mean force and torque each deformable body exerted on each rigid body it touched or
     /// is attached to, over the last frame of [`SoftCoupling::step`] (or the last
     /// [`SoftCoupling::substep`]): the impulses it handed over divided by the time. Colliders
-    /// without a rigid body (fixed ground) are not listed: see
-    /// [`DeformableBody::contact_force_on`](crate::body::DeformableBody::contact_force_on).
+    /// without a rigid body (fixed ground) are in [`SoftCoupling::collider_loads`].
     pub fn rigid_loads(&self) -> &[RigidLoad] {
-        self.loads.all()
+        self.loads.rigid()
+    }
+
+    /// The mean force and torque (about the world origin) each deformable body's contacts
+    /// exerted on each collider they touched over the last frame of [`SoftCoupling::step`] (or
+    /// the last [`SoftCoupling::substep`]): colliders without a rigid body, such as the ground,
+    /// included.
+    pub fn collider_loads(&self) -> &[ColliderLoad] {
+        self.loads.colliders()
     }
 
     /// The mean force (N) and torque about its centre of mass (N m) deformable body `soft`
@@ -301,7 +308,11 @@ impl SoftCoupling {
                 if result.is_ok() {
                     for (rigid_body, impulse, angular_impulse) in body.rigid_impulses() {
                         self.loads
-                            .add(*handle, rigid_body, impulse, angular_impulse);
+                            .add_rigid(*handle, rigid_body, impulse, angular_impulse);
+                    }
+                    for (collider, impulse, angular_impulse) in body.collider_impulses() {
+                        self.loads
+                            .add_collider(*handle, collider, impulse, angular_impulse);
                     }
                     body.transfer_contact_impulses(rigid.bodies);
                 }
@@ -320,7 +331,7 @@ fn hold_supported_bodies(
     bodies: &RigidBodySet,
     narrow_phase: &NarrowPhase,
 ) {
-    for proxy in &mut body.rigid_proxies {
+    for proxy in &mut body.constraints.rigid_proxies {
         let supported = bodies.get(proxy.handle).is_some_and(|rigid| {
             rigid.colliders().iter().any(|&collider| {
                 narrow_phase

@@ -186,18 +186,14 @@ impl FvmMesh {
             "positions, velocities and forces need one entry per node"
         );
         out.fill(DVec3::ZERO);
+        let law = ForceLaw { model, damping };
         if self.windows.is_empty() {
-            add_chunk_forces(
-                model,
-                damping,
-                &self.tets,
-                &self.blocks,
-                self.tet_count,
-                x,
-                v,
-                out,
-                0,
-            );
+            let run = TetRun {
+                tets: &self.tets,
+                blocks: &self.blocks,
+                valid: self.tet_count,
+            };
+            add_run_forces(law, run, [x, v], out, 0);
             return;
         }
         let (tets, blocks, tet_count) = (&self.tets, &self.blocks, self.tet_count);
@@ -206,18 +202,12 @@ impl FvmMesh {
             let start = c * CHUNK_TETS;
             let end = (start + CHUNK_TETS).min(tets.len());
             let blocks = &blocks[start / LANES..end / LANES];
-            let valid = tet_count - start;
-            add_chunk_forces(
-                model,
-                damping,
-                &tets[start..end],
+            let run = TetRun {
+                tets: &tets[start..end],
                 blocks,
-                valid,
-                x,
-                v,
-                window,
-                *first,
-            );
+                valid: tet_count - start,
+            };
+            add_run_forces(law, run, [x, v], window, *first);
         };
         #[cfg(feature = "parallel")]
         {
@@ -247,24 +237,41 @@ impl FvmMesh {
     }
 }
 
-/// Adds the forces of the first `valid` of `tets` (padded to whole blocks) into `out`, whose
-/// entry 0 is node `first`.
-#[allow(clippy::too_many_arguments)]
-#[inline(always)]
-fn add_chunk_forces<M: HyperelasticModel>(
-    model: &M,
-    damping: Option<&RayleighDamping>,
-    tets: &[[u32; 4]],
-    blocks: &[RestBlock],
+/// The constitutive side of the force loop: the elastic model and the optional damping.
+struct ForceLaw<'a, M> {
+    model: &'a M,
+    damping: Option<&'a RayleighDamping>,
+}
+
+impl<M> Clone for ForceLaw<'_, M> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<M> Copy for ForceLaw<'_, M> {}
+
+/// A run of tetrahedra padded to whole blocks of [`LANES`], with their rest data; only the first
+/// `valid` are real.
+struct TetRun<'a> {
+    tets: &'a [[u32; 4]],
+    blocks: &'a [RestBlock],
     valid: usize,
-    x: &[DVec3],
-    v: &[DVec3],
+}
+
+/// Adds the forces (N) of `run`'s real tetrahedra at positions `x` (m) and velocities `v` (m/s)
+/// into `out`, whose entry 0 is node `first`.
+#[inline(always)]
+fn add_run_forces<M: HyperelasticModel>(
+    law: ForceLaw<'_, M>,
+    run: TetRun<'_>,
+    [x, v]: [&[DVec3]; 2],
     out: &mut [DVec3],
     first: usize,
 ) {
-    for (b, (block_tets, rest)) in tets.chunks_exact(LANES).zip(blocks).enumerate() {
-        let forces = block_forces(model, damping, rest, block_tets, x, v);
-        let block_valid = valid.saturating_sub(b * LANES).min(LANES);
+    for (b, (block_tets, rest)) in run.tets.chunks_exact(LANES).zip(run.blocks).enumerate() {
+        let forces = block_forces(law.model, law.damping, rest, block_tets, x, v);
+        let block_valid = run.valid.saturating_sub(b * LANES).min(LANES);
         for (tet, tet_forces) in block_tets.iter().zip(&forces).take(block_valid) {
             for (&n, f) in tet.iter().zip(tet_forces) {
                 out[n as usize - first] += *f;

@@ -14,8 +14,9 @@
 use super::check_step;
 use crate::Error;
 use crate::body::DeformableBody;
+use crate::body::{BodyConstraints, SolverWorkspace};
 use crate::contact::BetweenContact;
-use crate::{attachment, contact};
+use crate::{constraint, contact};
 use rapier3d::glamx::DVec3;
 
 /// Ratio of the critical explicit step to `ℓ / c_p`. The true limit `2/ω_max` (power iteration
@@ -174,12 +175,12 @@ impl SymplecticEuler {
         let mut histories = Vec::with_capacity(bodies.len());
         for body in bodies.iter_mut() {
             body.save_state();
-            histories.push(body.previous_step.take());
+            histories.push(body.workspace.previous_step.take());
         }
         let fail = |bodies: &mut [&mut DeformableBody], histories: Vec<_>, error| {
             for (body, history) in bodies.iter_mut().zip(histories) {
                 body.restore_state();
-                body.previous_step = history;
+                body.workspace.previous_step = history;
             }
             Err(error)
         };
@@ -273,7 +274,7 @@ fn substep(
     let sweeps = if !between.is_empty() || bodies.iter().any(|b| contact::constraints_coupled(b)) {
         bodies
             .iter()
-            .map(|body| body.contact_settings.velocity_iterations)
+            .map(|body| body.constraints.settings.velocity_iterations)
             .max()
             .unwrap_or(1)
             .max(1)
@@ -282,9 +283,9 @@ fn substep(
     };
     for _ in 0..sweeps {
         for body in bodies.iter_mut() {
-            contact::solve_velocities(body);
-            contact::solve_corners(body);
-            attachment::solve_velocities(body);
+            for kind in constraint::EXPLICIT {
+                kind.sweep(body);
+            }
         }
         contact::solve_between(between, bodies);
     }
@@ -301,8 +302,8 @@ fn update_velocities(body: &mut DeformableBody, h: f64, gravity: DVec3) {
         velocities,
         masses,
         pinned,
-        forces,
-        rigid_proxies,
+        workspace: SolverWorkspace { forces, .. },
+        constraints: BodyConstraints { rigid_proxies, .. },
         ..
     } = body;
     for n in 0..velocities.len() {
@@ -314,15 +315,16 @@ fn update_velocities(body: &mut DeformableBody, h: f64, gravity: DVec3) {
     for proxy in rigid_proxies.iter_mut() {
         proxy.fall(gravity, h);
     }
-    contact::prepare_velocities(body, h);
-    contact::prepare_corners(body, h);
-    attachment::prepare_velocities(body, h);
+    for kind in constraint::EXPLICIT {
+        kind.prepare(body, h);
+    }
 }
 
 /// The substep's position update `x ← x + h v`, after the sweeps.
 fn update_positions(body: &mut DeformableBody, h: f64) {
-    attachment::advance_anchors(body, h);
-    contact::advance_corners(body, h);
+    for kind in constraint::EXPLICIT {
+        kind.advance(body, h);
+    }
     let DeformableBody {
         positions,
         velocities,

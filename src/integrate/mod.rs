@@ -3,10 +3,12 @@
 mod automatic;
 mod explicit;
 mod implicit;
+mod mesh_time_step;
 
 pub use automatic::{AutomaticIntegrator, AutomaticReport, CostPrediction, IntegratorKind};
 pub use explicit::{COURANT_NUMBER, StepReport, Substeps, SymplecticEuler};
 pub use implicit::{ImplicitIntegrator, ImplicitReport, ImplicitScheme};
+pub use mesh_time_step::MeshTimeSteps;
 
 use crate::Error;
 use rapier3d::glamx::DVec3;

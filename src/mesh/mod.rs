@@ -7,6 +7,7 @@
 
 mod generators;
 mod hex_mesher;
+#[cfg(feature = "import")]
 pub mod import;
 mod quadratic;
 mod quadratic_hex;

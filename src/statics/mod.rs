@@ -68,13 +68,13 @@ pub fn solve_equilibrium(
         return Err(Error::NoFreeNode);
     }
     body.save_state();
-    let history = body.previous_step.take();
+    let history = body.workspace.previous_step.take();
     let mut stiffness = body.take_tangent();
     let result = newton(body, &mut stiffness, gravity, settings);
-    body.tangent = Some(stiffness);
+    body.workspace.tangent = Some(stiffness);
     if result.is_err() {
         body.restore_state();
-        body.previous_step = history;
+        body.workspace.previous_step = history;
     }
     result
 }
@@ -243,7 +243,7 @@ fn out_of_balance(body: &mut DeformableBody, load: &[DVec3]) -> Vec<DVec3> {
             if body.pinned[n] {
                 DVec3::ZERO
             } else {
-                body.forces[n] + load[n]
+                body.workspace.forces[n] + load[n]
             }
         })
         .collect()
@@ -254,7 +254,7 @@ fn potential_energy(body: &DeformableBody, load: &[DVec3]) -> f64 {
     // The load's work is measured from the positions at the start of the solve.
     let load_work: f64 = load
         .iter()
-        .zip(body.positions.iter().zip(&body.saved_state.0))
+        .zip(body.positions.iter().zip(&body.workspace.saved_positions))
         .map(|(f, (x, x0))| f.dot(*x - *x0))
         .sum();
     body.elastic_energy() - load_work

@@ -1,10 +1,11 @@
-//! Quality of a tetrahedral mesh before validation: counts, volume, shape measures, defects
-//! and the explicit stability limit, for a `check` command to print.
+//! Quality of a tetrahedral mesh before validation: counts, volume, shape measures and
+//! defects, for a `check` command to print.
+//!
+//! Measures the mesh alone, any positions and node indices (out of range, repeated, inverted,
+//! flat), and never fails or panics. The explicit time step a mesh allows depends on its
+//! material as well: the integrator layer computes it
+//! ([`SymplecticEuler::mesh_time_steps`](crate::integrate::SymplecticEuler::mesh_time_steps)).
 
-use super::RawMesh;
-use crate::body::DeformableBodyBuilder;
-use crate::integrate::SymplecticEuler;
-use crate::material::Material;
 use crate::mesh::{DEGENERATE_RELATIVE_VOLUME, signed_volume};
 use rapier3d::glamx::DVec3;
 
@@ -15,7 +16,7 @@ pub struct QualityReport {
     pub tets: usize,
     /// Number of nodes given, used or not.
     pub nodes: usize,
-    /// Nodes that no tetrahedron uses (dropped by [`RawMesh::into_mesh`]).
+    /// Nodes that no tetrahedron uses (dropped by [`RawMesh::into_mesh`](super::RawMesh::into_mesh)).
     pub unused_nodes: usize,
     /// Sum of the tetrahedra's signed volumes (m³); inverted elements count negatively.
     pub volume: f64,
@@ -27,7 +28,7 @@ pub struct QualityReport {
     /// Smallest radius ratio `3 r_in / r_circ` (dimensionless): 1 for a regular tetrahedron, 0
     /// for a flat one.
     pub min_radius_ratio: f64,
-    /// Tetrahedra with negative volume (wrong node order; [`RawMesh::into_mesh`] fixes them).
+    /// Tetrahedra with negative volume (wrong node order; [`RawMesh::into_mesh`](super::RawMesh::into_mesh) fixes them).
     pub inverted: usize,
     /// Tetrahedra with (numerically) zero volume, `|V| <= 1e-12 l³` with `l` the longest edge,
     /// which no simulation can use.
@@ -35,17 +36,10 @@ pub struct QualityReport {
     /// Tetrahedra referring to a node that does not exist or twice to the same node; they are
     /// left out of every other measure.
     pub invalid: usize,
-    /// The explicit integrator's critical time step for the material given (s), from
-    /// [`SymplecticEuler::critical_time_step`] on the undamped body; `None` when the mesh
-    /// cannot be built (degenerate or invalid elements).
-    pub critical_time_step: Option<f64>,
-    /// The substep [`SymplecticEuler::default`] takes automatically (s): the critical step
-    /// times its safety factor; `None` as above.
-    pub stable_time_step: Option<f64>,
 }
 
-/// Measures the mesh of `positions` (m) and `tets` without requiring it to be valid, with the
-/// explicit time step for `material`. Never panics.
+/// Measures the mesh of `positions` (m) and `tets` without requiring it to be valid. Never
+/// panics.
 ///
 /// # Example
 /// ```
@@ -53,15 +47,13 @@ pub struct QualityReport {
 /// use rapier_fvm::mesh::import;
 ///
 /// let cube = mesh::cuboid(DVec3::splat(0.5), [2, 2, 2])?;
-/// let rubber = Material::new(MaterialModel::StableNeoHookean, 1e6, 0.45, 1100.0)?;
-/// let report = import::check(cube.positions(), cube.tets(), &rubber);
+/// let report = import::check(cube.positions(), cube.tets());
 /// assert_eq!(report.tets, 40);
 /// assert!((report.volume - 1.0).abs() < 1e-12);
 /// assert_eq!(report.inverted + report.degenerate, 0);
-/// assert!(report.stable_time_step.unwrap() > 0.0);
 /// # Ok::<(), rapier_fvm::Error>(())
 /// ```
-pub fn check(positions: &[DVec3], tets: &[[u32; 4]], material: &Material) -> QualityReport {
+pub fn check(positions: &[DVec3], tets: &[[u32; 4]]) -> QualityReport {
     let mut used = vec![false; positions.len()];
     let mut report = QualityReport {
         tets: tets.len(),
@@ -74,8 +66,6 @@ pub fn check(positions: &[DVec3], tets: &[[u32; 4]], material: &Material) -> Qua
         inverted: 0,
         degenerate: 0,
         invalid: 0,
-        critical_time_step: None,
-        stable_time_step: None,
     };
     for tet in tets {
         let in_range = tet.iter().all(|&n| (n as usize) < positions.len());
@@ -107,22 +97,6 @@ pub fn check(positions: &[DVec3], tets: &[[u32; 4]], material: &Material) -> Qua
         report.min_radius_ratio = report.min_radius_ratio.min(radius_ratio(&p, volume));
     }
     report.unused_nodes = used.iter().filter(|&&u| !u).count();
-    if report.invalid == 0 && report.degenerate == 0 && !tets.is_empty() {
-        let raw = RawMesh {
-            path: String::new(),
-            positions: positions.to_vec(),
-            tets: tets.to_vec(),
-            mid_edge_nodes: Vec::new(),
-            tet_locations: Vec::new(),
-        };
-        if let Ok(body) = raw
-            .into_mesh()
-            .and_then(|mesh| DeformableBodyBuilder::new(mesh, *material).build())
-        {
-            report.critical_time_step = Some(SymplecticEuler::critical_time_step(&body));
-            report.stable_time_step = Some(SymplecticEuler::default().stable_time_step(&body));
-        }
-    }
     if report.min_dihedral_angle.is_infinite() {
         report.min_dihedral_angle = 0.0;
     }

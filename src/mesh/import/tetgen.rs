@@ -7,11 +7,14 @@
 //! numbering. `#` starts a comment; blank lines are ignored. Ten-node (quadratic) tetrahedra
 //! are an [`ImportErrorKind::UnsupportedElement`] error.
 
-use super::text::{Source, parse_finite, parse_token, scaled};
+use super::text::{Source, end_of_line, parse_finite, parse_point, parse_token, scaled};
 use super::{RawMesh, check_scale};
 use crate::Error;
 use crate::error::ImportErrorKind;
 use rapier3d::glamx::DVec3;
+
+/// The error of a point or tetrahedron line holding more than its numbers.
+const TOO_MANY_NUMBERS: &str = "more numbers on the line than the header announces";
 
 /// Reads a `TetGen` mesh from the contents of its `.node` and `.ele` files (named `node_path`
 /// and `ele_path` in errors), coordinates times `scale` (m per file unit).
@@ -29,13 +32,44 @@ pub fn parse(
     check_scale(scale)?;
     let (positions, base) = parse_node(node, node_path, scale)?;
     let mut source = Source::new(ele_path, ele);
+    let (count, region) = parse_ele_header(&mut source)?;
+    let capacity = source.capacity(count, 10);
+    let mut tets = Vec::with_capacity(capacity);
+    let mut tet_locations = Vec::with_capacity(capacity);
+    let points = Numbering {
+        base,
+        count: positions.len() as u64,
+    };
+    for i in 0..count {
+        let line = source.content_line(Some('#'), "a tetrahedron line")?;
+        tets.push(parse_tet_line(
+            &source,
+            line,
+            base + i as u64,
+            points,
+            region,
+        )?);
+        tet_locations.push(source.location());
+    }
+    Ok(RawMesh {
+        path: ele_path.to_owned(),
+        positions,
+        tets,
+        mid_edge_nodes: Vec::new(),
+        tet_locations,
+    })
+}
+
+/// The header of an `.ele` file: the tetrahedron count (not zero) and whether each line ends
+/// with a region attribute; quadratic (10-node) tetrahedra are refused.
+fn parse_ele_header(source: &mut Source<'_>) -> Result<(usize, bool), Error> {
     let header = source.content_line(Some('#'), "the header `<tetrahedra> <4|10> <0|1>`")?;
     let mut tokens = header.split_ascii_whitespace();
-    let count: usize = parse_token(&source, tokens.next(), "tetrahedron count")?;
-    let per_tet: usize = parse_token(&source, tokens.next(), "nodes per tetrahedron")?;
+    let count: usize = parse_token(source, tokens.next(), "tetrahedron count")?;
+    let per_tet: usize = parse_token(source, tokens.next(), "nodes per tetrahedron")?;
     let region: u32 = tokens
         .next()
-        .map_or(Ok(0), |t| parse_token(&source, Some(t), "region flag"))?;
+        .map_or(Ok(0), |t| parse_token(source, Some(t), "region flag"))?;
     match per_tet {
         4 => {}
         10 => {
@@ -63,59 +97,56 @@ pub fn parse(
             "the file holds no tetrahedra",
         ));
     }
-    let capacity = source.capacity(count, 10);
-    let mut tets = Vec::with_capacity(capacity);
-    let mut tet_locations = Vec::with_capacity(capacity);
-    for i in 0..count {
-        let line = source.content_line(Some('#'), "a tetrahedron line")?;
-        let mut tokens = line.split_ascii_whitespace();
-        let index: u64 = parse_token(&source, tokens.next(), "tetrahedron index")?;
-        if index != base + i as u64 {
+    Ok((count, region == 1))
+}
+
+/// How the points are numbered: `count` of them from `base` (0 or 1).
+#[derive(Clone, Copy)]
+struct Numbering {
+    base: u64,
+    count: u64,
+}
+
+/// The corners (0-based) of the tetrahedron line `line` `<index> <n1> <n2> <n3> <n4>
+/// [region]`, whose index must be `index`; the nodes are numbered by `points`.
+fn parse_tet_line(
+    source: &Source<'_>,
+    line: &str,
+    expected: u64,
+    points: Numbering,
+    region: bool,
+) -> Result<[u32; 4], Error> {
+    let Numbering { base, count } = points;
+    let mut tokens = line.split_ascii_whitespace();
+    let index: u64 = parse_token(source, tokens.next(), "tetrahedron index")?;
+    if index != expected {
+        return Err(source.error(
+            ImportErrorKind::BadCount,
+            format!(
+                "tetrahedron index {index}, expected {expected}: tetrahedra are numbered \
+                 consecutively like the points"
+            ),
+        ));
+    }
+    let mut tet = [0u32; 4];
+    for corner in &mut tet {
+        let node: u64 = parse_token(source, tokens.next(), "node index")?;
+        let Some(local) = node.checked_sub(base).filter(|&n| n < count) else {
             return Err(source.error(
-                ImportErrorKind::BadCount,
+                ImportErrorKind::IndexOutOfRange,
                 format!(
-                    "tetrahedron index {index}, expected {}: tetrahedra are numbered \
-                     consecutively like the points",
-                    base + i as u64
+                    "node {node} does not exist: the points are numbered {base} to {}",
+                    base + count - 1
                 ),
             ));
-        }
-        let mut tet = [0u32; 4];
-        for corner in &mut tet {
-            let node: u64 = parse_token(&source, tokens.next(), "node index")?;
-            let local = node
-                .checked_sub(base)
-                .filter(|&n| n < positions.len() as u64);
-            let Some(local) = local else {
-                return Err(source.error(
-                    ImportErrorKind::IndexOutOfRange,
-                    format!(
-                        "node {node} does not exist: the points are numbered {base} to {}",
-                        base + positions.len() as u64 - 1
-                    ),
-                ));
-            };
-            *corner = local as u32;
-        }
-        if region == 1 {
-            parse_finite(&source, tokens.next(), "region attribute")?;
-        }
-        if tokens.next().is_some() {
-            return Err(source.error(
-                ImportErrorKind::BadCount,
-                "more numbers on the line than the header announces",
-            ));
-        }
-        tets.push(tet);
-        tet_locations.push(source.location());
+        };
+        *corner = local as u32;
     }
-    Ok(RawMesh {
-        path: ele_path.to_owned(),
-        positions,
-        tets,
-        mid_edge_nodes: Vec::new(),
-        tet_locations,
-    })
+    if region {
+        parse_finite(source, tokens.next(), "region attribute")?;
+    }
+    end_of_line(source, tokens, ImportErrorKind::BadCount, TOO_MANY_NUMBERS)?;
+    Ok(tet)
 }
 
 /// The points of a `.node` file and the index of the first (0 or 1).
@@ -175,22 +206,15 @@ fn parse_node(data: &[u8], path: &str, scale: f64) -> Result<(Vec<DVec3>, u64), 
                 ),
             ));
         }
-        let x = parse_finite(&source, tokens.next(), "x coordinate")?;
-        let y = parse_finite(&source, tokens.next(), "y coordinate")?;
-        let z = parse_finite(&source, tokens.next(), "z coordinate")?;
+        let p = parse_point(&source, &mut tokens)?;
         for _ in 0..attributes {
             parse_finite(&source, tokens.next(), "point attribute")?;
         }
         if markers == 1 {
             let _: i64 = parse_token(&source, tokens.next(), "boundary marker")?;
         }
-        if tokens.next().is_some() {
-            return Err(source.error(
-                ImportErrorKind::BadCount,
-                "more numbers on the line than the header announces",
-            ));
-        }
-        positions.push(scaled(&source, DVec3::new(x, y, z), scale)?);
+        end_of_line(&source, tokens, ImportErrorKind::BadCount, TOO_MANY_NUMBERS)?;
+        positions.push(scaled(&source, p, scale)?);
     }
     Ok((positions, base))
 }

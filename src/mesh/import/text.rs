@@ -222,6 +222,31 @@ pub(super) fn parse_finite(
     finite(source, value, what)
 }
 
+/// The point of the next three tokens, finite coordinates `x y z` (file units), with errors
+/// naming the coordinate.
+pub(super) fn parse_point<'t>(
+    source: &Source<'_>,
+    tokens: &mut impl Iterator<Item = &'t str>,
+) -> Result<DVec3, Error> {
+    let x = parse_finite(source, tokens.next(), "x coordinate")?;
+    let y = parse_finite(source, tokens.next(), "y coordinate")?;
+    let z = parse_finite(source, tokens.next(), "z coordinate")?;
+    Ok(DVec3::new(x, y, z))
+}
+
+/// `Ok` if `tokens` holds nothing more, else an error of `kind` saying `message`.
+pub(super) fn end_of_line<'t>(
+    source: &Source<'_>,
+    mut tokens: impl Iterator<Item = &'t str>,
+    kind: ImportErrorKind,
+    message: &str,
+) -> Result<(), Error> {
+    match tokens.next() {
+        Some(_) => Err(source.error(kind, message)),
+        None => Ok(()),
+    }
+}
+
 /// `value` if finite, else a [`ImportErrorKind::NonFinite`] error naming `what`.
 pub(super) fn finite(source: &Source<'_>, value: f64, what: &str) -> Result<f64, Error> {
     if value.is_finite() {

@@ -18,19 +18,18 @@
 //! cutting the out-of-balance force tenfold per iteration, iterations solve with it instead of
 //! assembling and factoring anew ([`crate::chord`]). Both schemes are stable at any step length.
 
+mod potential;
+
 use super::check_step;
 use crate::Error;
 use crate::assembly::{Stiffness, solve};
 use crate::body::{DeformableBody, PreviousStep};
 use crate::chord::{self, Chord};
-use crate::damping::RayleighDamping;
-use crate::element::add_point_forces;
-use crate::element::deformation_gradient;
+use crate::constraint;
 use crate::linear_solver::{LinearSolver, Method, solve_newton_system};
-use crate::material::green_strain;
 use crate::newton::{Search, check_tolerance, descend, norm};
-use crate::{attachment, contact};
-use rapier3d::glamx::{DMat3, DVec3};
+use potential::StepStart;
+use rapier3d::glamx::DVec3;
 
 /// Newton stops early on a stalled residual only below this relative value; above it, a slow
 /// descent is still progress.
@@ -75,7 +74,12 @@ pub struct ImplicitIntegrator {
     /// factorization of an earlier iteration or step (the chord method) while it keeps cutting
     /// the out-of-balance force tenfold per iteration: the same tolerance is met, and where the
     /// tangent changes little (the linear model, small strains, a fixed step) most iterations
-    /// skip the assembly and the factorization. See [`crate::chord`] for the rule. The body
+    /// skip the assembly and the factorization. An iteration reuses the last factorization when
+    /// it was made for the same effective step, reuse has not failed in this step, and the
+    /// iterations left could still reach the tolerance at a contraction of 0.1 per iteration
+    /// with one exact iteration to spare; a reused iteration that neither lowers the potential
+    /// nor cuts the out-of-balance force tenfold ends reuse for the step, and reuse pauses for
+    /// the next 1, 2, 4 … 16 implicit substeps after consecutive failures. The body
     /// then keeps its last factorization between steps (8 bytes per nonzero of the Cholesky
     /// factor); `false` frees it after each solve.
     pub reuse_factorization: bool,
@@ -142,22 +146,6 @@ struct Outcome {
     converged: bool,
 }
 
-/// Per-step data of the incremental potential.
-struct StepStart {
-    /// The effective step `ĥ` (s).
-    h: f64,
-    /// Positions (m) and velocities (m/s) at the start of the step.
-    positions: Vec<DVec3>,
-    velocities: Vec<DVec3>,
-    /// `a` (m): the new velocity is `(x - a)/ĥ`.
-    anchor: Vec<DVec3>,
-    /// `x̂` (m), the inertial target.
-    target: Vec<DVec3>,
-    /// Per tetrahedron, the Green strain the damping's rate is measured from (when damped).
-    green: Vec<DMat3>,
-    load: Vec<DVec3>,
-}
-
 impl ImplicitIntegrator {
     /// Advances `body` by `frame_dt` (s) under uniform gravity (m/s²).
     ///
@@ -192,7 +180,7 @@ impl ImplicitIntegrator {
         }
         self.linear_solver.check()?;
         body.save_state();
-        let history = body.previous_step.clone();
+        let history = body.workspace.previous_step.clone();
         let h = frame_dt / f64::from(self.substeps);
         let mut report = ImplicitReport {
             substeps: self.substeps,
@@ -209,7 +197,7 @@ impl ImplicitIntegrator {
             stiffness: body.take_tangent(),
             // Without reuse, a factorization kept by earlier steps is dropped.
             chord: if self.reuse_factorization {
-                std::mem::take(&mut body.chord)
+                std::mem::take(&mut body.workspace.chord)
             } else {
                 Chord::default()
             },
@@ -236,7 +224,7 @@ impl ImplicitIntegrator {
                 }
                 Err(error) => {
                     body.restore_state();
-                    body.previous_step = history;
+                    body.workspace.previous_step = history;
                     solver.give_back(body);
                     return Err(error);
                 }
@@ -245,7 +233,7 @@ impl ImplicitIntegrator {
         solver.give_back(body);
         if let Some(node) = body.first_non_finite_node() {
             body.restore_state();
-            body.previous_step = history;
+            body.workspace.previous_step = history;
             return Err(Error::NonFiniteState { node });
         }
         report.inverted_tets = body.inverted_tet_count();
@@ -261,7 +249,9 @@ impl ImplicitIntegrator {
         gravity: DVec3,
     ) -> Result<Outcome, Error> {
         let start = StepStart::new(body, h, gravity, self.scheme);
-        contact::lag_friction(body, start.h);
+        for kind in constraint::IMPLICIT {
+            kind.begin(body, start.h);
+        }
         // Newton starts from the inertial prediction `x̂` (free flight: the warm start that makes
         // smooth motion cost one iteration), or from where the body is when that is the lower
         // potential (a prediction deep inside an obstacle or crushing elements).
@@ -275,8 +265,9 @@ impl ImplicitIntegrator {
             potential = here;
         }
         let outcome = self.minimize(body, solver, &start, potential)?;
-        contact::record_penalty_impulses(body, start.h, h);
-        attachment::record_spring_impulses(body, start.h, h);
+        for kind in constraint::IMPLICIT {
+            kind.record_impulses(body, start.h, h);
+        }
         for n in 0..body.positions.len() {
             body.velocities[n] = if body.pinned[n] {
                 DVec3::ZERO
@@ -284,7 +275,7 @@ impl ImplicitIntegrator {
                 (body.positions[n] - start.anchor[n]) / start.h
             };
         }
-        body.previous_step = Some(PreviousStep {
+        body.workspace.previous_step = Some(PreviousStep {
             h,
             positions: start.positions,
             velocities: start.velocities,
@@ -333,16 +324,8 @@ impl ImplicitIntegrator {
                 let node = residual.iter().position(|r| !r.is_finite()).unwrap_or(0);
                 return Err(Error::NonFiniteState { node });
             }
-            if relative <= self.tolerance {
-                outcome.converged = true;
-                return finish(solver, outcome);
-            }
-            // A small residual that three iterations could not cut by 10 % sits on its round-off
-            // floor (very stiff or nearly incompressible material against a small load).
-            let stalled = relative <= STALL_CEILING
-                && history.len() >= 3
-                && relative > 0.9 * history[history.len() - 3];
-            if outcome.iterations == self.max_newton_iterations || stalled {
+            if let Some(converged) = self.stop(relative, &history, outcome.iterations) {
+                outcome.converged = converged;
                 return finish(solver, outcome);
             }
             history.push(relative);
@@ -374,12 +357,9 @@ impl ImplicitIntegrator {
                 outcome.reused_factorizations += 1;
                 // Converged counts as enough contraction; no descent as none.
                 let after = next.as_ref().map_or(f64::INFINITY, |(next, _)| {
-                    let after = norm(next);
-                    if after <= self.tolerance * reference {
-                        0.0
-                    } else {
-                        after
-                    }
+                    Some(norm(next))
+                        .filter(|&after| after > self.tolerance * reference)
+                        .unwrap_or(0.0)
                 });
                 solver.chord.record(norm(&residual), after);
                 if next.is_none() {
@@ -395,6 +375,21 @@ impl ImplicitIntegrator {
                 None => return finish(solver, outcome),
             }
         }
+    }
+
+    /// Whether Newton stops at the relative residual `relative` after `iterations`, the earlier
+    /// relative residuals being `history` (newest last): `Some(true)` when it meets the
+    /// tolerance, `Some(false)` when out of iterations or stalled, `None` to go on. A small
+    /// residual that three iterations could not cut by 10 % sits on its round-off floor (very
+    /// stiff or nearly incompressible material against a small load).
+    fn stop(&self, relative: f64, history: &[f64], iterations: usize) -> Option<bool> {
+        if relative <= self.tolerance {
+            return Some(true);
+        }
+        let stalled = relative <= STALL_CEILING
+            && history.len() >= 3
+            && relative > 0.9 * history[history.len() - 3];
+        (iterations == self.max_newton_iterations || stalled).then_some(false)
     }
 
     /// The Newton direction (m per node) of the exact tangent, which the chord keeps for reuse
@@ -444,205 +439,7 @@ struct Solver {
 impl Solver {
     /// Returns the workspace and the kept factorization to the body for its next step.
     fn give_back(self, body: &mut DeformableBody) {
-        body.tangent = Some(self.stiffness);
-        body.chord = self.chord;
-    }
-}
-
-impl StepStart {
-    /// The potential of a step of length `h` from the body's state; BDF2 uses the previous
-    /// step when it had the same length, backward Euler otherwise.
-    fn new(body: &DeformableBody, h: f64, gravity: DVec3, scheme: ImplicitScheme) -> Self {
-        let positions = body.positions.clone();
-        let previous = match scheme {
-            ImplicitScheme::Bdf2 => body.previous_step.as_ref().filter(|p| p.h == h),
-            ImplicitScheme::BackwardEuler => None,
-        };
-        let green_at = |x: &[DVec3]| -> Vec<DMat3> {
-            body.elements
-                .gradients(x)
-                .iter()
-                .map(green_strain)
-                .collect()
-        };
-        let damped = body.damping.is_some();
-        let (effective_h, anchor, velocity, green) = match previous {
-            Some(previous) => {
-                let combine = |now: &[DVec3], before: &[DVec3]| -> Vec<DVec3> {
-                    now.iter()
-                        .zip(before)
-                        .map(|(a, b)| (*a * 4.0 - *b) / 3.0)
-                        .collect()
-                };
-                let green = if damped {
-                    let (now, before) = (green_at(&positions), green_at(&previous.positions));
-                    now.iter()
-                        .zip(&before)
-                        .map(|(a, b)| (*a * 4.0 - *b) * (1.0 / 3.0))
-                        .collect()
-                } else {
-                    Vec::new()
-                };
-                (
-                    2.0 * h / 3.0,
-                    combine(&positions, &previous.positions),
-                    combine(&body.velocities, &previous.velocities),
-                    green,
-                )
-            }
-            None => {
-                let green = if damped {
-                    green_at(&positions)
-                } else {
-                    Vec::new()
-                };
-                (h, positions.clone(), body.velocities.clone(), green)
-            }
-        };
-        let target = (0..positions.len())
-            .map(|n| {
-                if body.pinned[n] {
-                    positions[n]
-                } else {
-                    anchor[n] + velocity[n] * effective_h
-                }
-            })
-            .collect();
-        let load = body.gravity_load(gravity);
-        Self {
-            h: effective_h,
-            positions,
-            velocities: body.velocities.clone(),
-            anchor,
-            target,
-            green,
-            load,
-        }
-    }
-
-    /// `-∇E` (N): elastic and damping forces, gravity, contact penalties and the inertial pull
-    /// toward `x̂`; zero on pinned nodes.
-    fn residual(&self, body: &mut DeformableBody) -> Vec<DVec3> {
-        body.velocities.fill(DVec3::ZERO);
-        body.compute_internal_forces();
-        let mut residual: Vec<DVec3> = (0..body.positions.len())
-            .map(|n| {
-                let inertial =
-                    (self.target[n] - body.positions[n]) * (body.masses[n] / (self.h * self.h));
-                body.forces[n] + self.load[n] + inertial
-            })
-            .collect();
-        if let Some(damping) = body.damping {
-            self.add_damping_forces(body, &damping, &mut residual);
-        }
-        contact::for_each_active_penalty(body, self.h, |at, stiffness, gap, normal| {
-            for (&node, w) in at.nodes.iter().zip(at.weights) {
-                residual[node as usize] -= normal * (w * stiffness * gap);
-            }
-        });
-        contact::for_each_friction(body, self.h, |at, _, force, _| {
-            for (&node, w) in at.nodes.iter().zip(at.weights) {
-                residual[node as usize] += force * *w;
-            }
-        });
-        attachment::for_each_spring(body, self.h, |node, stiffness, target| {
-            residual[node] += (target - body.positions[node]) * stiffness;
-        });
-        for (r, &pinned) in residual.iter_mut().zip(&body.pinned) {
-            if pinned {
-                *r = DVec3::ZERO;
-            }
-        }
-        residual
-    }
-
-    fn add_damping_forces(
-        &self,
-        body: &DeformableBody,
-        damping: &RayleighDamping,
-        out: &mut [DVec3],
-    ) {
-        body.elements
-            .for_each_point(|point, nodes, gradients, weight| {
-                let f = deformation_gradient(nodes, gradients, &body.positions);
-                let stress = damping.step_first_piola(&f, &self.green[point], self.h);
-                add_point_forces(nodes, gradients, &(stress * weight), out);
-            });
-    }
-
-    /// The force scale the tolerance is relative to (N): the largest of gravity, the inertial
-    /// pull and the initial out-of-balance force.
-    fn force_scale(&self, body: &DeformableBody, initial_residual: &[DVec3]) -> f64 {
-        let inertial: Vec<DVec3> = (0..body.positions.len())
-            .map(|n| (self.target[n] - self.positions[n]) * (body.masses[n] / (self.h * self.h)))
-            .collect();
-        norm(&self.load)
-            .max(norm(&inertial))
-            .max(norm(initial_residual))
-            .max(f64::MIN_POSITIVE)
-    }
-
-    /// The incremental potential `E(x)` (J) at the body's positions.
-    fn energy(&self, body: &DeformableBody) -> f64 {
-        let inertia: f64 = (0..body.positions.len())
-            .map(|n| 0.5 * body.masses[n] * (body.positions[n] - self.target[n]).length_squared())
-            .sum::<f64>()
-            / (self.h * self.h);
-        // The load's work is measured from the start of the step.
-        let load: f64 = self
-            .load
-            .iter()
-            .zip(body.positions.iter().zip(&self.positions))
-            .map(|(f, (x, x0))| f.dot(*x - *x0))
-            .sum();
-        let dissipation = match body.damping {
-            Some(damping) => {
-                let mut dissipation = 0.0;
-                body.elements
-                    .for_each_point(|point, nodes, gradients, weight| {
-                        let f = deformation_gradient(nodes, gradients, &body.positions);
-                        dissipation +=
-                            weight * damping.step_potential(&f, &self.green[point], self.h);
-                    });
-                dissipation
-            }
-            None => 0.0,
-        };
-        let mut penalty = 0.0;
-        contact::for_each_active_penalty(body, self.h, |_, stiffness, gap, _| {
-            penalty += 0.5 * stiffness * gap * gap;
-        });
-        contact::for_each_friction(body, self.h, |_, energy, _, _| {
-            penalty += energy;
-        });
-        attachment::for_each_spring(body, self.h, |node, stiffness, target| {
-            penalty += 0.5 * stiffness * (body.positions[node] - target).length_squared();
-        });
-        inertia + body.elastic_energy() + dissipation + penalty - load
-    }
-
-    /// `M/h² + K_elastic + K_damping + K_contact`, each element's stress tangent projected to be positive
-    /// semi-definite if `project`.
-    fn assemble(
-        &self,
-        body: &DeformableBody,
-        stiffness: &mut Stiffness,
-        inertia: &[f64],
-        project: bool,
-    ) {
-        let damping = body.damping;
-        stiffness.assemble(body, Some(inertia), project, |t, f, df| match &damping {
-            Some(d) => d.step_first_piola_differential(f, &self.green[t], self.h, df),
-            None => DMat3::ZERO,
-        });
-        contact::for_each_active_penalty(body, self.h, |at, k, _, normal| {
-            stiffness.add_stencil_block(at, &contact::penalty_tangent(k, normal), &body.pinned);
-        });
-        contact::for_each_friction(body, self.h, |at, _, _, tangent| {
-            stiffness.add_stencil_block(at, &tangent, &body.pinned);
-        });
-        attachment::for_each_spring(body, self.h, |node, k, _| {
-            stiffness.add_node_block(node, &(DMat3::IDENTITY * k));
-        });
+        body.workspace.tangent = Some(self.stiffness);
+        body.workspace.chord = self.chord;
     }
 }

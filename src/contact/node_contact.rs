@@ -1,0 +1,227 @@
+//! A node's contact: the plane `n·(x − p) ≥ 0` through the nearest surface point `p` with
+//! outward normal `n` that a surface node (or an embedded surface vertex) must stay on the outer
+//! side of, what it pushes against (a collider, or the body's own boundary triangle), and the
+//! implicit side's terms on it: the penalty `k/2 min(0, g)²` on the gap `g` and the lagged
+//! friction dissipation `μ λ f(|u|)` on the slip `u` over the step.
+
+use super::{
+    Coefficients, ContactSettings, SoftPoint, Stencil, VelocityConstraint, nearest_surface_point,
+    penalty_tangent,
+};
+use crate::embedding::Embedding;
+use rapier3d::geometry::{ColliderHandle, SharedShape};
+use rapier3d::glamx::{DMat3, DVec3};
+use rapier3d::math::Pose;
+
+/// What a node's contact pushes against.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ContactTarget {
+    /// A rapier collider.
+    Collider(ColliderHandle),
+    /// A triangle of the body's own boundary, far from the node in the rest shape
+    /// (self-contact; see [`DeformableBody::self_contact`](crate::body::DeformableBody::self_contact)).
+    OwnSurface {
+        /// The triangle's nodes.
+        triangle: [u32; 3],
+    },
+}
+
+/// Where on a soft body a contact acts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BodyPoint {
+    /// A simulation node.
+    Node(u32),
+    /// A vertex of the body's embedded mesh ([`DeformableBody::embedding`](crate::body::DeformableBody::embedding)), which moves with the nodes
+    /// of the element it lies in and shares its impulses among them by their weights.
+    Embedded(u32),
+}
+
+impl BodyPoint {
+    /// The nodes the point moves with and their weights; `embedding` is the body's, which every
+    /// embedded point comes from.
+    pub(super) fn stencil<'a>(&'a self, embedding: Option<&'a Embedding>) -> Stencil<'a> {
+        match self {
+            Self::Node(node) => Stencil {
+                nodes: std::slice::from_ref(node),
+                weights: &[1.0],
+            },
+            Self::Embedded(vertex) => embedding
+                .expect("embedded contact points are only made for a body with an embedding")
+                .point_stencil(*vertex),
+        }
+    }
+}
+
+/// A surface point's contact for the coming frame: the plane through `point` with outward normal
+/// `normal` that the point (a surface node, or a surface vertex of the body's embedded mesh) must
+/// not cross. Against a collider, the explicit integrator re-projects
+/// the node onto the collider's shape (at its pose when detected) every substep to update the
+/// plane; against a triangle of the body's own surface the plane follows the triangle.
+#[derive(Clone)]
+pub struct NodeContact {
+    /// The point of the soft body in contact.
+    pub at: BodyPoint,
+    /// What it touches.
+    pub target: ContactTarget,
+    /// The nearest point of the target's surface to the node when detected (m).
+    pub point: DVec3,
+    /// The target's outward unit normal there.
+    pub normal: DVec3,
+    /// Coulomb friction coefficient: the body's and the target's, combined by their rules.
+    pub friction: f64,
+    /// Restitution coefficient: the body's and the target's, combined by their rules (see
+    /// [`RESTITUTION_THRESHOLD`](super::RESTITUTION_THRESHOLD)).
+    pub restitution: f64,
+    /// The impulse (N s) the contact gave the node over the last step.
+    pub impulse: DVec3,
+    /// The far side of the contact, as the velocity constraints see it.
+    pub(super) obstacle: Obstacle,
+    /// Within an explicit substep: the velocity constraint.
+    pub(super) constraint: VelocityConstraint,
+    /// Within an implicit step: the normal force (N) friction is limited by, and the node's
+    /// position and the surface's velocity there at the start of the step (m, m/s).
+    pub(super) lagged_normal_force: f64,
+    pub(super) slip_origin: DVec3,
+    pub(super) surface_velocity: DVec3,
+}
+
+/// The far side of a contact.
+#[derive(Clone)]
+pub(super) enum Obstacle {
+    /// A collider's shape at its pose, and its rigid body's index among the body's proxies, if it
+    /// has one.
+    Collider {
+        shape: SharedShape,
+        pose: Pose,
+        proxy: Option<usize>,
+    },
+    /// The contact point of a triangle of the body's own surface.
+    OwnTriangle(SoftPoint),
+}
+
+impl std::fmt::Debug for NodeContact {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("NodeContact")
+            .field("at", &self.at)
+            .field("target", &self.target)
+            .field("point", &self.point)
+            .field("normal", &self.normal)
+            .field("friction", &self.friction)
+            .field("impulse", &self.impulse)
+            .finish_non_exhaustive()
+    }
+}
+
+impl NodeContact {
+    /// A contact of `at` with `target` through the plane at `point` (m) with outward unit
+    /// `normal`, with `coefficients`, enforced against `obstacle`.
+    pub(super) fn new(
+        at: BodyPoint,
+        target: ContactTarget,
+        point: DVec3,
+        normal: DVec3,
+        coefficients: Coefficients,
+        obstacle: Obstacle,
+    ) -> Self {
+        Self {
+            at,
+            target,
+            point,
+            normal,
+            friction: coefficients.friction,
+            restitution: coefficients.restitution,
+            impulse: DVec3::ZERO,
+            obstacle,
+            constraint: VelocityConstraint::default(),
+            lagged_normal_force: 0.0,
+            slip_origin: DVec3::ZERO,
+            surface_velocity: DVec3::ZERO,
+        }
+    }
+
+    /// Whether the implicit integrator enforces the contact: those with colliders (it leaves
+    /// self-contact to the explicit integrator).
+    pub(super) fn is_implicit(&self) -> bool {
+        matches!(self.obstacle, Obstacle::Collider { .. })
+    }
+
+    /// The contact with its collider's rigid body at `proxy` (an index into the body's rigid
+    /// proxies), if any.
+    pub(super) fn with_proxy(mut self, proxy: Option<usize>) -> Self {
+        if let Obstacle::Collider { proxy: slot, .. } = &mut self.obstacle {
+            *slot = proxy;
+        }
+        self
+    }
+
+    /// Signed distance (m) of position `x` from the contact plane, negative inside.
+    pub fn gap(&self, x: DVec3) -> f64 {
+        (x - self.point).dot(self.normal)
+    }
+
+    /// The penalty stiffness (N/m) and gap (m) of the contact's node at `x` (m), of mass `mass`
+    /// (kg), in an implicit step of effective length `h` (s); `None` outside its plane.
+    pub(super) fn penalty(
+        &self,
+        x: DVec3,
+        mass: f64,
+        settings: &ContactSettings,
+        h: f64,
+    ) -> Option<(f64, f64)> {
+        let gap = self.gap(x);
+        (gap < 0.0).then(|| (settings.penalty_stiffness(mass, h), gap))
+    }
+
+    /// The lagged friction dissipation of the node at `x` (m) over an implicit step of effective
+    /// length `h` (s): its energy `μ λ f(|u|)` (J), force (N) and positive semi-definite tangent
+    /// (N/m), where `u` is the slip relative to the surface in the contact plane and
+    /// `f(s) = s²/2ε` below `ε = stiction_speed h`, `s - ε/2` above; `None` without a friction
+    /// limit.
+    pub(super) fn friction_term(
+        &self,
+        x: DVec3,
+        settings: &ContactSettings,
+        h: f64,
+    ) -> Option<(f64, DVec3, DMat3)> {
+        let limit = self.friction * self.lagged_normal_force;
+        if limit <= 0.0 {
+            return None;
+        }
+        let plane = DMat3::IDENTITY - penalty_tangent(1.0, self.normal);
+        let slip = plane * (x - self.slip_origin - self.surface_velocity * h);
+        let (s, stick) = (slip.length(), settings.stiction_speed * h);
+        Some(if s < stick {
+            (
+                limit * s * s / (2.0 * stick),
+                -slip * (limit / stick),
+                plane * (limit / stick),
+            )
+        } else {
+            let direction = slip / s;
+            (
+                limit * (s - stick / 2.0),
+                -direction * limit,
+                (plane - penalty_tangent(1.0, direction)) * (limit / s),
+            )
+        })
+    }
+
+    /// Moves the plane to the collider's surface point nearest to `x` (m), if defined there, or
+    /// to an own triangle's contact point where its nodes are now (`positions`, m).
+    pub(super) fn refresh(&mut self, x: DVec3, positions: &[DVec3]) {
+        match &self.obstacle {
+            Obstacle::Collider { shape, pose, .. } => {
+                if let Some((point, normal, _)) = nearest_surface_point(&**shape, pose, x) {
+                    self.point = point;
+                    self.normal = normal;
+                }
+            }
+            Obstacle::OwnTriangle(point) => {
+                if let Some((point, normal)) = point.plane(positions) {
+                    self.point = point;
+                    self.normal = normal;
+                }
+            }
+        }
+    }
+}

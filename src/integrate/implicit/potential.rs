@@ -1,0 +1,206 @@
+//! The incremental potential of an implicit step of effective length `ĥ` from positions `x₀`:
+//! `E(x) = Σ m/(2ĥ²) |x − x̂|² + Ψ(x) + ĥ D((x − x₀)/ĥ) − W(x)`, with `x̂` the inertial target
+//! (backward Euler `x₀ + ĥ v₀`; BDF2 from the two previous states), `Ψ` the elastic energy, `D`
+//! the damping's dissipation on the strain rate measured from the step's start, and `W` the work
+//! of gravity, contacts and attachments. Its gradient is the out-of-balance force and its Hessian
+//! the Newton tangent; the new velocity is `(x − a)/ĥ`.
+
+use super::ImplicitScheme;
+use crate::assembly::Stiffness;
+use crate::body::DeformableBody;
+use crate::constraint;
+use crate::damping::RayleighDamping;
+use crate::element::{add_point_forces, deformation_gradient};
+use crate::material::green_strain;
+use crate::newton::norm;
+use rapier3d::glamx::{DMat3, DVec3};
+
+/// Per-step data of the incremental potential.
+pub(super) struct StepStart {
+    /// The effective step `ĥ` (s).
+    pub(super) h: f64,
+    /// Positions (m) and velocities (m/s) at the start of the step.
+    pub(super) positions: Vec<DVec3>,
+    pub(super) velocities: Vec<DVec3>,
+    /// `a` (m): the new velocity is `(x - a)/ĥ`.
+    pub(super) anchor: Vec<DVec3>,
+    /// `x̂` (m), the inertial target.
+    pub(super) target: Vec<DVec3>,
+    /// Per tetrahedron, the Green strain the damping's rate is measured from (when damped).
+    pub(super) green: Vec<DMat3>,
+    pub(super) load: Vec<DVec3>,
+}
+
+impl StepStart {
+    /// The potential of a step of length `h` from the body's state; BDF2 uses the previous
+    /// step when it had the same length, backward Euler otherwise.
+    pub(super) fn new(
+        body: &DeformableBody,
+        h: f64,
+        gravity: DVec3,
+        scheme: ImplicitScheme,
+    ) -> Self {
+        let positions = body.positions.clone();
+        let previous = match scheme {
+            ImplicitScheme::Bdf2 => body.workspace.previous_step.as_ref().filter(|p| p.h == h),
+            ImplicitScheme::BackwardEuler => None,
+        };
+        let green_at = |x: &[DVec3]| -> Vec<DMat3> {
+            body.elements
+                .gradients(x)
+                .iter()
+                .map(green_strain)
+                .collect()
+        };
+        let damped = body.damping.is_some();
+        let (effective_h, anchor, velocity, green) = match previous {
+            Some(previous) => {
+                let combine = |now: &[DVec3], before: &[DVec3]| -> Vec<DVec3> {
+                    now.iter()
+                        .zip(before)
+                        .map(|(a, b)| (*a * 4.0 - *b) / 3.0)
+                        .collect()
+                };
+                let green = if damped {
+                    let (now, before) = (green_at(&positions), green_at(&previous.positions));
+                    now.iter()
+                        .zip(&before)
+                        .map(|(a, b)| (*a * 4.0 - *b) * (1.0 / 3.0))
+                        .collect()
+                } else {
+                    Vec::new()
+                };
+                (
+                    2.0 * h / 3.0,
+                    combine(&positions, &previous.positions),
+                    combine(&body.velocities, &previous.velocities),
+                    green,
+                )
+            }
+            None => {
+                let green = if damped {
+                    green_at(&positions)
+                } else {
+                    Vec::new()
+                };
+                (h, positions.clone(), body.velocities.clone(), green)
+            }
+        };
+        let target = (0..positions.len())
+            .map(|n| {
+                if body.pinned[n] {
+                    positions[n]
+                } else {
+                    anchor[n] + velocity[n] * effective_h
+                }
+            })
+            .collect();
+        let load = body.gravity_load(gravity);
+        Self {
+            h: effective_h,
+            positions,
+            velocities: body.velocities.clone(),
+            anchor,
+            target,
+            green,
+            load,
+        }
+    }
+
+    /// `-∇E` (N): elastic and damping forces, gravity, contact penalties and the inertial pull
+    /// toward `x̂`; zero on pinned nodes.
+    pub(super) fn residual(&self, body: &mut DeformableBody) -> Vec<DVec3> {
+        body.velocities.fill(DVec3::ZERO);
+        body.compute_internal_forces();
+        let mut residual: Vec<DVec3> = (0..body.positions.len())
+            .map(|n| {
+                let inertial =
+                    (self.target[n] - body.positions[n]) * (body.masses[n] / (self.h * self.h));
+                body.workspace.forces[n] + self.load[n] + inertial
+            })
+            .collect();
+        if let Some(damping) = body.damping {
+            self.add_damping_forces(body, &damping, &mut residual);
+        }
+        constraint::add_implicit_forces(body, self.h, &mut residual);
+        for (r, &pinned) in residual.iter_mut().zip(&body.pinned) {
+            if pinned {
+                *r = DVec3::ZERO;
+            }
+        }
+        residual
+    }
+
+    pub(super) fn add_damping_forces(
+        &self,
+        body: &DeformableBody,
+        damping: &RayleighDamping,
+        out: &mut [DVec3],
+    ) {
+        body.elements
+            .for_each_point(|point, nodes, gradients, weight| {
+                let f = deformation_gradient(nodes, gradients, &body.positions);
+                let stress = damping.step_first_piola(&f, &self.green[point], self.h);
+                add_point_forces(nodes, gradients, &(stress * weight), out);
+            });
+    }
+
+    /// The force scale the tolerance is relative to (N): the largest of gravity, the inertial
+    /// pull and the initial out-of-balance force.
+    pub(super) fn force_scale(&self, body: &DeformableBody, initial_residual: &[DVec3]) -> f64 {
+        let inertial: Vec<DVec3> = (0..body.positions.len())
+            .map(|n| (self.target[n] - self.positions[n]) * (body.masses[n] / (self.h * self.h)))
+            .collect();
+        norm(&self.load)
+            .max(norm(&inertial))
+            .max(norm(initial_residual))
+            .max(f64::MIN_POSITIVE)
+    }
+
+    /// The incremental potential `E(x)` (J) at the body's positions.
+    pub(super) fn energy(&self, body: &DeformableBody) -> f64 {
+        let inertia: f64 = (0..body.positions.len())
+            .map(|n| 0.5 * body.masses[n] * (body.positions[n] - self.target[n]).length_squared())
+            .sum::<f64>()
+            / (self.h * self.h);
+        // The load's work is measured from the start of the step.
+        let load: f64 = self
+            .load
+            .iter()
+            .zip(body.positions.iter().zip(&self.positions))
+            .map(|(f, (x, x0))| f.dot(*x - *x0))
+            .sum();
+        let dissipation = match body.damping {
+            Some(damping) => {
+                let mut dissipation = 0.0;
+                body.elements
+                    .for_each_point(|point, nodes, gradients, weight| {
+                        let f = deformation_gradient(nodes, gradients, &body.positions);
+                        dissipation +=
+                            weight * damping.step_potential(&f, &self.green[point], self.h);
+                    });
+                dissipation
+            }
+            None => 0.0,
+        };
+        let penalty = constraint::implicit_energy(body, self.h);
+        inertia + body.elastic_energy() + dissipation + penalty - load
+    }
+
+    /// `M/h² + K_elastic + K_damping + K_contact`, each element's stress tangent projected to be positive
+    /// semi-definite if `project`.
+    pub(super) fn assemble(
+        &self,
+        body: &DeformableBody,
+        stiffness: &mut Stiffness,
+        inertia: &[f64],
+        project: bool,
+    ) {
+        let damping = body.damping;
+        stiffness.assemble(body, Some(inertia), project, |t, f, df| match &damping {
+            Some(d) => d.step_first_piola_differential(f, &self.green[t], self.h, df),
+            None => DMat3::ZERO,
+        });
+        constraint::add_implicit_tangents(body, self.h, stiffness);
+    }
+}

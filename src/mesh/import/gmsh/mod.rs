@@ -1,0 +1,214 @@
+//! Gmsh `.msh` files, versions 2.2 and 4.1, ASCII and binary.
+//!
+//! Linear tetrahedra (element type 4) and quadratic ones (type 11, `gmsh -order 2`; their
+//! mid-edge nodes go to [`RawMesh::mid_edge_nodes`]) are read; points, lines, triangles and
+//! quadrangles (boundary and geometry elements Gmsh saves beside the volume) are skipped; other
+//! volume elements, and linear and quadratic tetrahedra mixed in one file, are an
+//! [`ImportErrorKind::UnsupportedElement`] error, since dropping them would silently lose
+//! material. Sections other than `$MeshFormat`, `$Nodes` and `$Elements` are skipped; a second
+//! `$Nodes` section (a partitioned file) is refused.
+//!
+//! Hand-written rather than built on the `mshio` crate (0.4.2, the only MSH crate): it reads
+//! version 4.1 only, while 2.2, which many tools still write, needs this reader anyway; and it
+//! panics on a malformed header, e.g. a data size of `0` (`4.1 0 0`: "not implemented: No
+//! parser for input unsigned integer size of 0 bytes") or one that overflows (`4.1 0
+//! 4000000000`: an `unwrap` on `ParseIntError`), found by mutating a valid file.
+//!
+//! This module reads the file's sections in order and resolves the tetrahedra's node tags;
+//! its submodules read the `$MeshFormat` header and binary values (`format`), the element
+//! types (`elements`), and the `$Nodes` and `$Elements` sections of versions 2.2 (`v2`) and
+//! 4.1 (`v4`).
+
+mod elements;
+mod format;
+mod v2;
+mod v4;
+
+use super::text::{Source, scaled, shorten};
+use super::{RawMesh, check_scale};
+use crate::Error;
+use crate::error::{FileLocation, ImportErrorKind};
+use format::{MshFormat, Version};
+use rapier3d::glamx::DVec3;
+use std::collections::HashMap;
+
+/// Reads the Gmsh file `data` (named `path` in errors), coordinates times `scale` (m per file
+/// unit).
+///
+/// # Errors
+/// [`Error::InvalidSetting`] for a bad `scale`; [`Error::MeshImport`] for a malformed file, an
+/// unknown version, an unsupported element type or a file without tetrahedra.
+pub fn parse(data: &[u8], path: &str, scale: f64) -> Result<RawMesh, Error> {
+    check_scale(scale)?;
+    let mut source = Source::new(path, data);
+    let header = source.content_line(None, "`$MeshFormat`")?;
+    if header != "$MeshFormat" {
+        return Err(source.error(
+            ImportErrorKind::Syntax,
+            format!(
+                "a Gmsh file starts with `$MeshFormat`, not `{}`",
+                shorten(header)
+            ),
+        ));
+    }
+    let mut reader = Reader {
+        format: format::read_format(&mut source)?,
+        scale,
+        saw_nodes: false,
+        node_index: HashMap::new(),
+        positions: Vec::new(),
+        tets: Vec::new(),
+        mid_edge_tags: Vec::new(),
+    };
+    while let Some(line) = source.line()? {
+        reader.section(&mut source, line)?;
+    }
+    reader.finish(&source)
+}
+
+/// Skips whitespace and requires the line `marker`.
+fn expect_end(source: &mut Source<'_>, marker: &str) -> Result<(), Error> {
+    source.skip_whitespace();
+    let line = source.content_line(None, marker)?;
+    if line == marker {
+        Ok(())
+    } else {
+        Err(source.error(
+            ImportErrorKind::BadCount,
+            format!(
+                "expected `{marker}`, found `{}`: the section holds more or other data than its \
+                 counts say",
+                shorten(line)
+            ),
+        ))
+    }
+}
+
+/// What the sections read so far hold: nodes by tag, tetrahedra by node tag.
+struct Reader {
+    format: MshFormat,
+    /// Metres per file unit.
+    scale: f64,
+    /// Whether a `$Nodes` section has been read (a second one is refused).
+    saw_nodes: bool,
+    /// Node tag to index into `positions`.
+    node_index: HashMap<u64, u32>,
+    /// Node positions (m).
+    positions: Vec<DVec3>,
+    /// Tetrahedra as node tags, with where they were read.
+    tets: Vec<([u64; 4], FileLocation)>,
+    /// The mid-edge node tags of quadratic tetrahedra, in VTK's order, one per tetrahedron.
+    mid_edge_tags: Vec<[u64; 6]>,
+}
+
+impl Reader {
+    /// Reads the section that `line` (just read, outside any section) opens, up to and with its
+    /// end marker: `$Nodes` and `$Elements` of the file's version, any other `$Name` skipped to
+    /// its `$EndName`; blank lines pass, anything else is a syntax error.
+    fn section(&mut self, source: &mut Source<'_>, line: &str) -> Result<(), Error> {
+        match line {
+            "" => Ok(()),
+            "$Nodes" => {
+                if self.saw_nodes {
+                    return Err(source.error(
+                        ImportErrorKind::Syntax,
+                        "a second `$Nodes` section: partitioned files are not supported",
+                    ));
+                }
+                self.saw_nodes = true;
+                if self.format.version == Version::V2 {
+                    self.nodes_v2(source)?;
+                } else {
+                    self.nodes_v4(source)?;
+                }
+                expect_end(source, "$EndNodes")
+            }
+            "$Elements" => {
+                if self.format.version == Version::V2 {
+                    self.elements_v2(source)?;
+                } else {
+                    self.elements_v4(source)?;
+                }
+                expect_end(source, "$EndElements")
+            }
+            _ if line.starts_with('$') && !line.starts_with("$End") => {
+                let end = format!("$End{}", &line[1..]);
+                source.skip_past(end.as_bytes())
+            }
+            _ => Err(source.error(
+                ImportErrorKind::Syntax,
+                format!(
+                    "expected a section such as `$Nodes`, found `{}`",
+                    shorten(line)
+                ),
+            )),
+        }
+    }
+
+    /// Adds node `tag` at `p` (file units, scaled to m here), refusing a tag defined twice.
+    fn add_node(&mut self, source: &Source<'_>, tag: u64, p: DVec3) -> Result<(), Error> {
+        let p = scaled(source, p, self.scale)?;
+        if self.positions.len() >= u32::MAX as usize {
+            return Err(source.error(ImportErrorKind::BadCount, "more than 2^32 - 1 nodes"));
+        }
+        let index = self.positions.len() as u32;
+        if self.node_index.insert(tag, index).is_some() {
+            return Err(source.error(
+                ImportErrorKind::DuplicateId,
+                format!("node tag {tag} is defined twice"),
+            ));
+        }
+        self.positions.push(p);
+        Ok(())
+    }
+
+    /// The [`RawMesh`] of the nodes and tetrahedra read, their node tags resolved to indices;
+    /// [`ImportErrorKind::NoTetrahedra`] for a file without any, and
+    /// [`ImportErrorKind::IndexOutOfRange`] at the tetrahedron for a tag no node has.
+    fn finish(self, source: &Source<'_>) -> Result<RawMesh, Error> {
+        if self.tets.is_empty() {
+            return Err(source.error_at(
+                FileLocation::Whole,
+                ImportErrorKind::NoTetrahedra,
+                "the file holds no tetrahedra (element type 4 or 11)",
+            ));
+        }
+        let mut tets = Vec::with_capacity(self.tets.len());
+        let mut tet_locations = Vec::with_capacity(self.tets.len());
+        for (tags, location) in &self.tets {
+            tets.push(self.indices(source, tags, *location)?);
+            tet_locations.push(*location);
+        }
+        let mut mid_edge_nodes = Vec::with_capacity(self.mid_edge_tags.len());
+        for (tags, (_, location)) in self.mid_edge_tags.iter().zip(&self.tets) {
+            mid_edge_nodes.push(self.indices(source, tags, *location)?);
+        }
+        Ok(RawMesh {
+            path: source.path().to_owned(),
+            positions: self.positions,
+            tets,
+            mid_edge_nodes,
+            tet_locations,
+        })
+    }
+
+    /// The node indices of the node `tags` of the tetrahedron at `location`.
+    fn indices<const N: usize>(
+        &self,
+        source: &Source<'_>,
+        tags: &[u64; N],
+        location: FileLocation,
+    ) -> Result<[u32; N], Error> {
+        let mut indices = [0u32; N];
+        for (index, tag) in indices.iter_mut().zip(tags) {
+            *index = self.node_index.get(tag).copied().ok_or_else(|| {
+                source.error_at(
+                    location,
+                    ImportErrorKind::IndexOutOfRange,
+                    format!("the tetrahedron refers to node {tag}, which is not defined"),
+                )
+            })?;
+        }
+        Ok(indices)
+    }
+}

@@ -1,0 +1,194 @@
+//! Fuzzing of every reader: arbitrary bytes, mutations of the valid files and every truncation
+//! of their headers must give a mesh or a typed error, never a panic.
+
+use super::bytes;
+use proptest::prelude::*;
+use rapier_fvm::FileLocation;
+use rapier_fvm::mesh::import::{RawMesh, SurfaceOptions, gmsh, surface, tetgen, vtk};
+use rapier_fvm::prelude::*;
+
+// Fuzzing: arbitrary bytes and mutations of the valid files, for every reader. Each must
+// return Ok or a typed error, never panic (a panic fails the test). The number of executions
+// is `cases` of each property below; the total is printed by `fuzz_execution_count`.
+
+/// Cases per fuzz property.
+const CASES: u32 = 10_000;
+
+fn run_reader(reader: usize, data: &[u8]) {
+    let result = match reader {
+        0 => gmsh::parse(data, "fuzz.msh", 1.0),
+        1 => tetgen::parse(data, "fuzz.node", &bytes_cached_ele(), "cube.ele", 1.0),
+        2 => tetgen::parse(&bytes_cached_node(), "cube.node", data, "fuzz.ele", 1.0),
+        3 => vtk::parse_vtu(data, "fuzz.vtu", 1.0),
+        4 => vtk::parse_legacy(data, "fuzz.vtk", 1.0),
+        5 => located(surface::parse_obj(data, "fuzz.obj", 1.0))
+            .and_then(|s| surface::fill(&s, &SurfaceOptions { cells_across: 4 })),
+        _ => located(surface::parse_stl(data, "fuzz.stl", 1.0))
+            .and_then(|s| surface::fill(&s, &SurfaceOptions { cells_across: 4 })),
+    };
+    match result.and_then(RawMesh::into_mesh) {
+        Ok(mesh) => assert!(mesh.tet_count() > 0),
+        Err(Error::MeshImport { .. } | Error::InvalidSetting { .. }) => {}
+        Err(other) => panic!("untyped import error {other:?}"),
+    }
+}
+
+/// `result`, after checking that an error of the OBJ or STL reader says where: their
+/// locators must find every statement `tobj` or `stl_io` rejects.
+fn located(result: Result<surface::Surface, Error>) -> Result<surface::Surface, Error> {
+    if let Err(e @ Error::MeshImport { location, .. }) = &result {
+        assert_ne!(*location, FileLocation::Whole, "unplaced error: {e}");
+    }
+    result
+}
+
+fn bytes_cached_node() -> Vec<u8> {
+    static NODE: std::sync::OnceLock<Vec<u8>> = std::sync::OnceLock::new();
+    NODE.get_or_init(|| bytes("cube.node")).clone()
+}
+
+fn bytes_cached_ele() -> Vec<u8> {
+    static ELE: std::sync::OnceLock<Vec<u8>> = std::sync::OnceLock::new();
+    ELE.get_or_init(|| bytes("cube.ele")).clone()
+}
+
+/// (reader, valid file) pairs mutated by the fuzz properties.
+const SEEDS: [(usize, &str); 13] = [
+    (0, "cube_v22_ascii.msh"),
+    (0, "cube_v22_binary.msh"),
+    (0, "cube_v41_ascii.msh"),
+    (0, "cube_v41_binary.msh"),
+    (1, "cube.node"),
+    (2, "cube.ele"),
+    (3, "cube_ascii.vtu"),
+    (3, "cube_binary.vtu"),
+    (4, "cube_ascii.vtk"),
+    (4, "cube_binary.vtk"),
+    (5, "sphere.obj"),
+    (6, "cube.stl"),
+    (6, "sphere_ascii.stl"),
+];
+
+fn seed(index: usize) -> (usize, Vec<u8>) {
+    static FILES: std::sync::OnceLock<Vec<Vec<u8>>> = std::sync::OnceLock::new();
+    let files = FILES.get_or_init(|| SEEDS.iter().map(|(_, name)| bytes(name)).collect());
+    (SEEDS[index].0, files[index].clone())
+}
+
+/// A mutation of a valid file: truncation, byte overwrites, or a number replaced by an extreme
+/// one.
+#[derive(Debug, Clone)]
+enum Mutation {
+    Truncate(prop::sample::Index),
+    Bytes(Vec<(prop::sample::Index, u8)>),
+    Number(prop::sample::Index, &'static str),
+}
+
+fn mutation() -> impl Strategy<Value = Mutation> {
+    prop_oneof![
+        any::<prop::sample::Index>().prop_map(Mutation::Truncate),
+        prop::collection::vec((any::<prop::sample::Index>(), any::<u8>()), 1..4)
+            .prop_map(Mutation::Bytes),
+        (
+            any::<prop::sample::Index>(),
+            prop::sample::select(vec![
+                "0",
+                "-1",
+                "1",
+                "2",
+                "4000000000",
+                "18446744073709551615",
+                "99999999999999999999",
+                "nan",
+                "inf",
+                "-1e308",
+                "1e308",
+                "11",
+                "5",
+                "10",
+                "24",
+                "3",
+            ])
+        )
+            .prop_map(|(i, n)| Mutation::Number(i, n)),
+    ]
+}
+
+fn mutate(data: &[u8], mutation: &Mutation) -> Vec<u8> {
+    match mutation {
+        Mutation::Truncate(at) => data[..at.index(data.len() + 1)].to_vec(),
+        Mutation::Bytes(changes) => {
+            let mut data = data.to_vec();
+            for (at, byte) in changes {
+                let i = at.index(data.len());
+                data[i] = *byte;
+            }
+            data
+        }
+        Mutation::Number(at, number) => {
+            // Replace the run of digits at or after a position by `number`.
+            let start = at.index(data.len());
+            let Some(first) = data[start..].iter().position(u8::is_ascii_digit) else {
+                return data.to_vec();
+            };
+            let first = start + first;
+            let end = first
+                + data[first..]
+                    .iter()
+                    .position(|b| !b.is_ascii_digit())
+                    .unwrap_or(data.len() - first);
+            [&data[..first], number.as_bytes(), &data[end..]].concat()
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: CASES, failure_persistence: None, ..ProptestConfig::default() })]
+
+    #[test]
+    fn fuzz_arbitrary_bytes(reader in 0usize..7, data in prop::collection::vec(any::<u8>(), 0..512)) {
+        run_reader(reader, &data);
+    }
+
+    #[test]
+    fn fuzz_arbitrary_text(reader in 0usize..7, data in "[ -~\n]{0,300}") {
+        run_reader(reader, data.as_bytes());
+    }
+
+    #[test]
+    fn fuzz_mutated_files(file in 0usize..SEEDS.len(), mutation in mutation()) {
+        let (reader, data) = seed(file);
+        run_reader(reader, &mutate(&data, &mutation));
+    }
+
+    #[test]
+    fn fuzz_mutated_headers(file in 0usize..SEEDS.len(), mutation in mutation()) {
+        // The same mutations within the first 400 bytes, where the counts and versions are.
+        let (reader, data) = seed(file);
+        let head = data.len().min(400);
+        let mut mutated = mutate(&data[..head], &mutation);
+        mutated.extend_from_slice(&data[head..]);
+        run_reader(reader, &mutated);
+    }
+}
+
+/// Truncation at every length of the Gmsh and VTK cube files' first 4 kB and of the `TetGen`
+/// files: every prefix must give a typed error (or, for a prefix that is a whole file, a mesh).
+#[test]
+fn fuzz_every_truncation_of_the_headers() {
+    let mut executions = 0;
+    for index in 0..SEEDS.len() {
+        let (reader, data) = seed(index);
+        for len in 0..data.len().min(4096) {
+            run_reader(reader, &data[..len]);
+            executions += 1;
+        }
+    }
+    println!("truncations executed: {executions}");
+}
+
+#[test]
+fn fuzz_execution_count() {
+    // 4 properties of CASES cases each, plus the truncations (printed by their test).
+    println!("proptest fuzz executions: {}", 4 * CASES);
+}
