@@ -20,7 +20,39 @@
 //!    [`integrate::AutomaticIntegrator`] picks the cheaper of the two each frame; [`statics`]
 //!    finds equilibria and natural frequencies directly.
 //!
-//! ## Example
+//! ## Rigid and soft bodies together
+//! Both preludes import side by side. [`FvmWorld`](world::FvmWorld) holds rapier's
+//! `PhysicsWorld` and the deformable bodies; a program with its own `PhysicsPipeline` and sets
+//! uses [`coupling::SoftCoupling::step`] instead, with the same result (the stages of a frame are
+//! listed in [`coupling`]).
+//! ```
+//! use rapier3d::prelude::*;
+//! use rapier_fvm::prelude::*;
+//!
+//! let mut world = FvmWorld::default();
+//! world.physics.insert_collider(ColliderBuilder::new(SharedShape::halfspace(Vector::Y)), None);
+//! // A 20 cm rubber block on the ground, and a 10 cm rigid box dropped on it.
+//! let rubber = Material::new(MaterialModel::StableNeoHookean, 1e6, 0.3, 1000.0)?;
+//! let block = DeformableBodyBuilder::new(mesh::cuboid(DVec3::splat(0.1), [3, 3, 3])?, rubber)
+//!     .translation(DVec3::new(0.0, 0.1, 0.0))
+//!     .build()?;
+//! let block = world.soft_bodies.insert(block);
+//! let (rigid_box, _) = world.physics.insert(
+//!     RigidBodyBuilder::dynamic().translation(Vector::new(0.0, 0.3, 0.0)),
+//!     ColliderBuilder::cuboid(0.05, 0.05, 0.05),
+//! );
+//! for _frame in 0..30 {
+//!     for (_handle, outcome) in world.step() {
+//!         outcome?;
+//!     }
+//! }
+//! // The box has landed on the block (its top at 0.2 m) and the block pushes it up.
+//! assert!(world.physics.bodies[rigid_box].translation().y > 0.2);
+//! assert!(world.load_on(block, rigid_box).0.y > 0.0);
+//! # Ok::<(), rapier_fvm::Error>(())
+//! ```
+//!
+//! ## A body alone
 //! ```
 //! use rapier_fvm::prelude::*;
 //!

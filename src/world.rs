@@ -1,14 +1,16 @@
 //! [`FvmWorld`]: rapier's [`PhysicsWorld`] and a set of deformable bodies, advanced together
 //! frame by frame by a [`SoftCoupling`] (see [`crate::coupling`] for the stages of a frame).
 //!
-//! It is a convenience: a program that keeps its own [`PhysicsPipeline`](rapier3d::pipeline::PhysicsPipeline)
-//! and sets calls [`SoftCoupling::step`] with them instead, and gets the same motion.
+//! It is a convenience: a program that keeps its own [`PhysicsPipeline`] and sets calls
+//! [`SoftCoupling::step`] with them instead, and gets the same motion.
 
 use crate::body::{DeformableBodyHandle, DeformableBodySet};
 use crate::coupling::{ColliderLoad, RapierSets, RigidLoad, SoftCoupling, SoftStepResults};
 use rapier3d::dynamics::RigidBodyHandle;
 use rapier3d::glamx::DVec3;
-use rapier3d::pipeline::{EventHandler, PhysicsHooks, PhysicsWorld};
+use rapier3d::pipeline::{
+    CollisionPipeline, EventHandler, PhysicsHooks, PhysicsPipeline, PhysicsWorld,
+};
 
 /// Rigid and soft bodies in one world.
 ///
@@ -53,6 +55,35 @@ impl Default for FvmWorld {
             physics: PhysicsWorld::default(),
             soft_bodies: DeformableBodySet::new(),
             coupling: SoftCoupling::default(),
+        }
+    }
+}
+
+/// A copy of the world to go back to (a reset, a rollout's branch point): every rigid and
+/// deformable body, collider, joint and contact, the integrators' caches included, so that the
+/// copy and the original step on identically, bit for bit. rapier's pipelines hold no state
+/// between steps and start anew.
+impl Clone for FvmWorld {
+    fn clone(&self) -> Self {
+        let physics = &self.physics;
+        Self {
+            physics: PhysicsWorld {
+                gravity: physics.gravity,
+                integration_parameters: physics.integration_parameters,
+                physics_pipeline: PhysicsPipeline::new(),
+                collision_pipeline: CollisionPipeline::new(),
+                islands: physics.islands.clone(),
+                broad_phase: physics.broad_phase.clone(),
+                narrow_phase: physics.narrow_phase.clone(),
+                bodies: physics.bodies.clone(),
+                colliders: physics.colliders.clone(),
+                impulse_joints: physics.impulse_joints.clone(),
+                multibody_joints: physics.multibody_joints.clone(),
+                soft_bodies: physics.soft_bodies.clone(),
+                ccd_solver: physics.ccd_solver.clone(),
+            },
+            soft_bodies: self.soft_bodies.clone(),
+            coupling: self.coupling.clone(),
         }
     }
 }

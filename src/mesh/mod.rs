@@ -1,6 +1,6 @@
 //! Tetrahedral meshes: a validated [`TetMesh`] of rest positions (m) and positively oriented
 //! tetrahedra, its boundary surface, generators for boxes, cylinders and spheres, and readers for
-//! the files of other meshing tools ([`import`]).
+//! the files of other meshing tools (`import`, with the `import` feature).
 //!
 //! A tetrahedron `[a, b, c, d]` is positively oriented when `((b - a) x (c - a)) . (d - a) > 0`,
 //! i.e. its signed volume is positive.

@@ -7,11 +7,8 @@ use rapier_fvm::prelude::*;
 use rapier_fvm::{FileLocation, ImportErrorKind};
 use std::path::PathBuf;
 
-#[path = "mesh_import/filling.rs"]
 mod filling;
-#[path = "mesh_import/fuzz.rs"]
 mod fuzz;
-#[path = "mesh_import/malformed.rs"]
 mod malformed;
 
 fn asset(name: &str) -> PathBuf {
