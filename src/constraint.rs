@@ -9,7 +9,8 @@
 //!    velocity constraints for the substep;
 //! 3. sweeps: [`ExplicitSide::sweep`] for every kind in turn (then the contacts between soft
 //!    bodies), once, or [`ContactSettings::velocity_iterations`](crate::contact::ContactSettings::velocity_iterations)
-//!    times when dynamic rigid bodies or other soft bodies couple the constraints;
+//!    times when dynamic rigid bodies, self-contacts, rigid vertices or other soft bodies couple
+//!    the constraints;
 //! 4. [`ExplicitSide::advance`] for every kind (anchors and rigid vertices move with their
 //!    bodies), then `x ← x + h v`.
 //!
@@ -17,8 +18,8 @@
 //! energy `E_c` (J), its force `-∂E_c/∂x` (N) on a point of the body and its tangent
 //! `∂²E_c/∂x²` (N/m), each point moving with the nodes of its [`Stencil`]. Contacts give the
 //! penalty `k/2 min(0, g)²` and the lagged friction; attachments a spring `k/2 |x − a|²` to
-//! their anchor `a`. Self-contacts and rigid vertices have an explicit side only, so a body with
-//! some is stepped explicitly.
+//! their anchor `a`. Self-contacts and rigid vertices have an explicit side only: the automatic
+//! integrator steps a body with some explicitly, and a forced implicit step leaves them out.
 
 use crate::body::DeformableBody;
 use crate::contact::{self, Stencil};

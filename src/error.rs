@@ -286,3 +286,22 @@ pub enum Error {
         residual: f64,
     },
 }
+
+impl Error {
+    /// The checks every step makes before it starts: a positive, finite frame step `frame_dt`
+    /// (s) and a finite `gravity` (m/s²).
+    pub(crate) fn check_step(frame_dt: f64, gravity: rapier3d::glamx::DVec3) -> Result<(), Self> {
+        if !(frame_dt.is_finite() && frame_dt > 0.0) {
+            return Err(Self::InvalidTimeStep {
+                dt: frame_dt,
+                reason: "must be positive and finite",
+            });
+        }
+        if !gravity.is_finite() {
+            return Err(Self::NonFiniteInput {
+                parameter: "gravity",
+            });
+        }
+        Ok(())
+    }
+}

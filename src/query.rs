@@ -1,14 +1,16 @@
 //! Scene queries on deformable surfaces, as rapier's query pipeline offers them for colliders:
 //! a ray `x(t) = o + t d` cast against the bodies' boundary triangles where the nodes are now
 //! (the first `t ≥ 0` with `x(t)` on a triangle), and a point projected on the nearest of them.
-//! Each triangle is tested with parry's triangle queries (in rapier's `f32`); a query costs one
-//! test per boundary triangle of the bodies asked, with no acceleration structure to keep up to
-//! date as the bodies deform.
+//! Each triangle is tested with parry's triangle queries (in rapier's `f32`, relative to the
+//! triangle's first corner, so that rounding scales with the triangle, not with its distance
+//! from the origin); a query costs one test per boundary triangle of the bodies asked, with no
+//! acceleration structure to keep up to date as the bodies deform.
 
 use crate::body::{DeformableBody, DeformableBodyHandle, DeformableBodySet};
+use crate::contact::nearest_point_on_triangle;
 use rapier3d::geometry::{Ray, Triangle};
 use rapier3d::glamx::DVec3;
-use rapier3d::parry::query::{PointQuery, RayCast};
+use rapier3d::parry::query::RayCast;
 
 /// Where a ray meets a deformable body's surface.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -42,31 +44,39 @@ impl DeformableBody {
         &self.surface.triangles
     }
 
-    /// The boundary triangle `t` where the nodes are now.
-    fn surface_triangle(&self, t: usize) -> Triangle {
-        let [a, b, c] = self.surface.triangles[t].map(|n| self.positions[n as usize].as_vec3());
-        Triangle::new(a, b, c)
+    /// The corners (m) of boundary triangle `t` where the nodes are now.
+    fn triangle_corners(&self, t: usize) -> [DVec3; 3] {
+        self.surface.triangles[t].map(|n| self.positions[n as usize])
     }
 
     /// The first hit of the ray from `origin` (m) along `direction` within `max_time_of_impact`
-    /// (in units of `direction`) on the body's surface, from either side; `None` if it misses.
+    /// (in units of `direction`) on the body's surface, from either side; `None` if it misses or
+    /// the ray is not finite. The surface is the simulation mesh's, also for a body carrying an
+    /// embedded mesh.
     pub fn cast_ray(
         &self,
         origin: DVec3,
         direction: DVec3,
         max_time_of_impact: f64,
     ) -> Option<SurfaceRayHit> {
-        let ray = Ray::new(origin.as_vec3(), direction.as_vec3());
+        if !(origin.is_finite() && direction.is_finite()) {
+            return None;
+        }
         let mut best: Option<SurfaceRayHit> = None;
         for t in 0..self.surface.triangles.len() {
             let reach = best.map_or(max_time_of_impact, |hit| hit.time_of_impact);
-            let triangle = self.surface_triangle(t);
-            if let Some(hit) = triangle.cast_local_ray_and_get_normal(&ray, reach as f32, true) {
-                let time_of_impact = f64::from(hit.time_of_impact);
+            // Relative to the first corner, so that f32 rounds relative to the triangle's size.
+            let corners = self.triangle_corners(t);
+            let local = corners.map(|c| (c - corners[0]).as_vec3());
+            let triangle = Triangle::new(local[0], local[1], local[2]);
+            let ray = Ray::new((origin - corners[0]).as_vec3(), direction.as_vec3());
+            if let Some(hit) = triangle.cast_local_ray(&ray, reach as f32, true) {
+                let time_of_impact = f64::from(hit);
+                let normal = (corners[1] - corners[0]).cross(corners[2] - corners[0]);
                 best = Some(SurfaceRayHit {
                     time_of_impact,
                     point: origin + direction * time_of_impact,
-                    normal: triangle.normal().map_or(DVec3::ZERO, |n| n.as_dvec3()),
+                    normal: normal.normalize_or_zero(),
                     triangle: t,
                 });
             }
@@ -77,14 +87,15 @@ impl DeformableBody {
     /// The point of the body's surface nearest to `point` (m); `None` for a body without
     /// boundary triangles or a non-finite point.
     pub fn project_point(&self, point: DVec3) -> Option<SurfaceProjection> {
-        let query = point.as_vec3();
+        if !point.is_finite() {
+            return None;
+        }
         let mut best: Option<SurfaceProjection> = None;
         for t in 0..self.surface.triangles.len() {
-            let nearest = self
-                .surface_triangle(t)
-                .project_local_point(query, false)
-                .point
-                .as_dvec3();
+            let Some((_, nearest)) = nearest_point_on_triangle(self.triangle_corners(t), point)
+            else {
+                continue;
+            };
             let distance = (nearest - point).length();
             if best.is_none_or(|b| distance < b.distance) {
                 best = Some(SurfaceProjection {

@@ -61,8 +61,8 @@ impl Default for FvmWorld {
 
 /// A copy of the world to go back to (a reset, a rollout's branch point): every rigid and
 /// deformable body, collider, joint and contact, the integrators' caches included, so that the
-/// copy and the original step on identically, bit for bit. rapier's pipelines hold no state
-/// between steps and start anew.
+/// copy and the original step on identically, bit for bit. rapier's pipelines start anew: they
+/// carry nothing from one step to the next but the last step's quarantine report.
 impl Clone for FvmWorld {
     fn clone(&self) -> Self {
         let physics = &self.physics;

@@ -171,10 +171,14 @@ fn own_pipeline_and_fvm_world_step_a_scene_bit_identically() -> Result<(), Error
             world.rigid_loads(),
             "frame {frame}"
         );
+        assert_eq!(
+            own_coupling.collider_loads(),
+            world.collider_loads(),
+            "frame {frame}"
+        );
     }
     // The scene did what it is for: the box rests on the cube (its weight, 2.5 N, comes through
-    // the cube's contacts within 20 %, a loose bound on a frame's mean load while it settles),
-    // and the rod's root followed the driver.
+    // the cube's contacts within 20 %, a loose bound on a frame's mean load while it settles).
     let (force, _) = world.load_on(world_scene.cube, world_scene.carried);
     let weight = 500.0 * 0.08f64.powi(3) * 9.81;
     assert!(
@@ -182,5 +186,75 @@ fn own_pipeline_and_fvm_world_step_a_scene_bit_identically() -> Result<(), Error
         "load {force} N for weight {weight} N"
     );
     assert!(!world.rigid_loads().is_empty());
+    Ok(())
+}
+
+/// One rapier step of the frame's `dt` on `sets`, as a program that steps rapier itself does.
+fn rapier_step(sets: &mut OwnSets) {
+    sets.pipeline.step(
+        Vector::Y * -9.81,
+        &sets.parameters,
+        &mut sets.islands,
+        &mut sets.broad_phase,
+        &mut sets.narrow_phase,
+        &mut sets.bodies,
+        &mut sets.colliders,
+        &mut sets.impulse_joints,
+        &mut sets.multibody_joints,
+        &mut sets.rapier_soft_bodies,
+        &mut sets.ccd_solver,
+        &(),
+        &(),
+    );
+}
+
+#[test]
+fn a_soft_substep_between_own_rapier_steps_matches_a_world_of_one_substep() -> Result<(), Error> {
+    // `SoftCoupling::substep` then the program's own rapier step is what `FvmWorld` does with one
+    // coupling substep per frame (the kinematic driver stays put: its path is the frame's).
+    let mut own = OwnSets::new();
+    let mut own_soft = DeformableBodySet::new();
+    let mut own_coupling = SoftCoupling::default();
+    let own_scene = build(&mut own.bodies, &mut own.colliders, &mut own_soft)?;
+    let mut world = FvmWorld::default();
+    world.coupling.substeps = 1;
+    let physics = &mut world.physics;
+    let world_scene = build(
+        &mut physics.bodies,
+        &mut physics.colliders,
+        &mut world.soft_bodies,
+    )?;
+    let dt = f64::from(own.parameters.dt);
+    // Gravity as rapier holds it (f32), as the world hands it to its soft bodies.
+    let gravity = (Vector::Y * -9.81).as_dvec3();
+    for frame in 1..=FRAMES {
+        let rigid = RigidSets {
+            bodies: &mut own.bodies,
+            colliders: &own.colliders,
+            narrow_phase: &own.narrow_phase,
+        };
+        for (handle, result) in own_coupling.substep(&mut own_soft, rigid, dt, gravity) {
+            result.unwrap_or_else(|e| panic!("own substep, {handle:?}: {e}"));
+        }
+        rapier_step(&mut own);
+        for (handle, result) in world.step() {
+            result.unwrap_or_else(|e| panic!("FvmWorld, {handle:?}: {e}"));
+        }
+        assert_eq!(
+            own_soft[own_scene.cube].positions(),
+            world.soft_bodies[world_scene.cube].positions(),
+            "frame {frame}"
+        );
+        assert_eq!(
+            own.bodies[own_scene.carried].position(),
+            world.physics.bodies[world_scene.carried].position(),
+            "frame {frame}"
+        );
+        assert_eq!(
+            own_coupling.rigid_loads(),
+            world.rigid_loads(),
+            "frame {frame}"
+        );
+    }
     Ok(())
 }

@@ -53,6 +53,8 @@ fn run(world: &mut FvmWorld, frames: usize) -> Result<(), Error> {
 
 /// Asserts that two worlds hold the same state, bit for bit.
 fn assert_identical(a: &FvmWorld, b: &FvmWorld) {
+    assert_eq!(a.soft_bodies.len(), b.soft_bodies.len());
+    assert_eq!(a.physics.bodies.len(), b.physics.bodies.len());
     for ((ha, body_a), (hb, body_b)) in a.soft_bodies.iter().zip(b.soft_bodies.iter()) {
         assert_eq!(ha, hb);
         assert_eq!(body_a.positions(), body_b.positions(), "{ha:?}");

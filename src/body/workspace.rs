@@ -13,8 +13,9 @@ use rapier3d::glamx::DVec3;
 pub(crate) struct SolverWorkspace {
     /// The last internal forces computed (N per node).
     pub(crate) forces: Vec<DVec3>,
-    /// Positions (m) and velocities (m/s) saved before a step, restored if the step fails.
+    /// Positions (m) saved before a step, restored if the step fails.
     pub(crate) saved_positions: Vec<DVec3>,
+    /// Velocities (m/s) saved with them.
     pub(crate) saved_velocities: Vec<DVec3>,
     /// The state at the start of the last implicit substep, for two-step schemes; cleared by any
     /// other change of the state.

@@ -37,7 +37,7 @@ impl DeformableBody {
         gravity: DVec3,
         settings: &ContactSettings,
     ) -> Result<&[NodeContact], Error> {
-        crate::integrate::check_step(frame_dt, gravity)?;
+        Error::check_step(frame_dt, gravity)?;
         settings.check()?;
         let mut contacts = Vec::new();
         let mut proxies: Vec<RigidProxy> = Vec::new();
@@ -219,25 +219,33 @@ impl DeformableBody {
     /// gave each collider they touch over the last step (see
     /// [`DeformableBody::contact_force_on`]), one entry per collider.
     pub(crate) fn collider_impulses(&self) -> Vec<(ColliderHandle, DVec3, DVec3)> {
-        let mut colliders: Vec<ColliderHandle> = self
+        let from_nodes = self
             .constraints
             .contacts
             .iter()
             .filter_map(|c| match c.target {
-                ContactTarget::Collider(collider) => Some(collider),
+                ContactTarget::Collider(collider) => {
+                    let at = c.at.stencil(self.embedding.as_ref());
+                    Some((collider, at.interpolate(&self.positions), -c.impulse))
+                }
                 ContactTarget::OwnSurface { .. } => None,
-            })
-            .chain(self.constraints.corner_contacts.iter().map(|c| c.collider))
-            .collect();
-        colliders.sort_unstable_by_key(|c| c.into_raw_parts());
-        colliders.dedup();
-        colliders
-            .into_iter()
-            .filter_map(|collider| {
-                let (impulse, angular) = self.contact_force_on(collider, 1.0).ok()?;
-                Some((collider, impulse, angular))
-            })
-            .collect()
+            });
+        let from_corners = self.constraints.corner_contacts.iter().map(|c| {
+            let (at, impulse) = c.force_on_collider(1.0);
+            (c.collider, at, impulse)
+        });
+        let mut totals: Vec<(ColliderHandle, DVec3, DVec3)> = Vec::new();
+        for (collider, at, impulse) in from_nodes.chain(from_corners) {
+            let angular = at.cross(impulse);
+            match totals.iter_mut().find(|(c, _, _)| *c == collider) {
+                Some((_, total, total_angular)) => {
+                    *total += impulse;
+                    *total_angular += angular;
+                }
+                None => totals.push((collider, impulse, angular)),
+            }
+        }
+        totals
     }
 
     /// The mean force (N) and torque about the world origin (N m) the soft body's contacts

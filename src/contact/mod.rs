@@ -61,6 +61,7 @@ pub(crate) use penalty::{
 pub(crate) use rigid::{RigidProxy, coming_velocity};
 pub(crate) use soft_point::Stencil;
 use soft_point::{SoftPoint, node_inverse_mass};
+pub(crate) use surface_tree::nearest_point_on_triangle;
 use sweep::contacts_and_partners;
 pub(crate) use sweep::{constraints_coupled, prepare_velocities, solve_velocities};
 pub use velocity_constraint::RESTITUTION_THRESHOLD;

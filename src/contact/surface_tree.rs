@@ -115,7 +115,10 @@ impl SurfaceTree {
 /// The barycentric weights of the point of triangle `corners` (m) nearest to `x` (m), and that
 /// point, recomposed in f64 from parry's f32 projection (taken relative to the first corner, so
 /// that the rounding is relative to the triangle's size, not its distance from the origin).
-fn nearest_point_on_triangle(corners: [DVec3; 3], x: DVec3) -> Option<([f64; 3], DVec3)> {
+pub(crate) fn nearest_point_on_triangle(
+    corners: [DVec3; 3],
+    x: DVec3,
+) -> Option<([f64; 3], DVec3)> {
     let origin = corners[0];
     let local = corners.map(|c| (c - origin).as_vec3());
     let triangle = Triangle::new(local[0], local[1], local[2]);

@@ -42,7 +42,9 @@ pub struct ColliderLoad {
 trait PairLoad: Copy {
     /// The pair: deformable body and what it pushed.
     type Pair: PartialEq;
+    /// The deformable body and what it pushed.
     fn pair(&self) -> Self::Pair;
+    /// The summed force (impulse while summing) and torque (angular impulse).
     fn sums(&mut self) -> (&mut DVec3, &mut DVec3);
 }
 
@@ -81,10 +83,11 @@ fn accumulate<L: PairLoad>(loads: &mut Vec<L>, mut load: L) {
 
 /// Divides every summed impulse by `dt` (s).
 fn divide<L: PairLoad>(loads: &mut [L], dt: f64) {
+    let per_second = 1.0 / dt;
     for load in loads {
         let (force, torque) = load.sums();
-        *force /= dt;
-        *torque /= dt;
+        *force *= per_second;
+        *torque *= per_second;
     }
 }
 

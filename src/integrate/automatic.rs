@@ -149,7 +149,7 @@ impl AutomaticIntegrator {
         frame_dt: f64,
         gravity: DVec3,
     ) -> Result<AutomaticReport, Error> {
-        super::check_step(frame_dt, gravity)?;
+        Error::check_step(frame_dt, gravity)?;
         // The stability limit is evaluated once and serves both the prediction and the step.
         let needed = self.explicit.needed_substeps(body, frame_dt)?;
         let prediction = self.prediction(body, needed);

@@ -11,7 +11,6 @@
 //! (`β = (φ+2ψ)/(λ+2μ)`), the limit becomes `(2/ω)(sqrt(1+ζ²) - ζ)`. The automatic substep is that
 //! limit times a safety factor.
 
-use super::check_step;
 use crate::Error;
 use crate::body::DeformableBody;
 use crate::body::{BodyConstraints, SolverWorkspace};
@@ -112,7 +111,7 @@ impl SymplecticEuler {
         frame_dt: f64,
         gravity: DVec3,
     ) -> Result<StepReport, Error> {
-        check_step(frame_dt, gravity)?;
+        Error::check_step(frame_dt, gravity)?;
         let needed = self.needed_substeps(body, frame_dt)?;
         self.advance(body, frame_dt, gravity, needed)
     }
@@ -144,7 +143,7 @@ impl SymplecticEuler {
         frame_dt: f64,
         gravity: DVec3,
     ) -> Result<Vec<StepReport>, Error> {
-        check_step(frame_dt, gravity)?;
+        Error::check_step(frame_dt, gravity)?;
         let mut needed: f64 = 1.0;
         for body in bodies.iter() {
             needed = needed.max(self.needed_substeps(body, frame_dt)?);

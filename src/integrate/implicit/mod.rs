@@ -20,7 +20,6 @@
 
 mod potential;
 
-use super::check_step;
 use crate::Error;
 use crate::assembly::{Stiffness, solve};
 use crate::body::{DeformableBody, PreviousStep};
@@ -77,8 +76,8 @@ pub struct ImplicitIntegrator {
     /// skip the assembly and the factorization. An iteration reuses the last factorization when
     /// it was made for the same effective step, reuse has not failed in this step, and the
     /// iterations left could still reach the tolerance at a contraction of 0.1 per iteration
-    /// with one exact iteration to spare; a reused iteration that neither lowers the potential
-    /// nor cuts the out-of-balance force tenfold ends reuse for the step, and reuse pauses for
+    /// with one exact iteration to spare; a reused iteration that does not lower the potential,
+    /// or does not cut the out-of-balance force tenfold, ends reuse for the step, and reuse pauses for
     /// the next 1, 2, 4 … 16 implicit substeps after consecutive failures. The body
     /// then keeps its last factorization between steps (8 bytes per nonzero of the Cholesky
     /// factor); `false` frees it after each solve.
@@ -162,7 +161,7 @@ impl ImplicitIntegrator {
         frame_dt: f64,
         gravity: DVec3,
     ) -> Result<ImplicitReport, Error> {
-        check_step(frame_dt, gravity)?;
+        Error::check_step(frame_dt, gravity)?;
         if self.substeps == 0 {
             return Err(Error::InvalidSetting {
                 parameter: "substeps",
@@ -357,9 +356,12 @@ impl ImplicitIntegrator {
                 outcome.reused_factorizations += 1;
                 // Converged counts as enough contraction; no descent as none.
                 let after = next.as_ref().map_or(f64::INFINITY, |(next, _)| {
-                    Some(norm(next))
-                        .filter(|&after| after > self.tolerance * reference)
-                        .unwrap_or(0.0)
+                    let after = norm(next);
+                    if after <= self.tolerance * reference {
+                        0.0
+                    } else {
+                        after
+                    }
                 });
                 solver.chord.record(norm(&residual), after);
                 if next.is_none() {
