@@ -120,20 +120,53 @@ fn driver_target(frame: usize) -> Vector {
     Vector::new(0.05 * angle.cos(), 0.6, 0.05 * angle.sin())
 }
 
+/// The scene built twice: on a program's own sets, and in an `FvmWorld`, each stepped with
+/// `substeps` coupling substeps per frame.
+struct Pair {
+    own: OwnSets,
+    own_soft: DeformableBodySet,
+    own_coupling: SoftCoupling,
+    own_scene: Scene,
+    world: FvmWorld,
+    world_scene: Scene,
+}
+
+impl Pair {
+    fn new(substeps: u32) -> Result<Self, Error> {
+        let mut own = OwnSets::new();
+        let mut own_soft = DeformableBodySet::new();
+        let mut own_coupling = SoftCoupling::default();
+        own_coupling.substeps = substeps;
+        let own_scene = build(&mut own.bodies, &mut own.colliders, &mut own_soft)?;
+        let mut world = FvmWorld::default();
+        world.coupling.substeps = substeps;
+        let physics = &mut world.physics;
+        let world_scene = build(
+            &mut physics.bodies,
+            &mut physics.colliders,
+            &mut world.soft_bodies,
+        )?;
+        Ok(Self {
+            own,
+            own_soft,
+            own_coupling,
+            own_scene,
+            world,
+            world_scene,
+        })
+    }
+}
+
 #[test]
 fn own_pipeline_and_fvm_world_step_a_scene_bit_identically() -> Result<(), Error> {
-    let mut own = OwnSets::new();
-    let mut own_soft = DeformableBodySet::new();
-    let mut own_coupling = SoftCoupling::default();
-    let own_scene = build(&mut own.bodies, &mut own.colliders, &mut own_soft)?;
-
-    let mut world = FvmWorld::default();
-    let physics = &mut world.physics;
-    let world_scene = build(
-        &mut physics.bodies,
-        &mut physics.colliders,
-        &mut world.soft_bodies,
-    )?;
+    let Pair {
+        mut own,
+        mut own_soft,
+        mut own_coupling,
+        own_scene,
+        mut world,
+        world_scene,
+    } = Pair::new(4)?;
 
     for frame in 1..=FRAMES {
         own.bodies[own_scene.driver].set_next_kinematic_translation(driver_target(frame));
@@ -212,18 +245,14 @@ fn rapier_step(sets: &mut OwnSets) {
 fn a_soft_substep_between_own_rapier_steps_matches_a_world_of_one_substep() -> Result<(), Error> {
     // `SoftCoupling::substep` then the program's own rapier step is what `FvmWorld` does with one
     // coupling substep per frame (the kinematic driver stays put: its path is the frame's).
-    let mut own = OwnSets::new();
-    let mut own_soft = DeformableBodySet::new();
-    let mut own_coupling = SoftCoupling::default();
-    let own_scene = build(&mut own.bodies, &mut own.colliders, &mut own_soft)?;
-    let mut world = FvmWorld::default();
-    world.coupling.substeps = 1;
-    let physics = &mut world.physics;
-    let world_scene = build(
-        &mut physics.bodies,
-        &mut physics.colliders,
-        &mut world.soft_bodies,
-    )?;
+    let Pair {
+        mut own,
+        mut own_soft,
+        mut own_coupling,
+        own_scene,
+        mut world,
+        world_scene,
+    } = Pair::new(1)?;
     let dt = f64::from(own.parameters.dt);
     // Gravity as rapier holds it (f32), as the world hands it to its soft bodies.
     let gravity = (Vector::Y * -9.81).as_dvec3();
