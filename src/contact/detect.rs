@@ -215,27 +215,37 @@ impl DeformableBody {
         }
     }
 
-    /// The impulse (N s) and angular impulse about the world origin (N m s) the body's contacts
-    /// gave each collider they touch over the last step (see
-    /// [`DeformableBody::contact_force_on`]), one entry per collider.
-    pub(crate) fn collider_impulses(&self) -> Vec<(ColliderHandle, DVec3, DVec3)> {
+    /// Each contact's collider, the point (m) it acts at, and the mean force (N) it exerted on
+    /// the collider over the last step of `dt` (s): node contacts at their points' end-of-step
+    /// positions, rigid vertices at the vertices; nodes first, then vertices, in order.
+    fn forces_on_colliders(
+        &self,
+        dt: f64,
+    ) -> impl Iterator<Item = (ColliderHandle, DVec3, DVec3)> + '_ {
         let from_nodes = self
             .constraints
             .contacts
             .iter()
-            .filter_map(|c| match c.target {
+            .filter_map(move |c| match c.target {
                 ContactTarget::Collider(collider) => {
                     let at = c.at.stencil(self.embedding.as_ref());
-                    Some((collider, at.interpolate(&self.positions), -c.impulse))
+                    Some((collider, at.interpolate(&self.positions), -c.impulse / dt))
                 }
                 ContactTarget::OwnSurface { .. } => None,
             });
-        let from_corners = self.constraints.corner_contacts.iter().map(|c| {
-            let (at, impulse) = c.force_on_collider(1.0);
-            (c.collider, at, impulse)
+        let from_corners = self.constraints.corner_contacts.iter().map(move |c| {
+            let (at, force) = c.force_on_collider(dt);
+            (c.collider, at, force)
         });
+        from_nodes.chain(from_corners)
+    }
+
+    /// The impulse (N s) and angular impulse about the world origin (N m s) the body's contacts
+    /// gave each collider they touch over the last step (see
+    /// [`DeformableBody::contact_force_on`]), one entry per collider.
+    pub(crate) fn collider_impulses(&self) -> Vec<(ColliderHandle, DVec3, DVec3)> {
         let mut totals: Vec<(ColliderHandle, DVec3, DVec3)> = Vec::new();
-        for (collider, at, impulse) in from_nodes.chain(from_corners) {
+        for (collider, at, impulse) in self.forces_on_colliders(1.0) {
             let angular = at.cross(impulse);
             match totals.iter_mut().find(|(c, _, _)| *c == collider) {
                 Some((_, total, total_angular)) => {
@@ -267,27 +277,15 @@ impl DeformableBody {
                 reason: "must be positive and finite",
             });
         }
-        let from_nodes = self
-            .constraints
-            .contacts
-            .iter()
-            .filter(|c| c.target == ContactTarget::Collider(collider))
-            .map(|c| {
-                let at = c.at.stencil(self.embedding.as_ref());
-                (at.interpolate(&self.positions), -c.impulse / dt)
-            });
-        let from_corners = self
-            .constraints
-            .corner_contacts
-            .iter()
-            .filter(|c| c.collider == collider)
-            .map(|c| c.force_on_collider(dt));
-        Ok(from_nodes.chain(from_corners).fold(
-            (DVec3::ZERO, DVec3::ZERO),
-            |(force, torque), (at, on_collider)| {
-                (force + on_collider, torque + at.cross(on_collider))
-            },
-        ))
+        Ok(self
+            .forces_on_colliders(dt)
+            .filter(|(touched, _, _)| *touched == collider)
+            .fold(
+                (DVec3::ZERO, DVec3::ZERO),
+                |(force, torque), (_, at, on_collider)| {
+                    (force + on_collider, torque + at.cross(on_collider))
+                },
+            ))
     }
 }
 

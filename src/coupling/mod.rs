@@ -180,10 +180,7 @@ impl SoftCoupling {
             .num_solver_iterations
             .div_ceil(substeps as usize)
             .max(1);
-        let mut outcomes: Vec<(DeformableBodyHandle, Outcome)> = soft_bodies
-            .iter()
-            .map(|(handle, _)| (handle, None))
-            .collect();
+        let mut outcomes = unstepped(soft_bodies);
         let paths = KinematicPath::all(rapier.bodies);
         for substep in 1..=substeps {
             for path in &paths {
@@ -198,10 +195,7 @@ impl SoftCoupling {
             rapier.step_rapier(pipeline, &substep_parameters, hooks, events);
         }
         self.loads.finish(f64::from(frame.dt));
-        outcomes
-            .into_iter()
-            .filter_map(|(handle, outcome)| outcome.map(|outcome| (handle, outcome)))
-            .collect()
+        results(outcomes)
     }
 
     /// Steps every deformable body by `h` (s) under `gravity` (m/s²) against the rigid world as
@@ -216,18 +210,12 @@ impl SoftCoupling {
         gravity: DVec3,
     ) -> SoftStepResults {
         self.loads.clear();
-        let mut outcomes: Vec<(DeformableBodyHandle, Outcome)> = soft_bodies
-            .iter()
-            .map(|(handle, _)| (handle, None))
-            .collect();
+        let mut outcomes = unstepped(soft_bodies);
         self.step_soft_bodies(soft_bodies, rigid, &mut outcomes, h, gravity);
         if h > 0.0 {
             self.loads.finish(h);
         }
-        outcomes
-            .into_iter()
-            .filter_map(|(handle, outcome)| outcome.map(|outcome| (handle, outcome)))
-            .collect()
+        results(outcomes)
     }
 
     /// The mean force and torque each deformable body exerted on each rigid body it touched or
@@ -322,6 +310,22 @@ impl SoftCoupling {
             }
         }
     }
+}
+
+/// Every body of `soft_bodies`, not stepped yet.
+fn unstepped(soft_bodies: &DeformableBodySet) -> Vec<(DeformableBodyHandle, Outcome)> {
+    soft_bodies
+        .iter()
+        .map(|(handle, _)| (handle, None))
+        .collect()
+}
+
+/// The outcomes of the bodies that were stepped.
+fn results(outcomes: Vec<(DeformableBodyHandle, Outcome)>) -> SoftStepResults {
+    outcomes
+        .into_iter()
+        .filter_map(|(handle, outcome)| outcome.map(|outcome| (handle, outcome)))
+        .collect()
 }
 
 /// Holds the rigid bodies `body` touches that rigid contacts support: within the soft step they
