@@ -141,19 +141,27 @@ fn coupling_frame(c: &mut Criterion) {
         .soft_bodies
         .insert(soft_cube(0.1, 4, 1e5, DVec3::new(0.0, 0.151, 0.0)));
     let mut pair_alone = [
-        soft_cube(0.1, 4, 1e5, DVec3::new(0.0, 0.5, 0.0)),
-        soft_cube(0.1, 4, 1e5, DVec3::new(0.0, 0.7, 0.0)),
+        (
+            soft_cube(0.1, 4, 1e5, DVec3::new(0.0, 0.5, 0.0)),
+            SolverWorkspace::new(),
+        ),
+        (
+            soft_cube(0.1, 4, 1e5, DVec3::new(0.0, 0.7, 0.0)),
+            SolverWorkspace::new(),
+        ),
     ];
     // (a) The cube alone, stepped as the world steps its soft bodies; and the grasp's cube.
-    let mut alone = drop_cube(0.55);
-    let mut grasp_alone = grasp_cube(0.5);
+    let mut alone = (drop_cube(0.55), SolverWorkspace::new());
+    let mut grasp_alone = (grasp_cube(0.5), SolverWorkspace::new());
     let integrator = on_ground.coupling.integrator;
     let substeps = on_ground.coupling.substeps;
     let h = f64::from(on_ground.physics.integration_parameters.dt) / f64::from(substeps);
     let gravity = on_ground.physics.gravity.as_dvec3();
-    let frame_alone = |body: &mut DeformableBody| {
+    let frame_alone = |(body, workspace): &mut (DeformableBody, SolverWorkspace)| {
         for _ in 0..substeps {
-            integrator.step(body, h, gravity).expect("soft step");
+            integrator
+                .step(body, &mut BodyConstraints::new(), workspace, h, gravity)
+                .expect("soft step");
         }
     };
     for _ in 0..SETTLING_FRAMES {

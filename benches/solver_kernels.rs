@@ -22,8 +22,9 @@ use std::hint::black_box;
 
 const GRAVITY: DVec3 = DVec3::new(0.0, -9.81, 0.0);
 
-/// The reference beam at rest, its sparsity pattern and symbolic factorization already built.
-fn beam() -> DeformableBody {
+/// The reference beam at rest, with its solver workspace: the sparsity pattern and symbolic
+/// factorization already built.
+fn beam() -> (DeformableBody, SolverWorkspace) {
     let half = DVec3::new(0.5, 0.05, 0.05);
     let mesh = mesh::cuboid(half, [20, 4, 4]).expect("valid generator input");
     let clamped = mesh.nodes_where(|p| p.x <= -half.x + 1e-9);
@@ -35,21 +36,29 @@ fn beam() -> DeformableBody {
         .build()
         .expect("valid body");
     // Builds the pattern; zero gravity leaves the beam at rest.
+    let mut workspace = SolverWorkspace::new();
     ImplicitIntegrator::default()
-        .step(&mut body, 1.0 / 60.0, DVec3::ZERO)
+        .step(
+            &mut body,
+            &mut BodyConstraints::new(),
+            &mut workspace,
+            1.0 / 60.0,
+            DVec3::ZERO,
+        )
         .expect("first frame");
-    body
+    (body, workspace)
 }
 
 fn implicit_frame(c: &mut Criterion) {
-    let mut body = beam();
+    let (mut body, mut workspace) = beam();
+    let mut free = BodyConstraints::new();
     let integrator = ImplicitIntegrator::default();
     let mut group = c.benchmark_group("implicit_frame");
     group.sample_size(20);
     group.bench_function("stable_neo_hookean_1600_tets_dt_1_60", |b| {
         b.iter(|| {
             integrator
-                .step(&mut body, 1.0 / 60.0, GRAVITY)
+                .step(&mut body, &mut free, &mut workspace, 1.0 / 60.0, GRAVITY)
                 .expect("implicit frame")
                 .newton_iterations
         })
@@ -88,9 +97,15 @@ fn newton_iteration(c: &mut Criterion) {
         group.bench_function(name, |b| {
             b.iter_batched_ref(
                 || rest.clone(),
-                |body| {
+                |(body, workspace)| {
                     integrator
-                        .step(body, 1.0 / 60.0, GRAVITY)
+                        .step(
+                            body,
+                            &mut BodyConstraints::new(),
+                            workspace,
+                            1.0 / 60.0,
+                            GRAVITY,
+                        )
                         .expect("one Newton iteration")
                         .newton_iterations
                 },
@@ -111,10 +126,11 @@ fn contact_detection(c: &mut Criterion) {
         .flatten()
         .collect::<std::collections::BTreeSet<_>>()
         .len();
-    let mut body = DeformableBodyBuilder::new(mesh, material)
+    let body = DeformableBodyBuilder::new(mesh, material)
         .translation(DVec3::new(0.0, 0.1, 0.0))
         .build()
         .expect("valid body");
+    let mut constraints = BodyConstraints::new();
     let bodies = RigidBodySet::new();
     let mut colliders = ColliderSet::new();
     colliders.insert(ColliderBuilder::new(SharedShape::halfspace(Vec3::Y)));
@@ -127,7 +143,8 @@ fn contact_detection(c: &mut Criterion) {
     group.bench_function("ground_and_box", |b| {
         b.iter(|| {
             black_box(
-                body.detect_contacts(&colliders, &bodies, 1.0 / 60.0, GRAVITY, &settings)
+                constraints
+                    .detect_contacts(&body, &colliders, &bodies, 1.0 / 60.0, GRAVITY, &settings)
                     .expect("valid detection")
                     .len(),
             )

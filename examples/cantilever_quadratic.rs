@@ -216,9 +216,10 @@ fn dynamic_case(beam: &Beam, stepper: Stepper, dt: f64, reuse: bool) -> Result<D
         implicit.scheme = ImplicitScheme::Bdf2;
     }
     let (mut sum, mut newton, mut factorizations) = (0.0, 0usize, 0usize);
+    let (mut free, mut workspace) = (BodyConstraints::new(), SolverWorkspace::new());
     let start = Instant::now();
     for step in 0..steps {
-        let report = implicit.step(&mut body, dt, GRAVITY)?;
+        let report = implicit.step(&mut body, &mut free, &mut workspace, dt, GRAVITY)?;
         newton += report.newton_iterations;
         factorizations += report.factorizations;
         if step >= steps - averaged {
@@ -273,8 +274,9 @@ fn vibration_frequency(beam: &Beam, stepper: Stepper, dt: f64) -> Result<f64, Er
     };
     let mut crossings = Vec::new();
     let mut before = tip_height(&body, &tip) - rest;
+    let (mut free, mut workspace) = (BodyConstraints::new(), SolverWorkspace::new());
     for step in 1..=(1.0 / dt).round() as usize {
-        implicit.step(&mut body, dt, DVec3::ZERO)?;
+        implicit.step(&mut body, &mut free, &mut workspace, dt, DVec3::ZERO)?;
         let now = tip_height(&body, &tip) - rest;
         if before < 0.0 && now >= 0.0 {
             crossings.push((step as f64 - now / (now - before)) * dt);

@@ -74,9 +74,13 @@ fn main() -> Result<(), Error> {
     let mut alone = cube()?;
     let gravity = DVec3::new(0.0, -9.81, 0.0);
     let h = 1.0 / 60.0 / f64::from(world.coupling.substeps);
+    let (mut free, mut workspace) = (BodyConstraints::new(), SolverWorkspace::new());
     let start = Instant::now();
     for _ in 0..FRAMES * world.coupling.substeps as usize {
-        world.coupling.integrator.step(&mut alone, h, gravity)?;
+        world
+            .coupling
+            .integrator
+            .step(&mut alone, &mut free, &mut workspace, h, gravity)?;
     }
     let alone_ms = start.elapsed().as_secs_f64() * 1e3 / FRAMES as f64;
     let body = &world.soft_bodies[handle];

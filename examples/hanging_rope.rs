@@ -1,6 +1,6 @@
 //! A ball hanging from a soft rope, swinging: a 0.5 m rope (1 x 1 cm, 2 x 40 x 2 cells, stable
 //! Neo-Hookean, E = 1e6 Pa, ν = 0.3, 1000 kg/m³, Rayleigh damping 0.01 s) clamped at the top,
-//! with a 1 kg rigid ball (r = 5 cm) glued 1 cm below its end by [`DeformableBody::attach`], released
+//! with a 1 kg rigid ball (r = 5 cm) glued 1 cm below its end by `FvmWorld::attach`, released
 //! 5° from the vertical in an [`FvmWorld`] at 60 frames per second: how to hang a rigid body from
 //! a soft one, and whether the pair swings as the compound pendulum it is.
 //!
@@ -61,7 +61,7 @@ fn build_scene() -> Result<Scene, Error> {
         ColliderBuilder::ball(RADIUS as f32).density(density as f32),
     );
     let rope = world.soft_bodies.insert(rope);
-    world.soft_bodies[rope].attach(bottom, ball, &world.physics.bodies)?;
+    world.attach(rope, bottom, ball)?;
     Ok(Scene {
         world,
         rope,

@@ -35,12 +35,13 @@ fn main() -> Result<(), Error> {
         let explicit_substeps = automatic.predict(&body, frame).explicit_substeps;
         let integrator = ImplicitIntegrator::default();
         // The first frame also builds the sparsity pattern and its symbolic factorization.
-        integrator.step(&mut body, frame, gravity)?;
+        let (mut free, mut workspace) = (BodyConstraints::new(), SolverWorkspace::new());
+        integrator.step(&mut body, &mut free, &mut workspace, frame, gravity)?;
         let start = Instant::now();
         let mut iterations = 0;
         for _ in 0..frames {
             iterations += integrator
-                .step(&mut body, frame, gravity)?
+                .step(&mut body, &mut free, &mut workspace, frame, gravity)?
                 .newton_iterations;
         }
         let ms = start.elapsed().as_secs_f64() * 1e3 / frames as f64;

@@ -132,10 +132,7 @@ fn run(scene: &mut Scene) -> Result<Measured, Error> {
     let (mut reaction_sum, mut row_sum, mut fastest) = (0.0, 0.0, 0.0f64);
     for frame in 1..=MEASURE_S * FPS {
         step(world)?;
-        let reaction = -world.soft_bodies[scene.block]
-            .contact_force_on(scene.ground, h)?
-            .0
-            .y;
+        let reaction = -world.contact_force_on(scene.block, scene.ground, h)?.0.y;
         reaction_sum += reaction;
         row_sum += reaction;
         let rigid = &world.physics.bodies[scene.rigid_box];

@@ -125,8 +125,7 @@ fn run(scene: &mut Scene) -> Result<(f64, f64), Error> {
             outcome?;
         }
         if frame >= frames - 60 {
-            let (force, _) =
-                world.soft_bodies[scene.handles[0]].contact_force_on(scene.ground, substep)?;
+            let (force, _) = world.contact_force_on(scene.handles[0], scene.ground, substep)?;
             reaction -= force.y / 60.0;
         }
         for pair in scene.handles.windows(2) {

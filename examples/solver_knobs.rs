@@ -71,15 +71,16 @@ fn run(
     warm_up: usize,
     frames: usize,
 ) -> Result<Run, Error> {
+    let (mut free, mut workspace) = (BodyConstraints::new(), SolverWorkspace::new());
     for _ in 0..warm_up {
-        integrator.step(body, dt, gravity())?;
+        integrator.step(body, &mut free, &mut workspace, dt, gravity())?;
     }
     let start = Instant::now();
     let (mut newton, mut cg, mut converged) = (0, 0, true);
     let mut fastest = f64::INFINITY;
     for _ in 0..frames {
         let frame = Instant::now();
-        let report = integrator.step(body, dt, gravity())?;
+        let report = integrator.step(body, &mut free, &mut workspace, dt, gravity())?;
         fastest = fastest.min(frame.elapsed().as_secs_f64() * 1e3);
         newton += report.newton_iterations;
         cg += report.linear_iterations;

@@ -11,10 +11,10 @@
 
 use crate::Error;
 use crate::body::DeformableBody;
-use crate::contact::Stencil;
 use crate::element::deformation_gradient;
 use crate::fvm::NodalAveraging;
 use crate::material::{HyperelasticModel, with_hyperelastic_model};
+use crate::stencil::Stencil;
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
@@ -65,6 +65,13 @@ impl Stiffness {
             }
             couple_all_pairs(&mut lower_neighbours, patches.iter().map(|p| &p[..]));
         }
+        Self::with_neighbours(lower_neighbours)
+    }
+
+    /// The pattern of `lower_neighbours` (per node `b`, itself first, then its neighbours
+    /// `a > b`, ascending), values zero.
+    fn with_neighbours(lower_neighbours: Vec<Vec<u32>>) -> Self {
+        let n = lower_neighbours.len();
         let mut col_ptr = Vec::with_capacity(3 * n + 1);
         let mut row_idx = Vec::new();
         col_ptr.push(0);
@@ -88,6 +95,32 @@ impl Stiffness {
             element_nodes: Vec::new(),
             element_block: Vec::new(),
         }
+    }
+
+    /// Whether the pattern holds the blocks coupling nodes `a` and `b`.
+    pub(crate) fn couples(&self, a: u32, b: u32) -> bool {
+        let (high, low) = if a > b { (a, b) } else { (b, a) };
+        self.lower_neighbours[low as usize]
+            .binary_search(&high)
+            .is_ok()
+    }
+
+    /// The pattern widened by the node pairs `extra` (`[a, b]`, `a > b`: nodes a constraint
+    /// couples beyond the mesh's, such as a self-contact's node and triangle), values zero; its
+    /// symbolic factorization is made anew at the first factorization.
+    pub(crate) fn widened(&self, extra: &[[u32; 2]]) -> Self {
+        let mut lower_neighbours = self.lower_neighbours.clone();
+        for &[a, b] in extra {
+            lower_neighbours[b as usize].push(a);
+        }
+        for list in &mut lower_neighbours {
+            // Each node stays first in its own list.
+            list[1..].sort_unstable();
+        }
+        for list in &mut lower_neighbours {
+            list.dedup();
+        }
+        Self::with_neighbours(lower_neighbours)
     }
 
     /// Index into `values` of the entry (row `3a + i`, column `3b + j`), for `a > b`, or `a == b`

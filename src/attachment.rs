@@ -10,9 +10,9 @@
 //! for contacts.
 
 use crate::Error;
-use crate::body::BodyConstraints;
 use crate::body::DeformableBody;
-use crate::contact::RigidProxy;
+use crate::contact::ContactSettings;
+use crate::rigid::RigidProxy;
 use rapier3d::dynamics::{RigidBodyHandle, RigidBodySet};
 use rapier3d::glamx::{DMat3, DVec3};
 
@@ -39,57 +39,41 @@ pub struct Attachment {
     effective_mass: DMat3,
 }
 
-impl DeformableBody {
-    /// Glues `nodes` to the rigid body `body` of `bodies` where they are now: each node keeps
-    /// following the body's material point it sits at, and the body feels it (two-way when the
-    /// body is dynamic; a kinematic or fixed body drags the nodes along). The attachments act from
-    /// the next [`DeformableBody::detect_contacts`], which readies them for the coming step.
-    ///
-    /// # Errors
-    /// [`Error::NodeOutOfRange`] for a node that does not exist, [`Error::UnknownRigidBody`] if
-    /// `body` is not in `bodies`; nothing is attached then.
-    pub fn attach(
-        &mut self,
-        nodes: impl IntoIterator<Item = u32>,
-        body: RigidBodyHandle,
-        bodies: &RigidBodySet,
-    ) -> Result<(), Error> {
-        let rigid = bodies.get(body).ok_or(Error::UnknownRigidBody)?;
-        let pose = rigid.position();
-        let node_count = self.node_count();
-        let mut added = Vec::new();
-        for node in nodes {
-            let x = *self
-                .positions
-                .get(node as usize)
-                .ok_or(Error::NodeOutOfRange {
-                    node: node as usize,
-                    node_count,
-                })?;
-            let local_anchor = pose.inverse_transform_point(x.as_vec3()).as_dvec3();
-            added.push(Attachment {
-                node,
-                body,
-                local_anchor,
-                anchor: x,
-                proxy: usize::MAX,
-                drift_velocity: DVec3::ZERO,
-                effective_mass: DMat3::ZERO,
-            });
-        }
-        self.constraints.attachments.extend(added);
-        Ok(())
+/// The attachments gluing `nodes` of `body` to the rigid body `rigid` of `bodies` where they
+/// are now (see [`BodyConstraints::attach`](crate::constraint::BodyConstraints::attach)).
+///
+/// # Errors
+/// [`Error::NodeOutOfRange`] for a node that does not exist, [`Error::UnknownRigidBody`] if
+/// `rigid` is not in `bodies`.
+pub(crate) fn glue(
+    body: &DeformableBody,
+    nodes: impl IntoIterator<Item = u32>,
+    rigid: RigidBodyHandle,
+    bodies: &RigidBodySet,
+) -> Result<Vec<Attachment>, Error> {
+    let pose = bodies.get(rigid).ok_or(Error::UnknownRigidBody)?.position();
+    let node_count = body.node_count();
+    let mut added = Vec::new();
+    for node in nodes {
+        let x = *body
+            .positions()
+            .get(node as usize)
+            .ok_or(Error::NodeOutOfRange {
+                node: node as usize,
+                node_count,
+            })?;
+        let local_anchor = pose.inverse_transform_point(x.as_vec3()).as_dvec3();
+        added.push(Attachment {
+            node,
+            body: rigid,
+            local_anchor,
+            anchor: x,
+            proxy: usize::MAX,
+            drift_velocity: DVec3::ZERO,
+            effective_mass: DMat3::ZERO,
+        });
     }
-
-    /// The attachments.
-    pub fn attachments(&self) -> &[Attachment] {
-        &self.constraints.attachments
-    }
-
-    /// Removes every attachment to `body`.
-    pub fn detach(&mut self, body: RigidBodyHandle) {
-        self.constraints.attachments.retain(|a| a.body != body);
-    }
+    Ok(added)
 }
 
 /// Places the attachments' anchors where their bodies are now and gives each body a proxy
@@ -116,39 +100,42 @@ pub(crate) fn ready(
 
 /// Readies the attachments' velocity constraints for an explicit substep of `h` (s), before the
 /// sweeps of [`solve_velocities`].
-pub(crate) fn prepare_velocities(body: &mut DeformableBody, h: f64) {
-    for attachment in &mut body.constraints.attachments {
+pub(crate) fn prepare_velocities(
+    body: &DeformableBody,
+    attachments: &mut [Attachment],
+    proxies: &[RigidProxy],
+    h: f64,
+) {
+    for attachment in attachments {
         let n = attachment.node as usize;
         let x = body.positions[n];
         attachment.drift_velocity = (attachment.anchor - x) * (DRIFT_CORRECTION / h);
         attachment.effective_mass = (DMat3::IDENTITY * (1.0 / body.masses[n])
-            + body.constraints.rigid_proxies[attachment.proxy].inverse_mass_matrix(x))
+            + proxies[attachment.proxy].inverse_mass_matrix(x))
         .inverse();
     }
 }
 
 /// One sweep over the attachments' velocity constraints, after the contacts': each node's
 /// velocity is set to its anchor's plus the drift correction by an impulse shared with the body.
-pub(crate) fn solve_velocities(body: &mut DeformableBody) {
+pub(crate) fn solve_velocities(
+    body: &mut DeformableBody,
+    attachments: &[Attachment],
+    proxies: &mut [RigidProxy],
+) {
     let DeformableBody {
-        constraints:
-            BodyConstraints {
-                attachments,
-                rigid_proxies,
-                ..
-            },
         positions,
         velocities,
         masses,
         pinned,
         ..
     } = body;
-    for attachment in attachments.iter() {
+    for attachment in attachments {
         let n = attachment.node as usize;
         if pinned[n] {
             continue;
         }
-        let proxy = &mut rigid_proxies[attachment.proxy];
+        let proxy = &mut proxies[attachment.proxy];
         let wanted = proxy.velocity_at(attachment.anchor) + attachment.drift_velocity;
         let impulse = attachment.effective_mass * (wanted - velocities[n]);
         velocities[n] += impulse / masses[n];
@@ -157,9 +144,9 @@ pub(crate) fn solve_velocities(body: &mut DeformableBody) {
 }
 
 /// Carries the anchors with their bodies over an explicit substep of `h` (s), after the sweeps.
-pub(crate) fn advance_anchors(body: &mut DeformableBody, h: f64) {
-    for attachment in &mut body.constraints.attachments {
-        let proxy = &body.constraints.rigid_proxies[attachment.proxy];
+pub(crate) fn advance_anchors(attachments: &mut [Attachment], proxies: &[RigidProxy], h: f64) {
+    for attachment in attachments {
+        let proxy = &proxies[attachment.proxy];
         attachment.anchor += proxy.velocity_at(attachment.anchor) * h;
     }
 }
@@ -175,23 +162,19 @@ impl Attachment {
 /// Calls `each(node, stiffness k (N/m), target (m))` for every attachment in an implicit step of
 /// effective length `h` (s): the node is pulled toward the anchor's predicted end position with
 /// the energy `k/2 |x - target|²`.
-pub(crate) fn for_each_spring(
+pub(crate) fn for_each_spring<'a>(
     body: &DeformableBody,
+    attachments: &'a [Attachment],
+    proxies: &[RigidProxy],
+    settings: &ContactSettings,
     h: f64,
-    mut each: impl FnMut(&Attachment, f64, DVec3),
+    mut each: impl FnMut(&'a Attachment, f64, DVec3),
 ) {
-    for attachment in &body.constraints.attachments {
+    for attachment in attachments {
         let n = attachment.node as usize;
         if !body.pinned[n] {
-            let stiffness = body
-                .constraints
-                .settings
-                .penalty_stiffness(body.masses[n], h);
-            each(
-                attachment,
-                stiffness,
-                attachment.spring_target(&body.constraints.rigid_proxies, h),
-            );
+            let stiffness = settings.penalty_stiffness(body.masses[n], h);
+            each(attachment, stiffness, attachment.spring_target(proxies, h));
         }
     }
 }
@@ -199,21 +182,19 @@ pub(crate) fn for_each_spring(
 /// Records the impulses (N s) the implicit springs gave the nodes over a substep of length `h`
 /// (s), hands their opposite to the bodies, and moves the anchors with them. The targets are
 /// taken before any impulse is handed over, as the step's solve saw them.
-pub(crate) fn record_spring_impulses(body: &mut DeformableBody, effective_h: f64, h: f64) {
-    let targets: Vec<DVec3> = body
-        .constraints
-        .attachments
+pub(crate) fn record_spring_impulses(
+    body: &DeformableBody,
+    attachments: &mut [Attachment],
+    rigid_proxies: &mut [RigidProxy],
+    contact_settings: &ContactSettings,
+    effective_h: f64,
+    h: f64,
+) {
+    let targets: Vec<DVec3> = attachments
         .iter()
-        .map(|a| a.spring_target(&body.constraints.rigid_proxies, effective_h))
+        .map(|a| a.spring_target(rigid_proxies, effective_h))
         .collect();
     let DeformableBody {
-        constraints:
-            BodyConstraints {
-                attachments,
-                rigid_proxies,
-                settings: contact_settings,
-                ..
-            },
         positions,
         masses,
         pinned,

@@ -11,9 +11,9 @@
 //! exactly.
 
 use crate::Error;
-use crate::contact::Stencil;
 use crate::element::{Elements, QuadraticElements};
 use crate::mesh::TetMesh;
+use crate::stencil::Stencil;
 use rapier3d::glamx::DVec3;
 use rapier3d::parry::bounding_volume::Aabb;
 use rapier3d::parry::partitioning::{Bvh, BvhBuildStrategy};

@@ -180,6 +180,9 @@ pub enum Error {
     /// A rigid body handle given to a soft body (attachment) is not in the rigid-body set.
     #[error("the rigid body is not in the rigid-body set")]
     UnknownRigidBody,
+    /// A deformable body handle given to the coupling is not in the deformable-body set.
+    #[error("the deformable body is not in the deformable-body set")]
+    UnknownDeformableBody,
     /// A generator was asked for a shape it cannot mesh (zero cells, non-positive size).
     #[error("invalid mesh generator parameter `{parameter}` = {value}: {reason}")]
     InvalidGeneratorParameter {

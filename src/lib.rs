@@ -66,8 +66,11 @@
 //!     .pinned_nodes(clamped)
 //!     .build()?;
 //! let integrator = SymplecticEuler::default();
+//! // What acts on the beam from outside (nothing here) and the solver's caches, kept beside it.
+//! let (mut constraints, mut workspace) = (BodyConstraints::new(), SolverWorkspace::new());
 //! for _frame in 0..6 {
-//!     let report = integrator.step(&mut beam, 1.0 / 60.0, DVec3::new(0.0, -9.81, 0.0))?;
+//!     let gravity = DVec3::new(0.0, -9.81, 0.0);
+//!     let report = integrator.step(&mut beam, &mut constraints, &mut workspace, 1.0 / 60.0, gravity)?;
 //!     assert!(report.substeps >= 1);
 //! }
 //! assert!(beam.positions().iter().all(|x| x.is_finite()));
@@ -78,7 +81,7 @@ mod assembly;
 pub mod attachment;
 pub mod body;
 mod chord;
-mod constraint;
+pub mod constraint;
 pub mod contact;
 pub mod coupling;
 pub mod damping;
@@ -93,7 +96,10 @@ pub mod material;
 pub mod mesh;
 mod newton;
 pub mod query;
+mod rigid;
+pub mod shape;
 pub mod statics;
+mod stencil;
 pub mod world;
 
 pub use error::{Error, FileLocation, ImportErrorKind};
@@ -113,13 +119,14 @@ pub mod prelude {
     pub use crate::body::{
         DeformableBody, DeformableBodyBuilder, DeformableBodyHandle, DeformableBodySet,
     };
+    pub use crate::constraint::BodyConstraints;
     pub use crate::contact::{BodyPoint, ContactSettings, ContactTarget, NodeContact};
     pub use crate::coupling::{ColliderLoad, RapierSets, RigidLoad, RigidSets, SoftCoupling};
     pub use crate::damping::RayleighDamping;
     pub use crate::fvm::VolumetricTreatment;
     pub use crate::integrate::{
         AutomaticIntegrator, ImplicitIntegrator, ImplicitReport, ImplicitScheme, IntegratorKind,
-        StepReport, Substeps, SymplecticEuler,
+        SolverWorkspace, StepReport, Substeps, SymplecticEuler,
     };
     pub use crate::linear_solver::LinearSolver;
     pub use crate::material::{LameParameters, Material, MaterialModel, YoungPoisson};

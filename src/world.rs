@@ -4,9 +4,11 @@
 //! It is a convenience: a program that keeps its own [`PhysicsPipeline`] and sets calls
 //! [`SoftCoupling::step`] with them instead, and gets the same motion.
 
+use crate::Error;
 use crate::body::{DeformableBodyHandle, DeformableBodySet};
 use crate::coupling::{ColliderLoad, RapierSets, RigidLoad, SoftCoupling, SoftStepResults};
 use rapier3d::dynamics::RigidBodyHandle;
+use rapier3d::geometry::ColliderHandle;
 use rapier3d::glamx::DVec3;
 use rapier3d::pipeline::{
     CollisionPipeline, EventHandler, PhysicsHooks, PhysicsPipeline, PhysicsWorld,
@@ -106,6 +108,37 @@ impl FvmWorld {
     /// exerted on rigid body `rigid` over the last frame; zero if they did not interact.
     pub fn load_on(&self, soft: DeformableBodyHandle, rigid: RigidBodyHandle) -> (DVec3, DVec3) {
         self.coupling.load_on(soft, rigid)
+    }
+
+    /// Glues `nodes` of the deformable body `soft` to the rigid body `rigid` where they are now;
+    /// see [`SoftCoupling::attach`].
+    ///
+    /// # Errors
+    /// Those of [`SoftCoupling::attach`]; nothing is attached then.
+    pub fn attach(
+        &mut self,
+        soft: DeformableBodyHandle,
+        nodes: impl IntoIterator<Item = u32>,
+        rigid: RigidBodyHandle,
+    ) -> Result<(), Error> {
+        self.coupling
+            .attach(&self.soft_bodies, soft, nodes, rigid, &self.physics.bodies)
+    }
+
+    /// The mean force (N) and torque about the world origin (N m) the contacts of the deformable
+    /// body `soft` exerted on `collider` over the last coupling substep, of length `dt` (s); see
+    /// [`SoftCoupling::contact_force_on`].
+    ///
+    /// # Errors
+    /// Those of [`SoftCoupling::contact_force_on`].
+    pub fn contact_force_on(
+        &self,
+        soft: DeformableBodyHandle,
+        collider: ColliderHandle,
+        dt: f64,
+    ) -> Result<(DVec3, DVec3), Error> {
+        self.coupling
+            .contact_force_on(&self.soft_bodies, soft, collider, dt)
     }
 
     /// Advances the world by one frame (`physics.integration_parameters.dt`), without hooks or

@@ -37,8 +37,21 @@ fn stepping_a_set_reports_each_body_and_keeps_a_failed_one_unchanged() {
     let bad = set.insert(ball(1e5));
     set[bad].velocities_mut()[0].x = f64::NAN;
     let before = set[bad].positions().to_vec();
-    let outcomes =
-        AutomaticIntegrator::default().step_all(&mut set, 1.0 / 60.0, DVec3::new(0.0, -9.81, 0.0));
+    let integrator = AutomaticIntegrator::default();
+    // One set of constraints and solver caches per body, kept beside it.
+    let mut beside: Vec<(BodyConstraints, SolverWorkspace)> = set
+        .iter()
+        .map(|_| (BodyConstraints::new(), SolverWorkspace::new()))
+        .collect();
+    let outcomes: Vec<_> = set
+        .iter_mut()
+        .zip(&mut beside)
+        .map(|((handle, body), (constraints, workspace))| {
+            let gravity = DVec3::new(0.0, -9.81, 0.0);
+            let outcome = integrator.step(body, constraints, workspace, 1.0 / 60.0, gravity);
+            (handle, outcome)
+        })
+        .collect();
     assert_eq!(outcomes.len(), 2);
     for (handle, outcome) in outcomes {
         if handle == good {

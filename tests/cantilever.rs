@@ -132,8 +132,17 @@ fn cantilever_damped_at(
 /// Runs `seconds` of frames of 1/60 s; returns the largest node speed (m/s) at the end.
 fn settle(body: &mut DeformableBody, seconds: f64) -> f64 {
     let integrator = SymplecticEuler::default();
+    let (mut constraints, mut workspace) = (BodyConstraints::new(), SolverWorkspace::new());
     for _ in 0..(seconds * 60.0).round() as usize {
-        integrator.step(body, 1.0 / 60.0, gravity()).unwrap();
+        integrator
+            .step(
+                body,
+                &mut constraints,
+                &mut workspace,
+                1.0 / 60.0,
+                gravity(),
+            )
+            .unwrap();
     }
     body.velocities()
         .iter()

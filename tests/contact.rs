@@ -84,16 +84,27 @@ fn a_dropped_cube_comes_to_rest_on_the_ground() {
             ..AutomaticIntegrator::default()
         };
         let mut deepest = f64::INFINITY;
+        let (mut constraints, mut workspace) = (BodyConstraints::new(), SolverWorkspace::new());
         for _ in 0..120 {
-            body.detect_contacts(
-                &colliders,
-                &RigidBodySet::new(),
-                1.0 / 60.0,
-                GRAVITY,
-                &settings,
-            )
-            .unwrap();
-            integrator.step(&mut body, 1.0 / 60.0, GRAVITY).unwrap();
+            constraints
+                .detect_contacts(
+                    &body,
+                    &colliders,
+                    &RigidBodySet::new(),
+                    1.0 / 60.0,
+                    GRAVITY,
+                    &settings,
+                )
+                .unwrap();
+            integrator
+                .step(
+                    &mut body,
+                    &mut constraints,
+                    &mut workspace,
+                    1.0 / 60.0,
+                    GRAVITY,
+                )
+                .unwrap();
             deepest = deepest.min(lowest(&body));
         }
         let centre = body.center_of_mass().y;
@@ -144,16 +155,25 @@ fn a_block_on_a_slope_sticks_or_slides_as_coulomb_says() {
         body.friction = friction;
         let frame = 1.0 / 240.0;
         let mut history = Vec::new();
+        let (mut constraints, mut workspace) = (BodyConstraints::new(), SolverWorkspace::new());
         for _ in 0..240 {
-            body.detect_contacts(&colliders, &RigidBodySet::new(), frame, GRAVITY, &settings)
+            constraints
+                .detect_contacts(
+                    &body,
+                    &colliders,
+                    &RigidBodySet::new(),
+                    frame,
+                    GRAVITY,
+                    &settings,
+                )
                 .unwrap();
             if implicit {
                 ImplicitIntegrator::default()
-                    .step(&mut body, frame, GRAVITY)
+                    .step(&mut body, &mut constraints, &mut workspace, frame, GRAVITY)
                     .unwrap();
             } else {
                 SymplecticEuler::default()
-                    .step(&mut body, frame, GRAVITY)
+                    .step(&mut body, &mut constraints, &mut workspace, frame, GRAVITY)
                     .unwrap();
             }
             history.push(body.center_of_mass().dot(downhill));
@@ -204,16 +224,21 @@ fn collision_groups_decide_which_colliders_a_soft_body_touches() {
             InteractionGroups::new(Group::GROUP_1, filter, InteractionTestMode::And);
         let integrator = SymplecticEuler::default();
         let frame = 1.0 / 60.0;
+        let (mut constraints, mut workspace) = (BodyConstraints::new(), SolverWorkspace::new());
         for _ in 0..12 {
-            body.detect_contacts(
-                &colliders,
-                &RigidBodySet::new(),
-                frame,
-                GRAVITY,
-                &ContactSettings::default(),
-            )
-            .unwrap();
-            integrator.step(&mut body, frame, GRAVITY).unwrap();
+            constraints
+                .detect_contacts(
+                    &body,
+                    &colliders,
+                    &RigidBodySet::new(),
+                    frame,
+                    GRAVITY,
+                    &ContactSettings::default(),
+                )
+                .unwrap();
+            integrator
+                .step(&mut body, &mut constraints, &mut workspace, frame, GRAVITY)
+                .unwrap();
         }
         println!(
             "filter {filter:?}: lowest node at {:.1} mm",
@@ -255,12 +280,16 @@ fn an_elastic_bar_striking_a_wall_end_on_rebounds_at_its_impact_speed() {
     let (mut first_touch, mut last_touch) = (None, None);
     let bodies = RigidBodySet::new();
     let settings = ContactSettings::default();
+    let (mut constraints, mut workspace) = (BodyConstraints::new(), SolverWorkspace::new());
     while time < 0.1 {
-        bar.detect_contacts(&colliders, &bodies, dt, DVec3::ZERO, &settings)
+        constraints
+            .detect_contacts(&bar, &colliders, &bodies, dt, DVec3::ZERO, &settings)
             .unwrap();
-        integrator.step(&mut bar, dt, DVec3::ZERO).unwrap();
+        integrator
+            .step(&mut bar, &mut constraints, &mut workspace, dt, DVec3::ZERO)
+            .unwrap();
         time += dt;
-        let (force, _) = bar.contact_force_on(wall, dt).unwrap();
+        let (force, _) = constraints.contact_force_on(&bar, wall, dt).unwrap();
         if force.x.abs() > 0.0 {
             first_touch.get_or_insert(time - dt);
             last_touch = Some(time);

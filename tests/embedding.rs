@@ -141,16 +141,12 @@ fn a_cage_carrying_a_fine_mesh_rests_on_a_rapier_ground() {
         let cube = world.soft_bodies.insert(cube);
         let reaction = common::settled_reaction(&mut world, cube, ground);
         let body = &world.soft_bodies[cube];
-        let touching = body
-            .contacts()
+        let contacts = world.coupling.contacts(cube);
+        let touching = contacts
             .iter()
             .filter(|c| matches!(c.at, BodyPoint::Embedded(_)))
             .count();
-        assert_eq!(
-            touching,
-            body.contacts().len(),
-            "contacts act on the fine mesh"
-        );
+        assert_eq!(touching, contacts.len(), "contacts act on the fine mesh");
         let weight = body.total_mass() * 9.81;
         let lowest = body
             .embedded_positions()
@@ -205,8 +201,9 @@ fn an_embedded_surface_hitting_a_free_ball_conserves_momentum() {
         for (handle, outcome) in world.step() {
             outcome.unwrap_or_else(|e| panic!("{handle:?}: {e}"));
         }
-        fine_contacts += world.soft_bodies[soft]
-            .contacts()
+        fine_contacts += world
+            .coupling
+            .contacts(soft)
             .iter()
             .filter(|c| matches!(c.at, BodyPoint::Embedded(_)))
             .count();

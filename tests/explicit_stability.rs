@@ -100,8 +100,12 @@ fn energy_growth(mut body: DeformableBody, dt: f64, steps: usize) -> f64 {
         substeps: Substeps::Fixed(1),
         ..Default::default()
     };
+    let (mut constraints, mut workspace) = (BodyConstraints::new(), SolverWorkspace::new());
     for _ in 0..steps {
-        if integrator.step(&mut body, dt, DVec3::ZERO).is_err() {
+        if integrator
+            .step(&mut body, &mut constraints, &mut workspace, dt, DVec3::ZERO)
+            .is_err()
+        {
             return f64::INFINITY;
         }
     }
@@ -157,8 +161,12 @@ fn automatic_substeps_keep_every_case_bounded() {
                     let start = body.gravity_potential_energy(gravity);
                     let weight_scale = body.total_mass() * common::GRAVITY * common::LENGTH;
                     let integrator = SymplecticEuler::default();
+                    let (mut constraints, mut workspace) =
+                        (BodyConstraints::new(), SolverWorkspace::new());
                     for _ in 0..20 {
-                        integrator.step(&mut body, frame, gravity).unwrap();
+                        integrator
+                            .step(&mut body, &mut constraints, &mut workspace, frame, gravity)
+                            .unwrap();
                     }
                     let total = body.kinetic_energy()
                         + body.elastic_energy()
@@ -179,8 +187,15 @@ fn a_non_finite_state_is_rejected_and_the_previous_state_kept() {
     let mut body = excited_beam(0.0);
     body.velocities_mut()[5].y = f64::NAN;
     let before = (body.positions().to_vec(), body.velocities()[..5].to_vec());
+    let (mut constraints, mut workspace) = (BodyConstraints::new(), SolverWorkspace::new());
     let err = SymplecticEuler::default()
-        .step(&mut body, 1.0 / 60.0, DVec3::ZERO)
+        .step(
+            &mut body,
+            &mut constraints,
+            &mut workspace,
+            1.0 / 60.0,
+            DVec3::ZERO,
+        )
         .unwrap_err();
     assert!(matches!(err, Error::NonFiniteState { .. }));
     assert_eq!(body.positions(), &before.0[..]);
@@ -190,9 +205,11 @@ fn a_non_finite_state_is_rejected_and_the_previous_state_kept() {
 #[test]
 fn invalid_steps_are_typed_errors() {
     let mut body = excited_beam(0.0);
+    let (mut constraints, mut workspace) = (BodyConstraints::new(), SolverWorkspace::new());
+    let (c, w) = (&mut constraints, &mut workspace);
     for dt in [0.0, -1.0, f64::NAN, f64::INFINITY] {
         assert!(matches!(
-            SymplecticEuler::default().step(&mut body, dt, DVec3::ZERO),
+            SymplecticEuler::default().step(&mut body, c, w, dt, DVec3::ZERO),
             Err(Error::InvalidTimeStep { .. })
         ));
     }
@@ -201,7 +218,7 @@ fn invalid_steps_are_typed_errors() {
         ..Default::default()
     };
     assert!(matches!(
-        zero_substeps.step(&mut body, 0.01, DVec3::ZERO),
+        zero_substeps.step(&mut body, c, w, 0.01, DVec3::ZERO),
         Err(Error::InvalidSetting {
             parameter: "substeps",
             ..
@@ -212,14 +229,14 @@ fn invalid_steps_are_typed_errors() {
         ..Default::default()
     };
     assert!(matches!(
-        bad_safety.step(&mut body, 0.01, DVec3::ZERO),
+        bad_safety.step(&mut body, c, w, 0.01, DVec3::ZERO),
         Err(Error::InvalidSetting {
             parameter: "safety_factor",
             ..
         })
     ));
     assert!(matches!(
-        SymplecticEuler::default().step(&mut body, 0.01, DVec3::new(0.0, f64::NAN, 0.0)),
+        SymplecticEuler::default().step(&mut body, c, w, 0.01, DVec3::new(0.0, f64::NAN, 0.0)),
         Err(Error::NonFiniteInput {
             parameter: "gravity"
         })
@@ -231,7 +248,7 @@ fn invalid_steps_are_typed_errors() {
         ..Default::default()
     };
     assert!(matches!(
-        capped.step(&mut body, 1.0, DVec3::ZERO),
+        capped.step(&mut body, c, w, 1.0, DVec3::ZERO),
         Err(Error::TooManySubsteps { max: 10, .. })
     ));
     assert_eq!(body.positions(), &before[..]);
@@ -247,8 +264,15 @@ fn a_damped_body_with_a_flat_element_is_refused_not_stepped() {
     }
     assert_eq!(SymplecticEuler::critical_time_step(&body), 0.0);
     let before = body.positions().to_vec();
+    let (mut constraints, mut workspace) = (BodyConstraints::new(), SolverWorkspace::new());
     assert!(matches!(
-        SymplecticEuler::default().step(&mut body, 1.0 / 60.0, DVec3::ZERO),
+        SymplecticEuler::default().step(
+            &mut body,
+            &mut constraints,
+            &mut workspace,
+            1.0 / 60.0,
+            DVec3::ZERO
+        ),
         Err(Error::TooManySubsteps { .. })
     ));
     assert_eq!(body.positions(), &before[..]);

@@ -144,9 +144,11 @@ fn step_frames(
     let initial = energy(body);
     let scale = body.total_mass() * 9.81 * 1.0;
     let integrator = AutomaticIntegrator::default();
+    let (mut constraints, mut workspace) = (BodyConstraints::new(), SolverWorkspace::new());
     for _ in 0..frames {
-        let stepped = body
+        let stepped = constraints
             .detect_contacts(
+                body,
                 colliders,
                 &RigidBodySet::new(),
                 case.frame_dt,
@@ -154,7 +156,15 @@ fn step_frames(
                 &ContactSettings::default(),
             )
             .map(|_| ())
-            .and_then(|()| integrator.step(body, case.frame_dt, gravity));
+            .and_then(|()| {
+                integrator.step(
+                    body,
+                    &mut constraints,
+                    &mut workspace,
+                    case.frame_dt,
+                    gravity,
+                )
+            });
         match stepped {
             Ok(report) => case.integrator = integrator_label(&report),
             Err(error) => {

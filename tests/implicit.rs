@@ -27,11 +27,20 @@ fn huge_steps_on_a_stiff_beam_stay_stable_and_never_gain_energy() {
         let explicit_substeps =
             (1.0 / 30.0 / SymplecticEuler::default().stable_time_step(&body)).ceil();
         let integrator = ImplicitIntegrator::default();
+        let (mut constraints, mut workspace) = (BodyConstraints::new(), SolverWorkspace::new());
         let mut energy = total_energy(&body);
         let start = Instant::now();
         let mut iterations = 0;
         for _ in 0..30 {
-            let report = integrator.step(&mut body, 1.0 / 30.0, gravity()).unwrap();
+            let report = integrator
+                .step(
+                    &mut body,
+                    &mut constraints,
+                    &mut workspace,
+                    1.0 / 30.0,
+                    gravity(),
+                )
+                .unwrap();
             assert!(
                 report.converged,
                 "{model:?}: Newton did not converge: {report:?}"
@@ -62,8 +71,17 @@ fn large_steps_settle_on_the_static_solution() {
     statics::solve_equilibrium(&mut statik, gravity(), &StaticSettings::default()).unwrap();
     let (mut body, _) = cantilever([20, 2, 2], material);
     let integrator = ImplicitIntegrator::default();
+    let (mut constraints, mut workspace) = (BodyConstraints::new(), SolverWorkspace::new());
     for _ in 0..200 {
-        integrator.step(&mut body, 1.0 / 60.0, gravity()).unwrap();
+        integrator
+            .step(
+                &mut body,
+                &mut constraints,
+                &mut workspace,
+                1.0 / 60.0,
+                gravity(),
+            )
+            .unwrap();
     }
     let rest = body.mesh().positions()[tip].y;
     let (dynamic, expected) = (
@@ -87,12 +105,28 @@ fn small_steps_agree_with_the_explicit_integrator() {
     let (frame, frames) = (2e-4, 250);
     let mut largest_gap: f64 = 0.0;
     let mut largest_deflection: f64 = 0.0;
+    let (mut implicit_constraints, mut implicit_workspace) =
+        (BodyConstraints::new(), SolverWorkspace::new());
+    let (mut explicit_constraints, mut explicit_workspace) =
+        (BodyConstraints::new(), SolverWorkspace::new());
     for _ in 0..frames {
         ImplicitIntegrator::default()
-            .step(&mut implicit, frame, gravity())
+            .step(
+                &mut implicit,
+                &mut implicit_constraints,
+                &mut implicit_workspace,
+                frame,
+                gravity(),
+            )
             .unwrap();
         SymplecticEuler::default()
-            .step(&mut explicit, frame, gravity())
+            .step(
+                &mut explicit,
+                &mut explicit_constraints,
+                &mut explicit_workspace,
+                frame,
+                gravity(),
+            )
             .unwrap();
         let (a, b) = (implicit.positions()[tip].y, explicit.positions()[tip].y);
         largest_gap = largest_gap.max((a - b).abs());
@@ -157,6 +191,7 @@ fn numerical_damping_matches_the_closed_form_of_each_scheme() {
     ] {
         let h = omega_h / omega;
         let mut body = released.clone();
+        let (mut constraints, mut workspace) = (BodyConstraints::new(), SolverWorkspace::new());
         let rest = body.mesh().positions()[tip].y;
         let integrator = ImplicitIntegrator {
             scheme,
@@ -165,7 +200,9 @@ fn numerical_damping_matches_the_closed_form_of_each_scheme() {
         let steps = (6.0 * 2.0 * PI / omega_h).ceil() as usize;
         let deflection: Vec<f64> = (0..steps)
             .map(|_| {
-                integrator.step(&mut body, h, DVec3::ZERO).unwrap();
+                integrator
+                    .step(&mut body, &mut constraints, &mut workspace, h, DVec3::ZERO)
+                    .unwrap();
                 rest - body.positions()[tip].y
             })
             .collect();
@@ -202,9 +239,18 @@ fn tip_trajectory(
         substeps: steps_per_sample,
         ..Default::default()
     };
+    let (mut constraints, mut workspace) = (BodyConstraints::new(), SolverWorkspace::new());
     (0..samples)
         .map(|_| {
-            integrator.step(&mut body, sample, gravity()).unwrap();
+            integrator
+                .step(
+                    &mut body,
+                    &mut constraints,
+                    &mut workspace,
+                    sample,
+                    gravity(),
+                )
+                .unwrap();
             body.positions()[tip].y
         })
         .collect()
@@ -260,8 +306,17 @@ fn momentum_is_conserved_by_implicit_steps() {
             tolerance: 1e-10,
             ..Default::default()
         };
+        let (mut constraints, mut workspace) = (BodyConstraints::new(), SolverWorkspace::new());
         for _ in 0..10 {
-            integrator.step(&mut body, 1.0 / 60.0, DVec3::ZERO).unwrap();
+            integrator
+                .step(
+                    &mut body,
+                    &mut constraints,
+                    &mut workspace,
+                    1.0 / 60.0,
+                    DVec3::ZERO,
+                )
+                .unwrap();
         }
         let after = body.linear_momentum();
         println!("{scheme:?}: momentum before {before}, after {after}");
@@ -278,23 +333,29 @@ fn a_refused_implicit_step_leaves_the_body_and_its_history_untouched() {
         ..Default::default()
     };
     let (mut twin, _) = cantilever([6, 1, 1], material);
+    let (mut constraints, mut workspace) = (BodyConstraints::new(), SolverWorkspace::new());
+    let (mut twin_constraints, mut twin_workspace) =
+        (BodyConstraints::new(), SolverWorkspace::new());
+    let (c, w) = (&mut constraints, &mut workspace);
+    let (twin_c, twin_w) = (&mut twin_constraints, &mut twin_workspace);
     for _ in 0..3 {
-        bdf2.step(&mut body, 0.01, gravity()).unwrap();
-        bdf2.step(&mut twin, 0.01, gravity()).unwrap();
+        bdf2.step(&mut body, c, w, 0.01, gravity()).unwrap();
+        bdf2.step(&mut twin, twin_c, twin_w, 0.01, gravity())
+            .unwrap();
     }
     let before = (body.positions().to_vec(), body.velocities().to_vec());
     for bad in [
-        bdf2.step(&mut body, 0.01, DVec3::new(f64::NAN, 0.0, 0.0)),
+        bdf2.step(&mut body, c, w, 0.01, DVec3::new(f64::NAN, 0.0, 0.0)),
         ImplicitIntegrator {
             max_newton_iterations: 0,
             ..bdf2
         }
-        .step(&mut body, 0.01, gravity()),
+        .step(&mut body, c, w, 0.01, gravity()),
         ImplicitIntegrator {
             tolerance: -1.0,
             ..bdf2
         }
-        .step(&mut body, 0.01, gravity()),
+        .step(&mut body, c, w, 0.01, gravity()),
     ] {
         assert!(bad.is_err());
     }
@@ -303,8 +364,9 @@ fn a_refused_implicit_step_leaves_the_body_and_its_history_untouched() {
         before
     );
     // The BDF2 history survived: the next step matches the twin's to the last bit.
-    bdf2.step(&mut body, 0.01, gravity()).unwrap();
-    bdf2.step(&mut twin, 0.01, gravity()).unwrap();
+    bdf2.step(&mut body, c, w, 0.01, gravity()).unwrap();
+    bdf2.step(&mut twin, twin_c, twin_w, 0.01, gravity())
+        .unwrap();
     assert_eq!(body.positions()[tip], twin.positions()[tip]);
 }
 
@@ -312,8 +374,10 @@ fn a_refused_implicit_step_leaves_the_body_and_its_history_untouched() {
 fn invalid_implicit_steps_are_typed_errors() {
     let material = Material::new(MaterialModel::Linear, 1e6, 0.3, 1000.0).unwrap();
     let (mut body, _) = cantilever([4, 1, 1], material);
+    let (mut constraints, mut workspace) = (BodyConstraints::new(), SolverWorkspace::new());
+    let (c, w) = (&mut constraints, &mut workspace);
     assert!(matches!(
-        ImplicitIntegrator::default().step(&mut body, -1.0, gravity()),
+        ImplicitIntegrator::default().step(&mut body, c, w, -1.0, gravity()),
         Err(Error::InvalidTimeStep { .. })
     ));
     let zero = ImplicitIntegrator {
@@ -321,7 +385,7 @@ fn invalid_implicit_steps_are_typed_errors() {
         ..Default::default()
     };
     assert!(matches!(
-        zero.step(&mut body, 0.01, gravity()),
+        zero.step(&mut body, c, w, 0.01, gravity()),
         Err(Error::InvalidSetting {
             parameter: "substeps",
             ..
@@ -362,9 +426,18 @@ fn conjugate_gradient_and_direct_steps_agree() {
             ..Default::default()
         };
         let mut body = beam.clone();
+        let (mut constraints, mut workspace) = (BodyConstraints::new(), SolverWorkspace::new());
         let mut linear_iterations = 0;
         for _ in 0..10 {
-            let report = integrator.step(&mut body, 1.0 / 60.0, gravity()).unwrap();
+            let report = integrator
+                .step(
+                    &mut body,
+                    &mut constraints,
+                    &mut workspace,
+                    1.0 / 60.0,
+                    gravity(),
+                )
+                .unwrap();
             assert!(report.converged);
             linear_iterations += report.linear_iterations;
         }
@@ -404,8 +477,17 @@ fn conjugate_gradient_falls_back_to_the_projected_tangent_on_negative_curvature(
     let energy = |body: &DeformableBody| body.kinetic_energy() + body.elastic_energy();
     let (inverted, mut last) = (body.inverted_tet_count(), energy(&body));
     let (mut projected, mut cg_iterations) = (0, 0);
+    let (mut constraints, mut workspace) = (BodyConstraints::new(), SolverWorkspace::new());
     for _ in 0..30 {
-        let report = integrator.step(&mut body, 1.0 / 60.0, DVec3::ZERO).unwrap();
+        let report = integrator
+            .step(
+                &mut body,
+                &mut constraints,
+                &mut workspace,
+                1.0 / 60.0,
+                DVec3::ZERO,
+            )
+            .unwrap();
         projected += report.projected_tangents;
         cg_iterations += report.linear_iterations;
         assert!(body.positions().iter().all(|x| x.is_finite()));
@@ -429,6 +511,7 @@ fn invalid_conjugate_gradient_settings_are_typed_errors() {
     let material = Material::new(MaterialModel::Linear, 1e6, 0.3, 1000.0).unwrap();
     let (mut body, _) = cantilever([4, 1, 1], material);
     let before = body.positions().to_vec();
+    let (mut constraints, mut workspace) = (BodyConstraints::new(), SolverWorkspace::new());
     for (solver, parameter) in [
         (conjugate_gradient(0.0, 100), "linear_solver.tolerance"),
         (conjugate_gradient(-1e-3, 100), "linear_solver.tolerance"),
@@ -443,7 +526,7 @@ fn invalid_conjugate_gradient_settings_are_typed_errors() {
             linear_solver: solver,
             ..Default::default()
         };
-        match integrator.step(&mut body, 0.01, gravity()) {
+        match integrator.step(&mut body, &mut constraints, &mut workspace, 0.01, gravity()) {
             Err(Error::InvalidSetting { parameter: p, .. }) => assert_eq!(p, parameter),
             other => panic!("{solver:?}: {other:?}"),
         }
@@ -451,23 +534,34 @@ fn invalid_conjugate_gradient_settings_are_typed_errors() {
     assert_eq!(body.positions(), &before[..]);
 }
 
-/// `frames` steps of `dt` (s) from `body`, asserting that each converged; the final body, the
-/// Newton iterations that reused a factorization and the factorizations.
+/// A body with the constraints and solver caches kept beside it.
+type BodyState = (DeformableBody, BodyConstraints, SolverWorkspace);
+
+/// A body that has not been stepped, with empty constraints and caches.
+fn unstepped(body: &DeformableBody) -> BodyState {
+    (body.clone(), BodyConstraints::new(), SolverWorkspace::new())
+}
+
+/// `frames` steps of `dt` (s) from `state` (a body with its constraints and solver caches),
+/// asserting that each converged; the final state, the Newton iterations that reused a
+/// factorization and the factorizations.
 fn run_frames(
     integrator: &ImplicitIntegrator,
-    body: &DeformableBody,
+    state: &BodyState,
     frames: usize,
     dt: f64,
-) -> (DeformableBody, usize, usize) {
-    let mut body = body.clone();
+) -> (BodyState, usize, usize) {
+    let (mut body, mut constraints, mut workspace) = state.clone();
     let (mut reused, mut factorizations) = (0, 0);
     for _ in 0..frames {
-        let report = integrator.step(&mut body, dt, gravity()).unwrap();
+        let report = integrator
+            .step(&mut body, &mut constraints, &mut workspace, dt, gravity())
+            .unwrap();
         assert!(report.converged);
         reused += report.reused_factorizations;
         factorizations += report.factorizations;
     }
-    (body, reused, factorizations)
+    ((body, constraints, workspace), reused, factorizations)
 }
 
 #[test]
@@ -504,7 +598,7 @@ fn reusing_factorizations_meets_the_same_tolerance() {
         ),
     ];
     for (label, start, schedule) in cases {
-        let (mut with_exact, mut with_chord) = (start.clone(), start.clone());
+        let (mut with_exact, mut with_chord) = (unstepped(start), unstepped(start));
         let (mut reused, mut chord_factorizations, mut exact_factorizations) = (0, 0, 0);
         for &(frames, dt) in schedule {
             let (body, none, factorizations) = run_frames(&exact, &with_exact, frames, dt);
@@ -516,8 +610,8 @@ fn reusing_factorizations_meets_the_same_tolerance() {
             chord_factorizations += factorizations;
             with_chord = body;
         }
-        let gap = largest_gap(with_exact.positions(), with_chord.positions());
-        let motion = largest_gap(with_exact.positions(), start.positions());
+        let gap = largest_gap(with_exact.0.positions(), with_chord.0.positions());
+        let motion = largest_gap(with_exact.0.positions(), start.positions());
         println!(
             "{label}: gap {gap:.3e} m of {motion:.4} m of motion; exact Newton {exact_factorizations} factorizations, chord {chord_factorizations} factorizations and {reused} reuses"
         );

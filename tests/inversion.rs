@@ -26,10 +26,17 @@ fn soft_cube(model: MaterialModel) -> DeformableBody {
 
 /// Runs backward Euler frames of 1/60 s without gravity; returns the inverted count per frame.
 fn recover(body: &mut DeformableBody, frames: usize) -> Vec<usize> {
+    let (mut constraints, mut workspace) = (BodyConstraints::new(), SolverWorkspace::new());
     (0..frames)
         .map(|_| {
             ImplicitIntegrator::default()
-                .step(body, 1.0 / 60.0, DVec3::ZERO)
+                .step(
+                    body,
+                    &mut constraints,
+                    &mut workspace,
+                    1.0 / 60.0,
+                    DVec3::ZERO,
+                )
                 .unwrap()
                 .inverted_tets
         })
@@ -104,9 +111,16 @@ fn a_tetrahedron_turned_inside_out_recovers_with_the_explicit_integrator_too() {
         body.positions_mut()[3].z = -0.1;
         assert_eq!(body.inverted_tet_count(), 1);
         let mut last = 1;
+        let (mut constraints, mut workspace) = (BodyConstraints::new(), SolverWorkspace::new());
         for _ in 0..120 {
             last = SymplecticEuler::default()
-                .step(&mut body, 1.0 / 60.0, DVec3::ZERO)
+                .step(
+                    &mut body,
+                    &mut constraints,
+                    &mut workspace,
+                    1.0 / 60.0,
+                    DVec3::ZERO,
+                )
                 .unwrap()
                 .inverted_tets;
         }

@@ -73,11 +73,13 @@ struct Scene {
     cube: DeformableBodyHandle,
 }
 
-/// Builds the scene into `bodies`, `colliders` and `soft`.
+/// Builds the scene into `bodies`, `colliders` and `soft`, the rod's attachment into the
+/// `coupling` that steps them.
 fn build(
     bodies: &mut RigidBodySet,
     colliders: &mut ColliderSet,
     soft: &mut DeformableBodySet,
+    coupling: &mut SoftCoupling,
 ) -> Result<Scene, Error> {
     colliders.insert(ColliderBuilder::new(SharedShape::halfspace(Vector::Y)).friction(0.8));
     let driver = bodies.insert(
@@ -100,7 +102,7 @@ fn build(
         .translation(DVec3::new(0.05, 0.5, 0.0))
         .build()?;
     let rod = soft.insert(rod);
-    soft[rod].attach(root, driver, bodies)?;
+    coupling.attach(soft, rod, root, driver, bodies)?;
     let cube = DeformableBodyBuilder::new(mesh::cuboid(DVec3::splat(0.1), [3; 3])?, rubber)
         .damping(damping)
         .translation(DVec3::new(0.5, 0.1, 0.0))
@@ -137,7 +139,12 @@ impl Pair {
         let mut own_soft = DeformableBodySet::new();
         let mut own_coupling = SoftCoupling::default();
         own_coupling.substeps = substeps;
-        let own_scene = build(&mut own.bodies, &mut own.colliders, &mut own_soft)?;
+        let own_scene = build(
+            &mut own.bodies,
+            &mut own.colliders,
+            &mut own_soft,
+            &mut own_coupling,
+        )?;
         let mut world = FvmWorld::default();
         world.coupling.substeps = substeps;
         let physics = &mut world.physics;
@@ -145,6 +152,7 @@ impl Pair {
             &mut physics.bodies,
             &mut physics.colliders,
             &mut world.soft_bodies,
+            &mut world.coupling,
         )?;
         Ok(Self {
             own,

@@ -84,9 +84,7 @@ fn a_stack_of_two_soft_cubes_compresses_as_uniaxial_elasticity_says() {
                     .all(|(_, r)| r.choice == IntegratorKind::Explicit)
             );
             let substep = frame / f64::from(world.coupling.substeps);
-            let (force, _) = world.soft_bodies[bottom]
-                .contact_force_on(ground, substep)
-                .unwrap();
+            let (force, _) = world.contact_force_on(bottom, ground, substep).unwrap();
             reaction -= force.y;
             averaged += 1;
             fastest = world.soft_bodies[top]
@@ -212,12 +210,15 @@ fn a_body_of_two_separate_cubes_lands_on_itself_only_with_self_contact() {
     // as a single body on the ground (friction 0.5 everywhere), settled for 2 s at the default
     // 60 Hz frames. With self-contact the upper cube rests on the lower one: no more overlap than
     // the contact margin plus 1 mm (the issue's bound for a drop), and the ground carries the
-    // whole weight within 1 % (the issue's support bound). Without it the upper cube falls
-    // through to the ground.
+    // whole weight within 1 % (the issue's support bound), under the automatic integrator
+    // (explicit while there are self-contacts) and under forced implicit steps alike. Without it
+    // the upper cube falls through to the ground.
     let young = 1e5;
     let material = rubber(young);
-    for self_contact in [true, false] {
+    let implicit = Some(IntegratorKind::Implicit);
+    for (self_contact, force) in [(true, None), (true, implicit), (false, None)] {
         let (mut world, ground) = world_on_ground(0.5);
+        world.coupling.integrator.force = force;
         let body = DeformableBodyBuilder::new(
             two_cubes_one_mesh(DVec3::new(0.0, SIDE + 2e-3, 0.0)),
             material,
@@ -236,9 +237,7 @@ fn a_body_of_two_separate_cubes_lands_on_itself_only_with_self_contact() {
             step(&mut world);
             if index >= frames - 60 {
                 let substep = frame / f64::from(world.coupling.substeps);
-                let (force, _) = world.soft_bodies[handle]
-                    .contact_force_on(ground, substep)
-                    .unwrap();
+                let (force, _) = world.contact_force_on(handle, ground, substep).unwrap();
                 reaction -= force.y;
                 averaged += 1;
             }
@@ -253,8 +252,8 @@ fn a_body_of_two_separate_cubes_lands_on_itself_only_with_self_contact() {
         let lower_top = mean_height_of_layer(b, SIDE / 2.0);
         let weight = 2.0 * 9.81 * 1000.0 * SIDE.powi(3);
         println!(
-            "self-contact {self_contact}: upper cube's lowest node {:.3} mm, lower cube's top \
-             {:.3} mm, ground reaction {reaction:.4} N vs {weight:.4} N",
+            "self-contact {self_contact}, forced {force:?}: upper cube's lowest node {:.3} mm, \
+             lower cube's top {:.3} mm, ground reaction {reaction:.4} N vs {weight:.4} N",
             upper_lowest * 1e3,
             lower_top * 1e3
         );
@@ -278,7 +277,18 @@ fn the_halves_of_a_body_colliding_in_zero_gravity_conserve_its_momentum() {
     // The angular momentum changes by the impulses' lever-arm mismatch: a node acts on its
     // contact point while the two are within the contact margin of each other, so the change is
     // bounded by the margin times the impulse exchanged (the right cube's final momentum).
+    // Both under the automatic integrator (explicit while there are self-contacts) and under
+    // forced implicit steps, whose penalties push node and triangle equally and oppositely.
+    for force in [None, Some(IntegratorKind::Implicit)] {
+        halves_collide(force);
+    }
+}
+
+/// The collision of [`the_halves_of_a_body_colliding_in_zero_gravity_conserve_its_momentum`]
+/// with the integrator `force`d, or automatic.
+fn halves_collide(force: Option<IntegratorKind>) {
     let mut world = FvmWorld::default();
+    world.coupling.integrator.force = force;
     world.physics.gravity = Vector::ZERO;
     let mesh = two_cubes_one_mesh(DVec3::new(SIDE + 2e-3, 0.03, 0.0));
     let material = rubber(1e5);
@@ -306,7 +316,7 @@ fn the_halves_of_a_body_colliding_in_zero_gravity_conserve_its_momentum() {
     let mut touched = false;
     for _ in 0..30 {
         step(&mut world);
-        touched |= !world.soft_bodies[handle].contacts().is_empty();
+        touched |= !world.coupling.contacts(handle).is_empty();
     }
     let body = &world.soft_bodies[handle];
     let (p1, l1) = momenta(body);
@@ -318,8 +328,8 @@ fn the_halves_of_a_body_colliding_in_zero_gravity_conserve_its_momentum() {
         .sum::<f64>()
         / right_mass;
     println!(
-        "linear momentum change {:.3e} of {:.3} kg m/s; angular {:.3e} kg m²/s, bound {:.3e}; \
-         right cube's speed {:.3} m/s",
+        "forced {force:?}: linear momentum change {:.3e} of {:.3} kg m/s; angular {:.3e} \
+         kg m²/s, bound {:.3e}; right cube's speed {:.3} m/s",
         (p1 - p0).length(),
         p0.length(),
         (l1 - l0).length(),

@@ -55,9 +55,12 @@ fn released_from_static_deflection(
 /// Tip height (m) sampled every `dt` (s) for `duration` (s), with automatic substeps.
 fn tip_history(body: &mut DeformableBody, tip: usize, dt: f64, duration: f64) -> Vec<f64> {
     let integrator = SymplecticEuler::default();
+    let (mut constraints, mut workspace) = (BodyConstraints::new(), SolverWorkspace::new());
     (0..(duration / dt).round() as usize)
         .map(|_| {
-            integrator.step(body, dt, DVec3::ZERO).unwrap();
+            integrator
+                .step(body, &mut constraints, &mut workspace, dt, DVec3::ZERO)
+                .unwrap();
             body.positions()[tip].y
         })
         .collect()
@@ -109,8 +112,11 @@ fn undamped_vibration_has_no_secular_energy_drift() {
     let integrator = SymplecticEuler::default();
     let initial = body.elastic_energy();
     let mut energies = Vec::new();
+    let (mut constraints, mut workspace) = (BodyConstraints::new(), SolverWorkspace::new());
     for _ in 0..50 * per_period {
-        integrator.step(&mut body, dt, DVec3::ZERO).unwrap();
+        integrator
+            .step(&mut body, &mut constraints, &mut workspace, dt, DVec3::ZERO)
+            .unwrap();
         energies.push(body.kinetic_energy() + body.elastic_energy());
     }
     let mean = |e: &[f64]| e.iter().sum::<f64>() / e.len() as f64;

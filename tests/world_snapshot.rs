@@ -37,7 +37,7 @@ fn scene(integrator: Option<IntegratorKind>) -> Result<(FvmWorld, RigidBodyHandl
         .translation(DVec3::new(1.05, 0.9, 0.0))
         .build()?;
     let rod = world.soft_bodies.insert(rod);
-    world.soft_bodies[rod].attach(top, bar, &world.physics.bodies)?;
+    world.attach(rod, top, bar)?;
     Ok((world, bar))
 }
 

@@ -1,6 +1,6 @@
 //! [`DeformableBodyBuilder`]: the rapier-style way to describe a soft body before creating it.
 
-use super::{BodyConstraints, BodySurface, DeformableBody, SolverWorkspace, lumped_masses};
+use super::{BodySurface, DeformableBody, lumped_masses};
 use crate::Error;
 use crate::damping::RayleighDamping;
 use crate::element::{ElementShape, Elements, PressureBasis, QuadraticElements};
@@ -325,13 +325,11 @@ impl DeformableBodyBuilder {
             )?),
             None => None,
         };
-        let node_count = self.mesh.node_count();
         Ok(DeformableBody {
             elements,
             masses,
             surface: BodySurface::of(&self.mesh),
-            workspace: SolverWorkspace::new(node_count),
-            constraints: BodyConstraints::default(),
+            state_edits: 0,
             mesh: self.mesh,
             subdivision_parents,
             material: self.material,

@@ -2,19 +2,14 @@
 //! (m/s) and lumped masses (kg), plus pinned (Dirichlet) nodes.
 
 mod builder;
-mod constraints;
 mod set;
 mod stress;
 mod surface;
-mod workspace;
 
 pub use builder::{DEFAULT_FRICTION, DEFAULT_MIN_ELEMENT_QUALITY, DeformableBodyBuilder};
-pub(crate) use constraints::BodyConstraints;
 pub use set::{DeformableBodyHandle, DeformableBodySet};
 pub(crate) use surface::BodySurface;
-pub(crate) use workspace::SolverWorkspace;
 
-use crate::assembly::Stiffness;
 use crate::damping::RayleighDamping;
 use crate::element::{ElementOrder, ElementShape, Elements};
 use crate::embedding::Embedding;
@@ -49,10 +44,10 @@ pub struct DeformableBody {
     pub(crate) surface: BodySurface,
     /// A fine mesh carried by the nodes, whose surface contacts with colliders act on.
     pub(crate) embedding: Option<Embedding>,
-    /// The integrators' caches.
-    pub(crate) workspace: SolverWorkspace,
-    /// The contacts, rigid corners, attachments and rigid proxies of the coming step.
-    pub(crate) constraints: BodyConstraints,
+    /// How many times the state was edited from outside the integrators
+    /// ([`DeformableBody::positions_mut`], [`DeformableBody::velocities_mut`], a static solve):
+    /// two-step integrators restart after an edit.
+    state_edits: u64,
     /// The collision groups of the surface: the body touches only the colliders whose groups
     /// pass `InteractionGroups::test` with these, as rapier's colliders do.
     pub collision_groups: InteractionGroups,
@@ -71,9 +66,8 @@ pub struct DeformableBody {
     pub restitution_combine_rule: CoefficientCombineRule,
     /// Whether the body's surface collides with itself (a body folding over itself, or made of
     /// separate parts): off by default, as it costs a bounding-volume query per surface node and
-    /// detection. Self-contacts are solved by the explicit integrator
-    /// ([`SymplecticEuler`](crate::integrate::SymplecticEuler)); the automatic integrator picks
-    /// it while there are some, and a forced implicit step ignores them.
+    /// detection. Both integrators solve self-contacts; the automatic one picks the explicit
+    /// ([`SymplecticEuler`](crate::integrate::SymplecticEuler)) while there are some.
     pub self_contact: bool,
     /// Arbitrary user data, as on rapier's bodies.
     pub user_data: u128,
@@ -151,7 +145,7 @@ impl DeformableBody {
 
     /// Mutable world positions of the nodes (m). Editing the state restarts two-step integrators.
     pub fn positions_mut(&mut self) -> &mut [DVec3] {
-        self.workspace.previous_step = None;
+        self.state_edits += 1;
         &mut self.positions
     }
 
@@ -162,7 +156,7 @@ impl DeformableBody {
 
     /// Mutable node velocities (m/s). Editing the state restarts two-step integrators.
     pub fn velocities_mut(&mut self) -> &mut [DVec3] {
-        self.workspace.previous_step = None;
+        self.state_edits += 1;
         &mut self.velocities
     }
 
@@ -193,33 +187,37 @@ impl DeformableBody {
     }
 
     /// Internal forces (N per node): elastic plus damping, at the current positions and velocities.
-    pub fn internal_forces(&mut self) -> &[DVec3] {
-        self.compute_internal_forces();
-        &self.workspace.forces
+    pub fn internal_forces(&mut self) -> Vec<DVec3> {
+        let mut forces = Vec::new();
+        self.internal_forces_into(&mut forces);
+        forces
     }
 
-    /// Copies positions, velocities and the touched rigid bodies aside (no allocation after the
-    /// first call), and starts counting the contact impulses of a new step.
-    pub(crate) fn save_state(&mut self) {
-        self.workspace.saved_positions.clone_from(&self.positions);
-        self.workspace.saved_velocities.clone_from(&self.velocities);
-        self.constraints.save();
+    /// [`DeformableBody::internal_forces`] written into `forces` (resized to one per node), so
+    /// that repeated calls do not allocate.
+    pub fn internal_forces_into(&mut self, forces: &mut Vec<DVec3>) {
+        forces.resize(self.node_count(), DVec3::ZERO);
+        let Self {
+            elements,
+            material,
+            damping,
+            positions,
+            velocities,
+            ..
+        } = self;
+        with_hyperelastic_model!(material, |model| {
+            elements.internal_forces(&model, damping.as_ref(), positions, velocities, forces);
+        });
     }
 
-    /// Puts back the state saved by [`DeformableBody::save_state`].
-    pub(crate) fn restore_state(&mut self) {
-        self.positions.clone_from(&self.workspace.saved_positions);
-        self.velocities.clone_from(&self.workspace.saved_velocities);
-        self.constraints.restore();
+    /// How many times the state was edited from outside the integrators.
+    pub(crate) fn state_edits(&self) -> u64 {
+        self.state_edits
     }
 
-    /// The tangent workspace, built on first use; give it back with
-    /// `self.workspace.tangent = Some(..)`.
-    pub(crate) fn take_tangent(&mut self) -> Stiffness {
-        self.workspace
-            .tangent
-            .take()
-            .unwrap_or_else(|| Stiffness::new(self))
+    /// Counts an edit of the state from outside the integrators (a static solve).
+    pub(crate) fn count_state_edit(&mut self) {
+        self.state_edits += 1;
     }
 
     /// The weight of every free node, `m g` (N); zero on pinned nodes.
@@ -229,28 +227,6 @@ impl DeformableBody {
             .zip(&self.pinned)
             .map(|(m, &pinned)| if pinned { DVec3::ZERO } else { gravity * *m })
             .collect()
-    }
-
-    /// Recomputes `self.forces`.
-    pub(crate) fn compute_internal_forces(&mut self) {
-        let Self {
-            elements,
-            material,
-            damping,
-            positions,
-            velocities,
-            workspace,
-            ..
-        } = self;
-        with_hyperelastic_model!(material, |model| {
-            elements.internal_forces(
-                &model,
-                damping.as_ref(),
-                positions,
-                velocities,
-                &mut workspace.forces,
-            );
-        });
     }
 
     /// Elastic strain energy (J) at the current positions.
@@ -337,12 +313,4 @@ pub(crate) fn lumped_masses(mesh: &TetMesh, density: f64) -> Vec<f64> {
         }
     }
     masses
-}
-
-/// The state at the start of an implicit substep of length `h` (s), kept for the next one.
-#[derive(Debug, Clone)]
-pub(crate) struct PreviousStep {
-    pub(crate) h: f64,
-    pub(crate) positions: Vec<DVec3>,
-    pub(crate) velocities: Vec<DVec3>,
 }

@@ -10,10 +10,10 @@
 
 use super::surface_tree::SurfaceTree;
 use super::{
-    Coefficients, ContactSettings, ContactSides, SoftPoint, SurfaceCoefficients,
-    VelocityConstraint, node_inverse_mass,
+    Coefficients, ContactSettings, ContactSides, SoftPoint, SurfaceCoefficients, VelocityConstraint,
 };
 use crate::body::DeformableBody;
+use crate::stencil::node_inverse_mass;
 use rapier3d::glamx::DVec3;
 
 /// A surface node of one soft body touching a boundary triangle of another.
@@ -30,6 +30,8 @@ pub(crate) struct BetweenContact {
     normal: DVec3,
     /// The two bodies' coefficients, combined.
     coefficients: Coefficients,
+    /// The detection's [`ContactSettings::depenetration_speed`] (m/s).
+    depenetration_speed: f64,
     constraint: VelocityConstraint,
 }
 
@@ -87,6 +89,7 @@ pub(crate) fn detect_between(
                         point: hit.point,
                         normal: hit.normal,
                         coefficients,
+                        depenetration_speed: settings.depenetration_speed,
                         constraint: VelocityConstraint::default(),
                     });
                 }
@@ -132,9 +135,12 @@ pub(crate) fn prepare_between(
             (node_body.velocities[n] - contact.on_triangle.velocity(&triangle_body.velocities))
                 .dot(contact.normal)
         };
-        contact.constraint =
-            VelocityConstraint::new(gap, h, node_body.constraints.settings.depenetration_speed)
-                .bounce(gap, h, normal_speed, contact.coefficients.restitution);
+        contact.constraint = VelocityConstraint::new(gap, h, contact.depenetration_speed).bounce(
+            gap,
+            h,
+            normal_speed,
+            contact.coefficients.restitution,
+        );
     }
 }
 

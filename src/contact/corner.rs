@@ -8,13 +8,26 @@
 //! sweeps solve it like a node's contact with the roles swapped: the rigid body's point takes
 //! the impulse, the triangle's nodes its opposite by the contact point's barycentric weights,
 //! and the plane follows the triangle through the step.
+//!
+//! The implicit side is the penalty `k/2 min(0, g)²` on the gap `g = (v − p(x))·n` between the
+//! vertex `v`, carried over the step by its rigid body's velocity, and the triangle's contact
+//! point `p(x) = Σ w_i x_i`, with `k` the penalty factor times the point's effective `m/ĥ²`, and
+//! the lagged friction on the point's slip relative to the vertex; after the step their forces'
+//! opposite goes to the rigid body at the vertex.
 
 use super::detect::NearCollider;
+use super::node_contact::lagged_friction;
+use super::penalty::effective_mass;
 use super::surface_tree::SurfaceTree;
-use super::{Coefficients, ContactSides, RigidProxy, SoftPoint, VelocityConstraint};
-use crate::body::BodyConstraints;
+use super::{
+    Coefficients, ContactSet, ContactSettings, ContactSides, SoftPoint, VelocityConstraint,
+    penalty_tangent,
+};
 use crate::body::DeformableBody;
+use crate::rigid::RigidProxy;
+use crate::stencil::Stencil;
 use rapier3d::geometry::{ColliderHandle, Shape};
+use rapier3d::glamx::DMat3;
 use rapier3d::glamx::DVec3;
 use rapier3d::math::Pose;
 use rapier3d::parry::bounding_volume::BoundingVolume;
@@ -37,6 +50,10 @@ pub(crate) struct CornerContact {
     constraint: VelocityConstraint,
     /// The impulse (N s) the triangle gave the collider over the last step.
     pub(crate) impulse: DVec3,
+    /// Within an implicit step: the normal force (N) friction is limited by, and the triangle
+    /// point's position (m) at the start of the step.
+    lagged_normal_force: f64,
+    slip_origin: DVec3,
 }
 
 impl CornerContact {
@@ -85,63 +102,68 @@ fn for_each_vertex(shape: &dyn Shape, pose: &Pose, each: &mut impl FnMut(DVec3, 
     }
 }
 
-impl DeformableBody {
-    /// The contacts of the vertices of `near`'s shape within its reach (m) of the body's boundary
-    /// triangles in `tree`, skipping triangles with a node glued to the collider's rigid body;
-    /// their proxy is left for the caller to set.
-    pub(super) fn find_corner_contacts(
-        &self,
-        tree: &SurfaceTree,
-        near: &NearCollider<'_>,
-    ) -> Vec<CornerContact> {
-        let NearCollider {
-            handle: collider,
-            shape,
-            pose,
-            reach,
-            coefficients,
-            ref glued,
-            ..
-        } = *near;
-        let bounds = tree.bounds.loosened(reach as f32);
-        let mut found = Vec::new();
-        for_each_vertex(shape.as_ref(), pose, &mut |vertex, outward| {
-            if !bounds.contains_local_point(vertex.as_vec3()) {
-                return;
-            }
-            let skipped = |triangle: &[u32; 3]| triangle.iter().any(|n| glued.contains(n));
-            if let Some(hit) = tree.nearest_facing(self, vertex, outward, reach, skipped) {
-                found.push(CornerContact {
-                    collider,
-                    proxy: None,
-                    vertex,
-                    on_triangle: hit.soft_point(),
-                    point: hit.point,
-                    normal: hit.normal,
-                    coefficients,
-                    constraint: VelocityConstraint::default(),
-                    impulse: DVec3::ZERO,
-                });
-            }
-        });
-        found
-    }
+/// The contacts of the vertices of `near`'s shape within its reach (m) of `body`'s boundary
+/// triangles in `tree`, skipping triangles with a node glued to the collider's rigid body; their
+/// proxy is left for the caller to set.
+pub(super) fn find_corner_contacts(
+    body: &DeformableBody,
+    tree: &SurfaceTree,
+    near: &NearCollider<'_>,
+) -> Vec<CornerContact> {
+    let NearCollider {
+        handle: collider,
+        shape,
+        pose,
+        reach,
+        coefficients,
+        ref glued,
+        ..
+    } = *near;
+    let bounds = tree.bounds.loosened(reach as f32);
+    let mut found = Vec::new();
+    for_each_vertex(shape.as_ref(), pose, &mut |vertex, outward| {
+        if !bounds.contains_local_point(vertex.as_vec3()) {
+            return;
+        }
+        let skipped = |triangle: &[u32; 3]| triangle.iter().any(|n| glued.contains(n));
+        if let Some(hit) = tree.nearest_facing(body, vertex, outward, reach, skipped) {
+            found.push(CornerContact {
+                collider,
+                proxy: None,
+                vertex,
+                on_triangle: hit.soft_point(),
+                point: hit.point,
+                normal: hit.normal,
+                coefficients,
+                constraint: VelocityConstraint::default(),
+                impulse: DVec3::ZERO,
+                lagged_normal_force: 0.0,
+                slip_origin: DVec3::ZERO,
+            });
+        }
+    });
+    found
 }
 
 /// Readies the corner contacts for an explicit substep of `h` (s): each plane moves to its
 /// triangle's contact point where the nodes are now.
-pub(crate) fn prepare_corners(body: &mut DeformableBody, h: f64) {
-    let depenetration_speed = body.constraints.settings.depenetration_speed;
-    for contact in &mut body.constraints.corner_contacts {
+pub(crate) fn prepare_corners(
+    body: &DeformableBody,
+    contacts: &mut ContactSet,
+    proxies: &[RigidProxy],
+    h: f64,
+) {
+    let depenetration_speed = contacts.settings.depenetration_speed;
+    for contact in &mut contacts.corners {
         if let Some((point, normal)) = contact.on_triangle.plane(&body.positions) {
             contact.point = point;
             contact.normal = normal;
         }
         let gap = (contact.vertex - contact.point).dot(contact.normal);
         let normal_speed = || {
-            let vertex_velocity = contact.proxy.map_or(DVec3::ZERO, |p| {
-                body.constraints.rigid_proxies[p].velocity_at(contact.vertex)
-            });
+            let vertex_velocity = contact
+                .proxy
+                .map_or(DVec3::ZERO, |p| proxies[p].velocity_at(contact.vertex));
             (vertex_velocity - contact.on_triangle.velocity(&body.velocities)).dot(contact.normal)
         };
         contact.constraint = VelocityConstraint::new(gap, h, depenetration_speed).bounce(
@@ -155,31 +177,29 @@ pub(crate) fn prepare_corners(body: &mut DeformableBody, h: f64) {
 
 /// Moves the corners with their rigid bodies' velocities for `h` (s), as the body's nodes move
 /// at the end of an explicit substep: the gaps then follow both sides.
-pub(crate) fn advance_corners(body: &mut DeformableBody, h: f64) {
-    for contact in &mut body.constraints.corner_contacts {
+pub(crate) fn advance_corners(contacts: &mut ContactSet, proxies: &[RigidProxy], h: f64) {
+    for contact in &mut contacts.corners {
         if let Some(p) = contact.proxy {
-            contact.vertex += body.constraints.rigid_proxies[p].velocity_at(contact.vertex) * h;
+            contact.vertex += proxies[p].velocity_at(contact.vertex) * h;
         }
     }
 }
 
 /// One sweep over the corner contacts (see [`VelocityConstraint`]).
-pub(crate) fn solve_corners(body: &mut DeformableBody) {
+pub(crate) fn solve_corners(
+    body: &mut DeformableBody,
+    contacts: &mut ContactSet,
+    proxies: &mut [RigidProxy],
+) {
     let DeformableBody {
-        constraints:
-            BodyConstraints {
-                corner_contacts,
-                rigid_proxies,
-                ..
-            },
         velocities,
         masses,
         pinned,
         ..
     } = body;
-    for contact in corner_contacts.iter_mut() {
+    for contact in &mut contacts.corners {
         let mut sides = Corner {
-            rigid: contact.proxy.map(|p| &mut rigid_proxies[p]),
+            rigid: contact.proxy.map(|p| &mut proxies[p]),
             vertex: contact.vertex,
             velocities,
             masses,
@@ -225,5 +245,150 @@ impl ContactSides for Corner<'_> {
         }
         self.on_triangle
             .apply(-impulse, self.velocities, self.masses, self.pinned);
+    }
+}
+
+/// An implicit step as a corner's terms see it: the contact settings and the effective step
+/// length (s).
+type ImplicitStep<'a> = (&'a ContactSettings, f64);
+
+/// A corner's sides at the body's current positions: the triangle's point as a stencil, its
+/// position (m) and effective mass (kg), and the vertex's velocity (m/s).
+type Sides<'a> = (Stencil<'a>, DVec3, f64, DVec3);
+
+impl CornerContact {
+    /// The contact's [`Sides`] with the body at `body` and the rigid proxies `proxies`.
+    fn sides(&self, body: &DeformableBody, proxies: &[RigidProxy]) -> Sides<'_> {
+        let at = self.on_triangle.stencil();
+        let point = at.interpolate(&body.positions);
+        let mass = effective_mass(&at, &body.masses, &body.pinned);
+        (at, point, mass, self.vertex_velocity(proxies))
+    }
+
+    /// The vertex's velocity (m/s), with its rigid body's proxy among `proxies`.
+    fn vertex_velocity(&self, proxies: &[RigidProxy]) -> DVec3 {
+        self.proxy
+            .map_or(DVec3::ZERO, |p| proxies[p].velocity_at(self.vertex))
+    }
+
+    /// The penalty stiffness (N/m) and gap (m) of the contact in an implicit `step`, with the
+    /// triangle's point at `point` (m) of effective mass `mass` (kg) and the vertex moving at
+    /// `vertex_velocity` (m/s); `None` while the vertex stays outside.
+    fn penalty(
+        &self,
+        point: DVec3,
+        mass: f64,
+        vertex_velocity: DVec3,
+        (settings, h): ImplicitStep,
+    ) -> Option<(f64, f64)> {
+        let gap = (self.vertex + vertex_velocity * h - point).dot(self.normal);
+        (gap < 0.0).then(|| (settings.penalty_stiffness(mass, h), gap))
+    }
+
+    /// The lagged friction of the triangle's point at `point` (m) against the vertex moving at
+    /// `vertex_velocity` (m/s) over an implicit `step`: energy (J), force on the point (N),
+    /// tangent (N/m).
+    fn friction_term(
+        &self,
+        point: DVec3,
+        vertex_velocity: DVec3,
+        (settings, h): ImplicitStep,
+    ) -> Option<(f64, DVec3, DMat3)> {
+        lagged_friction(
+            self.coefficients.friction * self.lagged_normal_force,
+            self.normal,
+            point - self.slip_origin - vertex_velocity * h,
+            settings.stiction_speed * h,
+        )
+    }
+
+    /// The implicit force (N) on the triangle's point at `point` (m), of effective mass `mass`
+    /// (kg), the vertex moving at `vertex_velocity` (m/s).
+    fn implicit_force(
+        &self,
+        point: DVec3,
+        mass: f64,
+        vertex_velocity: DVec3,
+        step: ImplicitStep,
+    ) -> DVec3 {
+        let penalty = self
+            .penalty(point, mass, vertex_velocity, step)
+            .map_or(DVec3::ZERO, |(k, gap)| self.normal * (k * gap));
+        let friction = self
+            .friction_term(point, vertex_velocity, step)
+            .map_or(DVec3::ZERO, |(_, force, _)| force);
+        penalty + friction
+    }
+}
+
+/// Readies the corners' implicit friction for a step of effective length `h` (s) from the
+/// body's positions: each friction limit is the penalty force there, and slip is measured from
+/// there.
+pub(crate) fn lag_corner_friction(
+    body: &DeformableBody,
+    contacts: &mut ContactSet,
+    proxies: &[RigidProxy],
+    h: f64,
+) {
+    let settings = contacts.settings;
+    for contact in &mut contacts.corners {
+        let (_, point, mass, velocity) = contact.sides(body, proxies);
+        contact.lagged_normal_force = contact
+            .penalty(point, mass, velocity, (&settings, h))
+            .map_or(0.0, |(k, gap)| -k * gap);
+        contact.slip_origin = point;
+    }
+}
+
+/// Calls `each(point, energy (J), force (N), tangent (N/m))` for the implicit penalty and
+/// friction of every corner for an effective step `h` (s), at the body's positions, on the
+/// triangle's contact point: the penalty `k g²/2` with force `k g n` (into the body) and tangent
+/// `k n nᵀ`, then the lagged friction.
+pub(crate) fn for_each_corner_term(
+    body: &DeformableBody,
+    contacts: &ContactSet,
+    proxies: &[RigidProxy],
+    h: f64,
+    mut each: impl FnMut(Stencil, f64, DVec3, DMat3),
+) {
+    let step = (&contacts.settings, h);
+    for contact in &contacts.corners {
+        let (at, point, mass, velocity) = contact.sides(body, proxies);
+        if let Some((k, gap)) = contact.penalty(point, mass, velocity, step) {
+            let tangent = penalty_tangent(k, contact.normal);
+            each(at, 0.5 * k * gap * gap, contact.normal * (k * gap), tangent);
+        }
+        if let Some((energy, force, tangent)) = contact.friction_term(point, velocity, step) {
+            each(at, energy, force, tangent);
+        }
+    }
+}
+
+/// Calls `each` with the stencil of every corner's triangle point.
+pub(crate) fn for_each_corner_stencil(contacts: &ContactSet, mut each: impl FnMut(Stencil)) {
+    for contact in &contacts.corners {
+        each(contact.on_triangle.stencil());
+    }
+}
+
+/// Records the impulses (N s) the implicit corner terms gave the triangles over a substep of
+/// length `h` (s, effective length `effective_h`), at the positions that ended it: the
+/// collider receives their opposite at the vertex, and its rigid body's proxy too.
+pub(crate) fn record_corner_impulses(
+    body: &DeformableBody,
+    contacts: &mut ContactSet,
+    proxies: &mut [RigidProxy],
+    effective_h: f64,
+    h: f64,
+) {
+    let settings = contacts.settings;
+    for contact in &mut contacts.corners {
+        let (_, point, mass, velocity) = contact.sides(body, proxies);
+        let on_collider =
+            -contact.implicit_force(point, mass, velocity, (&settings, effective_h)) * h;
+        contact.impulse += on_collider;
+        if let Some(p) = contact.proxy {
+            proxies[p].apply(on_collider, contact.vertex);
+        }
     }
 }

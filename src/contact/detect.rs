@@ -1,292 +1,256 @@
 //! Contact detection against rapier colliders: each surface node is projected onto every
 //! non-sensor collider within reach whose collision groups interact with the body's (parry's
 //! point projection, so every shape), and keeps the nearest surface point and outward normal;
-//! rigid vertices are tested against the boundary triangles. Also the exchange with rapier: the
-//! impulses handed to rigid bodies and the force on any collider.
+//! rigid vertices are tested against the boundary triangles. Also the force the contacts exerted
+//! on any collider.
 
 use super::{
-    BodyPoint, Coefficients, ContactSettings, ContactTarget, NodeContact, Obstacle, RigidProxy,
-    SurfaceCoefficients, coming_velocity, corner, surface_tree,
+    BodyPoint, Coefficients, ContactSet, ContactSettings, ContactTarget, CornerContact,
+    NodeContact, Obstacle, SurfaceCoefficients, corner, surface_tree,
 };
 use crate::Error;
 use crate::body::DeformableBody;
+use crate::rigid::{RigidProxy, coming_velocity};
 use rapier3d::dynamics::{RigidBody, RigidBodyHandle, RigidBodySet};
 use rapier3d::geometry::{Collider, ColliderHandle, ColliderSet, Shape, SharedShape};
 use rapier3d::glamx::DVec3;
 use rapier3d::math::Pose;
 
-impl DeformableBody {
-    /// Finds the contacts of the body's surface nodes with `colliders` for a frame of `frame_dt`
-    /// (s) under `gravity` (m/s²), replacing the previous ones: a node gets a contact with each
-    /// non-sensor collider its [`DeformableBody::collision_groups`] interact with and it is within
-    /// `margin` of, plus twice the distance the body's fastest
-    /// node can travel in the frame (`2 (|v|max + |g| dt) dt`), plus twice the collider's own
-    /// travel (at most 1 m), except the colliders of a rigid body the node is attached to. The
-    /// integrators enforce them until
-    /// the next detection. It also places the attachments' anchors where their rigid bodies are
-    /// now, ready for the step.
-    ///
-    /// # Errors
-    /// [`Error::InvalidTimeStep`], [`Error::NonFiniteInput`] or [`Error::InvalidSetting`] for a bad
-    /// step, gravity or setting; the contacts are then left as they were.
-    pub fn detect_contacts(
-        &mut self,
-        colliders: &ColliderSet,
-        bodies: &RigidBodySet,
-        frame_dt: f64,
-        gravity: DVec3,
-        settings: &ContactSettings,
-    ) -> Result<&[NodeContact], Error> {
-        Error::check_step(frame_dt, gravity)?;
-        settings.check()?;
-        let mut contacts = Vec::new();
-        let mut proxies: Vec<RigidProxy> = Vec::new();
-        // Elastic waves can speed a node up within the frame: reach as far as the body's fastest
-        // node, twice over.
-        let reach = settings.margin
-            + 2.0 * (self.fastest_node_speed() + gravity.length() * frame_dt) * frame_dt;
-        let bounds = self.position_bounds();
-        let mut tree = None;
-        let mut corners = Vec::new();
-        let contact_points = self.contact_points();
-        for (handle, collider) in colliders.iter() {
-            if collider.is_sensor() || !self.collision_groups.test(collider.collision_groups()) {
+/// What one detection found for a body: its surface points' contacts, the rigid vertices
+/// against its triangles, the proxies of the rigid bodies they touch, and the reach (m) used.
+pub(crate) struct Detection {
+    pub(crate) nodes: Vec<NodeContact>,
+    pub(crate) corners: Vec<CornerContact>,
+    pub(crate) proxies: Vec<RigidProxy>,
+    pub(crate) reach: f64,
+}
+
+/// Finds the contacts of `body`'s surface points with `colliders` for a frame of `frame_dt` (s)
+/// under `gravity` (m/s²) (see
+/// [`BodyConstraints::detect_contacts`](crate::constraint::BodyConstraints::detect_contacts));
+/// `glued` lists the rigid bodies and the nodes glued to them, which do not touch their
+/// colliders.
+///
+/// # Errors
+/// [`Error::InvalidTimeStep`], [`Error::NonFiniteInput`] or [`Error::InvalidSetting`] for a bad
+/// step, gravity or setting.
+pub(crate) fn detect(
+    body: &DeformableBody,
+    glued: &[(RigidBodyHandle, u32)],
+    colliders: &ColliderSet,
+    bodies: &RigidBodySet,
+    frame_dt: f64,
+    gravity: DVec3,
+    settings: &ContactSettings,
+) -> Result<Detection, Error> {
+    Error::check_step(frame_dt, gravity)?;
+    settings.check()?;
+    let mut nodes = Vec::new();
+    let mut proxies: Vec<RigidProxy> = Vec::new();
+    // Elastic waves can speed a node up within the frame: reach as far as the body's fastest
+    // node, twice over.
+    let reach = settings.margin
+        + 2.0 * (body.fastest_node_speed() + gravity.length() * frame_dt) * frame_dt;
+    let bounds = body.position_bounds();
+    let mut tree = None;
+    let mut corners = Vec::new();
+    let contact_points = contact_points(body);
+    for (handle, collider) in colliders.iter() {
+        if collider.is_sensor() || !body.collision_groups.test(collider.collision_groups()) {
+            continue;
+        }
+        let near = near_collider(body, glued, handle, collider, bodies, reach, frame_dt);
+        let mut proxy = None;
+        for &at in &contact_points {
+            let Some(contact) = node_contact_with(body, &near, at) else {
                 continue;
+            };
+            if proxy.is_none() {
+                proxy = near.proxy_in(&mut proxies, frame_dt);
             }
-            let near = self.near_collider(handle, collider, bodies, reach, frame_dt);
-            let mut proxy = None;
-            for &at in &contact_points {
-                let Some(contact) = self.node_contact_with(&near, at) else {
-                    continue;
-                };
-                if proxy.is_none() {
-                    proxy = near.proxy_in(&mut proxies, frame_dt);
+            nodes.push(contact.with_proxy(proxy));
+        }
+        if near.overlaps(bounds) && corner::has_vertices(near.shape.as_ref()) {
+            let tree = tree.get_or_insert_with(|| surface_tree::SurfaceTree::of(body));
+            let mut found = corner::find_corner_contacts(body, tree, &near);
+            if !found.is_empty() {
+                let proxy = proxy.or_else(|| near.proxy_in(&mut proxies, frame_dt));
+                for contact in &mut found {
+                    contact.proxy = proxy;
                 }
-                contacts.push(contact.with_proxy(proxy));
             }
-            if near.overlaps(bounds) && corner::has_vertices(near.shape.as_ref()) {
-                let tree = tree.get_or_insert_with(|| surface_tree::SurfaceTree::of(self));
-                let mut found = self.find_corner_contacts(tree, &near);
-                if !found.is_empty() {
-                    let proxy = proxy.or_else(|| near.proxy_in(&mut proxies, frame_dt));
-                    for contact in &mut found {
-                        contact.proxy = proxy;
-                    }
-                }
-                corners.extend(found);
-            }
-        }
-        self.constraints.corner_contacts = corners;
-        crate::attachment::ready(
-            &mut self.constraints.attachments,
-            &mut proxies,
-            bodies,
-            frame_dt,
-        );
-        self.constraints.contacts = contacts;
-        self.constraints.rigid_proxies = proxies;
-        if self.self_contact {
-            self.detect_self_contacts(reach);
-        }
-        self.constraints.settings = *settings;
-        Ok(&self.constraints.contacts)
-    }
-
-    /// What detection needs of `collider` (handle `handle`): its shape, pose, parent body,
-    /// coefficients, the nodes glued to its body, and `reach` (m) widened by its own travel over
-    /// the frame of `frame_dt` (s).
-    fn near_collider<'a>(
-        &self,
-        handle: ColliderHandle,
-        collider: &'a Collider,
-        bodies: &'a RigidBodySet,
-        reach: f64,
-        frame_dt: f64,
-    ) -> NearCollider<'a> {
-        let aabb = collider.compute_aabb();
-        let parent = collider
-            .parent()
-            .and_then(|handle| bodies.get(handle).map(|body| (handle, body)));
-        // The collider's own travel in the frame, at its fastest point.
-        let collider_reach = parent.map_or(0.0, |(_, body)| {
-            let radius = f64::from(aabb.half_extents().length());
-            let (linvel, angvel) = coming_velocity(body, frame_dt);
-            2.0 * (linvel.length() + angvel.length() * radius) * frame_dt
-        });
-        NearCollider {
-            handle,
-            shape: collider.shared_shape(),
-            pose: collider.position(),
-            parent,
-            reach: reach + collider_reach.min(MAX_COLLIDER_REACH),
-            bounds: (aabb.mins.as_dvec3(), aabb.maxs.as_dvec3()),
-            glued: self
-                .constraints
-                .attachments
-                .iter()
-                .filter(|a| Some(a.body) == collider.parent())
-                .map(|a| a.node)
-                .collect(),
-            coefficients: SurfaceCoefficients::of_body(self)
-                .combine(SurfaceCoefficients::of_collider(collider)),
+            corners.extend(found);
         }
     }
+    Ok(Detection {
+        nodes,
+        corners,
+        proxies,
+        reach,
+    })
+}
 
-    /// The contact of the body's point `at` with `near`, if it lies within reach of its surface
-    /// and can move apart from it (not pinned, not glued to the collider's body); its proxy is
-    /// left for the caller to set.
-    fn node_contact_with(&self, near: &NearCollider<'_>, at: BodyPoint) -> Option<NodeContact> {
-        let stencil = at.stencil(self.embedding.as_ref());
-        if stencil.nodes.iter().all(|&n| self.pinned[n as usize])
-            || stencil.nodes.iter().any(|n| near.glued.contains(n))
-        {
-            return None;
-        }
-        let x = stencil.interpolate(&self.positions);
-        let reach = DVec3::splat(near.reach);
-        let (lo, hi) = near.bounds;
-        if (x + reach).cmplt(lo).any() || (x - reach).cmpgt(hi).any() {
-            return None;
-        }
-        let (point, normal, distance) = nearest_surface_point(near.shape.as_ref(), near.pose, x)?;
-        (distance <= near.reach).then(|| {
-            NodeContact::new(
-                at,
-                ContactTarget::Collider(near.handle),
-                point,
-                normal,
-                near.coefficients,
-                Obstacle::Collider {
-                    shape: near.shape.clone(),
-                    pose: *near.pose,
-                    proxy: None,
-                },
-            )
-        })
-    }
-
-    /// The points contacts with colliders are detected for: the surface vertices of the
-    /// embedded mesh if the body has one, else its surface nodes.
-    pub(super) fn contact_points(&self) -> Vec<BodyPoint> {
-        match &self.embedding {
-            Some(embedding) => embedding
-                .surface_vertices()
-                .iter()
-                .map(|&v| BodyPoint::Embedded(v))
-                .collect(),
-            None => self
-                .surface
-                .nodes
-                .iter()
-                .map(|&n| BodyPoint::Node(n))
-                .collect(),
-        }
-    }
-
-    /// The contacts found by the last [`DeformableBody::detect_contacts`].
-    pub fn contacts(&self) -> &[NodeContact] {
-        &self.constraints.contacts
-    }
-
-    /// Removes every contact.
-    pub fn clear_contacts(&mut self) {
-        self.constraints.contacts.clear();
-        self.constraints.corner_contacts.clear();
-        self.constraints.rigid_proxies.clear();
-    }
-
-    /// The impulse (N s) and angular impulse about the centre of mass (N m s) the body gave each
-    /// rigid body it touches or is attached to over the last step, not yet handed to rapier (see
-    /// [`DeformableBody::transfer_contact_impulses`]).
-    pub fn rigid_impulses(&self) -> impl Iterator<Item = (RigidBodyHandle, DVec3, DVec3)> + '_ {
-        self.constraints
-            .rigid_proxies
+/// What detection needs of `collider` (handle `handle`): its shape, pose, parent body,
+/// coefficients, the nodes glued to its body (from `glued`), and `reach` (m) widened by its own
+/// travel over the frame of `frame_dt` (s).
+fn near_collider<'a>(
+    body: &DeformableBody,
+    glued: &[(RigidBodyHandle, u32)],
+    handle: ColliderHandle,
+    collider: &'a Collider,
+    bodies: &'a RigidBodySet,
+    reach: f64,
+    frame_dt: f64,
+) -> NearCollider<'a> {
+    let aabb = collider.compute_aabb();
+    let parent = collider
+        .parent()
+        .and_then(|handle| bodies.get(handle).map(|body| (handle, body)));
+    // The collider's own travel in the frame, at its fastest point.
+    let collider_reach = parent.map_or(0.0, |(_, rigid)| {
+        let radius = f64::from(aabb.half_extents().length());
+        let (linvel, angvel) = coming_velocity(rigid, frame_dt);
+        2.0 * (linvel.length() + angvel.length() * radius) * frame_dt
+    });
+    NearCollider {
+        handle,
+        shape: collider.shared_shape(),
+        pose: collider.position(),
+        parent,
+        reach: reach + collider_reach.min(MAX_COLLIDER_REACH),
+        bounds: (aabb.mins.as_dvec3(), aabb.maxs.as_dvec3()),
+        glued: glued
             .iter()
-            .map(|proxy| (proxy.handle, proxy.impulse, proxy.angular_impulse))
+            .filter(|(rigid, _)| Some(*rigid) == collider.parent())
+            .map(|(_, node)| *node)
+            .collect(),
+        coefficients: SurfaceCoefficients::of_body(body)
+            .combine(SurfaceCoefficients::of_collider(collider)),
     }
+}
 
-    /// Hands the impulses the contacts of the last step gave rigid bodies to rapier's set (the
-    /// opposite of what the soft body received), and forgets them.
-    pub fn transfer_contact_impulses(&mut self, bodies: &mut RigidBodySet) {
-        for proxy in &mut self.constraints.rigid_proxies {
-            proxy.transfer(bodies);
-            proxy.impulse = DVec3::ZERO;
-            proxy.angular_impulse = DVec3::ZERO;
-        }
+/// The contact of `body`'s point `at` with `near`, if it lies within reach of its surface and
+/// can move apart from it (not pinned, not glued to the collider's body); its proxy is left for
+/// the caller to set.
+fn node_contact_with(
+    body: &DeformableBody,
+    near: &NearCollider<'_>,
+    at: BodyPoint,
+) -> Option<NodeContact> {
+    let stencil = at.stencil(body.embedding.as_ref());
+    if stencil.nodes.iter().all(|&n| body.pinned[n as usize])
+        || stencil.nodes.iter().any(|n| near.glued.contains(n))
+    {
+        return None;
     }
+    let x = stencil.interpolate(&body.positions);
+    let reach = DVec3::splat(near.reach);
+    let (lo, hi) = near.bounds;
+    if (x + reach).cmplt(lo).any() || (x - reach).cmpgt(hi).any() {
+        return None;
+    }
+    let (point, normal, distance) = nearest_surface_point(near.shape.as_ref(), near.pose, x)?;
+    (distance <= near.reach).then(|| {
+        NodeContact::new(
+            at,
+            ContactTarget::Collider(near.handle),
+            point,
+            normal,
+            near.coefficients,
+            Obstacle::Collider {
+                shape: near.shape.clone(),
+                pose: *near.pose,
+                proxy: None,
+            },
+        )
+    })
+}
 
-    /// Each contact's collider, the point (m) it acts at, and the mean force (N) it exerted on
-    /// the collider over the last step of `dt` (s): node contacts at their points' end-of-step
-    /// positions, rigid vertices at the vertices; nodes first, then vertices, in order.
-    fn forces_on_colliders(
-        &self,
-        dt: f64,
-    ) -> impl Iterator<Item = (ColliderHandle, DVec3, DVec3)> + '_ {
-        let from_nodes = self
-            .constraints
-            .contacts
+/// The points contacts with colliders are detected for: the surface vertices of the embedded
+/// mesh if `body` has one, else its surface nodes.
+fn contact_points(body: &DeformableBody) -> Vec<BodyPoint> {
+    match &body.embedding {
+        Some(embedding) => embedding
+            .surface_vertices()
             .iter()
-            .filter_map(move |c| match c.target {
-                ContactTarget::Collider(collider) => {
-                    let at = c.at.stencil(self.embedding.as_ref());
-                    Some((collider, at.interpolate(&self.positions), -c.impulse / dt))
-                }
-                ContactTarget::OwnSurface { .. } => None,
-            });
-        let from_corners = self.constraints.corner_contacts.iter().map(move |c| {
-            let (at, force) = c.force_on_collider(dt);
-            (c.collider, at, force)
-        });
-        from_nodes.chain(from_corners)
+            .map(|&v| BodyPoint::Embedded(v))
+            .collect(),
+        None => body
+            .surface
+            .nodes
+            .iter()
+            .map(|&n| BodyPoint::Node(n))
+            .collect(),
     }
+}
 
-    /// The impulse (N s) and angular impulse about the world origin (N m s) the body's contacts
-    /// gave each collider they touch over the last step (see
-    /// [`DeformableBody::contact_force_on`]), one entry per collider.
-    pub(crate) fn collider_impulses(&self) -> Vec<(ColliderHandle, DVec3, DVec3)> {
-        let mut totals: Vec<(ColliderHandle, DVec3, DVec3)> = Vec::new();
-        for (collider, at, impulse) in self.forces_on_colliders(1.0) {
-            let angular = at.cross(impulse);
-            match totals.iter_mut().find(|(c, _, _)| *c == collider) {
-                Some((_, total, total_angular)) => {
-                    *total += impulse;
-                    *total_angular += angular;
-                }
-                None => totals.push((collider, impulse, angular)),
+/// Each contact's collider, the point (m) it acts at, and the mean force (N) it exerted on the
+/// collider over the last step of `dt` (s): node contacts at their points' end-of-step
+/// positions, rigid vertices at the vertices; nodes first, then vertices, in order.
+fn forces_on_colliders<'a>(
+    body: &'a DeformableBody,
+    contacts: &'a ContactSet,
+    dt: f64,
+) -> impl Iterator<Item = (ColliderHandle, DVec3, DVec3)> + 'a {
+    let from_nodes = contacts.nodes.iter().filter_map(move |c| match c.target {
+        ContactTarget::Collider(collider) => {
+            let at = c.at.stencil(body.embedding.as_ref());
+            Some((collider, at.interpolate(&body.positions), -c.impulse / dt))
+        }
+        ContactTarget::OwnSurface { .. } => None,
+    });
+    let from_corners = contacts.corners.iter().map(move |c| {
+        let (at, force) = c.force_on_collider(dt);
+        (c.collider, at, force)
+    });
+    from_nodes.chain(from_corners)
+}
+
+/// The impulse (N s) and angular impulse about the world origin (N m s) `body`'s `contacts`
+/// gave each collider they touch over the last step, one entry per collider.
+pub(crate) fn collider_impulses(
+    body: &DeformableBody,
+    contacts: &ContactSet,
+) -> Vec<(ColliderHandle, DVec3, DVec3)> {
+    let mut totals: Vec<(ColliderHandle, DVec3, DVec3)> = Vec::new();
+    for (collider, at, impulse) in forces_on_colliders(body, contacts, 1.0) {
+        let angular = at.cross(impulse);
+        match totals.iter_mut().find(|(c, _, _)| *c == collider) {
+            Some((_, total, total_angular)) => {
+                *total += impulse;
+                *total_angular += angular;
             }
+            None => totals.push((collider, impulse, angular)),
         }
-        totals
     }
+    totals
+}
 
-    /// The mean force (N) and torque about the world origin (N m) the soft body's contacts
-    /// exerted on `collider` over the last step, of length `dt` (s): their impulses over `dt`
-    /// (the torque taken at the nodes' end-of-step positions, and at the collider's vertices for
-    /// its corners pressing on the surface). In an
-    /// [`FvmWorld`](crate::world::FvmWorld) the last step is the frame's last coupling substep.
-    ///
-    /// # Errors
-    /// [`Error::InvalidTimeStep`] for a non-positive or non-finite `dt`.
-    pub fn contact_force_on(
-        &self,
-        collider: ColliderHandle,
-        dt: f64,
-    ) -> Result<(DVec3, DVec3), Error> {
-        if !(dt.is_finite() && dt > 0.0) {
-            return Err(Error::InvalidTimeStep {
-                dt,
-                reason: "must be positive and finite",
-            });
-        }
-        Ok(self
-            .forces_on_colliders(dt)
-            .filter(|(touched, _, _)| *touched == collider)
-            .fold(
-                (DVec3::ZERO, DVec3::ZERO),
-                |(force, torque), (_, at, on_collider)| {
-                    (force + on_collider, torque + at.cross(on_collider))
-                },
-            ))
+/// The mean force (N) and torque about the world origin (N m) `body`'s `contacts` exerted on
+/// `collider` over the last step, of length `dt` (s).
+///
+/// # Errors
+/// [`Error::InvalidTimeStep`] for a non-positive or non-finite `dt`.
+pub(crate) fn force_on_collider(
+    body: &DeformableBody,
+    contacts: &ContactSet,
+    collider: ColliderHandle,
+    dt: f64,
+) -> Result<(DVec3, DVec3), Error> {
+    if !(dt.is_finite() && dt > 0.0) {
+        return Err(Error::InvalidTimeStep {
+            dt,
+            reason: "must be positive and finite",
+        });
     }
+    Ok(forces_on_colliders(body, contacts, dt)
+        .filter(|(touched, _, _)| *touched == collider)
+        .fold(
+            (DVec3::ZERO, DVec3::ZERO),
+            |(force, torque), (_, at, on_collider)| {
+                (force + on_collider, torque + at.cross(on_collider))
+            },
+        ))
 }
 
 /// A collider as one detection sees it.

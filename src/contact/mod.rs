@@ -1,7 +1,7 @@
 //! Contact of soft bodies with rapier colliders, with themselves (self-contact) and with each
 //! other.
 //!
-//! Detection ([`DeformableBody::detect_contacts`]) projects every surface node onto every collider
+//! Detection ([`BodyConstraints::detect_contacts`](crate::constraint::BodyConstraints::detect_contacts)) projects every surface node onto every collider
 //! (parry's point projection, which covers all of rapier's shapes) that the node can reach within
 //! the coming frame, and keeps the nearest surface point and its outward normal as a
 //! [`NodeContact`]: a plane the node must stay on the outer side of during the frame. The
@@ -42,28 +42,32 @@ mod corner;
 mod detect;
 mod node_contact;
 mod penalty;
-mod rigid;
 mod self_contact;
+mod set;
 mod soft_point;
 mod surface_tree;
 mod sweep;
 mod velocity_constraint;
 
 pub(crate) use between::{BetweenContact, detect_between, prepare_between, solve_between};
-pub(crate) use corner::{CornerContact, advance_corners, prepare_corners, solve_corners};
+pub(crate) use corner::{
+    CornerContact, advance_corners, for_each_corner_stencil, for_each_corner_term,
+    lag_corner_friction, prepare_corners, record_corner_impulses, solve_corners,
+};
 use detect::nearest_surface_point;
+pub(crate) use detect::{collider_impulses, detect, force_on_collider};
 use node_contact::Obstacle;
 pub use node_contact::{BodyPoint, ContactTarget, NodeContact};
 pub(crate) use penalty::{
-    for_each_active_penalty, for_each_friction, lag_friction, penalty_tangent,
+    for_each_contact_stencil, for_each_contact_term, lag_friction, penalty_tangent,
     record_penalty_impulses,
 };
-pub(crate) use rigid::{RigidProxy, coming_velocity};
-pub(crate) use soft_point::Stencil;
-use soft_point::{SoftPoint, node_inverse_mass};
+pub(crate) use self_contact::detect_self_contacts;
+pub(crate) use set::ContactSet;
+use soft_point::SoftPoint;
 pub(crate) use surface_tree::nearest_point_on_triangle;
-use sweep::contacts_and_partners;
-pub(crate) use sweep::{constraints_coupled, prepare_velocities, solve_velocities};
+use sweep::partners;
+pub(crate) use sweep::{prepare_velocities, solve_velocities};
 pub use velocity_constraint::RESTITUTION_THRESHOLD;
 pub(crate) use velocity_constraint::{ContactSides, VelocityConstraint};
 

@@ -5,10 +5,11 @@
 //! friction dissipation `μ λ f(|u|)` on the slip `u` over the step.
 
 use super::{
-    Coefficients, ContactSettings, SoftPoint, Stencil, VelocityConstraint, nearest_surface_point,
+    Coefficients, ContactSettings, SoftPoint, VelocityConstraint, nearest_surface_point,
     penalty_tangent,
 };
 use crate::embedding::Embedding;
+use crate::stencil::Stencil;
 use rapier3d::geometry::{ColliderHandle, SharedShape};
 use rapier3d::glamx::{DMat3, DVec3};
 use rapier3d::math::Pose;
@@ -139,12 +140,6 @@ impl NodeContact {
         }
     }
 
-    /// Whether the implicit integrator enforces the contact: those with colliders (it leaves
-    /// self-contact to the explicit integrator).
-    pub(super) fn is_implicit(&self) -> bool {
-        matches!(self.obstacle, Obstacle::Collider { .. })
-    }
-
     /// The contact with its collider's rigid body at `proxy` (an index into the body's rigid
     /// proxies), if any.
     pub(super) fn with_proxy(mut self, proxy: Option<usize>) -> Self {
@@ -183,27 +178,13 @@ impl NodeContact {
         settings: &ContactSettings,
         h: f64,
     ) -> Option<(f64, DVec3, DMat3)> {
-        let limit = self.friction * self.lagged_normal_force;
-        if limit <= 0.0 {
-            return None;
-        }
-        let plane = DMat3::IDENTITY - penalty_tangent(1.0, self.normal);
-        let slip = plane * (x - self.slip_origin - self.surface_velocity * h);
-        let (s, stick) = (slip.length(), settings.stiction_speed * h);
-        Some(if s < stick {
-            (
-                limit * s * s / (2.0 * stick),
-                -slip * (limit / stick),
-                plane * (limit / stick),
-            )
-        } else {
-            let direction = slip / s;
-            (
-                limit * (s - stick / 2.0),
-                -direction * limit,
-                (plane - penalty_tangent(1.0, direction)) * (limit / s),
-            )
-        })
+        let travel = x - self.slip_origin - self.surface_velocity * h;
+        lagged_friction(
+            self.friction * self.lagged_normal_force,
+            self.normal,
+            travel,
+            settings.stiction_speed * h,
+        )
     }
 
     /// Moves the plane to the collider's surface point nearest to `x` (m), if defined there, or
@@ -224,4 +205,37 @@ impl NodeContact {
             }
         }
     }
+}
+
+/// The lagged friction dissipation `μ λ f(|u|)` of a point whose travel relative to the surface
+/// over the step is `travel` (m), for the friction limit `μ λ` (N): its energy (J), its force on
+/// the point (N) and its positive semi-definite tangent (N/m), with `u` the travel's part in the
+/// plane of unit `normal` and `f(s) = s²/2ε` below `ε = stick` (m), `s - ε/2` above; `None`
+/// without a positive limit.
+pub(super) fn lagged_friction(
+    limit: f64,
+    normal: DVec3,
+    travel: DVec3,
+    stick: f64,
+) -> Option<(f64, DVec3, DMat3)> {
+    if limit <= 0.0 {
+        return None;
+    }
+    let plane = DMat3::IDENTITY - penalty_tangent(1.0, normal);
+    let slip = plane * travel;
+    let s = slip.length();
+    Some(if s < stick {
+        (
+            limit * s * s / (2.0 * stick),
+            -slip * (limit / stick),
+            plane * (limit / stick),
+        )
+    } else {
+        let direction = slip / s;
+        (
+            limit * (s - stick / 2.0),
+            -direction * limit,
+            (plane - penalty_tangent(1.0, direction)) * (limit / s),
+        )
+    })
 }

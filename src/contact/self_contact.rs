@@ -10,43 +10,42 @@
 //! The explicit integrator solves each such contact with the triangle's corners in the same
 //! sweep, each corner taking its share of the opposite impulse by the contact point's
 //! barycentric weights, and the plane follows the corners through the step: momentum is
-//! conserved within the body.
+//! conserved within the body. The implicit integrator's penalty acts on the node relative to
+//! the triangle's point (see [`super::penalty`]), equally and oppositely.
 
 use super::surface_tree::SurfaceTree;
 use super::{BodyPoint, ContactTarget, NodeContact, Obstacle, SurfaceCoefficients};
 use crate::body::DeformableBody;
 
-impl DeformableBody {
-    /// Adds the self-contacts of the body's surface nodes within `reach` (m) of its own
-    /// boundary triangles (see the module documentation).
-    pub(crate) fn detect_self_contacts(&mut self, reach: f64) {
-        let tree = SurfaceTree::of(self);
-        let node_normals = self.surface_node_normals();
-        let own = SurfaceCoefficients::of_body(self);
-        let coefficients = own.combine(own);
-        let mut found = Vec::new();
-        for &node in &self.surface.nodes {
-            let n = node as usize;
-            if self.pinned[n] {
-                continue;
-            }
-            let ring = &self.surface.rings[n];
-            let near = |triangle: &[u32; 3]| triangle.iter().any(|c| ring.binary_search(c).is_ok());
-            if let Some(hit) =
-                tree.nearest_facing(self, self.positions[n], node_normals[n], reach, near)
-            {
-                found.push(NodeContact::new(
-                    BodyPoint::Node(node),
-                    ContactTarget::OwnSurface {
-                        triangle: hit.triangle,
-                    },
-                    hit.point,
-                    hit.normal,
-                    coefficients,
-                    Obstacle::OwnTriangle(hit.soft_point()),
-                ));
-            }
+/// The self-contacts of `body`'s surface nodes within `reach` (m) of its own boundary triangles
+/// (see the module documentation).
+pub(crate) fn detect_self_contacts(body: &DeformableBody, reach: f64) -> Vec<NodeContact> {
+    let tree = SurfaceTree::of(body);
+    let node_normals = body.surface_node_normals();
+    let own = SurfaceCoefficients::of_body(body);
+    let coefficients = own.combine(own);
+    let mut found = Vec::new();
+    for &node in &body.surface.nodes {
+        let n = node as usize;
+        if body.pinned[n] {
+            continue;
         }
-        self.constraints.contacts.extend(found);
+        let ring = &body.surface.rings[n];
+        let near = |triangle: &[u32; 3]| triangle.iter().any(|c| ring.binary_search(c).is_ok());
+        if let Some(hit) =
+            tree.nearest_facing(body, body.positions[n], node_normals[n], reach, near)
+        {
+            found.push(NodeContact::new(
+                BodyPoint::Node(node),
+                ContactTarget::OwnSurface {
+                    triangle: hit.triangle,
+                },
+                hit.point,
+                hit.normal,
+                coefficients,
+                Obstacle::OwnTriangle(hit.soft_point()),
+            ));
+        }
     }
+    found
 }

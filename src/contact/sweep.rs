@@ -4,10 +4,11 @@
 //! impulse (Coulomb), with the opposite impulse on the partner (a rigid proxy or the body's own
 //! nodes), so that momentum is exchanged exactly.
 
-use super::{ContactSides, NodeContact, Obstacle, RigidProxy, Stencil, VelocityConstraint};
-use crate::body::BodyConstraints;
+use super::{ContactSet, ContactSides, Obstacle, VelocityConstraint};
 use crate::body::DeformableBody;
 use crate::embedding::Embedding;
+use crate::rigid::RigidProxy;
+use crate::stencil::Stencil;
 use rapier3d::glamx::DVec3;
 
 /// What a body's contacts push against, as the sweeps see it: the rigid bodies' proxies and the
@@ -60,23 +61,13 @@ impl Partners<'_> {
     }
 }
 
-/// Splits `body` into its contacts, its positions, its embedded mesh and what the contacts push
-/// against.
-pub(super) fn contacts_and_partners(
-    body: &mut DeformableBody,
-) -> (
-    &mut [NodeContact],
-    &[DVec3],
-    Option<&Embedding>,
-    Partners<'_>,
-) {
+/// Splits `body` into its positions, its embedded mesh and what its contacts push against (the
+/// rigid `proxies` and its own nodes).
+pub(super) fn partners<'a>(
+    body: &'a mut DeformableBody,
+    proxies: &'a mut [RigidProxy],
+) -> (&'a [DVec3], Option<&'a Embedding>, Partners<'a>) {
     let DeformableBody {
-        constraints:
-            BodyConstraints {
-                contacts,
-                rigid_proxies,
-                ..
-            },
         positions,
         velocities,
         masses,
@@ -85,11 +76,10 @@ pub(super) fn contacts_and_partners(
         ..
     } = body;
     (
-        contacts,
         positions,
         embedding.as_ref(),
         Partners {
-            rigid: rigid_proxies,
+            rigid: proxies,
             velocities,
             masses,
             pinned,
@@ -97,38 +87,19 @@ pub(super) fn contacts_and_partners(
     )
 }
 
-/// Whether the body's contact constraints are coupled to each other (through a dynamic rigid
-/// body's velocity or the nodes of a self-contact triangle), so that one sweep does not solve
-/// them.
-pub(crate) fn constraints_coupled(body: &DeformableBody) -> bool {
-    body.constraints
-        .rigid_proxies
-        .iter()
-        .any(RigidProxy::is_dynamic)
-        || body.needs_explicit_contacts()
-}
-
-impl DeformableBody {
-    /// Whether the last detection found self-contacts or rigid corners against the surface,
-    /// which only the explicit integrator solves.
-    pub(crate) fn needs_explicit_contacts(&self) -> bool {
-        !self.constraints.corner_contacts.is_empty()
-            || self
-                .constraints
-                .contacts
-                .iter()
-                .any(|c| matches!(c.obstacle, Obstacle::OwnTriangle(_)))
-    }
-}
-
 /// Readies the contacts' velocity constraints for an explicit substep of `h` (s), before the
 /// sweeps of [`solve_velocities`]: each plane moves to the collider's surface point nearest to its
 /// node, and the lowest normal velocity is set so that the node arrives at the plane but does not
 /// cross it within the substep, or, found inside, leaves at most at the depenetration speed.
-pub(crate) fn prepare_velocities(body: &mut DeformableBody, h: f64) {
-    let depenetration_speed = body.constraints.settings.depenetration_speed;
-    let (contacts, positions, embedding, mut partners) = contacts_and_partners(body);
-    for contact in contacts.iter_mut() {
+pub(crate) fn prepare_velocities(
+    body: &mut DeformableBody,
+    contacts: &mut ContactSet,
+    proxies: &mut [RigidProxy],
+    h: f64,
+) {
+    let depenetration_speed = contacts.settings.depenetration_speed;
+    let (positions, embedding, mut partners) = partners(body, proxies);
+    for contact in &mut contacts.nodes {
         let point = contact.at;
         let at = point.stencil(embedding);
         let x = at.interpolate(positions);
@@ -154,9 +125,13 @@ pub(crate) fn prepare_velocities(body: &mut DeformableBody, h: f64) {
 /// positions move; see [`VelocityConstraint`]). Against a rigid body or an own triangle the
 /// velocities are relative, the obstacle's effective mass counts, and the obstacle receives the
 /// opposite impulse.
-pub(crate) fn solve_velocities(body: &mut DeformableBody) {
-    let (contacts, positions, embedding, mut partners) = contacts_and_partners(body);
-    for contact in contacts.iter_mut() {
+pub(crate) fn solve_velocities(
+    body: &mut DeformableBody,
+    contacts: &mut ContactSet,
+    proxies: &mut [RigidProxy],
+) {
+    let (positions, embedding, mut partners) = partners(body, proxies);
+    for contact in &mut contacts.nodes {
         let point = contact.at;
         let at = point.stencil(embedding);
         let mut sides = WithinBody {

@@ -4,7 +4,8 @@
 //! their centre of mass; colliders (with or without a rigid body, the fixed ground among them)
 //! with the torque about the world origin.
 
-use crate::body::DeformableBodyHandle;
+use crate::body::{DeformableBody, DeformableBodyHandle};
+use crate::constraint::BodyConstraints;
 use rapier3d::dynamics::RigidBodyHandle;
 use rapier3d::geometry::ColliderHandle;
 use rapier3d::glamx::DVec3;
@@ -105,9 +106,25 @@ impl FrameLoads {
         self.colliders.clear();
     }
 
+    /// Adds what the deformable body `handle` (`body`, stepped against `constraints`) gave the
+    /// rigid bodies and colliders it touched over a substep to the frame's totals.
+    pub(crate) fn add_body(
+        &mut self,
+        handle: DeformableBodyHandle,
+        body: &DeformableBody,
+        constraints: &BodyConstraints,
+    ) {
+        for (rigid_body, impulse, angular_impulse) in constraints.rigid_impulses() {
+            self.add_rigid(handle, rigid_body, impulse, angular_impulse);
+        }
+        for (collider, impulse, angular_impulse) in constraints.collider_impulses(body) {
+            self.add_collider(handle, collider, impulse, angular_impulse);
+        }
+    }
+
     /// Adds a substep's impulse (N s) and angular impulse about the centre of mass (N m s) on a
     /// rigid body to the frame's total for the pair.
-    pub(crate) fn add_rigid(
+    fn add_rigid(
         &mut self,
         soft_body: DeformableBodyHandle,
         rigid_body: RigidBodyHandle,
@@ -125,7 +142,7 @@ impl FrameLoads {
 
     /// Adds a substep's impulse (N s) and angular impulse about the world origin (N m s) on a
     /// collider to the frame's total for the pair.
-    pub(crate) fn add_collider(
+    fn add_collider(
         &mut self,
         soft_body: DeformableBodyHandle,
         collider: ColliderHandle,

@@ -8,7 +8,7 @@
 //! 1. **Kinematic paths.** Each position-based kinematic body told where to be at the end of the
 //!    frame is told the part of its straight path it reaches by the end of this substep.
 //! 2. **Contacts.** Each deformable body finds the colliders its surface can reach within `h`
-//!    ([`DeformableBody::detect_contacts`](crate::body::DeformableBody::detect_contacts)), and
+//!    ([`BodyConstraints::detect_contacts`]), and
 //!    the bodies find each other's surfaces.
 //! 3. **Support.** Rigid bodies that rapier's narrow phase finds touching something are held in
 //!    place within the soft step: otherwise they would fall freely there, the ground that holds
@@ -28,6 +28,7 @@
 //! [`SoftCoupling::substep`] runs stages 2 to 5 alone, for a program that steps rapier itself.
 //! [`FvmWorld`](crate::world::FvmWorld) is the same over a [`PhysicsWorld`](rapier3d::pipeline::PhysicsWorld).
 
+mod bodies;
 mod groups;
 mod kinematic;
 mod loads;
@@ -36,8 +37,10 @@ pub use loads::{ColliderLoad, RigidLoad};
 
 use crate::Error;
 use crate::body::{DeformableBody, DeformableBodyHandle, DeformableBodySet};
-use crate::contact::{self, ContactSettings};
-use crate::integrate::{AutomaticIntegrator, AutomaticReport};
+use crate::constraint::BodyConstraints;
+use crate::contact::{self, ContactSettings, NodeContact};
+use crate::integrate::{AutomaticIntegrator, AutomaticReport, BodyInStep};
+use bodies::LinkSet;
 use groups::touching_groups;
 use kinematic::KinematicPath;
 use loads::FrameLoads;
@@ -45,7 +48,7 @@ use rapier3d::dynamics::{
     CCDSolver, ImpulseJointSet, IntegrationParameters, IslandManager, MultibodyJointSet,
     RigidBodyHandle, RigidBodySet,
 };
-use rapier3d::geometry::{BroadPhaseBvh, ColliderSet, NarrowPhase};
+use rapier3d::geometry::{BroadPhaseBvh, ColliderHandle, ColliderSet, NarrowPhase};
 use rapier3d::glamx::DVec3;
 use rapier3d::math::Vector;
 use rapier3d::pipeline::{EventHandler, PhysicsHooks, PhysicsPipeline};
@@ -138,6 +141,8 @@ pub struct SoftCoupling {
     pub substeps: u32,
     /// What each deformable body exerted on each rigid body over the last frame or substep.
     loads: FrameLoads,
+    /// Each deformable body's constraints and solver caches, by handle.
+    links: LinkSet,
 }
 
 impl Default for SoftCoupling {
@@ -147,6 +152,7 @@ impl Default for SoftCoupling {
             contact: ContactSettings::default(),
             substeps: 4,
             loads: FrameLoads::default(),
+            links: LinkSet::default(),
         }
     }
 }
@@ -240,6 +246,68 @@ impl SoftCoupling {
         self.loads.on(soft, rigid)
     }
 
+    /// Glues `nodes` of the deformable body `soft` of `soft_bodies` to the rigid body `rigid` of
+    /// `rigid_bodies` where they are now (see [`BodyConstraints::attach`]); the attachments act
+    /// from the next substep.
+    ///
+    /// # Errors
+    /// [`Error::UnknownDeformableBody`] if `soft` is not in `soft_bodies`, then those of
+    /// [`BodyConstraints::attach`]; nothing is attached then.
+    pub fn attach(
+        &mut self,
+        soft_bodies: &DeformableBodySet,
+        soft: DeformableBodyHandle,
+        nodes: impl IntoIterator<Item = u32>,
+        rigid: RigidBodyHandle,
+        rigid_bodies: &RigidBodySet,
+    ) -> Result<(), Error> {
+        let body = soft_bodies.get(soft).ok_or(Error::UnknownDeformableBody)?;
+        self.links
+            .entry(soft)
+            .constraints
+            .attach(body, nodes, rigid, rigid_bodies)
+    }
+
+    /// Removes every attachment of the deformable body `soft` to the rigid body `rigid`.
+    pub fn detach(&mut self, soft: DeformableBodyHandle, rigid: RigidBodyHandle) {
+        if let Some(links) = self.links.get_mut(soft) {
+            links.constraints.detach(rigid);
+        }
+    }
+
+    /// The contacts, rigid corners and attachments of the deformable body `soft` as the last
+    /// substep left them; `None` for a body never attached nor stepped.
+    pub fn constraints(&self, soft: DeformableBodyHandle) -> Option<&BodyConstraints> {
+        self.links.get(soft).map(|links| &links.constraints)
+    }
+
+    /// The contacts the deformable body `soft` had in the last substep (empty if none).
+    pub fn contacts(&self, soft: DeformableBodyHandle) -> &[NodeContact] {
+        self.constraints(soft)
+            .map_or(&[], BodyConstraints::contacts)
+    }
+
+    /// The mean force (N) and torque about the world origin (N m) the contacts of the deformable
+    /// body `soft` of `soft_bodies` exerted on `collider` over the last substep, of length `dt`
+    /// (s); see [`BodyConstraints::contact_force_on`]. Zero for a body without contacts.
+    ///
+    /// # Errors
+    /// [`Error::UnknownDeformableBody`] if `soft` is not in `soft_bodies`;
+    /// [`Error::InvalidTimeStep`] for a non-positive or non-finite `dt`.
+    pub fn contact_force_on(
+        &self,
+        soft_bodies: &DeformableBodySet,
+        soft: DeformableBodyHandle,
+        collider: ColliderHandle,
+        dt: f64,
+    ) -> Result<(DVec3, DVec3), Error> {
+        let body = soft_bodies.get(soft).ok_or(Error::UnknownDeformableBody)?;
+        match self.constraints(soft) {
+            Some(constraints) => constraints.contact_force_on(body, collider, dt),
+            None => BodyConstraints::new().contact_force_on(body, collider, dt),
+        }
+    }
+
     /// One coupling substep of `h` (s) of the bodies whose `outcomes` are not yet an error: each
     /// finds its contacts with the colliders, bodies touching each other are grouped and stepped
     /// together, the others alone, and the impulses they gave rigid bodies go to rapier and to
@@ -252,11 +320,13 @@ impl SoftCoupling {
         h: f64,
         gravity: DVec3,
     ) {
+        self.links.prune(soft_bodies);
         for (handle, outcome) in outcomes.iter_mut() {
             if matches!(outcome, Some(Err(_))) {
                 continue;
             }
-            if let Err(error) = soft_bodies[*handle].detect_contacts(
+            if let Err(error) = self.links.entry(*handle).constraints.detect_contacts(
+                &soft_bodies[*handle],
                 rigid.colliders,
                 rigid.bodies,
                 h,
@@ -277,32 +347,35 @@ impl SoftCoupling {
         };
         for (group, mut contacts) in touching_groups(live.len(), between) {
             let handles: Vec<DeformableBodyHandle> = group.iter().map(|&i| live[i]).collect();
-            let mut bodies = soft_bodies.get_many_mut(&handles);
-            for body in bodies.iter_mut() {
-                hold_supported_bodies(body, rigid.bodies, rigid.narrow_phase);
+            let bodies = soft_bodies.get_many_mut(&handles);
+            let mut steps: Vec<BodyInStep> = self
+                .links
+                .many_mut(&handles)
+                .into_iter()
+                .zip(bodies)
+                .map(|(links, body)| links.with(body))
+                .collect();
+            for step in &mut steps {
+                hold_supported_bodies(step.constraints, rigid.bodies, rigid.narrow_phase);
             }
-            let stepped: Vec<Result<AutomaticReport, Error>> = if let [body] = &mut bodies[..] {
-                vec![self.integrator.step(body, h, gravity)]
+            let stepped: Vec<Result<AutomaticReport, Error>> = if let [step] = &mut steps[..] {
+                vec![
+                    self.integrator
+                        .step(step.body, step.constraints, step.workspace, h, gravity),
+                ]
             } else {
                 match self
                     .integrator
-                    .step_together(&mut bodies, &mut contacts, h, gravity)
+                    .step_together(&mut steps, &mut contacts, h, gravity)
                 {
                     Ok(reports) => reports.into_iter().map(Ok).collect(),
-                    Err(error) => vec![Err(error); bodies.len()],
+                    Err(error) => vec![Err(error); steps.len()],
                 }
             };
-            for ((handle, body), result) in handles.iter().zip(bodies).zip(stepped) {
+            for ((handle, step), result) in handles.iter().zip(steps).zip(stepped) {
                 if result.is_ok() {
-                    for (rigid_body, impulse, angular_impulse) in body.rigid_impulses() {
-                        self.loads
-                            .add_rigid(*handle, rigid_body, impulse, angular_impulse);
-                    }
-                    for (collider, impulse, angular_impulse) in body.collider_impulses() {
-                        self.loads
-                            .add_collider(*handle, collider, impulse, angular_impulse);
-                    }
-                    body.transfer_contact_impulses(rigid.bodies);
+                    self.loads.add_body(*handle, step.body, step.constraints);
+                    step.constraints.transfer_contact_impulses(rigid.bodies);
                 }
                 if let Some((_, outcome)) = outcomes.iter_mut().find(|(h, _)| h == handle) {
                     *outcome = Some(result);
@@ -328,14 +401,14 @@ fn results(outcomes: Vec<(DeformableBodyHandle, Outcome)>) -> SoftStepResults {
         .collect()
 }
 
-/// Holds the rigid bodies `body` touches that rigid contacts support: within the soft step they
+/// Holds the rigid bodies a body's `constraints` touch that rigid contacts support: within the soft step they
 /// would otherwise fall freely, the ground that holds them acting only in rapier's step.
 fn hold_supported_bodies(
-    body: &mut DeformableBody,
+    constraints: &mut BodyConstraints,
     bodies: &RigidBodySet,
     narrow_phase: &NarrowPhase,
 ) {
-    for proxy in &mut body.constraints.rigid_proxies {
+    for proxy in &mut constraints.rigid_proxies {
         let supported = bodies.get(proxy.handle).is_some_and(|rigid| {
             rigid.colliders().iter().any(|&collider| {
                 narrow_phase

@@ -11,10 +11,10 @@
 //! and a quadratic hexahedron 27 (Galerkin quadrature, which the finite-volume form reduces to for
 //! linear elements).
 
-pub mod hex27;
 mod mean_dilatation;
 mod quadratic;
-pub mod tet10;
+
+pub use crate::shape::{hex27, tet10};
 
 use crate::damping::RayleighDamping;
 use crate::fvm::{FvmMesh, NodalAveraging, VolumetricTreatment};

@@ -9,9 +9,12 @@
 //! damping adds about half), an implicit Newton iteration about 6 µs (7 µs), and an implicit frame
 //! takes about 3.5 Newton iterations. Only their ratio matters for the choice.
 
-use super::{ImplicitIntegrator, ImplicitReport, StepReport, SymplecticEuler};
+use super::{
+    BodyInStep, ImplicitIntegrator, ImplicitReport, SolverWorkspace, StepReport, SymplecticEuler,
+};
 use crate::Error;
-use crate::body::{DeformableBody, DeformableBodyHandle, DeformableBodySet};
+use crate::body::DeformableBody;
+use crate::constraint::BodyConstraints;
 use crate::contact::BetweenContact;
 use crate::material::MaterialModel;
 use rapier3d::glamx::DVec3;
@@ -120,23 +123,9 @@ impl AutomaticIntegrator {
         }
     }
 
-    /// Advances every body of `bodies` by `frame_dt` (s) under gravity (m/s²), each with its own
-    /// choice of integrator. Each body's outcome is returned with its handle; a body whose step
-    /// failed keeps the state it had, the others are advanced.
-    pub fn step_all(
-        &self,
-        bodies: &mut DeformableBodySet,
-        frame_dt: f64,
-        gravity: DVec3,
-    ) -> Vec<(DeformableBodyHandle, Result<AutomaticReport, Error>)> {
-        bodies
-            .iter_mut()
-            .map(|(handle, body)| (handle, self.step(body, frame_dt, gravity)))
-            .collect()
-    }
-
-    /// Advances `body` by `frame_dt` (s) under gravity (m/s²) with the cheaper integrator (or the
-    /// forced one); explicit while the body has self-contacts or rigid corners against its surface.
+    /// Advances `body` by `frame_dt` (s) under gravity (m/s²) against its `constraints`, with
+    /// `workspace` its solver caches, by the cheaper integrator (or the forced one); explicit
+    /// while the body has self-contacts or rigid corners against its surface.
     ///
     /// # Errors
     /// [`Error::InvalidTimeStep`] for a non-positive or non-finite `frame_dt`, [`Error::NonFiniteInput`]
@@ -146,6 +135,8 @@ impl AutomaticIntegrator {
     pub fn step(
         &self,
         body: &mut DeformableBody,
+        constraints: &mut BodyConstraints,
+        workspace: &mut SolverWorkspace,
         frame_dt: f64,
         gravity: DVec3,
     ) -> Result<AutomaticReport, Error> {
@@ -153,9 +144,10 @@ impl AutomaticIntegrator {
         // The stability limit is evaluated once and serves both the prediction and the step.
         let needed = self.explicit.needed_substeps(body, frame_dt)?;
         let prediction = self.prediction(body, needed);
-        // Self-contacts and rigid corners are solved by the explicit integrator only.
+        // Self-contacts and rigid corners keep the explicit integrator: the cost model does not
+        // price their implicit terms (a forced implicit step solves them).
         let choice = self.force.unwrap_or_else(|| {
-            if body.needs_explicit_contacts() {
+            if constraints.needs_explicit_contacts() {
                 IntegratorKind::Explicit
             } else {
                 prediction.cheaper()
@@ -163,7 +155,12 @@ impl AutomaticIntegrator {
         });
         let explicit = match choice {
             IntegratorKind::Explicit => {
-                Some(self.explicit.advance(body, frame_dt, gravity, needed))
+                let mut step = BodyInStep {
+                    body,
+                    constraints,
+                    workspace,
+                };
+                Some(self.explicit.advance(&mut step, frame_dt, gravity, needed))
             }
             IntegratorKind::Implicit => None,
         };
@@ -180,7 +177,10 @@ impl AutomaticIntegrator {
         };
         let implicit = match explicit {
             Some(_) => None,
-            None => Some(self.implicit.step(body, frame_dt, gravity)?),
+            None => Some(
+                self.implicit
+                    .step(body, constraints, workspace, frame_dt, gravity)?,
+            ),
         };
         Ok(AutomaticReport {
             choice: if fell_back {
@@ -204,14 +204,14 @@ impl AutomaticIntegrator {
     /// Those of [`SymplecticEuler::step`]; every body is then left as it was.
     pub(crate) fn step_together(
         &self,
-        bodies: &mut [&mut DeformableBody],
+        bodies: &mut [BodyInStep<'_>],
         between: &mut [BetweenContact],
         frame_dt: f64,
         gravity: DVec3,
     ) -> Result<Vec<AutomaticReport>, Error> {
         let predictions: Vec<CostPrediction> = bodies
             .iter()
-            .map(|body| self.predict(body, frame_dt))
+            .map(|step| self.predict(step.body, frame_dt))
             .collect();
         let reports = self
             .explicit

@@ -11,11 +11,11 @@
 //! (`β = (φ+2ψ)/(λ+2μ)`), the limit becomes `(2/ω)(sqrt(1+ζ²) - ζ)`. The automatic substep is that
 //! limit times a safety factor.
 
+use super::{BodyInStep, SolverWorkspace};
 use crate::Error;
 use crate::body::DeformableBody;
-use crate::body::{BodyConstraints, SolverWorkspace};
-use crate::contact::BetweenContact;
-use crate::{constraint, contact};
+use crate::constraint::{self, BodyConstraints};
+use crate::contact::{self, BetweenContact};
 use rapier3d::glamx::DVec3;
 
 /// Ratio of the critical explicit step to `ℓ / c_p`. The true limit `2/ω_max` (power iteration
@@ -97,7 +97,8 @@ impl SymplecticEuler {
         self.safety_factor * Self::critical_time_step(body)
     }
 
-    /// Advances `body` by `frame_dt` (s) under uniform gravity (m/s²), in substeps.
+    /// Advances `body` by `frame_dt` (s) under uniform gravity (m/s²), in substeps, against
+    /// its `constraints`, with `workspace` its solver caches.
     ///
     /// # Errors
     /// [`Error::InvalidTimeStep`] for a non-positive or non-finite `frame_dt`;
@@ -108,24 +109,36 @@ impl SymplecticEuler {
     pub fn step(
         &self,
         body: &mut DeformableBody,
+        constraints: &mut BodyConstraints,
+        workspace: &mut SolverWorkspace,
         frame_dt: f64,
         gravity: DVec3,
     ) -> Result<StepReport, Error> {
         Error::check_step(frame_dt, gravity)?;
         let needed = self.needed_substeps(body, frame_dt)?;
-        self.advance(body, frame_dt, gravity, needed)
+        let mut step = BodyInStep {
+            body,
+            constraints,
+            workspace,
+        };
+        self.advance(&mut step, frame_dt, gravity, needed)
     }
 
     /// Runs a frame in `needed` substeps (as given by [`SymplecticEuler::needed_substeps`]),
     /// refusing more than `max_substeps` when they are automatic.
     pub(crate) fn advance(
         &self,
-        body: &mut DeformableBody,
+        step: &mut BodyInStep<'_>,
         frame_dt: f64,
         gravity: DVec3,
         needed: f64,
     ) -> Result<StepReport, Error> {
-        let reports = self.advance_together(&mut [body], &mut [], frame_dt, gravity, needed)?;
+        let one = BodyInStep {
+            body: step.body,
+            constraints: step.constraints,
+            workspace: step.workspace,
+        };
+        let reports = self.advance_together(&mut [one], &mut [], frame_dt, gravity, needed)?;
         Ok(reports[0])
     }
 
@@ -138,15 +151,15 @@ impl SymplecticEuler {
     /// as it was.
     pub(crate) fn step_together(
         &self,
-        bodies: &mut [&mut DeformableBody],
+        bodies: &mut [BodyInStep<'_>],
         between: &mut [BetweenContact],
         frame_dt: f64,
         gravity: DVec3,
     ) -> Result<Vec<StepReport>, Error> {
         Error::check_step(frame_dt, gravity)?;
         let mut needed: f64 = 1.0;
-        for body in bodies.iter() {
-            needed = needed.max(self.needed_substeps(body, frame_dt)?);
+        for step in bodies.iter() {
+            needed = needed.max(self.needed_substeps(step.body, frame_dt)?);
         }
         self.advance_together(bodies, between, frame_dt, gravity, needed)
     }
@@ -154,7 +167,7 @@ impl SymplecticEuler {
     /// [`SymplecticEuler::step_together`] in `needed` substeps.
     fn advance_together(
         &self,
-        bodies: &mut [&mut DeformableBody],
+        bodies: &mut [BodyInStep<'_>],
         between: &mut [BetweenContact],
         frame_dt: f64,
         gravity: DVec3,
@@ -172,14 +185,14 @@ impl SymplecticEuler {
         let mut left = needed as u32;
         let (mut taken, mut elapsed, mut smallest) = (0u32, 0.0, h);
         let mut histories = Vec::with_capacity(bodies.len());
-        for body in bodies.iter_mut() {
-            body.save_state();
-            histories.push(body.workspace.previous_step.take());
+        for step in bodies.iter_mut() {
+            step.save();
+            histories.push(step.workspace.previous_step.take());
         }
-        let fail = |bodies: &mut [&mut DeformableBody], histories: Vec<_>, error| {
-            for (body, history) in bodies.iter_mut().zip(histories) {
-                body.restore_state();
-                body.workspace.previous_step = history;
+        let fail = |bodies: &mut [BodyInStep<'_>], histories: Vec<_>, error| {
+            for (step, history) in bodies.iter_mut().zip(histories) {
+                step.restore();
+                step.workspace.previous_step = history;
             }
             Err(error)
         };
@@ -193,7 +206,7 @@ impl SymplecticEuler {
             if automatic && left > 0 && taken % RECHECK_INTERVAL == 0 {
                 let stable = bodies
                     .iter()
-                    .map(|body| self.stable_time_step(body))
+                    .map(|step| self.stable_time_step(step.body))
                     .fold(f64::INFINITY, f64::min);
                 if stable < h {
                     let remaining = frame_dt - elapsed;
@@ -217,15 +230,15 @@ impl SymplecticEuler {
                 }
             }
         }
-        if let Some(node) = bodies.iter().find_map(|body| body.first_non_finite_node()) {
+        if let Some(node) = bodies.iter().find_map(|s| s.body.first_non_finite_node()) {
             return fail(bodies, histories, Error::NonFiniteState { node });
         }
         Ok(bodies
             .iter()
-            .map(|body| StepReport {
+            .map(|step| StepReport {
                 substeps: taken,
                 substep_dt: smallest,
-                inverted_tets: body.inverted_tet_count(),
+                inverted_tets: step.body.inverted_tet_count(),
             })
             .collect())
     }
@@ -260,20 +273,18 @@ impl SymplecticEuler {
 }
 
 /// One symplectic Euler substep of length `h` (s) of `bodies` and the contacts `between` them.
-fn substep(
-    bodies: &mut [&mut DeformableBody],
-    between: &mut [BetweenContact],
-    h: f64,
-    gravity: DVec3,
-) {
-    for body in bodies.iter_mut() {
-        update_velocities(body, h, gravity);
+fn substep(bodies: &mut [BodyInStep<'_>], between: &mut [BetweenContact], h: f64, gravity: DVec3) {
+    for step in bodies.iter_mut() {
+        update_velocities(step, h, gravity);
     }
-    contact::prepare_between(between, bodies, h);
-    let sweeps = if !between.is_empty() || bodies.iter().any(|b| contact::constraints_coupled(b)) {
+    if !between.is_empty() {
+        contact::prepare_between(between, &soft_bodies(bodies), h);
+    }
+    let coupled = !between.is_empty() || bodies.iter().any(|s| s.constraints.coupled());
+    let sweeps = if coupled {
         bodies
             .iter()
-            .map(|body| body.constraints.settings.velocity_iterations)
+            .map(|s| s.constraints.contacts.settings.velocity_iterations)
             .max()
             .unwrap_or(1)
             .max(1)
@@ -281,55 +292,61 @@ fn substep(
         1
     };
     for _ in 0..sweeps {
-        for body in bodies.iter_mut() {
+        for step in bodies.iter_mut() {
             for kind in constraint::EXPLICIT {
-                kind.sweep(body);
+                kind.sweep(step.body, step.constraints);
             }
         }
-        contact::solve_between(between, bodies);
+        if !between.is_empty() {
+            contact::solve_between(between, &mut soft_bodies(bodies));
+        }
     }
-    for body in bodies.iter_mut() {
-        update_positions(body, h);
+    for step in bodies.iter_mut() {
+        update_positions(step, h);
     }
+}
+
+/// The bodies of `steps`, for the contacts between them.
+fn soft_bodies<'a>(steps: &'a mut [BodyInStep<'_>]) -> Vec<&'a mut DeformableBody> {
+    steps.iter_mut().map(|s| &mut *s.body).collect()
 }
 
 /// The substep's velocity update `v ← v + h (f/m + g)`, then the constraints readied for the
 /// sweeps.
-fn update_velocities(body: &mut DeformableBody, h: f64, gravity: DVec3) {
-    body.compute_internal_forces();
+fn update_velocities(step: &mut BodyInStep<'_>, h: f64, gravity: DVec3) {
+    step.workspace.compute_internal_forces(step.body);
     let DeformableBody {
         velocities,
         masses,
         pinned,
-        workspace: SolverWorkspace { forces, .. },
-        constraints: BodyConstraints { rigid_proxies, .. },
         ..
-    } = body;
+    } = &mut *step.body;
+    let forces = &step.workspace.forces;
     for n in 0..velocities.len() {
         if !pinned[n] {
             velocities[n] += (forces[n] / masses[n] + gravity) * h;
         }
     }
     // The rigid bodies touched fall too, as rapier will make them (unless held).
-    for proxy in rigid_proxies.iter_mut() {
+    for proxy in &mut step.constraints.rigid_proxies {
         proxy.fall(gravity, h);
     }
     for kind in constraint::EXPLICIT {
-        kind.prepare(body, h);
+        kind.prepare(step.body, step.constraints, h);
     }
 }
 
 /// The substep's position update `x ← x + h v`, after the sweeps.
-fn update_positions(body: &mut DeformableBody, h: f64) {
+fn update_positions(step: &mut BodyInStep<'_>, h: f64) {
     for kind in constraint::EXPLICIT {
-        kind.advance(body, h);
+        kind.advance(step.body, step.constraints, h);
     }
     let DeformableBody {
         positions,
         velocities,
         pinned,
         ..
-    } = body;
+    } = &mut *step.body;
     for n in 0..positions.len() {
         if pinned[n] {
             velocities[n] = DVec3::ZERO;

@@ -4,14 +4,14 @@
 
 use super::TetMesh;
 use crate::Error;
-use crate::element::tet10::{EDGES, NODES, reference_nodes};
+use crate::shape::tet10::{EDGES, NODES, reference_nodes};
 use rapier3d::glamx::DVec3;
 use std::collections::HashMap;
 
 /// A validated mesh of quadratic tetrahedra in its rest configuration.
 ///
 /// Each element lists its 4 corners then its 6 mid-edge nodes in VTK order (edges `(0,1) (1,2)
-/// (0,2) (0,3) (1,3) (2,3)`, see [`crate::element::tet10`]); neighbours share the mid-edge node of
+/// (0,2) (0,3) (1,3) (2,3)`, see [`crate::shape::tet10`]); neighbours share the mid-edge node of
 /// a shared edge. Every element is also split into 8 linear tetrahedra on its own nodes (the
 /// corners' 4 and 4 around the shortest diagonal of the inner octahedron), the
 /// [`QuadraticTetMesh::subdivided`] mesh: it has exactly the same nodes, so its boundary

@@ -1,10 +1,10 @@
 //! Coarse cages of 27-node quadratic hexahedra: a box of cells, each carrying the 3 x 3 x 3
-//! lattice of nodes of [`crate::element::hex27`], with its subdivision into linear tetrahedra on
+//! lattice of nodes of [`crate::shape::hex27`], with its subdivision into linear tetrahedra on
 //! the same nodes for contacts, surface extraction and output.
 
 use super::TetMesh;
 use crate::Error;
-use crate::element::hex27::{self, NODES};
+use crate::shape::hex27::{self, NODES};
 use rapier3d::glamx::DVec3;
 
 /// A box of quadratic hexahedra in its rest configuration: the coarse cage of a bending-dominated
@@ -12,7 +12,7 @@ use rapier3d::glamx::DVec3;
 /// continuum.
 ///
 /// Element `e` of cell `(ex, ey, ez)` lists the nodes of its 3 x 3 x 3 lattice in the order of
-/// [`crate::element::hex27`]; neighbours share the nodes of their common face. The
+/// [`crate::shape::hex27`]; neighbours share the nodes of their common face. The
 /// [`QuadraticHexMesh::subdivided`] mesh splits every cell's 8 lattice sub-cubes into 5
 /// tetrahedra on the same nodes, so the body's surface, contacts, pins and output act on the
 /// simulated nodes themselves.
@@ -106,7 +106,7 @@ impl QuadraticHexMesh {
         self.subdivided.positions()
     }
 
-    /// The elements: 27 nodes each, in the order of [`crate::element::hex27`].
+    /// The elements: 27 nodes each, in the order of [`crate::shape::hex27`].
     pub fn elements(&self) -> &[[u32; NODES]] {
         &self.elements
     }

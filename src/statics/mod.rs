@@ -9,6 +9,7 @@
 use crate::Error;
 use crate::assembly::{Stiffness, factorize, solve};
 use crate::body::DeformableBody;
+use crate::integrate::SolverWorkspace;
 use crate::linear_solver::{Method, solve_newton_system};
 use crate::newton::{Search, check_tolerance, descend, norm};
 use rapier3d::glamx::{DMat3, DVec3};
@@ -67,14 +68,13 @@ pub fn solve_equilibrium(
     if body.pinned.iter().all(|&p| p) {
         return Err(Error::NoFreeNode);
     }
-    body.save_state();
-    let history = body.workspace.previous_step.take();
-    let mut stiffness = body.take_tangent();
+    let mut workspace = SolverWorkspace::new();
+    workspace.save_state(body);
+    let mut stiffness = workspace.take_tangent(body);
     let result = newton(body, &mut stiffness, gravity, settings);
-    body.workspace.tangent = Some(stiffness);
-    if result.is_err() {
-        body.restore_state();
-        body.workspace.previous_step = history;
+    match result {
+        Ok(_) => body.count_state_edit(),
+        Err(_) => workspace.restore_state(body),
     }
     result
 }
@@ -97,7 +97,8 @@ fn newton(
         });
     }
     let mut history: Vec<f64> = Vec::new();
-    let mut potential = potential_energy(body, &load);
+    let start = body.positions.clone();
+    let mut potential = potential_energy(body, &load, &start);
     for iteration in 0..settings.max_iterations {
         let relative = norm(&residual) / reference;
         // Newton more than halves the residual each iteration until round-off in the force sum
@@ -126,7 +127,7 @@ fn newton(
             |stiffness, project| assemble_elastic(stiffness, body, project),
         )?
         .direction;
-        let energy = |body: &DeformableBody| potential_energy(body, &load);
+        let energy = |body: &DeformableBody| potential_energy(body, &load, &start);
         match descend(
             body,
             &residual,
@@ -237,24 +238,24 @@ fn assemble_elastic(stiffness: &mut Stiffness, body: &DeformableBody, project: b
 /// `f_int(x) + load`, zero on pinned nodes (N).
 fn out_of_balance(body: &mut DeformableBody, load: &[DVec3]) -> Vec<DVec3> {
     // The velocities are zero, so the damping adds nothing.
-    body.compute_internal_forces();
+    let forces = body.internal_forces();
     (0..load.len())
         .map(|n| {
             if body.pinned[n] {
                 DVec3::ZERO
             } else {
-                body.workspace.forces[n] + load[n]
+                forces[n] + load[n]
             }
         })
         .collect()
 }
 
-/// Total potential energy (J): elastic energy minus the work of the constant load.
-fn potential_energy(body: &DeformableBody, load: &[DVec3]) -> f64 {
-    // The load's work is measured from the positions at the start of the solve.
+/// Total potential energy (J): elastic energy minus the work of the constant load, measured
+/// from the positions `start` (m) the solve began at.
+fn potential_energy(body: &DeformableBody, load: &[DVec3], start: &[DVec3]) -> f64 {
     let load_work: f64 = load
         .iter()
-        .zip(body.positions.iter().zip(&body.workspace.saved_positions))
+        .zip(body.positions.iter().zip(start))
         .map(|(f, (x, x0))| f.dot(*x - *x0))
         .sum();
     body.elastic_energy() - load_work

@@ -186,9 +186,7 @@ pub fn glued_path_error(
         ColliderBuilder::ball(0.01).sensor(true),
     );
     let rod = world.soft_bodies.insert(rod);
-    world.soft_bodies[rod]
-        .attach(root.iter().copied(), driver, &world.physics.bodies)
-        .unwrap();
+    world.attach(rod, root.iter().copied(), driver).unwrap();
     let offsets: Vec<DVec3> = root
         .iter()
         .map(|&n| world.soft_bodies[rod].positions()[n as usize] - start.as_dvec3())
@@ -271,14 +269,27 @@ pub fn free_momentum_change(body: &mut DeformableBody, seed: u64, implicit: bool
         *v = rng.vector();
     }
     let before = body.linear_momentum();
+    let (mut constraints, mut workspace) = (BodyConstraints::new(), SolverWorkspace::new());
     for _ in 0..10 {
         if implicit {
             ImplicitIntegrator::default()
-                .step(body, 1.0 / 60.0, DVec3::ZERO)
+                .step(
+                    body,
+                    &mut constraints,
+                    &mut workspace,
+                    1.0 / 60.0,
+                    DVec3::ZERO,
+                )
                 .unwrap();
         } else {
             SymplecticEuler::default()
-                .step(body, 1.0 / 60.0, DVec3::ZERO)
+                .step(
+                    body,
+                    &mut constraints,
+                    &mut workspace,
+                    1.0 / 60.0,
+                    DVec3::ZERO,
+                )
                 .unwrap();
         }
     }
@@ -326,11 +337,7 @@ pub fn settled_reaction(
     let mut reaction = 0.0;
     for _ in 0..frames {
         step(world);
-        reaction -= world.soft_bodies[body]
-            .contact_force_on(ground, h)
-            .unwrap()
-            .0
-            .y;
+        reaction -= world.contact_force_on(body, ground, h).unwrap().0.y;
     }
     reaction / f64::from(frames)
 }
@@ -387,9 +394,16 @@ pub fn explicit_energy_change(
     }
     let initial = body.elastic_energy() + body.kinetic_energy();
     let (mut worst, mut longest): (f64, f64) = (0.0, 0.0);
+    let (mut constraints, mut workspace) = (BodyConstraints::new(), SolverWorkspace::new());
     for _ in 0..frames {
         let report = SymplecticEuler::default()
-            .step(body, 1.0 / 60.0, DVec3::ZERO)
+            .step(
+                body,
+                &mut constraints,
+                &mut workspace,
+                1.0 / 60.0,
+                DVec3::ZERO,
+            )
             .unwrap();
         longest = longest.max(1.0 / 60.0 / f64::from(report.substeps));
         let energy = body.elastic_energy() + body.kinetic_energy();

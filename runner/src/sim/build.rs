@@ -267,16 +267,16 @@ fn insert_soft(
                 .map_err(library(format!("{key}.damping")))?,
         );
     }
-    let mut body = builder.build().map_err(library(key.to_owned()))?;
-    for (nodes, handle, at) in attachments {
-        body.attach(nodes, handle, &world.physics.bodies)
-            .map_err(library(at))?;
-    }
+    let body = builder.build().map_err(library(key.to_owned()))?;
     let rest = body.positions().to_vec();
+    let handle = world.soft_bodies.insert(body);
+    for (nodes, rigid, at) in attachments {
+        world.attach(handle, nodes, rigid).map_err(library(at))?;
+    }
     Ok(SoftEntry {
         name: spec.name.clone(),
         label: spec.material.label(),
-        handle: world.soft_bodies.insert(body),
+        handle,
         rest,
     })
 }

@@ -20,14 +20,15 @@
 
 mod potential;
 
+use super::{PreviousStep, SolverWorkspace};
 use crate::Error;
 use crate::assembly::{Stiffness, solve};
-use crate::body::{DeformableBody, PreviousStep};
+use crate::body::DeformableBody;
 use crate::chord::{self, Chord};
-use crate::constraint;
+use crate::constraint::{self, BodyConstraints};
 use crate::linear_solver::{LinearSolver, Method, solve_newton_system};
 use crate::newton::{Search, check_tolerance, descend, norm};
-use potential::StepStart;
+use potential::{Potential, StepStart};
 use rapier3d::glamx::DVec3;
 
 /// Newton stops early on a stalled residual only below this relative value; above it, a slow
@@ -145,6 +146,34 @@ struct Outcome {
     converged: bool,
 }
 
+impl ImplicitReport {
+    /// Counts a substep's Newton solve in the report.
+    fn add(&mut self, outcome: &Outcome) {
+        self.newton_iterations += outcome.iterations;
+        self.linear_iterations += outcome.linear_iterations;
+        self.reused_factorizations += outcome.reused_factorizations;
+        self.factorizations += outcome.factorizations;
+        self.projected_tangents += outcome.projected_tangents;
+        self.relative_residual = self.relative_residual.max(outcome.residual);
+        self.converged &= outcome.converged;
+    }
+}
+
+impl Outcome {
+    /// No iteration yet; the residual and convergence are set on return.
+    fn start() -> Self {
+        Self {
+            iterations: 0,
+            linear_iterations: 0,
+            reused_factorizations: 0,
+            factorizations: 0,
+            projected_tangents: 0,
+            residual: f64::NAN,
+            converged: false,
+        }
+    }
+}
+
 impl ImplicitIntegrator {
     /// Advances `body` by `frame_dt` (s) under uniform gravity (m/s²).
     ///
@@ -158,10 +187,69 @@ impl ImplicitIntegrator {
     pub fn step(
         &self,
         body: &mut DeformableBody,
+        constraints: &mut BodyConstraints,
+        workspace: &mut SolverWorkspace,
         frame_dt: f64,
         gravity: DVec3,
     ) -> Result<ImplicitReport, Error> {
         Error::check_step(frame_dt, gravity)?;
+        self.check()?;
+        workspace.save_state(body);
+        constraints.save();
+        let history = workspace.history(body).cloned();
+        let h = frame_dt / f64::from(self.substeps);
+        let mut report = ImplicitReport {
+            substeps: self.substeps,
+            newton_iterations: 0,
+            linear_iterations: 0,
+            reused_factorizations: 0,
+            factorizations: 0,
+            projected_tangents: 0,
+            relative_residual: 0.0,
+            converged: true,
+            inverted_tets: 0,
+        };
+        let mut stiffness = workspace.take_tangent(body);
+        let uncoupled = constraint::uncoupled_pairs(body, constraints, &stiffness);
+        if !uncoupled.is_empty() {
+            stiffness = stiffness.widened(&uncoupled);
+        }
+        let mut solver = Solver {
+            stiffness,
+            // Without reuse, a factorization kept by earlier steps is dropped.
+            chord: if self.reuse_factorization {
+                std::mem::take(&mut workspace.chord)
+            } else {
+                Chord::default()
+            },
+            method: self.linear_solver.method(body, h),
+            last_step: history.clone(),
+        };
+        for _ in 0..self.substeps {
+            match self.substep(body, constraints, &mut solver, h, gravity) {
+                Ok(outcome) => report.add(&outcome),
+                Err(error) => {
+                    workspace.restore_state(body);
+                    constraints.restore();
+                    solver.give_back(workspace, history);
+                    return Err(error);
+                }
+            }
+        }
+        if let Some(node) = body.first_non_finite_node() {
+            workspace.restore_state(body);
+            constraints.restore();
+            solver.give_back(workspace, history);
+            return Err(Error::NonFiniteState { node });
+        }
+        let last = solver.last_step.take();
+        solver.give_back(workspace, last);
+        report.inverted_tets = body.inverted_tet_count();
+        Ok(report)
+    }
+
+    /// Checks the settings.
+    fn check(&self) -> Result<(), Error> {
         if self.substeps == 0 {
             return Err(Error::InvalidSetting {
                 parameter: "substeps",
@@ -177,95 +265,41 @@ impl ImplicitIntegrator {
                 reason: "at least one Newton iteration is needed",
             });
         }
-        self.linear_solver.check()?;
-        body.save_state();
-        let history = body.workspace.previous_step.clone();
-        let h = frame_dt / f64::from(self.substeps);
-        let mut report = ImplicitReport {
-            substeps: self.substeps,
-            newton_iterations: 0,
-            linear_iterations: 0,
-            reused_factorizations: 0,
-            factorizations: 0,
-            projected_tangents: 0,
-            relative_residual: 0.0,
-            converged: true,
-            inverted_tets: 0,
-        };
-        let mut solver = Solver {
-            stiffness: body.take_tangent(),
-            // Without reuse, a factorization kept by earlier steps is dropped.
-            chord: if self.reuse_factorization {
-                std::mem::take(&mut body.workspace.chord)
-            } else {
-                Chord::default()
-            },
-            method: self.linear_solver.method(body, h),
-        };
-        for _ in 0..self.substeps {
-            match self.substep(body, &mut solver, h, gravity) {
-                Ok(Outcome {
-                    iterations,
-                    linear_iterations,
-                    reused_factorizations,
-                    factorizations,
-                    projected_tangents,
-                    residual,
-                    converged,
-                }) => {
-                    report.newton_iterations += iterations;
-                    report.linear_iterations += linear_iterations;
-                    report.reused_factorizations += reused_factorizations;
-                    report.factorizations += factorizations;
-                    report.projected_tangents += projected_tangents;
-                    report.relative_residual = report.relative_residual.max(residual);
-                    report.converged &= converged;
-                }
-                Err(error) => {
-                    body.restore_state();
-                    body.workspace.previous_step = history;
-                    solver.give_back(body);
-                    return Err(error);
-                }
-            }
-        }
-        solver.give_back(body);
-        if let Some(node) = body.first_non_finite_node() {
-            body.restore_state();
-            body.workspace.previous_step = history;
-            return Err(Error::NonFiniteState { node });
-        }
-        report.inverted_tets = body.inverted_tet_count();
-        Ok(report)
+        self.linear_solver.check()
     }
 
     /// One substep.
     fn substep(
         &self,
         body: &mut DeformableBody,
+        constraints: &mut BodyConstraints,
         solver: &mut Solver,
         h: f64,
         gravity: DVec3,
     ) -> Result<Outcome, Error> {
-        let start = StepStart::new(body, h, gravity, self.scheme);
+        let start = StepStart::new(body, solver.last_step.as_ref(), h, gravity, self.scheme);
         for kind in constraint::IMPLICIT {
-            kind.begin(body, start.h);
+            kind.begin(body, constraints, start.h);
         }
         // Newton starts from the inertial prediction `x̂` (free flight: the warm start that makes
         // smooth motion cost one iteration), or from where the body is when that is the lower
         // potential (a prediction deep inside an obstacle or crushing elements).
         body.velocities.fill(DVec3::ZERO);
-        let here = start.energy(body);
+        let incremental = Potential {
+            start: &start,
+            constraints,
+        };
+        let here = incremental.energy(body);
         body.positions.clone_from(&start.target);
-        let mut potential = start.energy(body);
+        let mut potential = incremental.energy(body);
         // A NaN prediction is not lower either.
         if potential.is_nan() || potential > here {
             body.positions.clone_from(&start.positions);
             potential = here;
         }
-        let outcome = self.minimize(body, solver, &start, potential)?;
+        let outcome = self.minimize(body, solver, &incremental, potential)?;
         for kind in constraint::IMPLICIT {
-            kind.record_impulses(body, start.h, h);
+            kind.record_impulses(body, constraints, start.h, h);
         }
         for n in 0..body.positions.len() {
             body.velocities[n] = if body.pinned[n] {
@@ -274,10 +308,11 @@ impl ImplicitIntegrator {
                 (body.positions[n] - start.anchor[n]) / start.h
             };
         }
-        body.workspace.previous_step = Some(PreviousStep {
+        solver.last_step = Some(PreviousStep {
             h,
             positions: start.positions,
             velocities: start.velocities,
+            edits: body.state_edits(),
         });
         Ok(outcome)
     }
@@ -289,28 +324,20 @@ impl ImplicitIntegrator {
         &self,
         body: &mut DeformableBody,
         solver: &mut Solver,
-        start: &StepStart,
+        incremental: &Potential,
         mut potential: f64,
     ) -> Result<Outcome, Error> {
         let inertia: Vec<f64> = body
             .masses
             .iter()
-            .map(|m| m / (start.h * start.h))
+            .map(|m| m / (incremental.start.h * incremental.start.h))
             .collect();
-        let mut residual = start.residual(body);
-        let reference = start.force_scale(body, &residual);
+        let start = incremental.start;
+        let mut residual = incremental.residual(body);
+        let reference = incremental.force_scale(body, &residual);
         // Relative residuals of the earlier iterations, newest last.
         let mut history: Vec<f64> = Vec::new();
-        // Filled in as Newton goes; `residual` and `converged` are set on return.
-        let mut outcome = Outcome {
-            iterations: 0,
-            linear_iterations: 0,
-            reused_factorizations: 0,
-            factorizations: 0,
-            projected_tangents: 0,
-            residual: f64::NAN,
-            converged: false,
-        };
+        let mut outcome = Outcome::start();
         solver.chord.start_step();
         let finish = |solver: &mut Solver, outcome: Outcome| -> Result<Outcome, Error> {
             solver.chord.end_step(outcome.reused_factorizations > 0);
@@ -338,11 +365,18 @@ impl ImplicitIntegrator {
             let (direction, search) = match reusable {
                 Some(factor) => (solve(factor, &residual), Search::Short),
                 None => (
-                    self.exact_direction(body, solver, start, &inertia, &residual, &mut outcome)?,
+                    self.exact_direction(
+                        body,
+                        solver,
+                        incremental,
+                        &inertia,
+                        &residual,
+                        &mut outcome,
+                    )?,
                     Search::Thorough,
                 ),
             };
-            let energy = |body: &DeformableBody| start.energy(body);
+            let energy = |body: &DeformableBody| incremental.energy(body);
             let mut next = descend(
                 body,
                 &residual,
@@ -350,20 +384,11 @@ impl ImplicitIntegrator {
                 &direction,
                 search,
                 energy,
-                |body| start.residual(body),
+                |body| incremental.residual(body),
             );
             if search == Search::Short {
                 outcome.reused_factorizations += 1;
-                // Converged counts as enough contraction; no descent as none.
-                let after = next.as_ref().map_or(f64::INFINITY, |(next, _)| {
-                    let after = norm(next);
-                    if after <= self.tolerance * reference {
-                        0.0
-                    } else {
-                        after
-                    }
-                });
-                solver.chord.record(norm(&residual), after);
+                self.record_reuse(&mut solver.chord, &residual, next.as_ref(), reference);
                 if next.is_none() {
                     // The exact tangent may still descend where an earlier one does not; this
                     // iteration did not move, so it leaves the stall history.
@@ -377,6 +402,27 @@ impl ImplicitIntegrator {
                 None => return finish(solver, outcome),
             }
         }
+    }
+
+    /// Tells the chord how a reused iteration from `residual` went: to `next` (its residual), or
+    /// nowhere; a residual within the tolerance of the force scale `reference` (N) counts as
+    /// enough contraction.
+    fn record_reuse(
+        &self,
+        chord: &mut Chord,
+        residual: &[DVec3],
+        next: Option<&(Vec<DVec3>, f64)>,
+        reference: f64,
+    ) {
+        let after = next.map_or(f64::INFINITY, |(next, _)| {
+            let after = norm(next);
+            if after <= self.tolerance * reference {
+                0.0
+            } else {
+                after
+            }
+        });
+        chord.record(norm(residual), after);
     }
 
     /// Whether Newton stops at the relative residual `relative` after `iterations`, the earlier
@@ -400,7 +446,7 @@ impl ImplicitIntegrator {
         &self,
         body: &DeformableBody,
         solver: &mut Solver,
-        start: &StepStart,
+        incremental: &Potential,
         inertia: &[f64],
         residual: &[DVec3],
         outcome: &mut Outcome,
@@ -413,7 +459,7 @@ impl ImplicitIntegrator {
             &mut solver.stiffness,
             residual,
             outcome.iterations,
-            |stiffness, project| start.assemble(body, stiffness, inertia, project),
+            |stiffness, project| incremental.assemble(body, stiffness, inertia, project),
         )?;
         outcome.linear_iterations += solution.cg_iterations;
         outcome.factorizations += solution.factorizations;
@@ -424,24 +470,28 @@ impl ImplicitIntegrator {
         if let Some(factor) = solution.factor
             && self.reuse_factorization
         {
-            solver.chord.keep(factor, start.h);
+            solver.chord.keep(factor, incremental.start.h);
         }
         Ok(solution.direction)
     }
 }
 
-/// The implicit step's linear algebra, carried across substeps: the tangent workspace, the
-/// factorization kept for reuse and the solve method.
+/// The implicit step's linear algebra and history, carried across substeps: the tangent
+/// workspace, the factorization kept for reuse, the solve method, and the start of the last
+/// substep (for BDF2).
 struct Solver {
     stiffness: Stiffness,
     chord: Chord,
     method: Method,
+    last_step: Option<PreviousStep>,
 }
 
 impl Solver {
-    /// Returns the workspace and the kept factorization to the body for its next step.
-    fn give_back(self, body: &mut DeformableBody) {
-        body.workspace.tangent = Some(self.stiffness);
-        body.workspace.chord = self.chord;
+    /// Returns the tangent and the kept factorization to the workspace for the body's next
+    /// step, with `history` as the state two-step schemes start from.
+    fn give_back(self, workspace: &mut SolverWorkspace, history: Option<PreviousStep>) {
+        workspace.tangent = Some(self.stiffness);
+        workspace.chord = self.chord;
+        workspace.previous_step = history;
     }
 }

@@ -8,9 +8,10 @@
 use super::ImplicitScheme;
 use crate::assembly::Stiffness;
 use crate::body::DeformableBody;
-use crate::constraint;
+use crate::constraint::{self, BodyConstraints};
 use crate::damping::RayleighDamping;
 use crate::element::{add_point_forces, deformation_gradient};
+use crate::integrate::PreviousStep;
 use crate::material::green_strain;
 use crate::newton::norm;
 use rapier3d::glamx::{DMat3, DVec3};
@@ -36,13 +37,14 @@ impl StepStart {
     /// step when it had the same length, backward Euler otherwise.
     pub(super) fn new(
         body: &DeformableBody,
+        previous: Option<&PreviousStep>,
         h: f64,
         gravity: DVec3,
         scheme: ImplicitScheme,
     ) -> Self {
         let positions = body.positions.clone();
         let previous = match scheme {
-            ImplicitScheme::Bdf2 => body.workspace.previous_step.as_ref().filter(|p| p.h == h),
+            ImplicitScheme::Bdf2 => previous.filter(|p| p.h == h),
             ImplicitScheme::BackwardEuler => None,
         };
         let green_at = |x: &[DVec3]| -> Vec<DMat3> {
@@ -106,23 +108,30 @@ impl StepStart {
             load,
         }
     }
+}
 
+/// The incremental potential of one step: the step's start and the constraints' terms.
+pub(super) struct Potential<'a> {
+    pub(super) start: &'a StepStart,
+    pub(super) constraints: &'a BodyConstraints,
+}
+
+impl Potential<'_> {
     /// `-∇E` (N): elastic and damping forces, gravity, contact penalties and the inertial pull
     /// toward `x̂`; zero on pinned nodes.
     pub(super) fn residual(&self, body: &mut DeformableBody) -> Vec<DVec3> {
         body.velocities.fill(DVec3::ZERO);
-        body.compute_internal_forces();
-        let mut residual: Vec<DVec3> = (0..body.positions.len())
-            .map(|n| {
-                let inertial =
-                    (self.target[n] - body.positions[n]) * (body.masses[n] / (self.h * self.h));
-                body.workspace.forces[n] + self.load[n] + inertial
-            })
-            .collect();
+        let start = self.start;
+        let mut residual = body.internal_forces();
+        for (n, r) in residual.iter_mut().enumerate() {
+            let inertial =
+                (start.target[n] - body.positions[n]) * (body.masses[n] / (start.h * start.h));
+            *r = *r + start.load[n] + inertial;
+        }
         if let Some(damping) = body.damping {
             self.add_damping_forces(body, &damping, &mut residual);
         }
-        constraint::add_implicit_forces(body, self.h, &mut residual);
+        constraint::add_implicit_forces(body, self.constraints, self.start.h, &mut residual);
         for (r, &pinned) in residual.iter_mut().zip(&body.pinned) {
             if pinned {
                 *r = DVec3::ZERO;
@@ -140,7 +149,7 @@ impl StepStart {
         body.elements
             .for_each_point(|point, nodes, gradients, weight| {
                 let f = deformation_gradient(nodes, gradients, &body.positions);
-                let stress = damping.step_first_piola(&f, &self.green[point], self.h);
+                let stress = damping.step_first_piola(&f, &self.start.green[point], self.start.h);
                 add_point_forces(nodes, gradients, &(stress * weight), out);
             });
     }
@@ -149,9 +158,12 @@ impl StepStart {
     /// pull and the initial out-of-balance force.
     pub(super) fn force_scale(&self, body: &DeformableBody, initial_residual: &[DVec3]) -> f64 {
         let inertial: Vec<DVec3> = (0..body.positions.len())
-            .map(|n| (self.target[n] - self.positions[n]) * (body.masses[n] / (self.h * self.h)))
+            .map(|n| {
+                (self.start.target[n] - self.start.positions[n])
+                    * (body.masses[n] / (self.start.h * self.start.h))
+            })
             .collect();
-        norm(&self.load)
+        norm(&self.start.load)
             .max(norm(&inertial))
             .max(norm(initial_residual))
             .max(f64::MIN_POSITIVE)
@@ -160,14 +172,17 @@ impl StepStart {
     /// The incremental potential `E(x)` (J) at the body's positions.
     pub(super) fn energy(&self, body: &DeformableBody) -> f64 {
         let inertia: f64 = (0..body.positions.len())
-            .map(|n| 0.5 * body.masses[n] * (body.positions[n] - self.target[n]).length_squared())
+            .map(|n| {
+                0.5 * body.masses[n] * (body.positions[n] - self.start.target[n]).length_squared()
+            })
             .sum::<f64>()
-            / (self.h * self.h);
+            / (self.start.h * self.start.h);
         // The load's work is measured from the start of the step.
         let load: f64 = self
+            .start
             .load
             .iter()
-            .zip(body.positions.iter().zip(&self.positions))
+            .zip(body.positions.iter().zip(&self.start.positions))
             .map(|(f, (x, x0))| f.dot(*x - *x0))
             .sum();
         let dissipation = match body.damping {
@@ -176,14 +191,14 @@ impl StepStart {
                 body.elements
                     .for_each_point(|point, nodes, gradients, weight| {
                         let f = deformation_gradient(nodes, gradients, &body.positions);
-                        dissipation +=
-                            weight * damping.step_potential(&f, &self.green[point], self.h);
+                        dissipation += weight
+                            * damping.step_potential(&f, &self.start.green[point], self.start.h);
                     });
                 dissipation
             }
             None => 0.0,
         };
-        let penalty = constraint::implicit_energy(body, self.h);
+        let penalty = constraint::implicit_energy(body, self.constraints, self.start.h);
         inertia + body.elastic_energy() + dissipation + penalty - load
     }
 
@@ -198,9 +213,9 @@ impl StepStart {
     ) {
         let damping = body.damping;
         stiffness.assemble(body, Some(inertia), project, |t, f, df| match &damping {
-            Some(d) => d.step_first_piola_differential(f, &self.green[t], self.h, df),
+            Some(d) => d.step_first_piola_differential(f, &self.start.green[t], self.start.h, df),
             None => DMat3::ZERO,
         });
-        constraint::add_implicit_tangents(body, self.h, stiffness);
+        constraint::add_implicit_tangents(body, self.constraints, self.start.h, stiffness);
     }
 }

@@ -202,8 +202,12 @@ fn run_beam(
         nodes: soft.node_count(),
         dofs: knobs::dofs(&soft),
     };
+    let mut workspace = SolverWorkspace::new();
     for k in 0..steps {
-        match run.timer.time(|| stepper.step(&mut soft, dt, GRAVITY)) {
+        match run
+            .timer
+            .time(|| stepper.step(&mut soft, &mut workspace, dt, GRAVITY))
+        {
             Ok(work) => {
                 run.work_sum += work.iterations;
                 run.work_max = run.work_max.max(work.iterations);

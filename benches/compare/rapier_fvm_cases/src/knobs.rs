@@ -42,9 +42,17 @@ impl Stepper {
         }
     }
 
-    /// Advances `body` by `dt` (s) under `gravity` (m/s²); returns the Newton iterations (implicit)
-    /// or substeps (explicit) the step took and whether it converged.
-    pub fn step(self, body: &mut DeformableBody, dt: f64, gravity: DVec3) -> Result<Work, Error> {
+    /// Advances `body` by `dt` (s) under `gravity` (m/s²), with `workspace` its solver caches;
+    /// returns the Newton iterations (implicit) or substeps (explicit) the step took and whether
+    /// it converged.
+    pub fn step(
+        self,
+        body: &mut DeformableBody,
+        workspace: &mut SolverWorkspace,
+        dt: f64,
+        gravity: DVec3,
+    ) -> Result<Work, Error> {
+        let free = &mut BodyConstraints::new();
         match self {
             Stepper::Implicit(scheme, tolerance) => {
                 let integrator = ImplicitIntegrator {
@@ -52,14 +60,14 @@ impl Stepper {
                     tolerance,
                     ..ImplicitIntegrator::default()
                 };
-                let report = integrator.step(body, dt, gravity)?;
+                let report = integrator.step(body, free, workspace, dt, gravity)?;
                 Ok(Work {
                     iterations: report.newton_iterations,
                     converged: report.converged,
                 })
             }
             Stepper::Explicit => {
-                let report = SymplecticEuler::default().step(body, dt, gravity)?;
+                let report = SymplecticEuler::default().step(body, free, workspace, dt, gravity)?;
                 Ok(Work {
                     iterations: report.substeps as usize,
                     converged: true,

@@ -1,0 +1,232 @@
+//! The constraints acting on one deformable body over the coming step, kept beside the body (by
+//! [`SoftCoupling`](crate::coupling::SoftCoupling), per body handle): the contacts the last
+//! detection found (its surface against colliders and against itself, rigid vertices against its
+//! boundary triangles), the nodes glued to rigid bodies, and the proxies of the rigid bodies
+//! they touch (frozen in pose, their velocities following the impulses). A step saves what it
+//! moves of them and puts it back if it fails.
+
+use crate::Error;
+use crate::attachment::{self, Attachment};
+use crate::body::DeformableBody;
+use crate::contact::{self, ContactSet, ContactSettings, NodeContact};
+use crate::rigid::RigidProxy;
+use rapier3d::dynamics::{RigidBodyHandle, RigidBodySet};
+use rapier3d::geometry::{ColliderHandle, ColliderSet};
+use rapier3d::glamx::DVec3;
+
+/// The contacts and attachments of one deformable body, and the rigid bodies they touch.
+///
+/// [`SoftCoupling`](crate::coupling::SoftCoupling) keeps one per body and fills it every
+/// substep; a program stepping a body alone with an integrator keeps its own and hands it to
+/// the step (an empty one for a body touching nothing).
+///
+/// # Example
+/// ```
+/// use rapier_fvm::prelude::*;
+///
+/// let material = Material::new(MaterialModel::StableNeoHookean, 1e5, 0.4, 1000.0)?;
+/// let mut cube = DeformableBodyBuilder::new(mesh::cuboid(DVec3::splat(0.05), [2; 3])?, material).build()?;
+/// let (mut constraints, mut workspace) = (BodyConstraints::new(), SolverWorkspace::new());
+/// let gravity = DVec3::new(0.0, -9.81, 0.0);
+/// ImplicitIntegrator::default().step(&mut cube, &mut constraints, &mut workspace, 0.01, gravity)?;
+/// assert!(constraints.contacts().is_empty());
+/// # Ok::<(), rapier_fvm::Error>(())
+/// ```
+#[derive(Debug, Clone, Default)]
+pub struct BodyConstraints {
+    /// The contacts the integrators enforce, from the last detection.
+    pub(crate) contacts: ContactSet,
+    /// The nodes glued to rigid bodies.
+    pub(crate) attachments: Vec<Attachment>,
+    /// The rigid bodies the contacts and attachments touch, as the soft step sees them.
+    pub(crate) rigid_proxies: Vec<RigidProxy>,
+    /// What [`BodyConstraints::save`] set aside.
+    saved: SavedConstraints,
+}
+
+/// The proxies, attachment anchors (m) and contact planes (point and normal) saved with the
+/// state before a step: explicit substeps move them.
+#[derive(Debug, Clone, Default)]
+struct SavedConstraints {
+    proxies: Vec<RigidProxy>,
+    anchors: Vec<DVec3>,
+    planes: Vec<(DVec3, DVec3)>,
+}
+
+impl BodyConstraints {
+    /// No contacts and no attachments.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Finds the contacts of `body`'s surface with `colliders` for a frame of `frame_dt` (s)
+    /// under `gravity` (m/s²), replacing the previous ones: a surface point gets a contact with
+    /// each non-sensor collider the body's
+    /// [`collision_groups`](crate::body::DeformableBody::collision_groups) interact with and it
+    /// is within `settings.margin` of, plus twice the distance the body's fastest node can
+    /// travel in the frame (`2 (|v|max + |g| dt) dt`), plus twice the collider's own travel (at
+    /// most 1 m), except the colliders of a rigid body the point is attached to; with
+    /// [`self_contact`](crate::body::DeformableBody::self_contact) on, also with the body's own
+    /// boundary. The integrators enforce them until the next detection. It also places the
+    /// attachments' anchors where their rigid bodies are now (dropping attachments to bodies no
+    /// longer in `bodies`), ready for the step.
+    ///
+    /// # Errors
+    /// [`Error::InvalidTimeStep`], [`Error::NonFiniteInput`] or [`Error::InvalidSetting`] for a bad
+    /// step, gravity or setting; the contacts are then left as they were.
+    pub fn detect_contacts(
+        &mut self,
+        body: &DeformableBody,
+        colliders: &ColliderSet,
+        bodies: &RigidBodySet,
+        frame_dt: f64,
+        gravity: DVec3,
+        settings: &ContactSettings,
+    ) -> Result<&[NodeContact], Error> {
+        let glued: Vec<(RigidBodyHandle, u32)> =
+            self.attachments.iter().map(|a| (a.body, a.node)).collect();
+        let found = contact::detect(body, &glued, colliders, bodies, frame_dt, gravity, settings)?;
+        let mut proxies = found.proxies;
+        attachment::ready(&mut self.attachments, &mut proxies, bodies, frame_dt);
+        self.rigid_proxies = proxies;
+        self.contacts = ContactSet {
+            nodes: found.nodes,
+            corners: found.corners,
+            settings: *settings,
+        };
+        if body.self_contact {
+            let own = contact::detect_self_contacts(body, found.reach);
+            self.contacts.nodes.extend(own);
+        }
+        Ok(&self.contacts.nodes)
+    }
+
+    /// The contacts found by the last [`BodyConstraints::detect_contacts`].
+    pub fn contacts(&self) -> &[NodeContact] {
+        &self.contacts.nodes
+    }
+
+    /// Removes every contact (the attachments stay).
+    pub fn clear_contacts(&mut self) {
+        self.contacts.nodes.clear();
+        self.contacts.corners.clear();
+        self.rigid_proxies.clear();
+    }
+
+    /// Glues `nodes` of `body` to the rigid body `rigid` of `bodies` where they are now: each
+    /// node keeps following the rigid body's material point it sits at, and the rigid body feels
+    /// it (two-way when it is dynamic; a kinematic or fixed body drags the nodes along). The
+    /// attachments act from the next [`BodyConstraints::detect_contacts`], which readies them
+    /// for the coming step.
+    ///
+    /// # Errors
+    /// [`Error::NodeOutOfRange`] for a node that does not exist, [`Error::UnknownRigidBody`] if
+    /// `rigid` is not in `bodies`; nothing is attached then.
+    pub fn attach(
+        &mut self,
+        body: &DeformableBody,
+        nodes: impl IntoIterator<Item = u32>,
+        rigid: RigidBodyHandle,
+        bodies: &RigidBodySet,
+    ) -> Result<(), Error> {
+        let added = attachment::glue(body, nodes, rigid, bodies)?;
+        self.attachments.extend(added);
+        Ok(())
+    }
+
+    /// The attachments.
+    pub fn attachments(&self) -> &[Attachment] {
+        &self.attachments
+    }
+
+    /// Removes every attachment to the rigid body `rigid`.
+    pub fn detach(&mut self, rigid: RigidBodyHandle) {
+        self.attachments.retain(|a| a.body != rigid);
+    }
+
+    /// The impulse (N s) and angular impulse about the centre of mass (N m s) the body gave each
+    /// rigid body it touches or is attached to over the last step, not yet handed to rapier (see
+    /// [`BodyConstraints::transfer_contact_impulses`]).
+    pub fn rigid_impulses(&self) -> impl Iterator<Item = (RigidBodyHandle, DVec3, DVec3)> + '_ {
+        self.rigid_proxies
+            .iter()
+            .map(|proxy| (proxy.handle, proxy.impulse, proxy.angular_impulse))
+    }
+
+    /// Hands the impulses the contacts and attachments of the last step gave rigid bodies to
+    /// rapier's set (the opposite of what the soft body received), and forgets them.
+    pub fn transfer_contact_impulses(&mut self, bodies: &mut RigidBodySet) {
+        for proxy in &mut self.rigid_proxies {
+            proxy.transfer(bodies);
+            proxy.impulse = DVec3::ZERO;
+            proxy.angular_impulse = DVec3::ZERO;
+        }
+    }
+
+    /// The mean force (N) and torque about the world origin (N m) `body`'s contacts exerted on
+    /// `collider` over the last step, of length `dt` (s): their impulses over `dt` (the torque
+    /// taken at the surface points' end-of-step positions, and at the collider's vertices for
+    /// its corners pressing on the surface). In an [`FvmWorld`](crate::world::FvmWorld) the last
+    /// step is the frame's last coupling substep.
+    ///
+    /// # Errors
+    /// [`Error::InvalidTimeStep`] for a non-positive or non-finite `dt`.
+    pub fn contact_force_on(
+        &self,
+        body: &DeformableBody,
+        collider: ColliderHandle,
+        dt: f64,
+    ) -> Result<(DVec3, DVec3), Error> {
+        contact::force_on_collider(body, &self.contacts, collider, dt)
+    }
+
+    /// The impulse (N s) and angular impulse about the world origin (N m s) `body`'s contacts
+    /// gave each collider they touch over the last step, one entry per collider.
+    pub(crate) fn collider_impulses(
+        &self,
+        body: &DeformableBody,
+    ) -> Vec<(ColliderHandle, DVec3, DVec3)> {
+        contact::collider_impulses(body, &self.contacts)
+    }
+
+    /// Whether the last detection found self-contacts or rigid corners against the surface, for
+    /// which the automatic integrator keeps the explicit one.
+    pub(crate) fn needs_explicit_contacts(&self) -> bool {
+        self.contacts.needs_explicit()
+    }
+
+    /// Whether the constraints are coupled to each other (through a dynamic rigid body's
+    /// velocity or the nodes of a self-contact triangle or a rigid corner), so that one explicit
+    /// sweep does not solve them.
+    pub(crate) fn coupled(&self) -> bool {
+        self.rigid_proxies.iter().any(RigidProxy::is_dynamic) || self.needs_explicit_contacts()
+    }
+
+    /// Sets aside what a step moves (no allocation after the first call), and starts counting
+    /// the contact impulses of a new step.
+    pub(crate) fn save(&mut self) {
+        self.contacts.clear_impulses();
+        self.saved.proxies.clone_from(&self.rigid_proxies);
+        self.saved.anchors.clear();
+        self.saved
+            .anchors
+            .extend(self.attachments.iter().map(|a| a.anchor));
+        self.saved.planes.clear();
+        self.saved
+            .planes
+            .extend(self.contacts.nodes.iter().map(|c| (c.point, c.normal)));
+    }
+
+    /// Puts back what [`BodyConstraints::save`] set aside.
+    pub(crate) fn restore(&mut self) {
+        self.contacts.clear_impulses();
+        self.rigid_proxies.clone_from(&self.saved.proxies);
+        for (attachment, anchor) in self.attachments.iter_mut().zip(&self.saved.anchors) {
+            attachment.anchor = *anchor;
+        }
+        for (contact, (point, normal)) in self.contacts.nodes.iter_mut().zip(&self.saved.planes) {
+            contact.point = *point;
+            contact.normal = *normal;
+        }
+    }
+}

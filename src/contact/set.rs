@@ -1,0 +1,39 @@
+//! A body's contacts from the last detection: its surface points against colliders and against
+//! its own boundary, rigid vertices against its boundary triangles, and the settings they were
+//! found with and are enforced by.
+
+use super::{ContactSettings, CornerContact, NodeContact, Obstacle};
+use rapier3d::glamx::DVec3;
+
+/// The contacts one detection found for a body.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct ContactSet {
+    /// Surface points against colliders and against the body's own triangles.
+    pub(crate) nodes: Vec<NodeContact>,
+    /// Rigid vertices against the body's boundary triangles.
+    pub(crate) corners: Vec<CornerContact>,
+    /// The settings of the detection.
+    pub(crate) settings: ContactSettings,
+}
+
+impl ContactSet {
+    /// Whether the set holds self-contacts or rigid corners, for which the automatic integrator
+    /// keeps the explicit one (its cost model does not price their implicit terms).
+    pub(crate) fn needs_explicit(&self) -> bool {
+        !self.corners.is_empty()
+            || self
+                .nodes
+                .iter()
+                .any(|c| matches!(c.obstacle, Obstacle::OwnTriangle(_)))
+    }
+
+    /// Zeroes the impulses the contacts gave over the last step.
+    pub(crate) fn clear_impulses(&mut self) {
+        for contact in &mut self.nodes {
+            contact.impulse = DVec3::ZERO;
+        }
+        for contact in &mut self.corners {
+            contact.impulse = DVec3::ZERO;
+        }
+    }
+}

@@ -1,0 +1,101 @@
+//! What the integrators keep of a body between steps, beside the body itself: scratch forces,
+//! the nodal state saved before a step (restored if it fails), the state at the start of the
+//! last implicit step (for two-step schemes), the sparse tangent's pattern and symbolic
+//! factorization, and the chord method's last numeric factorization. None of it is the body's
+//! state: an empty workspace steps a body to the same result, except that BDF2 restarts with a
+//! backward Euler step and the first Newton iteration refactors.
+
+use crate::assembly::Stiffness;
+use crate::body::DeformableBody;
+use crate::chord::Chord;
+use rapier3d::glamx::DVec3;
+
+/// The solver caches of one deformable body.
+///
+/// [`SoftCoupling`](crate::coupling::SoftCoupling) keeps one per body; a program stepping a
+/// body alone with an integrator keeps its own beside the body (see
+/// [`BodyConstraints`](crate::constraint::BodyConstraints) for an example). Give each body its
+/// own: a workspace used for another body is rebuilt.
+#[derive(Debug, Clone, Default)]
+pub struct SolverWorkspace {
+    /// The node and tetrahedron counts of the body the caches were made for.
+    fitted: (usize, usize),
+    /// The last internal forces computed (N per node).
+    pub(crate) forces: Vec<DVec3>,
+    /// Positions (m) saved before a step, restored if the step fails.
+    saved_positions: Vec<DVec3>,
+    /// Velocities (m/s) saved with them.
+    saved_velocities: Vec<DVec3>,
+    /// The state at the start of the last implicit substep, for two-step schemes.
+    pub(crate) previous_step: Option<PreviousStep>,
+    /// The sparse tangent's pattern and symbolic factorization, built by the first implicit or
+    /// static solve and kept for the next.
+    pub(crate) tangent: Option<Stiffness>,
+    /// The implicit integrator's last factorization, kept for reuse by the chord method.
+    pub(crate) chord: Chord,
+}
+
+/// The state at the start of an implicit substep of length `h` (s), kept for the next one.
+#[derive(Debug, Clone)]
+pub(crate) struct PreviousStep {
+    pub(crate) h: f64,
+    pub(crate) positions: Vec<DVec3>,
+    pub(crate) velocities: Vec<DVec3>,
+    /// The body's [`DeformableBody::state_edits`] when the step ended: an edit of the state since
+    /// then makes it stale.
+    pub(crate) edits: u64,
+}
+
+impl SolverWorkspace {
+    /// An empty workspace.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Fits the workspace to `body`: caches made for a body of other node or tetrahedron counts
+    /// are dropped.
+    pub(crate) fn fit(&mut self, body: &DeformableBody) {
+        let fitted = (body.node_count(), body.mesh().tet_count());
+        if self.fitted != fitted || self.forces.len() != fitted.0 {
+            *self = Self {
+                fitted,
+                forces: vec![DVec3::ZERO; fitted.0],
+                ..Self::default()
+            };
+        }
+    }
+
+    /// The state at the start of the last implicit substep, if the body was not edited since
+    /// that step ended.
+    pub(crate) fn history(&self, body: &DeformableBody) -> Option<&PreviousStep> {
+        self.previous_step
+            .as_ref()
+            .filter(|p| p.edits == body.state_edits())
+    }
+
+    /// Recomputes [`SolverWorkspace::forces`] for `body`.
+    pub(crate) fn compute_internal_forces(&mut self, body: &mut DeformableBody) {
+        self.fit(body);
+        body.internal_forces_into(&mut self.forces);
+    }
+
+    /// Copies `body`'s positions and velocities aside (no allocation after the first call).
+    pub(crate) fn save_state(&mut self, body: &DeformableBody) {
+        self.fit(body);
+        self.saved_positions.clone_from(&body.positions);
+        self.saved_velocities.clone_from(&body.velocities);
+    }
+
+    /// Puts back the state saved by [`SolverWorkspace::save_state`].
+    pub(crate) fn restore_state(&self, body: &mut DeformableBody) {
+        body.positions.clone_from(&self.saved_positions);
+        body.velocities.clone_from(&self.saved_velocities);
+    }
+
+    /// The tangent workspace for `body`, built on first use; give it back with
+    /// `self.tangent = Some(..)`.
+    pub(crate) fn take_tangent(&mut self, body: &DeformableBody) -> Stiffness {
+        self.fit(body);
+        self.tangent.take().unwrap_or_else(|| Stiffness::new(body))
+    }
+}
