@@ -13,6 +13,10 @@ use rapier3d::glamx::DMat3;
 
 /// Rayleigh damping coefficients, the viscous counterparts of the Lamé parameters.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "serde-serialize",
+    derive(serde::Serialize, serde::Deserialize)
+)]
 pub struct RayleighDamping {
     /// Volumetric damping coefficient `φ` (Pa·s), multiplying `tr(ε̇)`.
     phi: f64,

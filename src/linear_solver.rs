@@ -36,6 +36,10 @@ use rapier3d::glamx::{DMat3, DVec3};
 
 /// How the Newton system of each implicit iteration is solved.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(
+    feature = "serde-serialize",
+    derive(serde::Serialize, serde::Deserialize)
+)]
 pub enum LinearSolver {
     /// Chooses, each frame, between [`LinearSolver::Direct`] and the conjugate gradient by their
     /// predicted costs per solve.

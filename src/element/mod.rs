@@ -29,6 +29,10 @@ pub(crate) const MAX_ELEMENT_NODES: usize = hex27::NODES;
 
 /// The polynomial order of a body's elements.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(
+    feature = "serde-serialize",
+    derive(serde::Serialize, serde::Deserialize)
+)]
 pub enum ElementOrder {
     /// 4-node tetrahedra, linear motion and constant strain per element.
     Linear,
@@ -39,6 +43,10 @@ pub enum ElementOrder {
 
 /// A body's elements with their rest data.
 #[derive(Debug, Clone)]
+#[cfg_attr(
+    feature = "serde-serialize",
+    derive(serde::Serialize, serde::Deserialize)
+)]
 pub(crate) enum Elements {
     Linear {
         fvm: FvmMesh,

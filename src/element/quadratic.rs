@@ -8,6 +8,10 @@ use rapier3d::glamx::{DMat3, DVec3};
 
 /// The reference shape of a body's quadratic elements.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(
+    feature = "serde-serialize",
+    derive(serde::Serialize, serde::Deserialize)
+)]
 pub enum ElementShape {
     /// Tetrahedra (10 nodes: corners and mid-edge nodes).
     Tetrahedron,
@@ -132,6 +136,10 @@ fn rest_gradients(shape: ElementShape, p: &[DVec3], xi: DVec3) -> Result<(Vec<DV
 
 /// The rest data of a mesh of quadratic elements of one shape.
 #[derive(Debug, Clone)]
+#[cfg_attr(
+    feature = "serde-serialize",
+    derive(serde::Serialize, serde::Deserialize)
+)]
 pub struct QuadraticElements {
     shape: ElementShape,
     /// The elements' nodes, `shape.node_count()` per element.

@@ -22,6 +22,10 @@ use rapier3d::glamx::{DMat3, DVec3};
 
 /// How the volumetric (first Lamé parameter) part of the elastic energy is evaluated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(
+    feature = "serde-serialize",
+    derive(serde::Serialize, serde::Deserialize)
+)]
 pub enum VolumetricTreatment {
     /// Per tetrahedron, as every other term: the plain linear tetrahedron. Accurate for
     /// compressible materials; locks as `ν → 0.5` (and is stiff in bending at any `ν`).
@@ -44,6 +48,10 @@ pub enum VolumetricTreatment {
 
 /// The node-to-element incidence and rest volumes nodal averaging needs, built once per body.
 #[derive(Debug, Clone)]
+#[cfg_attr(
+    feature = "serde-serialize",
+    derive(serde::Serialize, serde::Deserialize)
+)]
 pub(crate) struct NodalAveraging {
     /// Per node, the summed rest volume of its tetrahedra (m³).
     patch_volume: Vec<f64>,
@@ -56,6 +64,10 @@ pub(crate) struct NodalAveraging {
 
 /// The volume measures of one configuration.
 #[derive(Debug, Clone, Default)]
+#[cfg_attr(
+    feature = "serde-serialize",
+    derive(serde::Serialize, serde::Deserialize)
+)]
 pub(crate) struct VolumeMeasures {
     /// `m_e` per tetrahedron.
     pub(crate) element: Vec<f64>,

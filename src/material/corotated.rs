@@ -13,6 +13,10 @@ use rapier3d::glamx::{DMat3, DVec3};
 
 /// Corotated linear elastic material with the given Lamé parameters.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "serde-serialize",
+    derive(serde::Serialize, serde::Deserialize)
+)]
 pub struct Corotated(pub LameParameters);
 
 /// Below this `det F / (‖F‖²/3)^(3/2)` (1 for a rotation, 0 for a flat element) the polar

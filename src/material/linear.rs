@@ -9,6 +9,10 @@ use rapier3d::glamx::DMat3;
 
 /// Linear (small-strain) elasticity with the given Lamé parameters. Not invariant under rotation.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "serde-serialize",
+    derive(serde::Serialize, serde::Deserialize)
+)]
 pub struct LinearElastic(pub LameParameters);
 
 impl LinearElastic {

@@ -13,6 +13,10 @@ const LARGE_STRAIN: f64 = 0.1;
 
 /// Stable Neo-Hookean material.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "serde-serialize",
+    derive(serde::Serialize, serde::Deserialize)
+)]
 pub struct StableNeoHookean {
     pub(super) mu: f64,
     /// `λ' = λ + μ` (Pa), the volumetric coefficient of this energy.

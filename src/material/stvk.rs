@@ -34,6 +34,10 @@ const CONTINUATION_DECAY: f64 = COMPRESSION_THRESHOLD / 4.0;
 
 /// St. Venant–Kirchhoff material with the given Lamé parameters.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "serde-serialize",
+    derive(serde::Serialize, serde::Deserialize)
+)]
 pub struct StVenantKirchhoff(pub LameParameters);
 
 /// The continued energy at given signed singular values: density, gradient and Hessian.
