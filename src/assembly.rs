@@ -36,6 +36,8 @@ pub(crate) struct Stiffness {
     lower_neighbours: Vec<Vec<u32>>,
     /// Matrix entries in compressed-column order (N/m).
     pub(crate) values: Vec<f64>,
+    /// The node pairs `[a, b]` (`a > b`) the pattern couples beyond the mesh's, sorted.
+    extra_pairs: Vec<[u32; 2]>,
     /// The symbolic Cholesky factorization (fill-reducing ordering and elimination tree) of the
     /// pattern, computed at the first factorization and reused by every later one.
     symbolic: Option<SymbolicLlt<usize>>,
@@ -90,6 +92,7 @@ impl Stiffness {
             col_ptr,
             row_idx,
             lower_neighbours,
+            extra_pairs: Vec::new(),
             symbolic: None,
             stress_maps: Vec::new(),
             element_nodes: Vec::new(),
@@ -107,20 +110,36 @@ impl Stiffness {
 
     /// The pattern widened by the node pairs `extra` (`[a, b]`, `a > b`: nodes a constraint
     /// couples beyond the mesh's, such as a self-contact's node and triangle), values zero; its
-    /// symbolic factorization is made anew at the first factorization.
-    pub(crate) fn widened(&self, extra: &[[u32; 2]]) -> Self {
+    /// symbolic factorization is made anew at the first factorization. `None` for a pair naming
+    /// a node the pattern does not have, or not ordered.
+    pub(crate) fn widened(&self, extra: &[[u32; 2]]) -> Option<Self> {
+        let n = self.lower_neighbours.len();
+        if extra.iter().any(|&[a, b]| a <= b || a as usize >= n) {
+            return None;
+        }
         let mut lower_neighbours = self.lower_neighbours.clone();
         for &[a, b] in extra {
             lower_neighbours[b as usize].push(a);
         }
         for list in &mut lower_neighbours {
-            // Each node stays first in its own list.
-            list[1..].sort_unstable();
-        }
-        for list in &mut lower_neighbours {
+            // Each node stays first in its own list (its neighbours are all greater).
+            list.sort_unstable();
             list.dedup();
         }
-        Self::with_neighbours(lower_neighbours)
+        let mut extra_pairs = self.extra_pairs.clone();
+        extra_pairs.extend_from_slice(extra);
+        extra_pairs.sort_unstable();
+        extra_pairs.dedup();
+        Some(Self {
+            extra_pairs,
+            ..Self::with_neighbours(lower_neighbours)
+        })
+    }
+
+    /// The node pairs the pattern couples beyond the mesh's (see [`Stiffness::widened`]).
+    #[cfg(feature = "serde-serialize")]
+    pub(crate) fn extra_pairs(&self) -> &[[u32; 2]] {
+        &self.extra_pairs
     }
 
     /// Index into `values` of the entry (row `3a + i`, column `3b + j`), for `a > b`, or `a == b`

@@ -20,7 +20,14 @@ use rapier3d::glamx::{DMat3, DVec3};
 const DRIFT_CORRECTION: f64 = 0.2;
 
 /// A node glued to a point of a rigid body.
+///
+/// Written (feature `serde-serialize`) as its node, rigid body and local anchor: the rest is
+/// readied again by the next contact detection.
 #[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(
+    feature = "serde-serialize",
+    derive(serde::Serialize, serde::Deserialize)
+)]
 pub struct Attachment {
     /// The soft body's node.
     pub node: u32,
@@ -29,14 +36,24 @@ pub struct Attachment {
     /// The anchor point in the rigid body's local frame (m).
     pub local_anchor: DVec3,
     /// The anchor in the world (m), moved with the body during a soft step.
+    #[cfg_attr(feature = "serde-serialize", serde(skip))]
     pub(crate) anchor: DVec3,
     /// Index of the body among the soft body's rigid proxies.
+    #[cfg_attr(feature = "serde-serialize", serde(skip, default = "unready"))]
     pub(crate) proxy: usize,
     /// Within an explicit substep: the velocity (m/s) of the node relative to the anchor that
     /// corrects part of the drift, and the inverse of the node's and body's joint inverse mass
     /// (kg).
+    #[cfg_attr(feature = "serde-serialize", serde(skip))]
     drift_velocity: DVec3,
+    #[cfg_attr(feature = "serde-serialize", serde(skip))]
     effective_mass: DMat3,
+}
+
+/// The proxy index of an attachment not readied for a step yet.
+#[cfg(feature = "serde-serialize")]
+fn unready() -> usize {
+    usize::MAX
 }
 
 /// The attachments gluing `nodes` of `body` to the rigid body `rigid` of `bodies` where they

@@ -20,6 +20,8 @@
 //! [`MAX_PAUSE`] implicit substeps (doubling with each consecutive failing substep), so a
 //! strongly nonlinear motion wastes at most one solve every few substeps.
 
+#[cfg(feature = "serde-serialize")]
+use crate::assembly::Stiffness;
 use faer::sparse::linalg::solvers::Llt;
 
 /// A reused factorization must bring the out-of-balance force to at most this fraction of its
@@ -41,11 +43,24 @@ pub(crate) fn within_budget(reduction: f64, remaining: usize) -> bool {
 }
 
 /// The factorization kept for reuse and the pause after failures; one per body.
+///
+/// Serialized (feature `serde-serialize`) as the matrix the kept factorization was made of and
+/// the pause; read back, the matrix is factored again at the body's next implicit step, which
+/// gives the same factor (the same pattern, ordering and arithmetic).
 #[derive(Debug, Clone, Default)]
+#[cfg_attr(
+    feature = "serde-serialize",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(into = "ChordRecord", from = "ChordRecord")
+)]
 pub(crate) struct Chord {
     /// The last factorization of the implicit Newton system and the effective step `ĥ` (s) whose
     /// inertia it holds.
     factor: Option<(Llt<usize, f64>, f64)>,
+    /// The matrix the kept factorization was made of, kept for serialization and factored
+    /// again after reading back.
+    #[cfg(feature = "serde-serialize")]
+    factored: Option<FactoredMatrix>,
     /// Steps still to take without reuse.
     pause: u32,
     /// The pause the next failing step sets.
@@ -77,8 +92,45 @@ impl Chord {
     }
 
     /// Keeps a fresh factorization made for effective step `h` (s).
+    /// Keeps a fresh factorization made for effective step `h` (s).
     pub(crate) fn keep(&mut self, factor: Llt<usize, f64>, h: f64) {
         self.factor = Some((factor, h));
+    }
+
+    /// Remembers the matrix the factorization just kept was made of, `stiffness`, for
+    /// serialization.
+    #[cfg(feature = "serde-serialize")]
+    pub(crate) fn remember(&mut self, stiffness: &Stiffness) {
+        if let Some((_, h)) = self.factor {
+            self.factored = Some(FactoredMatrix {
+                values: stiffness.values.clone(),
+                extra_pairs: stiffness.extra_pairs().to_vec(),
+                h,
+            });
+        }
+    }
+
+    /// After reading back: factors the kept matrix of `body` again, on the pattern it was made
+    /// on; a matrix that does not fit the body is dropped.
+    #[cfg(feature = "serde-serialize")]
+    pub(crate) fn refactor(&mut self, body: &crate::body::DeformableBody) {
+        if self.factor.is_some() {
+            return;
+        }
+        let Some(matrix) = self.factored.take() else {
+            return;
+        };
+        let Some(mut stiffness) = Stiffness::new(body).widened(&matrix.extra_pairs) else {
+            return;
+        };
+        if matrix.values.len() != stiffness.values.len() {
+            return;
+        }
+        stiffness.values.clone_from(&matrix.values);
+        if let Ok(factor) = crate::assembly::factorize(&mut stiffness, 0) {
+            self.factor = Some((factor, matrix.h));
+            self.factored = Some(matrix);
+        }
     }
 
     /// Records a reused iteration that cut the out-of-balance force from `before` to `after`
@@ -99,6 +151,48 @@ impl Chord {
     pub(crate) fn end_step(&mut self, reused: bool) {
         if reused && !self.failed_this_step {
             self.next_pause = 0;
+        }
+    }
+}
+
+/// The matrix a kept factorization was made of: its values (compressed-column order, N/m), the
+/// node pairs its pattern couples beyond the mesh's, and its effective step `ĥ` (s).
+#[cfg(feature = "serde-serialize")]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
+pub(crate) struct FactoredMatrix {
+    values: Vec<f64>,
+    extra_pairs: Vec<[u32; 2]>,
+    h: f64,
+}
+
+/// What a [`Chord`] is written as: the matrix of its kept factorization and its pause.
+#[cfg(feature = "serde-serialize")]
+#[derive(serde::Serialize, serde::Deserialize)]
+pub(crate) struct ChordRecord {
+    factored: Option<FactoredMatrix>,
+    pause: u32,
+    next_pause: u32,
+}
+
+#[cfg(feature = "serde-serialize")]
+impl From<Chord> for ChordRecord {
+    fn from(chord: Chord) -> Self {
+        Self {
+            factored: chord.factored,
+            pause: chord.pause,
+            next_pause: chord.next_pause,
+        }
+    }
+}
+
+#[cfg(feature = "serde-serialize")]
+impl From<ChordRecord> for Chord {
+    fn from(record: ChordRecord) -> Self {
+        Self {
+            factored: record.factored,
+            pause: record.pause.min(MAX_PAUSE),
+            next_pause: record.next_pause.min(MAX_PAUSE),
+            ..Self::default()
         }
     }
 }

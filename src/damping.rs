@@ -15,13 +15,32 @@ use rapier3d::glamx::DMat3;
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(
     feature = "serde-serialize",
-    derive(serde::Serialize, serde::Deserialize)
+    derive(serde::Serialize, serde::Deserialize),
+    serde(try_from = "DampingParts")
 )]
 pub struct RayleighDamping {
     /// Volumetric damping coefficient `φ` (Pa·s), multiplying `tr(ε̇)`.
     phi: f64,
     /// Shear damping coefficient `ψ` (Pa·s), multiplying `2 ε̇`.
     psi: f64,
+}
+
+/// A [`RayleighDamping`] as written (feature `serde-serialize`); read back through
+/// [`RayleighDamping::new`].
+#[cfg(feature = "serde-serialize")]
+#[derive(serde::Deserialize)]
+struct DampingParts {
+    phi: f64,
+    psi: f64,
+}
+
+#[cfg(feature = "serde-serialize")]
+impl TryFrom<DampingParts> for RayleighDamping {
+    type Error = Error;
+
+    fn try_from(parts: DampingParts) -> Result<Self, Error> {
+        Self::new(parts.phi, parts.psi)
+    }
 }
 
 impl RayleighDamping {

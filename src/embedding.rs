@@ -21,10 +21,6 @@ use rapier3d::parry::partitioning::{Bvh, BvhBuildStrategy};
 /// A fine mesh embedded in a body's simulation mesh (see the [module](self) documentation).
 /// Made by [`DeformableBodyBuilder::embedded`](crate::body::DeformableBodyBuilder::embedded).
 #[derive(Debug, Clone)]
-#[cfg_attr(
-    feature = "serde-serialize",
-    derive(serde::Serialize, serde::Deserialize)
-)]
 pub struct Embedding {
     mesh: TetMesh,
     surface_triangles: Vec<[u32; 3]>,

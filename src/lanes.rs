@@ -10,10 +10,6 @@ pub const LANES: usize = 4;
 
 /// A 3-vector of four lanes.
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(
-    feature = "serde-serialize",
-    derive(serde::Serialize, serde::Deserialize)
-)]
 pub struct Vec3x4 {
     /// x components.
     pub x: f64x4,
@@ -25,10 +21,6 @@ pub struct Vec3x4 {
 
 /// A 3x3 matrix of four lanes, stored by columns like `glam::DMat3`.
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(
-    feature = "serde-serialize",
-    derive(serde::Serialize, serde::Deserialize)
-)]
 pub struct Mat3x4 {
     /// The three columns.
     pub cols: [Vec3x4; 3],

@@ -40,6 +40,34 @@ use rapier3d::pipeline::{
 /// assert!(world.soft_bodies[handle].positions().iter().all(|x| x.y > -2e-3));
 /// # Ok::<(), rapier_fvm::Error>(())
 /// ```
+///
+/// With the feature `serde-serialize`, a world also serializes, and one read back steps on as the
+/// original, bit for bit (a binary format such as CBOR: rapier's state holds infinities, which
+/// JSON cannot carry):
+/// ```
+/// # #[cfg(feature = "serde-serialize")] {
+/// use rapier_fvm::prelude::*;
+///
+/// let mut world = FvmWorld::default();
+/// let rubber = Material::new(MaterialModel::StableNeoHookean, 1e5, 0.3, 1000.0)?;
+/// world
+///     .soft_bodies
+///     .insert(DeformableBodyBuilder::new(mesh::cuboid(DVec3::splat(0.05), [2; 3])?, rubber).build()?);
+/// world.step();
+/// let mut file = Vec::new();
+/// ciborium::into_writer(&world, &mut file).expect("a world serializes");
+/// let mut restored: FvmWorld = ciborium::from_reader(&file[..]).expect("and reads back");
+/// world.step();
+/// restored.step();
+/// let (a, b) = (world.soft_bodies.iter().next(), restored.soft_bodies.iter().next());
+/// assert_eq!(a.map(|(_, body)| body.positions()), b.map(|(_, body)| body.positions()));
+/// # }
+/// # Ok::<(), rapier_fvm::Error>(())
+/// ```
+#[cfg_attr(
+    feature = "serde-serialize",
+    derive(serde::Serialize, serde::Deserialize)
+)]
 pub struct FvmWorld {
     /// The rapier world: rigid bodies, colliders, joints and the integration parameters, whose
     /// `dt` is the frame step (s) and whose `gravity` (m/s²) acts on the deformable bodies too.

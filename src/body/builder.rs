@@ -161,6 +161,49 @@ impl DeformableBodyBuilder {
         }
     }
 
+    /// A body of quadratic elements of `shape` on `subdivision` (their linear subdivision):
+    /// `nodes` lists each element's nodes, `parents` the element of each subdivision tetrahedron.
+    ///
+    /// # Errors
+    /// [`Error::InvalidSetting`] for node lists of the wrong length or an element node or parent
+    /// beyond the mesh's or the elements' count.
+    #[cfg(feature = "serde-serialize")]
+    pub(super) fn from_quadratic_parts(
+        subdivision: TetMesh,
+        material: Material,
+        (shape, nodes, parents): (ElementShape, Vec<u32>, Vec<u32>),
+    ) -> Result<Self, Error> {
+        let per_element = shape.node_count();
+        let elements = nodes.len() / per_element;
+        if nodes.len() % per_element != 0 || parents.len() != subdivision.tet_count() {
+            return Err(Error::InvalidSetting {
+                parameter: "quadratic elements",
+                value: nodes.len() as f64,
+                reason: "need the element's node count per element and a parent per tetrahedron",
+            });
+        }
+        let out_of_range = |index: u32, count: usize| (index as usize >= count).then_some(index);
+        let bad_node = nodes
+            .iter()
+            .find_map(|&n| out_of_range(n, subdivision.node_count()));
+        let bad_parent = parents.iter().find_map(|&p| out_of_range(p, elements));
+        if let Some(index) = bad_node.or(bad_parent) {
+            return Err(Error::InvalidSetting {
+                parameter: "quadratic elements",
+                value: f64::from(index),
+                reason: "an element node or parent index beyond the mesh's nodes or elements",
+            });
+        }
+        Ok(Self {
+            quadratic: Some(QuadraticSpec {
+                shape,
+                nodes,
+                parents,
+            }),
+            ..Self::new(subdivision, material)
+        })
+    }
+
     /// Rayleigh damping on the strain rate.
     pub fn damping(mut self, damping: RayleighDamping) -> Self {
         self.damping = Some(damping);

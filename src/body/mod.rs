@@ -2,6 +2,8 @@
 //! (m/s) and lumped masses (kg), plus pinned (Dirichlet) nodes.
 
 mod builder;
+#[cfg(feature = "serde-serialize")]
+mod record;
 mod set;
 mod stress;
 mod surface;

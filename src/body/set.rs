@@ -6,6 +6,10 @@ use super::DeformableBody;
 /// A stable reference to a body of a [`DeformableBodySet`]. A handle whose body was removed stays
 /// invalid even if its slot is reused (the generation differs).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[cfg_attr(
+    feature = "serde-serialize",
+    derive(serde::Serialize, serde::Deserialize)
+)]
 pub struct DeformableBodyHandle {
     index: u32,
     generation: u32,
@@ -25,6 +29,10 @@ impl DeformableBodyHandle {
 }
 
 #[derive(Debug, Clone)]
+#[cfg_attr(
+    feature = "serde-serialize",
+    derive(serde::Serialize, serde::Deserialize)
+)]
 struct Slot {
     generation: u32,
     body: Option<DeformableBody>,
@@ -49,10 +57,50 @@ struct Slot {
 /// # Ok::<(), rapier_fvm::Error>(())
 /// ```
 #[derive(Debug, Clone, Default)]
+#[cfg_attr(
+    feature = "serde-serialize",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(try_from = "SetParts")
+)]
 pub struct DeformableBodySet {
     slots: Vec<Slot>,
     free: Vec<u32>,
     len: usize,
+}
+
+/// A [`DeformableBodySet`] as written (feature `serde-serialize`): read back, its free slots
+/// and count must agree with its bodies.
+#[cfg(feature = "serde-serialize")]
+#[derive(serde::Deserialize)]
+struct SetParts {
+    slots: Vec<Slot>,
+    free: Vec<u32>,
+    len: usize,
+}
+
+#[cfg(feature = "serde-serialize")]
+impl TryFrom<SetParts> for DeformableBodySet {
+    type Error = crate::Error;
+
+    fn try_from(parts: SetParts) -> Result<Self, crate::Error> {
+        let empty: Vec<u32> = (0..parts.slots.len() as u32)
+            .filter(|&i| parts.slots[i as usize].body.is_none())
+            .collect();
+        let mut free = parts.free.clone();
+        free.sort_unstable();
+        if free != empty || parts.len != parts.slots.len() - empty.len() {
+            return Err(crate::Error::InvalidSetting {
+                parameter: "deformable body set",
+                value: parts.len as f64,
+                reason: "its free slots and body count do not match its bodies",
+            });
+        }
+        Ok(Self {
+            slots: parts.slots,
+            free: parts.free,
+            len: parts.len,
+        })
+    }
 }
 
 impl DeformableBodySet {

@@ -32,15 +32,25 @@ use rapier3d::glamx::DVec3;
 /// assert!(constraints.contacts().is_empty());
 /// # Ok::<(), rapier_fvm::Error>(())
 /// ```
+///
+/// Written (feature `serde-serialize`) as its attachments: the contacts and the rigid bodies'
+/// proxies are found again by every detection, before every step.
 #[derive(Debug, Clone, Default)]
+#[cfg_attr(
+    feature = "serde-serialize",
+    derive(serde::Serialize, serde::Deserialize)
+)]
 pub struct BodyConstraints {
     /// The contacts the integrators enforce, from the last detection.
+    #[cfg_attr(feature = "serde-serialize", serde(skip))]
     pub(crate) contacts: ContactSet,
     /// The nodes glued to rigid bodies.
     pub(crate) attachments: Vec<Attachment>,
     /// The rigid bodies the contacts and attachments touch, as the soft step sees them.
+    #[cfg_attr(feature = "serde-serialize", serde(skip))]
     pub(crate) rigid_proxies: Vec<RigidProxy>,
     /// What [`BodyConstraints::save`] set aside.
+    #[cfg_attr(feature = "serde-serialize", serde(skip))]
     saved: SavedConstraints,
 }
 

@@ -77,6 +77,10 @@ use rapier3d::dynamics::CoefficientCombineRule;
 
 /// How contacts are detected and enforced.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "serde-serialize",
+    derive(serde::Serialize, serde::Deserialize)
+)]
 pub struct ContactSettings {
     /// Nodes within this distance (m) of a collider, beyond the distance they can travel in the
     /// frame, get a contact.

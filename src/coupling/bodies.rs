@@ -10,6 +10,10 @@ use std::collections::BTreeMap;
 
 /// One body's constraints and solver caches.
 #[derive(Debug, Clone, Default)]
+#[cfg_attr(
+    feature = "serde-serialize",
+    derive(serde::Serialize, serde::Deserialize)
+)]
 pub(super) struct BodyLinks {
     pub(super) constraints: BodyConstraints,
     pub(super) workspace: SolverWorkspace,
@@ -28,8 +32,31 @@ impl BodyLinks {
 
 /// The links of every deformable body, by handle.
 #[derive(Debug, Clone, Default)]
+#[cfg_attr(
+    feature = "serde-serialize",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(
+        into = "Vec<(DeformableBodyHandle, BodyLinks)>",
+        from = "Vec<(DeformableBodyHandle, BodyLinks)>"
+    )
+)]
 pub(super) struct LinkSet {
     links: BTreeMap<DeformableBodyHandle, BodyLinks>,
+}
+
+/// Written as a list of pairs (formats such as JSON take only strings as map keys).
+impl From<LinkSet> for Vec<(DeformableBodyHandle, BodyLinks)> {
+    fn from(set: LinkSet) -> Self {
+        set.links.into_iter().collect()
+    }
+}
+
+impl From<Vec<(DeformableBodyHandle, BodyLinks)>> for LinkSet {
+    fn from(pairs: Vec<(DeformableBodyHandle, BodyLinks)>) -> Self {
+        Self {
+            links: pairs.into_iter().collect(),
+        }
+    }
 }
 
 impl LinkSet {

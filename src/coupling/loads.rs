@@ -14,6 +14,10 @@ use rapier3d::glamx::DVec3;
 /// contacts and attachments (rigid bodies of every type: a fixed or kinematic body feels it too,
 /// though it does not move).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "serde-serialize",
+    derive(serde::Serialize, serde::Deserialize)
+)]
 pub struct RigidLoad {
     /// The deformable body.
     pub soft_body: DeformableBodyHandle,
@@ -28,6 +32,10 @@ pub struct RigidLoad {
 /// The mean force and torque a deformable body's contacts exerted on a collider over a frame:
 /// any collider, a fixed ground without a rigid body as well as a body's.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "serde-serialize",
+    derive(serde::Serialize, serde::Deserialize)
+)]
 pub struct ColliderLoad {
     /// The deformable body.
     pub soft_body: DeformableBodyHandle,
@@ -94,6 +102,10 @@ fn divide<L: PairLoad>(loads: &mut [L], dt: f64) {
 
 /// The loads of a frame, gathered as impulses and turned into forces at its end.
 #[derive(Debug, Clone, Default)]
+#[cfg_attr(
+    feature = "serde-serialize",
+    derive(serde::Serialize, serde::Deserialize)
+)]
 pub(crate) struct FrameLoads {
     rigid: Vec<RigidLoad>,
     colliders: Vec<ColliderLoad>,

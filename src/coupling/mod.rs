@@ -132,6 +132,10 @@ impl RapierSets<'_> {
 /// How deformable bodies are stepped beside rapier's rigid bodies, and what they exerted on them
 /// over the last frame.
 #[derive(Debug, Clone)]
+#[cfg_attr(
+    feature = "serde-serialize",
+    derive(serde::Serialize, serde::Deserialize)
+)]
 pub struct SoftCoupling {
     /// How the deformable bodies are stepped.
     pub integrator: AutomaticIntegrator,

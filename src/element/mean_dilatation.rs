@@ -31,10 +31,6 @@ const MAX_FUNCTIONS: usize = 4;
 /// The pressure functions of every element, orthonormal for its rest quadrature weights: rest
 /// data, built once per body.
 #[derive(Debug, Clone)]
-#[cfg_attr(
-    feature = "serde-serialize",
-    derive(serde::Serialize, serde::Deserialize)
-)]
 pub(crate) struct PressureBasis {
     /// Functions per element: 1 for tetrahedra, 4 for hexahedra.
     functions: usize,

@@ -43,10 +43,6 @@ pub enum ElementOrder {
 
 /// A body's elements with their rest data.
 #[derive(Debug, Clone)]
-#[cfg_attr(
-    feature = "serde-serialize",
-    derive(serde::Serialize, serde::Deserialize)
-)]
 pub(crate) enum Elements {
     Linear {
         fvm: FvmMesh,
@@ -68,6 +64,15 @@ impl Elements {
         match self {
             Self::Linear { .. } => ElementOrder::Linear,
             Self::Quadratic { .. } => ElementOrder::Quadratic,
+        }
+    }
+
+    /// The quadratic elements' shape and nodes; `None` for linear tetrahedra.
+    #[cfg(feature = "serde-serialize")]
+    pub(crate) fn quadratic_nodes(&self) -> Option<(ElementShape, &[u32])> {
+        match self {
+            Self::Linear { .. } => None,
+            Self::Quadratic { elements, .. } => Some((elements.shape(), elements.nodes())),
         }
     }
 

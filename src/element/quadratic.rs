@@ -136,10 +136,6 @@ fn rest_gradients(shape: ElementShape, p: &[DVec3], xi: DVec3) -> Result<(Vec<DV
 
 /// The rest data of a mesh of quadratic elements of one shape.
 #[derive(Debug, Clone)]
-#[cfg_attr(
-    feature = "serde-serialize",
-    derive(serde::Serialize, serde::Deserialize)
-)]
 pub struct QuadraticElements {
     shape: ElementShape,
     /// The elements' nodes, `shape.node_count()` per element.
@@ -206,6 +202,12 @@ impl QuadraticElements {
     /// The elements' shape.
     pub fn shape(&self) -> ElementShape {
         self.shape
+    }
+
+    /// The elements' nodes, [`ElementShape::node_count`] per element.
+    #[cfg(feature = "serde-serialize")]
+    pub(crate) fn nodes(&self) -> &[u32] {
+        &self.nodes
     }
 
     /// Number of elements.

@@ -57,10 +57,6 @@ pub fn stress_forces(rest: &TetRest, stress: &DMat3) -> [DVec3; 4] {
 
 /// Rest data of [`LANES`] consecutive tetrahedra, one per lane.
 #[derive(Debug, Clone, Copy)]
-#[cfg_attr(
-    feature = "serde-serialize",
-    derive(serde::Serialize, serde::Deserialize)
-)]
 struct RestBlock {
     inverse_rest_edges: Mat3x4,
     volume: f64x4,
@@ -69,10 +65,6 @@ struct RestBlock {
 /// The mesh as the finite-volume method sees it: tetrahedra, their rest data, and reusable storage
 /// for summing the forces into nodal forces.
 #[derive(Debug, Clone)]
-#[cfg_attr(
-    feature = "serde-serialize",
-    derive(serde::Serialize, serde::Deserialize)
-)]
 pub struct FvmMesh {
     /// The tetrahedra, padded with copies of the last one to a multiple of [`LANES`].
     tets: Vec<[u32; 4]>,

@@ -48,10 +48,6 @@ pub enum VolumetricTreatment {
 
 /// The node-to-element incidence and rest volumes nodal averaging needs, built once per body.
 #[derive(Debug, Clone)]
-#[cfg_attr(
-    feature = "serde-serialize",
-    derive(serde::Serialize, serde::Deserialize)
-)]
 pub(crate) struct NodalAveraging {
     /// Per node, the summed rest volume of its tetrahedra (m³).
     patch_volume: Vec<f64>,
@@ -64,10 +60,6 @@ pub(crate) struct NodalAveraging {
 
 /// The volume measures of one configuration.
 #[derive(Debug, Clone, Default)]
-#[cfg_attr(
-    feature = "serde-serialize",
-    derive(serde::Serialize, serde::Deserialize)
-)]
 pub(crate) struct VolumeMeasures {
     /// `m_e` per tetrahedron.
     pub(crate) element: Vec<f64>,

@@ -5,10 +5,6 @@ use rapier3d::glamx::{DMat3, DVec3};
 
 /// Rest data of one tetrahedron `[x0, x1, x2, x3]`: 10 numbers, the least the force kernel needs.
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(
-    feature = "serde-serialize",
-    derive(serde::Serialize, serde::Deserialize)
-)]
 pub struct TetRest {
     /// `Dm⁻¹` (1/m), the inverse of the rest edge matrix `Dm = [p1 - p0, p2 - p0, p3 - p0]`, so that
     /// `F = Ds Dm⁻¹` with `Ds` the deformed edge matrix. Its rows are the gradients of the linear

@@ -40,6 +40,10 @@ const NEWTON_ITERATIONS_PER_FRAME: f64 = 3.5;
 
 /// Which integrator advanced a frame.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(
+    feature = "serde-serialize",
+    derive(serde::Serialize, serde::Deserialize)
+)]
 pub enum IntegratorKind {
     /// [`SymplecticEuler`].
     Explicit,
@@ -88,6 +92,10 @@ pub struct AutomaticReport {
 
 /// Picks, frame by frame, the cheaper of an explicit and an implicit integrator.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(
+    feature = "serde-serialize",
+    derive(serde::Serialize, serde::Deserialize)
+)]
 pub struct AutomaticIntegrator {
     /// The explicit integrator (its automatic substeps set the explicit cost).
     pub explicit: SymplecticEuler,

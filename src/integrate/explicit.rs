@@ -31,6 +31,10 @@ const RECHECK_INTERVAL: u32 = 16;
 
 /// How a frame step is split into substeps.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(
+    feature = "serde-serialize",
+    derive(serde::Serialize, serde::Deserialize)
+)]
 pub enum Substeps {
     /// As many equal substeps as needed to stay below the stable step.
     #[default]
@@ -42,6 +46,10 @@ pub enum Substeps {
 
 /// The symplectic Euler integrator and its settings.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "serde-serialize",
+    derive(serde::Serialize, serde::Deserialize)
+)]
 pub struct SymplecticEuler {
     /// Fraction of the critical step used by [`Substeps::Automatic`] (dimensionless, in (0, 1]).
     pub safety_factor: f64,

@@ -16,7 +16,17 @@ use rapier3d::glamx::DVec3;
 /// body alone with an integrator keeps its own beside the body (see
 /// [`BodyConstraints`](crate::constraint::BodyConstraints) for an example). Give each body its
 /// own: a workspace used for another body is rebuilt.
+///
+/// With the feature `serde-serialize` it is written as the two-step history, the pause and
+/// matrix of the kept factorization, and the node pairs the tangent couples beyond the mesh's;
+/// read back, the tangent and the factorization are made again at the next implicit step, the
+/// same as they were, so a restored run continues as the original.
 #[derive(Debug, Clone, Default)]
+#[cfg_attr(
+    feature = "serde-serialize",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(into = "WorkspaceRecord", from = "WorkspaceRecord")
+)]
 pub struct SolverWorkspace {
     /// The node and tetrahedron counts of the body the caches were made for.
     fitted: (usize, usize),
@@ -33,10 +43,57 @@ pub struct SolverWorkspace {
     pub(crate) tangent: Option<Stiffness>,
     /// The implicit integrator's last factorization, kept for reuse by the chord method.
     pub(crate) chord: Chord,
+    /// Read back: the node pairs the tangent coupled beyond the mesh's, for its next build.
+    #[cfg(feature = "serde-serialize")]
+    pending_pairs: Vec<[u32; 2]>,
+}
+
+/// What a [`SolverWorkspace`] is written as.
+#[cfg(feature = "serde-serialize")]
+#[derive(serde::Serialize, serde::Deserialize)]
+struct WorkspaceRecord {
+    fitted: (usize, usize),
+    previous_step: Option<PreviousStep>,
+    tangent_pairs: Vec<[u32; 2]>,
+    chord: Chord,
+}
+
+#[cfg(feature = "serde-serialize")]
+impl From<SolverWorkspace> for WorkspaceRecord {
+    fn from(workspace: SolverWorkspace) -> Self {
+        let tangent_pairs = match &workspace.tangent {
+            Some(tangent) => tangent.extra_pairs().to_vec(),
+            None => workspace.pending_pairs,
+        };
+        Self {
+            fitted: workspace.fitted,
+            previous_step: workspace.previous_step,
+            tangent_pairs,
+            chord: workspace.chord,
+        }
+    }
+}
+
+#[cfg(feature = "serde-serialize")]
+impl From<WorkspaceRecord> for SolverWorkspace {
+    fn from(record: WorkspaceRecord) -> Self {
+        Self {
+            fitted: record.fitted,
+            forces: vec![DVec3::ZERO; record.fitted.0],
+            previous_step: record.previous_step,
+            chord: record.chord,
+            pending_pairs: record.tangent_pairs,
+            ..Self::default()
+        }
+    }
 }
 
 /// The state at the start of an implicit substep of length `h` (s), kept for the next one.
 #[derive(Debug, Clone)]
+#[cfg_attr(
+    feature = "serde-serialize",
+    derive(serde::Serialize, serde::Deserialize)
+)]
 pub(crate) struct PreviousStep {
     pub(crate) h: f64,
     pub(crate) positions: Vec<DVec3>,
@@ -68,9 +125,12 @@ impl SolverWorkspace {
     /// The state at the start of the last implicit substep, if the body was not edited since
     /// that step ended.
     pub(crate) fn history(&self, body: &DeformableBody) -> Option<&PreviousStep> {
-        self.previous_step
-            .as_ref()
-            .filter(|p| p.edits == body.state_edits())
+        let nodes = body.node_count();
+        self.previous_step.as_ref().filter(|p| {
+            p.edits == body.state_edits()
+                && p.positions.len() == nodes
+                && p.velocities.len() == nodes
+        })
     }
 
     /// Recomputes [`SolverWorkspace::forces`] for `body`.
@@ -96,6 +156,13 @@ impl SolverWorkspace {
     /// `self.tangent = Some(..)`.
     pub(crate) fn take_tangent(&mut self, body: &DeformableBody) -> Stiffness {
         self.fit(body);
-        self.tangent.take().unwrap_or_else(|| Stiffness::new(body))
+        self.tangent.take().unwrap_or_else(|| {
+            let mesh = Stiffness::new(body);
+            #[cfg(feature = "serde-serialize")]
+            if let Some(widened) = mesh.widened(&std::mem::take(&mut self.pending_pairs)) {
+                return widened;
+            }
+            mesh
+        })
     }
 }

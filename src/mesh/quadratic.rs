@@ -28,10 +28,6 @@ use std::collections::HashMap;
 /// # Ok::<(), rapier_fvm::Error>(())
 /// ```
 #[derive(Debug, Clone, PartialEq)]
-#[cfg_attr(
-    feature = "serde-serialize",
-    derive(serde::Serialize, serde::Deserialize)
-)]
 pub struct QuadraticTetMesh {
     elements: Vec<[u32; NODES]>,
     subdivided: TetMesh,

@@ -27,10 +27,6 @@ use rapier3d::glamx::DVec3;
 /// # Ok::<(), rapier_fvm::Error>(())
 /// ```
 #[derive(Debug, Clone, PartialEq)]
-#[cfg_attr(
-    feature = "serde-serialize",
-    derive(serde::Serialize, serde::Deserialize)
-)]
 pub struct QuadraticHexMesh {
     elements: Vec<[u32; NODES]>,
     subdivided: TetMesh,

@@ -37,6 +37,10 @@ const STALL_CEILING: f64 = 1e-4;
 
 /// Which implicit scheme [`ImplicitIntegrator`] uses.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(
+    feature = "serde-serialize",
+    derive(serde::Serialize, serde::Deserialize)
+)]
 pub enum ImplicitScheme {
     /// Backward Euler: first order, strongly damps high frequencies. The most robust.
     #[default]
@@ -55,6 +59,10 @@ pub enum ImplicitScheme {
 /// crushing its elements), Newton starts from the current positions instead. The linear solves
 /// start from zero (they solve for the Newton correction).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "serde-serialize",
+    derive(serde::Serialize, serde::Deserialize)
+)]
 pub struct ImplicitIntegrator {
     /// The time discretization.
     pub scheme: ImplicitScheme,
@@ -211,9 +219,13 @@ impl ImplicitIntegrator {
         };
         let mut stiffness = workspace.take_tangent(body);
         let uncoupled = constraint::uncoupled_pairs(body, constraints, &stiffness);
-        if !uncoupled.is_empty() {
-            stiffness = stiffness.widened(&uncoupled);
+        if !uncoupled.is_empty()
+            && let Some(widened) = stiffness.widened(&uncoupled)
+        {
+            stiffness = widened;
         }
+        #[cfg(feature = "serde-serialize")]
+        workspace.chord.refactor(body);
         let mut solver = Solver {
             stiffness,
             // Without reuse, a factorization kept by earlier steps is dropped.
@@ -471,6 +483,8 @@ impl ImplicitIntegrator {
             && self.reuse_factorization
         {
             solver.chord.keep(factor, incremental.start.h);
+            #[cfg(feature = "serde-serialize")]
+            solver.chord.remember(&solver.stiffness);
         }
         Ok(solution.direction)
     }

@@ -1,0 +1,178 @@
+//! An `FvmWorld` written mid-run (CBOR: rapier's state holds infinities, which JSON cannot carry)
+//! and read back steps on exactly as the original does,
+//! bit for bit (tolerance 0), under the automatic integrator and under forced implicit BDF2
+//! steps (whose two-step history and kept factorization the file carries), with contacts, a
+//! dynamic rigid body on a soft one, an attachment, a quadratic body and an embedded mesh; a
+//! file that breaks a body's rules is refused with the error a new body would get, never a panic.
+
+use rapier_fvm::prelude::*;
+use rapier3d::prelude::*;
+use serde_json::Value;
+
+/// A soft block on the ground with a box dropped on it, a soft rod glued to a fixed bar, and a
+/// quadratic cube carrying an embedded mesh, stepped by `integrator` (`None`: automatic).
+fn scene(integrator: Option<IntegratorKind>) -> Result<FvmWorld, Error> {
+    let mut world = FvmWorld::default();
+    world.coupling.integrator.force = integrator;
+    world.coupling.integrator.implicit.scheme = ImplicitScheme::Bdf2;
+    world.physics.insert_collider(
+        ColliderBuilder::new(SharedShape::halfspace(Vector::Y)).friction(0.8),
+        None,
+    );
+    let rubber = Material::new(MaterialModel::StableNeoHookean, 1e6, 0.3, 1000.0)?;
+    let damping = RayleighDamping::stiffness_proportional(2e-3, rubber.lame())?;
+    let block = DeformableBodyBuilder::new(mesh::cuboid(DVec3::splat(0.1), [3; 3])?, rubber)
+        .damping(damping)
+        .translation(DVec3::new(0.0, 0.1, 0.0))
+        .build()?;
+    world.soft_bodies.insert(block);
+    world.physics.insert(
+        RigidBodyBuilder::dynamic().translation(Vector::new(0.02, 0.27, 0.0)),
+        ColliderBuilder::cuboid(0.05, 0.05, 0.05).density(1000.0),
+    );
+    let (bar, _) = world.physics.insert(
+        RigidBodyBuilder::fixed().translation(Vector::new(1.0, 1.0, 0.0)),
+        ColliderBuilder::cuboid(0.1, 0.01, 0.01).sensor(true),
+    );
+    let rod_mesh = mesh::cuboid(DVec3::new(0.02, 0.1, 0.02), [1, 4, 1])?;
+    let top = rod_mesh.nodes_where(|p| p.y >= 0.1 - 1e-9);
+    let rod = DeformableBodyBuilder::new(rod_mesh, rubber)
+        .damping(damping)
+        .translation(DVec3::new(1.05, 0.9, 0.0))
+        .build()?;
+    let rod = world.soft_bodies.insert(rod);
+    world.attach(rod, top, bar)?;
+    let coarse = mesh::QuadraticTetMesh::from_linear(&mesh::cuboid(DVec3::splat(0.05), [1; 3])?)?;
+    let cube = DeformableBodyBuilder::quadratic(coarse, rubber)
+        .damping(damping)
+        .embedded(mesh::cuboid(DVec3::splat(0.05), [3; 3])?)
+        .translation(DVec3::new(-0.5, 0.3, 0.0))
+        .build()?;
+    world.soft_bodies.insert(cube);
+    Ok(world)
+}
+
+/// Steps `world` by `frames` frames.
+fn run(world: &mut FvmWorld, frames: usize) -> Result<(), Error> {
+    for _ in 0..frames {
+        for (_, outcome) in world.step() {
+            outcome?;
+        }
+    }
+    Ok(())
+}
+
+/// Asserts that two worlds hold the same state, bit for bit.
+fn assert_identical(a: &FvmWorld, b: &FvmWorld) {
+    assert_eq!(a.soft_bodies.len(), b.soft_bodies.len());
+    assert_eq!(a.physics.bodies.len(), b.physics.bodies.len());
+    for ((ha, body_a), (hb, body_b)) in a.soft_bodies.iter().zip(b.soft_bodies.iter()) {
+        assert_eq!(ha, hb);
+        assert_eq!(body_a.positions(), body_b.positions(), "{ha:?}");
+        assert_eq!(body_a.velocities(), body_b.velocities(), "{ha:?}");
+        assert_eq!(body_a.masses(), body_b.masses(), "{ha:?}");
+    }
+    for ((ha, rigid_a), (hb, rigid_b)) in a.physics.bodies.iter().zip(b.physics.bodies.iter()) {
+        assert_eq!(ha, hb);
+        assert_eq!(rigid_a.position(), rigid_b.position(), "{ha:?}");
+        assert_eq!(rigid_a.linvel(), rigid_b.linvel(), "{ha:?}");
+        assert_eq!(rigid_a.angvel(), rigid_b.angvel(), "{ha:?}");
+    }
+    assert_eq!(a.rigid_loads(), b.rigid_loads());
+}
+
+#[test]
+fn a_world_read_back_steps_on_bit_identically() -> Result<(), Error> {
+    for integrator in [None, Some(IntegratorKind::Implicit)] {
+        let mut original = scene(integrator)?;
+        run(&mut original, 20)?;
+        let mut file = Vec::new();
+        ciborium::into_writer(&original, &mut file).expect("a world serializes");
+        let mut restored: FvmWorld = ciborium::from_reader(&file[..]).expect("and reads back");
+        assert_identical(&original, &restored);
+        run(&mut original, 25)?;
+        run(&mut restored, 25)?;
+        println!(
+            "{integrator:?}: {} bytes of CBOR, identical after 25 more frames",
+            file.len()
+        );
+        assert_identical(&original, &restored);
+    }
+    Ok(())
+}
+
+/// The JSON of the scene's first deformable body.
+fn first_body(world: &Value) -> Value {
+    world["soft_bodies"]["slots"][0]["body"].clone()
+}
+
+/// The error reading a world back gives after `edit` changed its first deformable body's JSON
+/// (the world not stepped yet, so that JSON holds all of it).
+fn refusal(edit: impl Fn(&mut Value)) -> String {
+    let world = scene(None).expect("the scene builds");
+    let mut json = serde_json::to_value(&world).expect("a world serializes");
+    let mut body = first_body(&json);
+    edit(&mut body);
+    json["soft_bodies"]["slots"][0]["body"] = body;
+    match serde_json::from_value::<FvmWorld>(json) {
+        Ok(_) => panic!("the edited world was accepted"),
+        Err(error) => error.to_string(),
+    }
+}
+
+/// A change to a body's JSON.
+type Edit = Box<dyn Fn(&mut Value)>;
+
+#[test]
+fn a_file_breaking_a_bodys_rules_is_refused_with_a_typed_error() {
+    // Each message is the one `TetMesh::new`, `Material::new` or the builder gives a new body.
+    let cases: [(&str, Edit, &str); 5] = [
+        (
+            "a tetrahedron naming a node the mesh lacks",
+            Box::new(|b| b["mesh"]["tets"][3][1] = Value::from(100_000)),
+            "node",
+        ),
+        (
+            "a NaN rest coordinate (JSON null)",
+            Box::new(|b| b["mesh"]["positions"][5][0] = Value::Null),
+            "",
+        ),
+        (
+            "a negative density",
+            Box::new(|b| b["material"]["density"] = Value::from(-1000.0)),
+            "density",
+        ),
+        (
+            "a state of the wrong length",
+            Box::new(|b| {
+                b["velocities"]
+                    .as_array_mut()
+                    .expect("velocities are a list")
+                    .pop();
+            }),
+            "one entry per node",
+        ),
+        (
+            "a pinned node beyond the mesh",
+            Box::new(|b| b["pinned"] = Value::from(vec![1_000_000])),
+            "node",
+        ),
+    ];
+    for (what, edit, expected) in cases {
+        let message = refusal(edit);
+        println!("{what}: {message}");
+        assert!(message.contains(expected), "{what}: {message}");
+    }
+}
+
+#[test]
+fn a_set_whose_count_disagrees_with_its_bodies_is_refused() {
+    let world = scene(None).expect("the scene builds");
+    let mut json = serde_json::to_value(&world).expect("a world serializes");
+    json["soft_bodies"]["len"] = Value::from(7);
+    let error = serde_json::from_value::<FvmWorld>(json)
+        .err()
+        .expect("refused");
+    println!("{error}");
+    assert!(error.to_string().contains("body count"));
+}
