@@ -13,8 +13,9 @@ use crate::Error;
 use crate::body::DeformableBody;
 use crate::contact::ContactSettings;
 use crate::rigid::RigidProxy;
-use rapier3d::dynamics::{RigidBodyHandle, RigidBodySet};
+use rapier3d::dynamics::RigidBodyHandle;
 use rapier3d::glamx::{DMat3, DVec3};
+use rapier3d::math::Pose;
 
 /// Fraction of an attachment's position drift corrected per explicit substep.
 const DRIFT_CORRECTION: f64 = 0.2;
@@ -56,19 +57,17 @@ fn unready() -> usize {
     usize::MAX
 }
 
-/// The attachments gluing `nodes` of `body` to the rigid body `rigid` of `bodies` where they
-/// are now (see [`BodyConstraints::attach`](crate::constraint::BodyConstraints::attach)).
+/// The attachments gluing `nodes` of `body` to the rigid body `rigid`, at `pose`, where they are
+/// now (see [`BodyConstraints::attach`](crate::constraint::BodyConstraints::attach)).
 ///
 /// # Errors
-/// [`Error::NodeOutOfRange`] for a node that does not exist, [`Error::UnknownRigidBody`] if
-/// `rigid` is not in `bodies`.
+/// [`Error::NodeOutOfRange`] for a node that does not exist.
 pub(crate) fn glue(
     body: &DeformableBody,
     nodes: impl IntoIterator<Item = u32>,
     rigid: RigidBodyHandle,
-    bodies: &RigidBodySet,
+    pose: &Pose,
 ) -> Result<Vec<Attachment>, Error> {
-    let pose = bodies.get(rigid).ok_or(Error::UnknownRigidBody)?.position();
     let node_count = body.node_count();
     let mut added = Vec::new();
     for node in nodes {
@@ -94,24 +93,22 @@ pub(crate) fn glue(
 }
 
 /// Places the attachments' anchors where their bodies are now and gives each body a proxy
-/// (shared with the contacts') for a step of `dt` (s); attachments to bodies no longer in
-/// `bodies` are dropped.
+/// (shared with the contacts'): `rigid` tells a rigid body's pose and fresh proxy for the step,
+/// `None` for a body no longer there, whose attachments are dropped.
 pub(crate) fn ready(
     attachments: &mut Vec<Attachment>,
     proxies: &mut Vec<RigidProxy>,
-    bodies: &RigidBodySet,
-    dt: f64,
+    rigid: &dyn Fn(RigidBodyHandle) -> Option<(Pose, RigidProxy)>,
 ) {
-    attachments.retain(|a| bodies.get(a.body).is_some());
+    attachments.retain(|a| rigid(a.body).is_some());
     for attachment in attachments.iter_mut() {
-        let Some(rigid) = bodies.get(attachment.body) else {
+        let Some((pose, fresh)) = rigid(attachment.body) else {
             continue;
         };
-        attachment.anchor = rigid
-            .position()
+        attachment.anchor = pose
             .transform_point(attachment.local_anchor.as_vec3())
             .as_dvec3();
-        attachment.proxy = RigidProxy::index_in(proxies, attachment.body, rigid, dt);
+        attachment.proxy = RigidProxy::index_in(proxies, &fresh);
     }
 }
 

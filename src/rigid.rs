@@ -2,7 +2,7 @@
 //! inverse mass, frozen in pose for the step, updated by the contact impulses as they are applied,
 //! and the total impulse to hand back to rapier when the step is accepted.
 
-use rapier3d::dynamics::{RigidBody, RigidBodyHandle, RigidBodySet, RigidBodyType};
+use rapier3d::dynamics::{RigidBody, RigidBodyHandle, RigidBodyType};
 use rapier3d::glamx::{DMat3, DVec3};
 
 /// The linear velocity of the centre of mass (m/s) and the angular velocity (rad/s) `body` will
@@ -87,18 +87,14 @@ impl RigidProxy {
         self.fall = 0.0;
     }
 
-    /// The index of `body`'s proxy in `proxies` for a step of `dt` (s), added if missing: one
-    /// proxy per rigid body, whatever its number of colliders and attachments.
-    pub(crate) fn index_in(
-        proxies: &mut Vec<RigidProxy>,
-        handle: RigidBodyHandle,
-        body: &RigidBody,
-        dt: f64,
-    ) -> usize {
-        match proxies.iter().position(|p| p.handle == handle) {
+    /// The index in `proxies` of the proxy of the rigid body `fresh` is the proxy of, added
+    /// (a copy of `fresh`) if missing: one proxy per rigid body, whatever its number of
+    /// colliders and attachments.
+    pub(crate) fn index_in(proxies: &mut Vec<RigidProxy>, fresh: &RigidProxy) -> usize {
+        match proxies.iter().position(|p| p.handle == fresh.handle) {
             Some(index) => index,
             None => {
-                proxies.push(RigidProxy::new(handle, body, dt));
+                proxies.push(fresh.clone());
                 proxies.len() - 1
             }
         }
@@ -139,16 +135,5 @@ impl RigidProxy {
         self.angvel += self.inv_inertia * angular;
         self.impulse += impulse;
         self.angular_impulse += angular;
-    }
-
-    /// Hands the impulses received back to the body in rapier's set.
-    pub(crate) fn transfer(&self, bodies: &mut RigidBodySet) {
-        if let Some(body) = bodies.get_mut(self.handle)
-            && body.is_dynamic()
-            && (self.impulse != DVec3::ZERO || self.angular_impulse != DVec3::ZERO)
-        {
-            body.apply_impulse(self.impulse.as_vec3(), true);
-            body.apply_torque_impulse(self.angular_impulse.as_vec3(), true);
-        }
     }
 }

@@ -8,11 +8,12 @@
 use crate::Error;
 use crate::attachment::{self, Attachment};
 use crate::body::DeformableBody;
-use crate::contact::{self, ContactSet, ContactSettings, NodeContact};
+use crate::contact::{self, ColliderView, ContactSet, ContactSettings, NodeContact};
 use crate::rigid::RigidProxy;
-use rapier3d::dynamics::{RigidBodyHandle, RigidBodySet};
-use rapier3d::geometry::{ColliderHandle, ColliderSet};
+use rapier3d::dynamics::RigidBodyHandle;
+use rapier3d::geometry::ColliderHandle;
 use rapier3d::glamx::DVec3;
+use rapier3d::math::Pose;
 
 /// The contacts and attachments of one deformable body, and the rigid bodies they touch.
 ///
@@ -69,35 +70,25 @@ impl BodyConstraints {
         Self::default()
     }
 
-    /// Finds the contacts of `body`'s surface with `colliders` for a frame of `frame_dt` (s)
-    /// under `gravity` (m/s²), replacing the previous ones: a surface point gets a contact with
-    /// each non-sensor collider the body's
-    /// [`collision_groups`](crate::body::DeformableBody::collision_groups) interact with and it
-    /// is within `settings.margin` of, plus twice the distance the body's fastest node can
-    /// travel in the frame (`2 (|v|max + |g| dt) dt`), plus twice the collider's own travel (at
-    /// most 1 m), except the colliders of a rigid body the point is attached to; with
-    /// [`self_contact`](crate::body::DeformableBody::self_contact) on, also with the body's own
-    /// boundary. The integrators enforce them until the next detection. It also places the
-    /// attachments' anchors where their rigid bodies are now (dropping attachments to bodies no
-    /// longer in `bodies`), ready for the step.
+    /// [`BodyConstraints::detect_contacts`] against `colliders` as the coupling sees them, with
+    /// `rigid` telling an attached rigid body's pose and fresh proxy.
     ///
     /// # Errors
-    /// [`Error::InvalidTimeStep`], [`Error::NonFiniteInput`] or [`Error::InvalidSetting`] for a bad
-    /// step, gravity or setting; the contacts are then left as they were.
-    pub fn detect_contacts(
+    /// Those of [`BodyConstraints::detect_contacts`].
+    pub(crate) fn detect_among(
         &mut self,
         body: &DeformableBody,
-        colliders: &ColliderSet,
-        bodies: &RigidBodySet,
+        colliders: &[ColliderView],
+        rigid: &dyn Fn(RigidBodyHandle) -> Option<(Pose, RigidProxy)>,
         frame_dt: f64,
         gravity: DVec3,
         settings: &ContactSettings,
     ) -> Result<&[NodeContact], Error> {
         let glued: Vec<(RigidBodyHandle, u32)> =
             self.attachments.iter().map(|a| (a.body, a.node)).collect();
-        let found = contact::detect(body, &glued, colliders, bodies, frame_dt, gravity, settings)?;
+        let found = contact::detect(body, &glued, colliders, frame_dt, gravity, settings)?;
         let mut proxies = found.proxies;
-        attachment::ready(&mut self.attachments, &mut proxies, bodies, frame_dt);
+        attachment::ready(&mut self.attachments, &mut proxies, rigid);
         self.rigid_proxies = proxies;
         self.contacts = ContactSet {
             nodes: found.nodes,
@@ -123,25 +114,9 @@ impl BodyConstraints {
         self.rigid_proxies.clear();
     }
 
-    /// Glues `nodes` of `body` to the rigid body `rigid` of `bodies` where they are now: each
-    /// node keeps following the rigid body's material point it sits at, and the rigid body feels
-    /// it (two-way when it is dynamic; a kinematic or fixed body drags the nodes along). The
-    /// attachments act from the next [`BodyConstraints::detect_contacts`], which readies them
-    /// for the coming step.
-    ///
-    /// # Errors
-    /// [`Error::NodeOutOfRange`] for a node that does not exist, [`Error::UnknownRigidBody`] if
-    /// `rigid` is not in `bodies`; nothing is attached then.
-    pub fn attach(
-        &mut self,
-        body: &DeformableBody,
-        nodes: impl IntoIterator<Item = u32>,
-        rigid: RigidBodyHandle,
-        bodies: &RigidBodySet,
-    ) -> Result<(), Error> {
-        let added = attachment::glue(body, nodes, rigid, bodies)?;
+    /// Adds attachments made by [`BodyConstraints::attach`].
+    pub(crate) fn add_attachments(&mut self, added: Vec<Attachment>) {
         self.attachments.extend(added);
-        Ok(())
     }
 
     /// The attachments.
@@ -163,14 +138,9 @@ impl BodyConstraints {
             .map(|proxy| (proxy.handle, proxy.impulse, proxy.angular_impulse))
     }
 
-    /// Hands the impulses the contacts and attachments of the last step gave rigid bodies to
-    /// rapier's set (the opposite of what the soft body received), and forgets them.
-    pub fn transfer_contact_impulses(&mut self, bodies: &mut RigidBodySet) {
-        for proxy in &mut self.rigid_proxies {
-            proxy.transfer(bodies);
-            proxy.impulse = DVec3::ZERO;
-            proxy.angular_impulse = DVec3::ZERO;
-        }
+    /// The rigid bodies' proxies, whose impulses the coupling hands to rapier.
+    pub(crate) fn rigid_proxies_mut(&mut self) -> &mut [RigidProxy] {
+        &mut self.rigid_proxies
     }
 
     /// The mean force (N) and torque about the world origin (N m) `body`'s contacts exerted on

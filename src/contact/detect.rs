@@ -1,6 +1,7 @@
-//! Contact detection against rapier colliders: each surface node is projected onto every
-//! non-sensor collider within reach whose collision groups interact with the body's (parry's
-//! point projection, so every shape), and keeps the nearest surface point and outward normal;
+//! Contact detection against colliders (as the coupling hands them over, [`ColliderView`]s):
+//! each surface node is projected onto every collider within reach whose collision groups
+//! interact with the body's (parry's point projection, so every shape), and keeps the nearest
+//! surface point and outward normal;
 //! rigid vertices are tested against the boundary triangles. Also the force the contacts exerted
 //! on any collider.
 
@@ -10,11 +11,28 @@ use super::{
 };
 use crate::Error;
 use crate::body::DeformableBody;
-use crate::rigid::{RigidProxy, coming_velocity};
-use rapier3d::dynamics::{RigidBody, RigidBodyHandle, RigidBodySet};
-use rapier3d::geometry::{Collider, ColliderHandle, ColliderSet, Shape, SharedShape};
+use crate::rigid::RigidProxy;
+use rapier3d::dynamics::RigidBodyHandle;
+use rapier3d::geometry::{ColliderHandle, InteractionGroups, Shape, SharedShape};
 use rapier3d::glamx::DVec3;
 use rapier3d::math::Pose;
+
+/// A collider as detection sees it, made once per step for every deformable body (by the
+/// coupling, from rapier's sets): its shape and pose, bounds, collision groups and coefficients,
+/// its rigid body's proxy for the step, and how far its fastest point travels over the step.
+pub(crate) struct ColliderView {
+    pub(crate) handle: ColliderHandle,
+    pub(crate) shape: SharedShape,
+    pub(crate) pose: Pose,
+    /// Its bounding box (m).
+    pub(crate) bounds: (DVec3, DVec3),
+    pub(crate) groups: InteractionGroups,
+    pub(crate) coefficients: SurfaceCoefficients,
+    /// Its rigid body's proxy, fresh for the step; `None` for a collider without a body.
+    pub(crate) parent: Option<RigidProxy>,
+    /// Twice the distance (m) its fastest point travels over the step.
+    pub(crate) travel: f64,
+}
 
 /// What one detection found for a body: its surface points' contacts, the rigid vertices
 /// against its triangles, the proxies of the rigid bodies they touch, and the reach (m) used.
@@ -25,8 +43,8 @@ pub(crate) struct Detection {
     pub(crate) reach: f64,
 }
 
-/// Finds the contacts of `body`'s surface points with `colliders` for a frame of `frame_dt` (s)
-/// under `gravity` (m/s²) (see
+/// Finds the contacts of `body`'s surface points with the `colliders` for a frame of `frame_dt`
+/// (s) under `gravity` (m/s²) (see
 /// [`BodyConstraints::detect_contacts`](crate::constraint::BodyConstraints::detect_contacts));
 /// `glued` lists the rigid bodies and the nodes glued to them, which do not touch their
 /// colliders.
@@ -37,8 +55,7 @@ pub(crate) struct Detection {
 pub(crate) fn detect(
     body: &DeformableBody,
     glued: &[(RigidBodyHandle, u32)],
-    colliders: &ColliderSet,
-    bodies: &RigidBodySet,
+    colliders: &[ColliderView],
     frame_dt: f64,
     gravity: DVec3,
     settings: &ContactSettings,
@@ -55,18 +72,18 @@ pub(crate) fn detect(
     let mut tree = None;
     let mut corners = Vec::new();
     let contact_points = contact_points(body);
-    for (handle, collider) in colliders.iter() {
-        if collider.is_sensor() || !body.collision_groups.test(collider.collision_groups()) {
+    for view in colliders {
+        if !body.collision_groups.test(view.groups) {
             continue;
         }
-        let near = near_collider(body, glued, handle, collider, bodies, reach, frame_dt);
+        let near = near_collider(body, glued, view, reach);
         let mut proxy = None;
         for &at in &contact_points {
             let Some(contact) = node_contact_with(body, &near, at) else {
                 continue;
             };
             if proxy.is_none() {
-                proxy = near.proxy_in(&mut proxies, frame_dt);
+                proxy = near.proxy_in(&mut proxies);
             }
             nodes.push(contact.with_proxy(proxy));
         }
@@ -74,7 +91,7 @@ pub(crate) fn detect(
             let tree = tree.get_or_insert_with(|| surface_tree::SurfaceTree::of(body));
             let mut found = corner::find_corner_contacts(body, tree, &near);
             if !found.is_empty() {
-                let proxy = proxy.or_else(|| near.proxy_in(&mut proxies, frame_dt));
+                let proxy = proxy.or_else(|| near.proxy_in(&mut proxies));
                 for contact in &mut found {
                     contact.proxy = proxy;
                 }
@@ -90,42 +107,28 @@ pub(crate) fn detect(
     })
 }
 
-/// What detection needs of `collider` (handle `handle`): its shape, pose, parent body,
-/// coefficients, the nodes glued to its body (from `glued`), and `reach` (m) widened by its own
-/// travel over the frame of `frame_dt` (s).
+/// What detection needs of the collider `view` for `body`: the nodes glued to its body (from
+/// `glued`), its combined coefficients, and `reach` (m) widened by its own travel.
 fn near_collider<'a>(
     body: &DeformableBody,
     glued: &[(RigidBodyHandle, u32)],
-    handle: ColliderHandle,
-    collider: &'a Collider,
-    bodies: &'a RigidBodySet,
+    view: &'a ColliderView,
     reach: f64,
-    frame_dt: f64,
 ) -> NearCollider<'a> {
-    let aabb = collider.compute_aabb();
-    let parent = collider
-        .parent()
-        .and_then(|handle| bodies.get(handle).map(|body| (handle, body)));
-    // The collider's own travel in the frame, at its fastest point.
-    let collider_reach = parent.map_or(0.0, |(_, rigid)| {
-        let radius = f64::from(aabb.half_extents().length());
-        let (linvel, angvel) = coming_velocity(rigid, frame_dt);
-        2.0 * (linvel.length() + angvel.length() * radius) * frame_dt
-    });
+    let parent = view.parent.as_ref().map(|proxy| proxy.handle);
     NearCollider {
-        handle,
-        shape: collider.shared_shape(),
-        pose: collider.position(),
-        parent,
-        reach: reach + collider_reach.min(MAX_COLLIDER_REACH),
-        bounds: (aabb.mins.as_dvec3(), aabb.maxs.as_dvec3()),
+        handle: view.handle,
+        shape: &view.shape,
+        pose: &view.pose,
+        parent: view.parent.as_ref(),
+        reach: reach + view.travel.min(MAX_COLLIDER_REACH),
+        bounds: view.bounds,
         glued: glued
             .iter()
-            .filter(|(rigid, _)| Some(*rigid) == collider.parent())
+            .filter(|(rigid, _)| Some(*rigid) == parent)
             .map(|(_, node)| *node)
             .collect(),
-        coefficients: SurfaceCoefficients::of_body(body)
-            .combine(SurfaceCoefficients::of_collider(collider)),
+        coefficients: SurfaceCoefficients::of_body(body).combine(view.coefficients),
     }
 }
 
@@ -260,8 +263,8 @@ pub(super) struct NearCollider<'a> {
     /// Its shape and pose.
     pub(super) shape: &'a SharedShape,
     pub(super) pose: &'a Pose,
-    /// Its rigid body, if it has one.
-    parent: Option<(RigidBodyHandle, &'a RigidBody)>,
+    /// Its rigid body's fresh proxy, if it has one.
+    parent: Option<&'a RigidProxy>,
     /// How far (m) from its surface a point gets a contact.
     pub(super) reach: f64,
     /// Its bounding box (m).
@@ -273,11 +276,11 @@ pub(super) struct NearCollider<'a> {
 }
 
 impl NearCollider<'_> {
-    /// The index in `proxies` of the proxy of its body (added if new), for a step of `dt` (s);
-    /// `None` for a collider without a body.
-    fn proxy_in(&self, proxies: &mut Vec<RigidProxy>, dt: f64) -> Option<usize> {
+    /// The index in `proxies` of the proxy of its body (added if new); `None` for a collider
+    /// without a body.
+    fn proxy_in(&self, proxies: &mut Vec<RigidProxy>) -> Option<usize> {
         self.parent
-            .map(|(handle, body)| RigidProxy::index_in(proxies, handle, body, dt))
+            .map(|fresh| RigidProxy::index_in(proxies, fresh))
     }
 
     /// Whether its bounding box, widened by the reach, overlaps the box `(lo, hi)` (m).

@@ -32,6 +32,7 @@ mod bodies;
 mod groups;
 mod kinematic;
 mod loads;
+mod rapier_view;
 
 pub use loads::{ColliderLoad, RigidLoad};
 
@@ -325,19 +326,23 @@ impl SoftCoupling {
         gravity: DVec3,
     ) {
         self.links.prune(soft_bodies);
-        for (handle, outcome) in outcomes.iter_mut() {
-            if matches!(outcome, Some(Err(_))) {
-                continue;
-            }
-            if let Err(error) = self.links.entry(*handle).constraints.detect_contacts(
-                &soft_bodies[*handle],
-                rigid.colliders,
-                rigid.bodies,
-                h,
-                gravity,
-                &self.contact,
-            ) {
-                *outcome = Some(Err(error));
+        let views = rapier_view::collider_views(rigid.colliders, rigid.bodies, h);
+        {
+            let lookup = rapier_view::rigid_lookup(rigid.bodies, h);
+            for (handle, outcome) in outcomes.iter_mut() {
+                if matches!(outcome, Some(Err(_))) {
+                    continue;
+                }
+                if let Err(error) = self.links.entry(*handle).constraints.detect_among(
+                    &soft_bodies[*handle],
+                    &views,
+                    &lookup,
+                    h,
+                    gravity,
+                    &self.contact,
+                ) {
+                    *outcome = Some(Err(error));
+                }
             }
         }
         let live: Vec<DeformableBodyHandle> = outcomes
