@@ -236,6 +236,7 @@ impl ImplicitIntegrator {
             },
             method: self.linear_solver.method(body, h),
             last_step: history.clone(),
+            forces: std::mem::take(&mut workspace.forces),
         };
         for _ in 0..self.substeps {
             match self.substep(body, constraints, &mut solver, h, gravity) {
@@ -345,7 +346,7 @@ impl ImplicitIntegrator {
             .map(|m| m / (incremental.start.h * incremental.start.h))
             .collect();
         let start = incremental.start;
-        let mut residual = incremental.residual(body);
+        let mut residual = incremental.residual(body, &mut solver.forces);
         let reference = incremental.force_scale(body, &residual);
         // Relative residuals of the earlier iterations, newest last.
         let mut history: Vec<f64> = Vec::new();
@@ -396,7 +397,7 @@ impl ImplicitIntegrator {
                 &direction,
                 search,
                 energy,
-                |body| incremental.residual(body),
+                |body| incremental.residual(body, &mut solver.forces),
             );
             if search == Search::Short {
                 outcome.reused_factorizations += 1;
@@ -498,6 +499,8 @@ struct Solver {
     chord: Chord,
     method: Method,
     last_step: Option<PreviousStep>,
+    /// Scratch for the internal forces (N per node).
+    forces: Vec<DVec3>,
 }
 
 impl Solver {
@@ -506,6 +509,7 @@ impl Solver {
     fn give_back(self, workspace: &mut SolverWorkspace, history: Option<PreviousStep>) {
         workspace.tangent = Some(self.stiffness);
         workspace.chord = self.chord;
+        workspace.forces = self.forces;
         workspace.previous_step = history;
     }
 }

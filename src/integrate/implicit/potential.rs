@@ -118,16 +118,22 @@ pub(super) struct Potential<'a> {
 
 impl Potential<'_> {
     /// `-∇E` (N): elastic and damping forces, gravity, contact penalties and the inertial pull
-    /// toward `x̂`; zero on pinned nodes.
-    pub(super) fn residual(&self, body: &mut DeformableBody) -> Vec<DVec3> {
+    /// toward `x̂`; zero on pinned nodes. `forces` is scratch for the internal forces.
+    pub(super) fn residual(
+        &self,
+        body: &mut DeformableBody,
+        forces: &mut Vec<DVec3>,
+    ) -> Vec<DVec3> {
         body.velocities.fill(DVec3::ZERO);
+        body.internal_forces_into(forces);
         let start = self.start;
-        let mut residual = body.internal_forces();
-        for (n, r) in residual.iter_mut().enumerate() {
-            let inertial =
-                (start.target[n] - body.positions[n]) * (body.masses[n] / (start.h * start.h));
-            *r = *r + start.load[n] + inertial;
-        }
+        let mut residual: Vec<DVec3> = (0..body.positions.len())
+            .map(|n| {
+                let inertial =
+                    (start.target[n] - body.positions[n]) * (body.masses[n] / (start.h * start.h));
+                forces[n] + start.load[n] + inertial
+            })
+            .collect();
         if let Some(damping) = body.damping {
             self.add_damping_forces(body, &damping, &mut residual);
         }
