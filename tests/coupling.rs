@@ -576,3 +576,38 @@ fn a_coarse_soft_block_rests_on_the_corners_of_a_small_pedestal() {
     }
     assert!((heights[0] - heights[1]).abs() < 5e-4);
 }
+
+#[test]
+fn a_frame_of_negative_or_undefined_length_or_no_substeps_is_refused_and_moves_nothing() {
+    // A frame step of -1 s or NaN, or zero coupling substeps, has no meaning: every deformable
+    // body's result is the error, and nothing moves, rapier's bodies included (a pause, dt = 0,
+    // stays a pause). Exact comparison: nothing may have been integrated.
+    let cases: [(f32, u32, &str); 3] = [
+        (-1.0, 4, "time step"),
+        (f32::NAN, 4, "time step"),
+        (1.0 / 60.0, 0, "substeps"),
+    ];
+    for (dt, substeps, named) in cases {
+        let mut world = FvmWorld::default();
+        world.physics.integration_parameters.dt = dt;
+        world.coupling.substeps = substeps;
+        let (ball, _) = world.physics.insert(
+            RigidBodyBuilder::dynamic().translation(Vec3::new(0.0, 1.0, 0.0)),
+            ColliderBuilder::ball(0.05),
+        );
+        let cube = world
+            .soft_bodies
+            .insert(soft_cube(0.1, 2, DVec3::new(0.5, 0.5, 0.0), 1e5));
+        let before = world.soft_bodies[cube].positions().to_vec();
+        let results = world.step();
+        assert_eq!(results.len(), 1);
+        let error = results[0].1.as_ref().expect_err("the frame is refused");
+        println!("dt {dt}, {substeps} substeps: {error}");
+        assert!(error.to_string().contains(named), "{error}");
+        assert_eq!(world.soft_bodies[cube].positions(), &before[..]);
+        assert_eq!(
+            world.physics.bodies[ball].translation(),
+            Vec3::new(0.0, 1.0, 0.0)
+        );
+    }
+}

@@ -107,6 +107,14 @@ fn a_poisson_ratio_of_one_half_is_refused() {
 }
 
 #[test]
+fn a_time_step_that_underflows_rapiers_f32_step_is_refused() {
+    // 1e-46 s is a positive f64 but rounds to zero in rapier's f32 step: every frame would be a
+    // pause.
+    let e = error(broken("dt = 0.01", "dt = 1e-46"));
+    assert_names(&e, 5, "world.dt", "not a positive f32 step");
+}
+
+#[test]
 fn a_zero_time_step_is_refused() {
     let e = error(broken("dt = 0.01", "dt = 0.0"));
     assert_names(&e, 5, "world.dt", "positive");

@@ -142,7 +142,8 @@ pub struct SoftCoupling {
     pub integrator: AutomaticIntegrator,
     /// How their contacts are detected and enforced.
     pub contact: ContactSettings,
-    /// rapier steps per frame, with the deformable bodies stepped between them (at least 1).
+    /// rapier steps per frame, with the deformable bodies stepped between them (at least 1: zero
+    /// is refused by [`SoftCoupling::step`]).
     pub substeps: u32,
     /// What each deformable body exerted on each rigid body over the last frame or substep.
     loads: FrameLoads,
@@ -167,7 +168,9 @@ impl SoftCoupling {
     /// [`SoftCoupling::substeps`] coupling substeps of the module's documentation, each a soft
     /// step then one `pipeline` step on the caller's `rapier` sets with `hooks` and `events`.
     /// A frame of `dt = 0` (a pause) only lets rapier apply changes, and steps no deformable
-    /// body.
+    /// body. A negative or non-finite `dt`, or zero [`SoftCoupling::substeps`], steps nothing,
+    /// rapier included, and every deformable body's result is the error
+    /// ([`Error::InvalidTimeStep`], [`Error::InvalidSetting`]).
     pub fn step(
         &mut self,
         pipeline: &mut PhysicsPipeline,
@@ -178,11 +181,14 @@ impl SoftCoupling {
     ) -> SoftStepResults {
         let frame = *rapier.integration_parameters;
         self.loads.clear();
-        if frame.dt <= 0.0 {
+        if let Some(error) = self.frame_error(frame.dt) {
+            return refused(soft_bodies, &error);
+        }
+        if frame.dt == 0.0 {
             rapier.step_rapier(pipeline, &frame, hooks, events);
             return Vec::new();
         }
-        let substeps = self.substeps.max(1);
+        let substeps = self.substeps;
         let h = f64::from(frame.dt) / f64::from(substeps);
         let gravity = rapier.gravity.as_dvec3();
         let mut substep_parameters = frame;
@@ -207,6 +213,22 @@ impl SoftCoupling {
         }
         self.loads.finish(f64::from(frame.dt));
         results(outcomes)
+    }
+
+    /// Why a frame of `dt` (s) cannot be stepped, if it cannot: a negative or non-finite step, or
+    /// zero coupling substeps.
+    fn frame_error(&self, dt: f32) -> Option<Error> {
+        if !(dt.is_finite() && dt >= 0.0) {
+            return Some(Error::InvalidTimeStep {
+                dt: f64::from(dt),
+                reason: "a frame step must be non-negative and finite (zero pauses)",
+            });
+        }
+        (self.substeps == 0).then_some(Error::InvalidSetting {
+            parameter: "substeps",
+            value: 0.0,
+            reason: "a frame needs at least one coupling substep",
+        })
     }
 
     /// Steps every deformable body by `h` (s) under `gravity` (m/s²) against the rigid world as
@@ -392,6 +414,14 @@ impl SoftCoupling {
             }
         }
     }
+}
+
+/// Every body of `soft_bodies` with `error`: a frame refused before anything moved.
+fn refused(soft_bodies: &DeformableBodySet, error: &Error) -> SoftStepResults {
+    soft_bodies
+        .iter()
+        .map(|(handle, _)| (handle, Err(error.clone())))
+        .collect()
 }
 
 /// Every body of `soft_bodies`, not stepped yet.

@@ -53,6 +53,17 @@ impl WorldSpec {
     pub(crate) fn check(&self, c: &mut Checker<'_>) {
         c.finite_vector("world.gravity", self.gravity);
         c.positive("world.dt", self.dt, "s");
+        // rapier steps in f32: a step that rounds to zero there would pause every frame.
+        let substep = self.dt as f32 / self.coupling_substeps.max(1) as f32;
+        if self.dt > 0.0 && !(substep > 0.0 && substep.is_finite()) {
+            c.fail(
+                "world.dt",
+                format!(
+                    "{} s split into {} coupling substeps is not a positive f32 step for rapier",
+                    self.dt, self.coupling_substeps
+                ),
+            );
+        }
         c.positive("world.duration", self.duration, "s");
         if self.dt > 0.0 && self.duration / self.dt > MAX_FRAMES {
             c.fail(
