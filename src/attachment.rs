@@ -100,16 +100,16 @@ pub(crate) fn ready(
     proxies: &mut Vec<RigidProxy>,
     rigid: &dyn Fn(RigidBodyHandle) -> Option<(Pose, RigidProxy)>,
 ) {
-    attachments.retain(|a| rigid(a.body).is_some());
-    for attachment in attachments.iter_mut() {
+    attachments.retain_mut(|attachment| {
         let Some((pose, fresh)) = rigid(attachment.body) else {
-            continue;
+            return false;
         };
         attachment.anchor = pose
             .transform_point(attachment.local_anchor.as_vec3())
             .as_dvec3();
         attachment.proxy = RigidProxy::index_in(proxies, &fresh);
-    }
+        true
+    });
 }
 
 /// Readies the attachments' velocity constraints for an explicit substep of `h` (s), before the
