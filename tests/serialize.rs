@@ -5,6 +5,9 @@
 //! dynamic rigid body on a soft one, an attachment, a quadratic body and an embedded mesh; a
 //! file that breaks a body's rules is refused with the error a new body would get, never a panic.
 
+mod common;
+
+use common::{assert_identical, run};
 use rapier_fvm::prelude::*;
 use rapier3d::prelude::*;
 use serde_json::Value;
@@ -50,35 +53,6 @@ fn scene(integrator: Option<IntegratorKind>) -> Result<FvmWorld, Error> {
         .build()?;
     world.soft_bodies.insert(cube);
     Ok(world)
-}
-
-/// Steps `world` by `frames` frames.
-fn run(world: &mut FvmWorld, frames: usize) -> Result<(), Error> {
-    for _ in 0..frames {
-        for (_, outcome) in world.step() {
-            outcome?;
-        }
-    }
-    Ok(())
-}
-
-/// Asserts that two worlds hold the same state, bit for bit.
-fn assert_identical(a: &FvmWorld, b: &FvmWorld) {
-    assert_eq!(a.soft_bodies.len(), b.soft_bodies.len());
-    assert_eq!(a.physics.bodies.len(), b.physics.bodies.len());
-    for ((ha, body_a), (hb, body_b)) in a.soft_bodies.iter().zip(b.soft_bodies.iter()) {
-        assert_eq!(ha, hb);
-        assert_eq!(body_a.positions(), body_b.positions(), "{ha:?}");
-        assert_eq!(body_a.velocities(), body_b.velocities(), "{ha:?}");
-        assert_eq!(body_a.masses(), body_b.masses(), "{ha:?}");
-    }
-    for ((ha, rigid_a), (hb, rigid_b)) in a.physics.bodies.iter().zip(b.physics.bodies.iter()) {
-        assert_eq!(ha, hb);
-        assert_eq!(rigid_a.position(), rigid_b.position(), "{ha:?}");
-        assert_eq!(rigid_a.linvel(), rigid_b.linvel(), "{ha:?}");
-        assert_eq!(rigid_a.angvel(), rigid_b.angvel(), "{ha:?}");
-    }
-    assert_eq!(a.rigid_loads(), b.rigid_loads());
 }
 
 #[test]
