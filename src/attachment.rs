@@ -5,14 +5,15 @@
 //! velocity (the node's velocity relative to the anchor's, with a fifth of the position drift
 //! corrected per substep), solved with the 3 x 3 effective mass of node and body; the body gets
 //! the opposite impulse at the node. The implicit integrator adds a stiff spring to the anchor's
-//! predicted position at the end of the step, `k = penalty_factor m/ĥ²`, to its potential. In
-//! both, the body is frozen in pose for the soft step and its velocity follows the impulses, as
-//! for contacts.
+//! position at the end of the step, `k = penalty_factor m/ĥ²`, to its potential, the anchor
+//! carried by its body at the velocity the step's solve gives it (a dynamic body's response to
+//! the springs and contacts is part of the solve). In both, the body is frozen in pose for the
+//! soft step and its velocity follows the impulses, as for contacts.
 
 use crate::Error;
 use crate::body::DeformableBody;
-use crate::contact::ContactSettings;
-use crate::rigid::RigidProxy;
+use crate::contact::{ContactSettings, ImplicitStep};
+use crate::rigid::{RigidPoint, RigidProxy};
 use rapier3d::dynamics::RigidBodyHandle;
 use rapier3d::glamx::{DMat3, DVec3};
 use rapier3d::math::Pose;
@@ -166,63 +167,77 @@ pub(crate) fn advance_anchors(attachments: &mut [Attachment], proxies: &[RigidPr
 }
 
 impl Attachment {
-    /// Where the implicit spring pulls the node at the end of a step of effective length `h`
-    /// (s): the anchor carried by the body's velocity there (m).
-    fn spring_target(&self, proxies: &[RigidProxy], h: f64) -> DVec3 {
-        self.anchor + proxies[self.proxy].velocity_at(self.anchor) * h
+    /// Where the implicit spring pulls the node at the end of the implicit `step`: the anchor
+    /// carried by its body's velocity there over the step's length (m).
+    fn spring_target(&self, step: &ImplicitStep) -> DVec3 {
+        self.anchor + step.rigid[self.proxy].velocity_at(self.anchor) * step.length
+    }
+
+    /// The implicit spring's stiffness (N/m) in `step`: the penalty factor times `m/ĥ²`, with
+    /// `m` the node's mass plus, for a dynamic body, the least effective mass of the body at the
+    /// anchor, so that the spring holds a heavy body as firmly as a light one.
+    fn spring_stiffness(
+        &self,
+        body: &DeformableBody,
+        settings: &ContactSettings,
+        step: &ImplicitStep,
+    ) -> f64 {
+        let rigid = &step.rigid[self.proxy];
+        let partner = if rigid.is_dynamic() {
+            rigid.least_effective_mass(self.anchor)
+        } else {
+            0.0
+        };
+        settings.penalty_stiffness(body.masses[self.node as usize] + partner, step.effective)
+    }
+
+    /// The dynamic rigid body's point the spring pulls against, if the body is dynamic.
+    pub(crate) fn partner(&self, step: &ImplicitStep) -> Option<RigidPoint> {
+        step.rigid[self.proxy].is_dynamic().then_some(RigidPoint {
+            proxy: self.proxy,
+            point: self.anchor,
+        })
     }
 }
 
-/// Calls `each(node, stiffness k (N/m), target (m))` for every attachment in an implicit step of
-/// effective length `h` (s): the node is pulled toward the anchor's predicted end position with
-/// the energy `k/2 |x - target|²`.
+/// Calls `each(attachment, stiffness k (N/m), target (m))` for every attachment of a free node
+/// in the implicit `step`: the node is pulled toward the anchor's end position with the energy
+/// `k/2 |x - target|²` (see [`Attachment::spring_stiffness`]).
 pub(crate) fn for_each_spring<'a>(
     body: &DeformableBody,
     attachments: &'a [Attachment],
-    proxies: &[RigidProxy],
     settings: &ContactSettings,
-    h: f64,
+    step: &ImplicitStep,
     mut each: impl FnMut(&'a Attachment, f64, DVec3),
 ) {
     for attachment in attachments {
         let n = attachment.node as usize;
         if !body.pinned[n] {
-            let stiffness = settings.penalty_stiffness(body.masses[n], h);
-            each(attachment, stiffness, attachment.spring_target(proxies, h));
+            let stiffness = attachment.spring_stiffness(body, settings, step);
+            each(attachment, stiffness, attachment.spring_target(step));
         }
     }
 }
 
-/// Records the impulses (N s) the implicit springs gave the nodes over a substep of length `h`
-/// (s), hands their opposite to the bodies, and moves the anchors with them. The targets are
-/// taken before any impulse is handed over, as the step's solve saw them.
+/// Records the impulses (N s) the implicit springs gave the nodes over the implicit `step`, at
+/// the rigid velocities of `step`, hands their opposite to the bodies' `proxies` at the anchors,
+/// and carries the anchors with them.
 pub(crate) fn record_spring_impulses(
     body: &DeformableBody,
     attachments: &mut [Attachment],
-    rigid_proxies: &mut [RigidProxy],
-    contact_settings: &ContactSettings,
-    effective_h: f64,
-    h: f64,
+    settings: &ContactSettings,
+    step: &ImplicitStep,
+    proxies: &mut [RigidProxy],
 ) {
-    let targets: Vec<DVec3> = attachments
-        .iter()
-        .map(|a| a.spring_target(rigid_proxies, effective_h))
-        .collect();
-    let DeformableBody {
-        positions,
-        masses,
-        pinned,
-        ..
-    } = body;
-    for (attachment, target) in attachments.iter_mut().zip(targets) {
+    for attachment in attachments.iter_mut() {
         let n = attachment.node as usize;
-        if pinned[n] {
+        if body.pinned[n] {
             continue;
         }
-        let stiffness = contact_settings.penalty_stiffness(masses[n], effective_h);
-        let impulse = (target - positions[n]) * (stiffness * h);
-        let proxy = &mut rigid_proxies[attachment.proxy];
-        proxy.apply(-impulse, positions[n]);
-        attachment.anchor += proxy.velocity_at(attachment.anchor) * h;
+        let stiffness = attachment.spring_stiffness(body, settings, step);
+        let target = attachment.spring_target(step);
+        let impulse = (target - body.positions[n]) * (stiffness * step.length);
+        proxies[attachment.proxy].apply(-impulse, attachment.anchor);
+        attachment.anchor = target;
     }
 }

@@ -19,6 +19,17 @@ pub(crate) fn coming_velocity(body: &RigidBody, dt: f64) -> (DVec3, DVec3) {
     (travel.as_dvec3() / dt, turn.as_dvec3() / dt)
 }
 
+/// A material point of a dynamic rigid body that an implicit term acts against: the term
+/// depends on its soft point's position relative to where the rigid body carries this point over
+/// the step, and the body takes the opposite of the term's force there.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct RigidPoint {
+    /// The body's index among the soft body's proxies.
+    pub(crate) proxy: usize,
+    /// The point (m), where it is at the start of the step.
+    pub(crate) point: DVec3,
+}
+
 /// A rigid body in contact with a soft body during one soft step.
 #[derive(Debug, Clone)]
 pub(crate) struct RigidProxy {
@@ -116,6 +127,20 @@ impl RigidProxy {
         direction.dot(self.inv_mass * direction) + arm.dot(self.inv_inertia * arm)
     }
 
+    /// The effective mass (kg) of the body at `point` (m) along unit `direction`; infinite
+    /// for a body contact impulses do not move.
+    pub(crate) fn effective_mass_along(&self, point: DVec3, direction: DVec3) -> f64 {
+        self.inverse_mass_along(point, direction).recip()
+    }
+
+    /// A lower bound (kg) of the body's effective mass at `point` (m) in every direction: one
+    /// over the trace of its inverse effective mass there; infinite for a body contact impulses
+    /// do not move.
+    pub(crate) fn least_effective_mass(&self, point: DVec3) -> f64 {
+        let w = self.inverse_mass_matrix(point);
+        (w.x_axis.x + w.y_axis.y + w.z_axis.z).recip()
+    }
+
     /// The 3 x 3 inverse effective mass (1/kg) of the body at `point` (m): the change of the
     /// point's velocity per unit impulse there, `diag(1/m) - [r]x I⁻¹ [r]x`.
     pub(crate) fn inverse_mass_matrix(&self, point: DVec3) -> DMat3 {
@@ -126,6 +151,37 @@ impl RigidProxy {
             DVec3::new(r.y, -r.x, 0.0),
         );
         DMat3::from_diagonal(self.inv_mass) - cross * self.inv_inertia * cross
+    }
+
+    /// The change of linear (m/s) and angular (rad/s) velocity an impulse `impulse` (N s) and
+    /// angular impulse `angular` about the centre of mass (N m s) give the body.
+    pub(crate) fn response(&self, [impulse, angular]: [DVec3; 2]) -> [DVec3; 2] {
+        [self.inv_mass * impulse, self.inv_inertia * angular]
+    }
+
+    /// The kinetic energy (J) the velocity change of an impulse and angular impulse (N s, N m s)
+    /// carries, `½ ιᵀ W ι` with `W` the body's inverse mass and inertia.
+    pub(crate) fn kinetic_energy_of(&self, impulses: [DVec3; 2]) -> f64 {
+        let [dv, dw] = self.response(impulses);
+        0.5 * (impulses[0].dot(dv) + impulses[1].dot(dw))
+    }
+
+    /// A copy of `base` moving with the velocity change of `impulses` (linear, N s; angular
+    /// about the centre of mass, N m s) added, its received impulses unchanged.
+    pub(crate) fn nudge_from(&mut self, base: &RigidProxy, impulses: [DVec3; 2]) {
+        let [dv, dw] = base.response(impulses);
+        self.linvel = base.linvel + dv;
+        self.angvel = base.angvel + dw;
+    }
+
+    /// The world centre of mass (m).
+    pub(crate) fn center_of_mass(&self) -> DVec3 {
+        self.com
+    }
+
+    /// The per-axis inverse mass (1/kg) and the world inverse inertia (1/(kg m²)).
+    pub(crate) fn inverse_mass_and_inertia(&self) -> (DVec3, DMat3) {
+        (self.inv_mass, self.inv_inertia)
     }
 
     /// Applies `impulse` (N s) at `point` (m).

@@ -22,8 +22,12 @@
 //! `∂²E_c/∂x²` (N/m), each point moving with the nodes of its stencil. Contacts give the
 //! penalty `k/2 min(0, g)²` and the lagged friction (a self-contact's on the node relative to its
 //! triangle, a rigid vertex's on the triangle's point relative to the vertex); attachments a
-//! spring `k/2 |x − a|²` to their anchor `a`. Contacts between soft bodies have an explicit side
-//! only: bodies touching each other are stepped together explicitly.
+//! spring `k/2 |x − a|²` to their anchor `a`. A term against a rigid body depends on its point's
+//! position relative to where the body carries its own point over the step, at the velocity the
+//! step gives the body: a dynamic body's response is part of the step's solve
+//! (`integrate::implicit::rigid_response`), so that the coupled system's energy cannot grow.
+//! Contacts between soft bodies have an explicit side only: bodies touching each other are
+//! stepped together explicitly.
 
 mod set;
 
@@ -32,7 +36,8 @@ pub use set::BodyConstraints;
 use crate::assembly::Stiffness;
 use crate::attachment;
 use crate::body::DeformableBody;
-use crate::contact;
+use crate::contact::{self, ImplicitStep};
+use crate::rigid::RigidPoint;
 use crate::stencil::Stencil;
 use rapier3d::glamx::{DMat3, DVec3};
 
@@ -52,6 +57,10 @@ pub(crate) trait ExplicitSide {
 pub(crate) struct ImplicitTerm<'a> {
     /// The point: the nodes it moves with and their weights.
     pub(crate) at: Stencil<'a>,
+    /// The dynamic rigid body's point the term acts against, if any: the term depends on the
+    /// point's position relative to where that body carries it over the step, and the body takes
+    /// the opposite force there.
+    pub(crate) partner: Option<RigidPoint>,
     /// The term's energy (J).
     pub(crate) energy: f64,
     /// Its force on the point, `-∂E/∂x` (N); node `a` of the stencil takes `w_a` of it.
@@ -62,25 +71,26 @@ pub(crate) struct ImplicitTerm<'a> {
 
 /// A constraint kind's implicit side: terms of the incremental potential.
 pub(crate) trait ImplicitSide {
-    /// Called once at the start of an implicit step of effective length `h` (s), before Newton.
-    fn begin(&self, body: &mut DeformableBody, constraints: &mut BodyConstraints, h: f64);
-    /// Calls `each` with every term the kind adds for an effective step `h` (s) at the body's
-    /// current positions.
+    /// Called once at the start of an implicit `step`, before Newton (the rigid bodies of
+    /// `step` at their velocities at its start).
+    fn begin(&self, body: &DeformableBody, constraints: &mut BodyConstraints, step: ImplicitStep);
+    /// Calls `each` with every term the kind adds in the implicit `step` at the body's current
+    /// positions.
     fn for_each_term(
         &self,
         body: &DeformableBody,
         constraints: &BodyConstraints,
-        h: f64,
+        step: ImplicitStep,
         each: &mut dyn FnMut(ImplicitTerm),
     );
-    /// After the step of length `h` (s, effective length `effective_h`): records the impulses
-    /// (N s) the terms gave, for the rigid bodies and the loads.
+    /// After the `step`, whose solve gave the rigid bodies the velocities of `step`: records the
+    /// impulses (N s) the terms gave, hands their opposite to the constraints' rigid proxies, and
+    /// carries what the rigid bodies carry over the step.
     fn record_impulses(
         &self,
         body: &mut DeformableBody,
         constraints: &mut BodyConstraints,
-        effective_h: f64,
-        h: f64,
+        step: ImplicitStep,
     );
     /// Calls `each` with every stencil the kind's terms may act on over the step, active or
     /// not: the tangent's pattern must couple their nodes.
@@ -92,14 +102,15 @@ pub(crate) trait ImplicitSide {
     );
 }
 
-/// `each` called with a term given by its parts: the point, its energy (J), force (N) and
-/// tangent (N/m).
+/// `each` called with a term given by its parts: the point, its rigid partner, its energy (J),
+/// force (N) and tangent (N/m).
 fn from_parts<'e>(
     each: &'e mut dyn FnMut(ImplicitTerm),
-) -> impl FnMut(Stencil, f64, DVec3, DMat3) + 'e {
-    move |at, energy, force, tangent| {
+) -> impl FnMut(Stencil, Option<RigidPoint>, f64, DVec3, DMat3) + 'e {
+    move |at, partner, energy, force, tangent| {
         each(ImplicitTerm {
             at,
+            partner,
             energy,
             force,
             tangent,
@@ -154,32 +165,25 @@ impl ExplicitSide for Attachments {
 }
 
 impl ImplicitSide for NodeContacts {
-    fn begin(&self, body: &mut DeformableBody, c: &mut BodyConstraints, h: f64) {
-        contact::lag_friction(body, &mut c.contacts, &mut c.rigid_proxies, h);
+    fn begin(&self, body: &DeformableBody, c: &mut BodyConstraints, step: ImplicitStep) {
+        contact::lag_friction(body, &mut c.contacts, step);
     }
     fn for_each_term(
         &self,
         body: &DeformableBody,
         c: &BodyConstraints,
-        h: f64,
+        step: ImplicitStep,
         each: &mut dyn FnMut(ImplicitTerm),
     ) {
-        contact::for_each_contact_term(body, &c.contacts, h, from_parts(each));
+        contact::for_each_contact_term(body, &c.contacts, step, from_parts(each));
     }
     fn record_impulses(
         &self,
         body: &mut DeformableBody,
         c: &mut BodyConstraints,
-        effective_h: f64,
-        h: f64,
+        step: ImplicitStep,
     ) {
-        contact::record_penalty_impulses(
-            body,
-            &mut c.contacts,
-            &mut c.rigid_proxies,
-            effective_h,
-            h,
-        );
+        contact::record_penalty_impulses(body, &mut c.contacts, step, &mut c.rigid_proxies);
     }
     fn for_each_stencil(
         &self,
@@ -192,28 +196,25 @@ impl ImplicitSide for NodeContacts {
 }
 
 impl ImplicitSide for CornerContacts {
-    fn begin(&self, body: &mut DeformableBody, c: &mut BodyConstraints, h: f64) {
-        contact::lag_corner_friction(body, &mut c.contacts, &c.rigid_proxies, h);
+    fn begin(&self, body: &DeformableBody, c: &mut BodyConstraints, step: ImplicitStep) {
+        contact::lag_corner_friction(body, &mut c.contacts, step);
     }
     fn for_each_term(
         &self,
         body: &DeformableBody,
         c: &BodyConstraints,
-        h: f64,
+        step: ImplicitStep,
         each: &mut dyn FnMut(ImplicitTerm),
     ) {
-        let proxies = &c.rigid_proxies;
-        contact::for_each_corner_term(body, &c.contacts, proxies, h, from_parts(each));
+        contact::for_each_corner_term(body, &c.contacts, step, from_parts(each));
     }
     fn record_impulses(
         &self,
         body: &mut DeformableBody,
         c: &mut BodyConstraints,
-        effective_h: f64,
-        h: f64,
+        step: ImplicitStep,
     ) {
-        let proxies = &mut c.rigid_proxies;
-        contact::record_corner_impulses(body, &mut c.contacts, proxies, effective_h, h);
+        contact::record_corner_impulses(body, &mut c.contacts, step, &mut c.rigid_proxies);
     }
     fn for_each_stencil(
         &self,
@@ -229,41 +230,34 @@ impl ImplicitSide for CornerContacts {
 const UNIT_WEIGHT: [f64; 1] = [1.0];
 
 impl ImplicitSide for Attachments {
-    fn begin(&self, _body: &mut DeformableBody, _c: &mut BodyConstraints, _h: f64) {}
+    fn begin(&self, _body: &DeformableBody, _c: &mut BodyConstraints, _step: ImplicitStep) {}
     fn for_each_term(
         &self,
         body: &DeformableBody,
         c: &BodyConstraints,
-        h: f64,
+        step: ImplicitStep,
         each: &mut dyn FnMut(ImplicitTerm),
     ) {
-        let (proxies, settings) = (&c.rigid_proxies, &c.contacts.settings);
-        attachment::for_each_spring(
-            body,
-            &c.attachments,
-            proxies,
-            settings,
-            h,
-            |a, k, target| {
-                let offset = body.positions[a.node as usize] - target;
-                each(ImplicitTerm {
-                    at: Stencil {
-                        nodes: std::slice::from_ref(&a.node),
-                        weights: &UNIT_WEIGHT,
-                    },
-                    energy: 0.5 * k * offset.length_squared(),
-                    force: -offset * k,
-                    tangent: DMat3::IDENTITY * k,
-                });
-            },
-        );
+        let settings = &c.contacts.settings;
+        attachment::for_each_spring(body, &c.attachments, settings, &step, |a, k, target| {
+            let offset = body.positions[a.node as usize] - target;
+            each(ImplicitTerm {
+                at: Stencil {
+                    nodes: std::slice::from_ref(&a.node),
+                    weights: &UNIT_WEIGHT,
+                },
+                partner: a.partner(&step),
+                energy: 0.5 * k * offset.length_squared(),
+                force: -offset * k,
+                tangent: DMat3::IDENTITY * k,
+            });
+        });
     }
     fn record_impulses(
         &self,
         body: &mut DeformableBody,
         c: &mut BodyConstraints,
-        effective_h: f64,
-        h: f64,
+        step: ImplicitStep,
     ) {
         let BodyConstraints {
             attachments,
@@ -272,14 +266,7 @@ impl ImplicitSide for Attachments {
             ..
         } = c;
         let settings = &contacts.settings;
-        attachment::record_spring_impulses(
-            body,
-            attachments,
-            rigid_proxies,
-            settings,
-            effective_h,
-            h,
-        );
+        attachment::record_spring_impulses(body, attachments, settings, &step, rigid_proxies);
     }
     fn for_each_stencil(
         &self,
@@ -315,41 +302,52 @@ pub(crate) fn uncoupled_pairs(
     missing
 }
 
-/// Adds every implicit term's force (N) into `residual` (per node), for an effective step `h`.
+/// Calls `each` with every implicit term of every kind in the implicit `step`.
+pub(crate) fn for_each_implicit_term(
+    body: &DeformableBody,
+    constraints: &BodyConstraints,
+    step: ImplicitStep,
+    each: &mut dyn FnMut(ImplicitTerm),
+) {
+    for kind in IMPLICIT {
+        kind.for_each_term(body, constraints, step, each);
+    }
+}
+
+/// Adds every implicit term's force (N) into `residual` (per node), in the implicit `step`.
 pub(crate) fn add_implicit_forces(
     body: &DeformableBody,
     constraints: &BodyConstraints,
-    h: f64,
+    step: ImplicitStep,
     residual: &mut [DVec3],
 ) {
-    for kind in IMPLICIT {
-        kind.for_each_term(body, constraints, h, &mut |term| {
-            for (&node, w) in term.at.nodes.iter().zip(term.at.weights) {
-                residual[node as usize] += term.force * *w;
-            }
-        });
-    }
+    for_each_implicit_term(body, constraints, step, &mut |term| {
+        for (&node, w) in term.at.nodes.iter().zip(term.at.weights) {
+            residual[node as usize] += term.force * *w;
+        }
+    });
 }
 
-/// The implicit terms' total energy (J) for an effective step `h`.
-pub(crate) fn implicit_energy(body: &DeformableBody, constraints: &BodyConstraints, h: f64) -> f64 {
+/// The implicit terms' total energy (J) in the implicit `step`.
+pub(crate) fn implicit_energy(
+    body: &DeformableBody,
+    constraints: &BodyConstraints,
+    step: ImplicitStep,
+) -> f64 {
     let mut energy = 0.0;
-    for kind in IMPLICIT {
-        kind.for_each_term(body, constraints, h, &mut |term| energy += term.energy);
-    }
+    for_each_implicit_term(body, constraints, step, &mut |term| energy += term.energy);
     energy
 }
 
-/// Adds every implicit term's tangent (N/m) into `stiffness`, for an effective step `h`.
+/// Adds every implicit term's tangent (N/m) into `stiffness`, in the implicit `step`, as if the
+/// rigid bodies' velocities were held (their response is added to the Newton direction apart).
 pub(crate) fn add_implicit_tangents(
     body: &DeformableBody,
     constraints: &BodyConstraints,
-    h: f64,
+    step: ImplicitStep,
     stiffness: &mut Stiffness,
 ) {
-    for kind in IMPLICIT {
-        kind.for_each_term(body, constraints, h, &mut |term| {
-            stiffness.add_stencil_block(term.at, &term.tangent, &body.pinned);
-        });
-    }
+    for_each_implicit_term(body, constraints, step, &mut |term| {
+        stiffness.add_stencil_block(term.at, &term.tangent, &body.pinned);
+    });
 }

@@ -20,11 +20,11 @@ use super::node_contact::lagged_friction;
 use super::penalty::effective_mass;
 use super::surface_tree::SurfaceTree;
 use super::{
-    Coefficients, ContactSet, ContactSettings, ContactSides, SoftPoint, VelocityConstraint,
-    penalty_tangent,
+    Coefficients, ContactSet, ContactSettings, ContactSides, ImplicitStep, SoftPoint,
+    VelocityConstraint, penalty_tangent,
 };
 use crate::body::DeformableBody;
-use crate::rigid::RigidProxy;
+use crate::rigid::{RigidPoint, RigidProxy};
 use crate::stencil::Stencil;
 use rapier3d::geometry::{ColliderHandle, Shape};
 use rapier3d::glamx::DMat3;
@@ -248,20 +248,25 @@ impl ContactSides for Corner<'_> {
     }
 }
 
-/// An implicit step as a corner's terms see it: the contact settings and the effective step
-/// length (s).
-type ImplicitStep<'a> = (&'a ContactSettings, f64);
-
 /// A corner's sides at the body's current positions: the triangle's point as a stencil, its
 /// position (m) and effective mass (kg), and the vertex's velocity (m/s).
 type Sides<'a> = (Stencil<'a>, DVec3, f64, DVec3);
 
 impl CornerContact {
-    /// The contact's [`Sides`] with the body at `body` and the rigid proxies `proxies`.
+    /// The contact's [`Sides`] with the body at `body` and the rigid proxies `proxies`: the
+    /// mass is the triangle point's, plus the vertex's rigid body's effective mass along the
+    /// normal when that body is dynamic.
     fn sides(&self, body: &DeformableBody, proxies: &[RigidProxy]) -> Sides<'_> {
         let at = self.on_triangle.stencil();
         let point = at.interpolate(&body.positions);
-        let mass = effective_mass(&at, &body.masses, &body.pinned);
+        let rigid = self
+            .proxy
+            .map(|p| &proxies[p])
+            .filter(|rigid| rigid.is_dynamic())
+            .map_or(0.0, |rigid| {
+                rigid.effective_mass_along(self.vertex, self.normal)
+            });
+        let mass = effective_mass(&at, &body.masses, &body.pinned) + rigid;
         (at, point, mass, self.vertex_velocity(proxies))
     }
 
@@ -271,35 +276,46 @@ impl CornerContact {
             .map_or(DVec3::ZERO, |p| proxies[p].velocity_at(self.vertex))
     }
 
-    /// The penalty stiffness (N/m) and gap (m) of the contact in an implicit `step`, with the
-    /// triangle's point at `point` (m) of effective mass `mass` (kg) and the vertex moving at
-    /// `vertex_velocity` (m/s); `None` while the vertex stays outside.
+    /// The penalty stiffness (N/m) and gap (m) of the contact in an implicit step of
+    /// `settings` and `step`, with the triangle's point at `point` (m) of effective mass `mass`
+    /// (kg) and the vertex moving at `vertex_velocity` (m/s); `None` while the vertex stays
+    /// outside.
     fn penalty(
         &self,
         point: DVec3,
         mass: f64,
         vertex_velocity: DVec3,
-        (settings, h): ImplicitStep,
+        (settings, step): (&ContactSettings, &ImplicitStep),
     ) -> Option<(f64, f64)> {
-        let gap = (self.vertex + vertex_velocity * h - point).dot(self.normal);
-        (gap < 0.0).then(|| (settings.penalty_stiffness(mass, h), gap))
+        let gap = (self.vertex + vertex_velocity * step.length - point).dot(self.normal);
+        (gap < 0.0).then(|| (settings.penalty_stiffness(mass, step.effective), gap))
     }
 
     /// The lagged friction of the triangle's point at `point` (m) against the vertex moving at
-    /// `vertex_velocity` (m/s) over an implicit `step`: energy (J), force on the point (N),
-    /// tangent (N/m).
+    /// `vertex_velocity` (m/s) over an implicit step of `settings` and `step`: energy (J), force
+    /// on the point (N), tangent (N/m).
     fn friction_term(
         &self,
         point: DVec3,
         vertex_velocity: DVec3,
-        (settings, h): ImplicitStep,
+        (settings, step): (&ContactSettings, &ImplicitStep),
     ) -> Option<(f64, DVec3, DMat3)> {
         lagged_friction(
             self.coefficients.friction * self.lagged_normal_force,
             self.normal,
-            point - self.slip_origin - vertex_velocity * h,
-            settings.stiction_speed * h,
+            point - self.slip_origin - vertex_velocity * step.length,
+            settings.stiction_speed * step.effective,
         )
+    }
+
+    /// The dynamic rigid body's vertex the corner's terms act against, if it has one.
+    fn partner(&self, step: &ImplicitStep) -> Option<RigidPoint> {
+        self.proxy
+            .filter(|&p| step.rigid[p].is_dynamic())
+            .map(|proxy| RigidPoint {
+                proxy,
+                point: self.vertex,
+            })
     }
 
     /// The implicit force (N) on the triangle's point at `point` (m), of effective mass `mass`
@@ -309,7 +325,7 @@ impl CornerContact {
         point: DVec3,
         mass: f64,
         vertex_velocity: DVec3,
-        step: ImplicitStep,
+        step: (&ContactSettings, &ImplicitStep),
     ) -> DVec3 {
         let penalty = self
             .penalty(point, mass, vertex_velocity, step)
@@ -321,45 +337,51 @@ impl CornerContact {
     }
 }
 
-/// Readies the corners' implicit friction for a step of effective length `h` (s) from the
-/// body's positions: each friction limit is the penalty force there, and slip is measured from
-/// there.
+/// Readies the corners' implicit friction for an implicit `step` from the body's positions:
+/// each friction limit is the penalty force there, with the vertex where it is at the step's
+/// start (as a node's contact takes it against its collider where that is), and slip is
+/// measured from there.
 pub(crate) fn lag_corner_friction(
     body: &DeformableBody,
     contacts: &mut ContactSet,
-    proxies: &[RigidProxy],
-    h: f64,
+    step: ImplicitStep,
 ) {
     let settings = contacts.settings;
     for contact in &mut contacts.corners {
-        let (_, point, mass, velocity) = contact.sides(body, proxies);
+        let (_, point, mass, _) = contact.sides(body, step.rigid);
         contact.lagged_normal_force = contact
-            .penalty(point, mass, velocity, (&settings, h))
+            .penalty(point, mass, DVec3::ZERO, (&settings, &step))
             .map_or(0.0, |(k, gap)| -k * gap);
         contact.slip_origin = point;
     }
 }
 
-/// Calls `each(point, energy (J), force (N), tangent (N/m))` for the implicit penalty and
-/// friction of every corner for an effective step `h` (s), at the body's positions, on the
+/// Calls `each(point, partner, energy (J), force (N), tangent (N/m))` for the implicit penalty
+/// and friction of every corner in the implicit `step`, at the body's positions, on the
 /// triangle's contact point: the penalty `k g²/2` with force `k g n` (into the body) and tangent
-/// `k n nᵀ`, then the lagged friction.
+/// `k n nᵀ`, then the lagged friction; `partner` is the vertex when its rigid body is dynamic.
 pub(crate) fn for_each_corner_term(
     body: &DeformableBody,
     contacts: &ContactSet,
-    proxies: &[RigidProxy],
-    h: f64,
-    mut each: impl FnMut(Stencil, f64, DVec3, DMat3),
+    step: ImplicitStep,
+    mut each: impl FnMut(Stencil, Option<RigidPoint>, f64, DVec3, DMat3),
 ) {
-    let step = (&contacts.settings, h);
+    let terms = (&contacts.settings, &step);
     for contact in &contacts.corners {
-        let (at, point, mass, velocity) = contact.sides(body, proxies);
-        if let Some((k, gap)) = contact.penalty(point, mass, velocity, step) {
+        let (at, point, mass, velocity) = contact.sides(body, step.rigid);
+        let partner = contact.partner(&step);
+        if let Some((k, gap)) = contact.penalty(point, mass, velocity, terms) {
             let tangent = penalty_tangent(k, contact.normal);
-            each(at, 0.5 * k * gap * gap, contact.normal * (k * gap), tangent);
+            each(
+                at,
+                partner,
+                0.5 * k * gap * gap,
+                contact.normal * (k * gap),
+                tangent,
+            );
         }
-        if let Some((energy, force, tangent)) = contact.friction_term(point, velocity, step) {
-            each(at, energy, force, tangent);
+        if let Some((energy, force, tangent)) = contact.friction_term(point, velocity, terms) {
+            each(at, partner, energy, force, tangent);
         }
     }
 }
@@ -371,24 +393,25 @@ pub(crate) fn for_each_corner_stencil(contacts: &ContactSet, mut each: impl FnMu
     }
 }
 
-/// Records the impulses (N s) the implicit corner terms gave the triangles over a substep of
-/// length `h` (s, effective length `effective_h`), at the positions that ended it: the
-/// collider receives their opposite at the vertex, and its rigid body's proxy too.
+/// Records the impulses (N s) the implicit corner terms gave the triangles over the implicit
+/// `step`, at the positions that ended it and the rigid velocities of `step`: the collider
+/// receives their opposite at the vertex, its rigid body's proxy among `proxies` too, and the
+/// vertex travels with its body.
 pub(crate) fn record_corner_impulses(
     body: &DeformableBody,
     contacts: &mut ContactSet,
+    step: ImplicitStep,
     proxies: &mut [RigidProxy],
-    effective_h: f64,
-    h: f64,
 ) {
     let settings = contacts.settings;
     for contact in &mut contacts.corners {
-        let (_, point, mass, velocity) = contact.sides(body, proxies);
-        let on_collider =
-            -contact.implicit_force(point, mass, velocity, (&settings, effective_h)) * h;
+        let (_, point, mass, velocity) = contact.sides(body, step.rigid);
+        let force = contact.implicit_force(point, mass, velocity, (&settings, &step));
+        let on_collider = -force * step.length;
         contact.impulse += on_collider;
         if let Some(p) = contact.proxy {
             proxies[p].apply(on_collider, contact.vertex);
         }
+        contact.vertex += velocity * step.length;
     }
 }

@@ -73,7 +73,20 @@ pub(crate) use velocity_constraint::{ContactSides, VelocityConstraint};
 
 use crate::Error;
 use crate::body::DeformableBody;
+use crate::rigid::RigidProxy;
 use rapier3d::dynamics::CoefficientCombineRule;
+
+/// An implicit step as the contact and attachment terms see it.
+#[derive(Clone, Copy)]
+pub(crate) struct ImplicitStep<'a> {
+    /// The effective step `ĥ` (s): the penalties' `m/ĥ²` and friction's stick length use it.
+    pub(crate) effective: f64,
+    /// The step's length `h` (s): rigid bodies carry their colliders, vertices and anchors over
+    /// it at their velocity.
+    pub(crate) length: f64,
+    /// The rigid bodies the body touches, at the velocities the step's solve gives them.
+    pub(crate) rigid: &'a [RigidProxy],
+}
 
 /// How contacts are detected and enforced.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -80,10 +80,9 @@ pub struct NodeContact {
     /// Within an explicit substep: the velocity constraint.
     pub(super) constraint: VelocityConstraint,
     /// Within an implicit step: the normal force (N) friction is limited by, and the node's
-    /// position and the surface's velocity there at the start of the step (m, m/s).
+    /// position at the start of the step (m).
     pub(super) lagged_normal_force: f64,
     pub(super) slip_origin: DVec3,
-    pub(super) surface_velocity: DVec3,
 }
 
 /// The far side of a contact.
@@ -136,7 +135,6 @@ impl NodeContact {
             constraint: VelocityConstraint::default(),
             lagged_normal_force: 0.0,
             slip_origin: DVec3::ZERO,
-            surface_velocity: DVec3::ZERO,
         }
     }
 
@@ -167,18 +165,18 @@ impl NodeContact {
         (gap < 0.0).then(|| (settings.penalty_stiffness(mass, h), gap))
     }
 
-    /// The lagged friction dissipation of the node at `x` (m) over an implicit step of effective
-    /// length `h` (s): its energy `μ λ f(|u|)` (J), force (N) and positive semi-definite tangent
-    /// (N/m), where `u` is the slip relative to the surface in the contact plane and
-    /// `f(s) = s²/2ε` below `ε = stiction_speed h`, `s - ε/2` above; `None` without a friction
-    /// limit.
+    /// The lagged friction dissipation of the node at `x` (m) relative to the surface (its
+    /// position less the surface's travel over the step) in an implicit step of effective length
+    /// `h` (s): its energy `μ λ f(|u|)` (J), force (N) and positive semi-definite tangent (N/m),
+    /// where `u` is the slip in the contact plane and `f(s) = s²/2ε` below
+    /// `ε = stiction_speed h`, `s - ε/2` above; `None` without a friction limit.
     pub(super) fn friction_term(
         &self,
         x: DVec3,
         settings: &ContactSettings,
         h: f64,
     ) -> Option<(f64, DVec3, DMat3)> {
-        let travel = x - self.slip_origin - self.surface_velocity * h;
+        let travel = x - self.slip_origin;
         lagged_friction(
             self.friction * self.lagged_normal_force,
             self.normal,

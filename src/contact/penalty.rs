@@ -5,15 +5,19 @@
 //! impulses handed to rigid bodies.
 //!
 //! Against a collider the point is the surface point itself (a node, or an embedded vertex with
-//! its element's nodes). Against a triangle of the body's own surface it is the node relative to
+//! its element's nodes), and the plane travels with the collider's rigid body over the step (at
+//! the velocity the step's solve gives a dynamic body, which takes the opposite force at the
+//! plane's point). Against a triangle of the body's own surface it is the node relative to
 //! the triangle's contact point, `x_n − Σ w_i x_i` (weights `1, −w_a, −w_b, −w_c`): the gap, the
 //! slip and every force are then those of the node against the moving triangle, node and
 //! triangle take equal and opposite forces, and the body's momentum is kept.
 
-use super::{BodyPoint, ContactSet, NodeContact, Obstacle, partners};
+use super::{
+    BodyPoint, ContactSet, ContactSettings, ImplicitStep, NodeContact, Obstacle, partners,
+};
 use crate::body::DeformableBody;
 use crate::embedding::Embedding;
-use crate::rigid::RigidProxy;
+use crate::rigid::{RigidPoint, RigidProxy};
 use crate::stencil::Stencil;
 use rapier3d::glamx::{DMat3, DVec3};
 
@@ -67,63 +71,108 @@ fn contact_point<'a>(
     }
 }
 
+/// A contact's obstacle over an implicit step.
+struct Carried {
+    /// How far (m) it carries its plane over the step: its rigid body's velocity at the plane's
+    /// point times the step's length.
+    travel: DVec3,
+    /// The rigid point the contact acts against when that body is dynamic.
+    partner: Option<RigidPoint>,
+    /// That body's effective mass (kg) at the point along the normal; zero otherwise.
+    mass: f64,
+}
+
+/// `contact`'s obstacle in the implicit `step`.
+fn carried(contact: &NodeContact, step: &ImplicitStep) -> Carried {
+    match contact.obstacle {
+        Obstacle::Collider { proxy: Some(p), .. } => {
+            let rigid = &step.rigid[p];
+            let dynamic = rigid.is_dynamic();
+            Carried {
+                travel: rigid.velocity_at(contact.point) * step.length,
+                partner: dynamic.then_some(RigidPoint {
+                    proxy: p,
+                    point: contact.point,
+                }),
+                mass: if dynamic {
+                    rigid.effective_mass_along(contact.point, contact.normal)
+                } else {
+                    0.0
+                },
+            }
+        }
+        _ => Carried {
+            travel: DVec3::ZERO,
+            partner: None,
+            mass: 0.0,
+        },
+    }
+}
+
+/// The implicit force (N) on a contact's point at `x` (m, its position relative to the
+/// obstacle's travel), of effective mass `mass` (kg), in an implicit step of effective length
+/// `h` (s): the penalty and the lagged friction.
+fn implicit_force(
+    contact: &NodeContact,
+    x: DVec3,
+    mass: f64,
+    settings: &ContactSettings,
+    h: f64,
+) -> DVec3 {
+    let friction = contact
+        .friction_term(x, settings, h)
+        .map_or(DVec3::ZERO, |(_, force, _)| force);
+    let penalty = contact
+        .penalty(x, mass, settings, h)
+        .map_or(DVec3::ZERO, |(stiffness, gap)| {
+            -contact.normal * (stiffness * gap)
+        });
+    friction + penalty
+}
+
 /// Records the impulses (N s) the implicit penalty and friction gave the contact points over a
-/// substep of length `h` (s), at the positions that ended it, and hands their opposite to the
-/// rigid bodies (a self-contact's stay within the body).
+/// substep of length `step.length` (s), at the positions that ended it and the rigid bodies'
+/// velocities of `step`, hands their opposite to the rigid bodies' `proxies` at the planes'
+/// points (a self-contact's stay within the body), and carries the planes along with their
+/// rigid bodies.
 pub(crate) fn record_penalty_impulses(
     body: &mut DeformableBody,
     contacts: &mut ContactSet,
+    step: ImplicitStep,
     proxies: &mut [RigidProxy],
-    effective_h: f64,
-    h: f64,
 ) {
     let settings = contacts.settings;
     let (positions, embedding, mut partners) = partners(body, proxies);
     for contact in &mut contacts.nodes {
         let point = contact_point(contact, embedding);
         let at = point.stencil();
-        let x = point.position(positions);
-        let mut force = contact
-            .friction_term(x, &settings, effective_h)
-            .map_or(DVec3::ZERO, |(_, force, _)| force);
-        let mass = effective_mass(&at, partners.masses, partners.pinned);
-        if let Some((stiffness, gap)) = contact.penalty(x, mass, &settings, effective_h) {
-            force -= contact.normal * (stiffness * gap);
+        let obstacle = carried(contact, &step);
+        let x = point.position(positions) - obstacle.travel;
+        let mass = effective_mass(&at, partners.masses, partners.pinned) + obstacle.mass;
+        let impulse = implicit_force(contact, x, mass, &settings, step.effective) * step.length;
+        if !matches!(contact.obstacle, Obstacle::OwnTriangle(_)) {
+            partners.apply(&contact.obstacle, -impulse, contact.point);
         }
-        let impulse = force * h;
-        let own = matches!(contact.obstacle, Obstacle::OwnTriangle(_));
-        if !own {
-            partners.apply(&contact.obstacle, -impulse, x);
-        }
+        contact.point += obstacle.travel;
         contact.impulse += impulse;
     }
 }
 
-/// Readies implicit friction for a step of effective length `h` (s) from the body's positions:
-/// each contact's friction limit is its penalty force there, and slip is measured from there
-/// (relative to a collider's surface moving at its velocity, or to the own triangle).
-pub(crate) fn lag_friction(
-    body: &mut DeformableBody,
-    contacts: &mut ContactSet,
-    proxies: &mut [RigidProxy],
-    h: f64,
-) {
+/// Readies implicit friction for the implicit `step` from the body's positions: each contact's
+/// friction limit is its penalty force there, against the obstacle where it is at the step's
+/// start, and slip is measured from there (relative to the collider's surface as it travels,
+/// or to the own triangle).
+pub(crate) fn lag_friction(body: &DeformableBody, contacts: &mut ContactSet, step: ImplicitStep) {
     let settings = contacts.settings;
-    let (positions, embedding, partners) = partners(body, proxies);
     for contact in &mut contacts.nodes {
-        let point = contact_point(contact, embedding);
-        let x = point.position(positions);
-        let mass = effective_mass(&point.stencil(), partners.masses, partners.pinned);
-        let lagged = contact
-            .penalty(x, mass, &settings, h)
+        let point = contact_point(contact, body.embedding.as_ref());
+        let x = point.position(&body.positions);
+        let mass = effective_mass(&point.stencil(), &body.masses, &body.pinned)
+            + carried(contact, &step).mass;
+        contact.lagged_normal_force = contact
+            .penalty(x, mass, &settings, step.effective)
             .map_or(0.0, |(stiffness, gap)| -stiffness * gap);
-        let surface_velocity = match contact.obstacle {
-            Obstacle::OwnTriangle(_) => DVec3::ZERO,
-            Obstacle::Collider { .. } => partners.velocity_at(&contact.obstacle, x),
-        };
-        contact.lagged_normal_force = lagged;
         contact.slip_origin = x;
-        contact.surface_velocity = surface_velocity;
     }
 }
 
@@ -133,27 +182,31 @@ pub(super) fn effective_mass(at: &Stencil, masses: &[f64], pinned: &[bool]) -> f
     at.inverse_mass(masses, pinned).recip()
 }
 
-/// Calls `each(point, energy (J), force (N), tangent (N/m))` for the implicit penalty and
-/// friction of every contact for an effective step `h` (s), at the body's positions: the
-/// penalty `k g²/2` of a point inside its plane (`g < 0`), with force `-k g n` and tangent
-/// `k n nᵀ`, and the lagged friction of a point with a friction limit (see [`lag_friction`]).
-/// The force acts on the contact point, so node `a` of its stencil takes `w_a f` and the
-/// tangent couples nodes `a, b` by `w_a w_b T`.
+/// Calls `each(point, partner, energy (J), force (N), tangent (N/m))` for the implicit penalty
+/// and friction of every contact in the implicit `step`, at the body's positions: the penalty
+/// `k g²/2` of a point inside its plane (`g < 0`, the plane carried over the step by its rigid
+/// body), with force `-k g n` and tangent `k n nᵀ`, and the lagged friction of a point with a
+/// friction limit (see [`lag_friction`]). The force acts on the contact point, so node `a` of
+/// its stencil takes `w_a f` and the tangent couples nodes `a, b` by `w_a w_b T`; `partner` is
+/// the dynamic rigid body's point that takes the opposite force.
 pub(crate) fn for_each_contact_term(
     body: &DeformableBody,
     contacts: &ContactSet,
-    h: f64,
-    mut each: impl FnMut(Stencil, f64, DVec3, DMat3),
+    step: ImplicitStep,
+    mut each: impl FnMut(Stencil, Option<RigidPoint>, f64, DVec3, DMat3),
 ) {
     // Every penalty, then every friction term.
     for contact in &contacts.nodes {
         let point = contact_point(contact, body.embedding.as_ref());
         let at = point.stencil();
-        let mass = effective_mass(&at, &body.masses, &body.pinned);
-        let x = point.position(&body.positions);
-        if let Some((stiffness, gap)) = contact.penalty(x, mass, &contacts.settings, h) {
+        let obstacle = carried(contact, &step);
+        let mass = effective_mass(&at, &body.masses, &body.pinned) + obstacle.mass;
+        let x = point.position(&body.positions) - obstacle.travel;
+        if let Some((stiffness, gap)) = contact.penalty(x, mass, &contacts.settings, step.effective)
+        {
             each(
                 at,
+                obstacle.partner,
                 0.5 * stiffness * gap * gap,
                 -contact.normal * (stiffness * gap),
                 penalty_tangent(stiffness, contact.normal),
@@ -162,9 +215,12 @@ pub(crate) fn for_each_contact_term(
     }
     for contact in &contacts.nodes {
         let point = contact_point(contact, body.embedding.as_ref());
-        let x = point.position(&body.positions);
-        if let Some((energy, force, tangent)) = contact.friction_term(x, &contacts.settings, h) {
-            each(point.stencil(), energy, force, tangent);
+        let obstacle = carried(contact, &step);
+        let x = point.position(&body.positions) - obstacle.travel;
+        if let Some((energy, force, tangent)) =
+            contact.friction_term(x, &contacts.settings, step.effective)
+        {
+            each(point.stencil(), obstacle.partner, energy, force, tangent);
         }
     }
 }

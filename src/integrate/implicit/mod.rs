@@ -19,6 +19,7 @@
 //! assembling and factoring anew ([`crate::chord`]). Both schemes are stable at any step length.
 
 mod potential;
+mod rigid_response;
 
 use super::{PreviousStep, SolverWorkspace};
 use crate::Error;
@@ -30,6 +31,8 @@ use crate::linear_solver::{LinearSolver, Method, solve_newton_system};
 use crate::newton::{Search, check_tolerance, descend, norm};
 use potential::{Potential, StepStart};
 use rapier3d::glamx::DVec3;
+use rigid_response::RigidResponse;
+use std::cell::RefCell;
 
 /// Newton stops early on a stalled residual only below this relative value; above it, a slow
 /// descent is still progress.
@@ -291,8 +294,14 @@ impl ImplicitIntegrator {
         gravity: DVec3,
     ) -> Result<Outcome, Error> {
         let start = StepStart::new(body, solver.last_step.as_ref(), h, gravity, self.scheme);
+        // The rigid bodies touched fall too, as rapier will make them (unless held); their
+        // response to the soft body is part of the solve.
+        for proxy in &mut constraints.rigid_proxies {
+            proxy.fall(gravity, h);
+        }
+        let response = RigidResponse::new(constraints.rigid_proxies.clone(), start.h, h);
         for kind in constraint::IMPLICIT {
-            kind.begin(body, constraints, start.h);
+            kind.begin(body, constraints, response.start());
         }
         // Newton starts from the inertial prediction `x̂` (free flight: the warm start that makes
         // smooth motion cost one iteration), or from where the body is when that is the lower
@@ -301,6 +310,7 @@ impl ImplicitIntegrator {
         let incremental = Potential {
             start: &start,
             constraints,
+            rigid: RefCell::new(response),
         };
         let here = incremental.energy(body);
         body.positions.clone_from(&start.target);
@@ -311,8 +321,10 @@ impl ImplicitIntegrator {
             potential = here;
         }
         let outcome = self.minimize(body, solver, &incremental, potential)?;
+        let mut response = incremental.rigid.into_inner();
+        response.solve(body, constraints);
         for kind in constraint::IMPLICIT {
-            kind.record_impulses(body, constraints, start.h, h);
+            kind.record_impulses(body, constraints, response.step());
         }
         for n in 0..body.positions.len() {
             body.velocities[n] = if body.pinned[n] {
@@ -376,7 +388,12 @@ impl ImplicitIntegrator {
                 })
                 .flatten();
             let (direction, search) = match reusable {
-                Some(factor) => (solve(factor, &residual), Search::Short),
+                Some(factor) => {
+                    let direction = solve(factor, &residual);
+                    let direction =
+                        incremental.take_in_rigid_response(body, factor, &residual, direction);
+                    (direction, Search::Short)
+                }
                 None => (
                     self.exact_direction(
                         body,
@@ -480,6 +497,10 @@ impl ImplicitIntegrator {
         if solution.fell_back {
             solver.method = Method::Direct;
         }
+        let mut direction = solution.direction;
+        if let Some(factor) = &solution.factor {
+            direction = incremental.take_in_rigid_response(body, factor, residual, direction);
+        }
         if let Some(factor) = solution.factor
             && self.reuse_factorization
         {
@@ -487,7 +508,7 @@ impl ImplicitIntegrator {
             #[cfg(feature = "serde-serialize")]
             solver.chord.remember(&solver.stiffness);
         }
-        Ok(solution.direction)
+        Ok(direction)
     }
 }
 

@@ -2,10 +2,12 @@
 //! `E(x) = Σ m/(2ĥ²) |x − x̂|² + Ψ(x) + ĥ D((x − x₀)/ĥ) − W(x)`, with `x̂` the inertial target
 //! (backward Euler `x₀ + ĥ v₀`; BDF2 from the two previous states), `Ψ` the elastic energy, `D`
 //! the damping's dissipation on the strain rate measured from the step's start, and `W` the work
-//! of gravity, contacts and attachments. Its gradient is the out-of-balance force and its Hessian
+//! of gravity, contacts and attachments, plus the response `½ ιᵀ W ι` of the dynamic rigid
+//! bodies those act against, minimized over their impulses `ι` for each `x`. Its gradient is the out-of-balance force and its Hessian
 //! the Newton tangent; the new velocity is `(x − a)/ĥ`.
 
 use super::ImplicitScheme;
+use super::rigid_response::RigidResponse;
 use crate::assembly::Stiffness;
 use crate::body::DeformableBody;
 use crate::constraint::{self, BodyConstraints};
@@ -14,7 +16,9 @@ use crate::element::{add_point_forces, deformation_gradient};
 use crate::integrate::PreviousStep;
 use crate::material::green_strain;
 use crate::newton::norm;
+use faer::sparse::linalg::solvers::Llt;
 use rapier3d::glamx::{DMat3, DVec3};
+use std::cell::RefCell;
 
 /// Per-step data of the incremental potential.
 pub(super) struct StepStart {
@@ -110,10 +114,13 @@ impl StepStart {
     }
 }
 
-/// The incremental potential of one step: the step's start and the constraints' terms.
+/// The incremental potential of one step: the step's start, the constraints' terms and the
+/// response of the dynamic rigid bodies they act against (solved anew wherever the potential is
+/// evaluated, see [`RigidResponse`]).
 pub(super) struct Potential<'a> {
     pub(super) start: &'a StepStart,
     pub(super) constraints: &'a BodyConstraints,
+    pub(super) rigid: RefCell<RigidResponse>,
 }
 
 impl Potential<'_> {
@@ -137,7 +144,9 @@ impl Potential<'_> {
         if let Some(damping) = body.damping {
             self.add_damping_forces(body, &damping, &mut residual);
         }
-        constraint::add_implicit_forces(body, self.constraints, self.start.h, &mut residual);
+        let mut rigid = self.rigid.borrow_mut();
+        rigid.solve(body, self.constraints);
+        constraint::add_implicit_forces(body, self.constraints, rigid.step(), &mut residual);
         for (r, &pinned) in residual.iter_mut().zip(&body.pinned) {
             if pinned {
                 *r = DVec3::ZERO;
@@ -204,8 +213,10 @@ impl Potential<'_> {
             }
             None => 0.0,
         };
-        let penalty = constraint::implicit_energy(body, self.constraints, self.start.h);
-        inertia + body.elastic_energy() + dissipation + penalty - load
+        let mut rigid = self.rigid.borrow_mut();
+        let response = rigid.solve(body, self.constraints);
+        let penalty = constraint::implicit_energy(body, self.constraints, rigid.step());
+        inertia + body.elastic_energy() + dissipation + penalty + response - load
     }
 
     /// `M/h² + K_elastic + K_damping + K_contact`, each element's stress tangent projected to be positive
@@ -222,6 +233,22 @@ impl Potential<'_> {
             Some(d) => d.step_first_piola_differential(f, &self.start.green[t], self.start.h, df),
             None => DMat3::ZERO,
         });
-        constraint::add_implicit_tangents(body, self.constraints, self.start.h, stiffness);
+        let mut rigid = self.rigid.borrow_mut();
+        rigid.solve(body, self.constraints);
+        constraint::add_implicit_tangents(body, self.constraints, rigid.step(), stiffness);
+    }
+
+    /// The Newton direction `direction` (m per node), solved with `factor`, with the rigid
+    /// bodies' response taken in (see [`RigidResponse::take_in`]).
+    pub(super) fn take_in_rigid_response(
+        &self,
+        body: &DeformableBody,
+        factor: &Llt<usize, f64>,
+        residual: &[DVec3],
+        direction: Vec<DVec3>,
+    ) -> Vec<DVec3> {
+        let mut rigid = self.rigid.borrow_mut();
+        rigid.solve(body, self.constraints);
+        rigid.take_in(body, self.constraints, factor, residual, direction)
     }
 }

@@ -1,0 +1,398 @@
+//! The dynamic rigid bodies' part of an implicit step: the soft body and the rigid bodies it
+//! touches or is glued to are stepped as one system, so that the coupling cannot create energy.
+//!
+//! A dynamic body's unknown is the impulse `ι` (N s, and N m s about its centre of mass) the
+//! step gives it on top of the velocity it starts the step with (gravity included): its velocity
+//! becomes `v + W ι` (`W` its inverse mass and world inverse inertia) and it carries each of its
+//! points over the step of length `h` by `h (v + W ι)` there (its pose frozen, as everywhere in
+//! the soft step). Its part of the incremental potential is `½ ιᵀ W ι`, the kinetic energy of the
+//! velocity change (backward Euler for the body), plus the terms that act against it, each a
+//! function of its soft point's position relative to the body's point, `x − h J W ι` with
+//! `J = [I | −[r]×]` and `r` the point's arm from the centre of mass.
+//!
+//! For the soft positions `x`, `ι*(x) = argmin ½ ιᵀ W ι + Σ e_c(x_c − h J_c W ι)` is found by
+//! Newton's method with a backtracking line search on six unknowns per body (the penalties and
+//! the lagged friction are convex in the relative position); the soft step minimizes
+//! `E(x) + min_ι(…)`, whose gradient is the terms' forces at `ι*(x)` (the envelope theorem) and
+//! whose Hessian is the tangent with the bodies held less the coupling through them, `U Q Uᵀ`
+//! (`U = −Σ P_cᵀ T_c J_c`, `Q = h² (I + h² W A)⁻¹ W`, `A = Σ J_cᵀ T_c J_c`), which the Newton
+//! direction takes in by the Woodbury identity with the held tangent's factorization (six solves
+//! per body). At `ι*`, `ι = −h Σ J_cᵀ f_c`: exactly the opposite of the impulses the terms give
+//! the soft body, which is what the bodies receive when the step's impulses are recorded.
+
+use crate::assembly::solve;
+use crate::body::DeformableBody;
+use crate::constraint::{self, BodyConstraints, ImplicitTerm};
+use crate::contact::ImplicitStep;
+use crate::rigid::RigidProxy;
+use faer::sparse::linalg::solvers::Llt;
+use rapier3d::glamx::{DMat3, DVec3};
+use rapier3d::na::{DMatrix, DVector, Matrix3, Matrix3x6, Matrix6, Vector3, Vector6};
+
+/// Newton iterations (line-search halvings included) of one body-response solve at most.
+const MAX_ITERATIONS: usize = 60;
+/// The response is solved when its stationarity residual is below this fraction of the impulses'
+/// scale.
+const TOLERANCE: f64 = 1e-11;
+/// The line search's sufficient decrease (Armijo) fraction and smallest step.
+const ARMIJO: f64 = 1e-4;
+const MIN_STEP: f64 = 1e-6;
+
+/// The rigid bodies' response within one implicit substep.
+pub(super) struct RigidResponse {
+    /// The bodies at the substep's start (gravity included): what the impulses add to.
+    base: Vec<RigidProxy>,
+    /// The bodies moving with the impulses of the last solve.
+    trial: Vec<RigidProxy>,
+    /// Per body, the linear (N s) and angular (N m s) impulse of the last solve.
+    impulses: Vec<[DVec3; 2]>,
+    /// The soft positions of the last solve (m), and its `½ ιᵀ W ι` (J).
+    solved_at: Vec<DVec3>,
+    kinetic: f64,
+    /// Whether some term acts against a dynamic body (none: nothing to solve).
+    coupled: bool,
+    /// The effective step `ĥ` and the step's length `h` (s).
+    effective: f64,
+    length: f64,
+}
+
+/// What the terms against one body add up to at the trial velocities.
+#[derive(Clone, Copy)]
+struct Gathered {
+    /// `Σ J_cᵀ f_c` (N, N m).
+    force: Vector6<f64>,
+    /// `A = Σ J_cᵀ T_c J_c` (N/m in the body's coordinates).
+    stiffness: Matrix6<f64>,
+    /// `Σ |f_c|` (N): the scale of the force.
+    magnitude: f64,
+}
+
+impl Gathered {
+    fn zero() -> Self {
+        Self {
+            force: Vector6::zeros(),
+            stiffness: Matrix6::zeros(),
+            magnitude: 0.0,
+        }
+    }
+
+    /// Adds `term`, whose point moves with the body by `j`.
+    fn add(&mut self, term: &ImplicitTerm, j: &Matrix3x6<f64>) {
+        let f = term.force;
+        self.force += j.transpose() * Vector3::new(f.x, f.y, f.z);
+        self.stiffness += j.transpose() * matrix(&term.tangent) * j;
+        self.magnitude += f.length();
+    }
+}
+
+/// The response's energy (J) and what the terms add up to per body, at some impulses.
+struct Evaluation {
+    energy: f64,
+    gathered: Vec<Option<Gathered>>,
+}
+
+fn matrix(m: &DMat3) -> Matrix3<f64> {
+    Matrix3::from_column_slice(&m.to_cols_array())
+}
+
+fn vector6(v: [DVec3; 2]) -> Vector6<f64> {
+    Vector6::new(v[0].x, v[0].y, v[0].z, v[1].x, v[1].y, v[1].z)
+}
+
+fn pair(v: &Vector6<f64>) -> [DVec3; 2] {
+    [DVec3::new(v[0], v[1], v[2]), DVec3::new(v[3], v[4], v[5])]
+}
+
+/// `J = [I | −[r]×]` (3 x 6): how a point at arm `r` (m) moves with the body's translation and
+/// rotation.
+fn jacobian(arm: DVec3) -> Matrix3x6<f64> {
+    let mut j = Matrix3x6::zeros();
+    j.fixed_view_mut::<3, 3>(0, 0).fill_with_identity();
+    let cross = Matrix3::new(0.0, -arm.z, arm.y, arm.z, 0.0, -arm.x, -arm.y, arm.x, 0.0);
+    j.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-cross));
+    j
+}
+
+/// The body's `W` (6 x 6): inverse mass per axis and world inverse inertia.
+fn inverse_mass(proxy: &RigidProxy) -> Matrix6<f64> {
+    let (mass, inertia) = proxy.inverse_mass_and_inertia();
+    let mut w = Matrix6::zeros();
+    w.fixed_view_mut::<3, 3>(0, 0)
+        .copy_from(&Matrix3::from_diagonal(&mass.to_array().into()));
+    w.fixed_view_mut::<3, 3>(3, 3).copy_from(&matrix(&inertia));
+    w
+}
+
+impl RigidResponse {
+    /// The response of the bodies `base` (at the substep's start) in a step of effective length
+    /// `effective` and length `length` (s).
+    pub(super) fn new(base: Vec<RigidProxy>, effective: f64, length: f64) -> Self {
+        Self {
+            trial: base.clone(),
+            impulses: vec![[DVec3::ZERO; 2]; base.len()],
+            coupled: base.iter().any(RigidProxy::is_dynamic),
+            base,
+            solved_at: Vec::new(),
+            kinetic: 0.0,
+            effective,
+            length,
+        }
+    }
+
+    /// The step as the terms see it, the bodies at their start.
+    pub(super) fn start(&self) -> ImplicitStep<'_> {
+        self.step_with(&self.base)
+    }
+
+    /// The step as the terms see it, the bodies moving as the last solve left them.
+    pub(super) fn step(&self) -> ImplicitStep<'_> {
+        self.step_with(&self.trial)
+    }
+
+    fn step_with<'a>(&self, rigid: &'a [RigidProxy]) -> ImplicitStep<'a> {
+        ImplicitStep {
+            effective: self.effective,
+            length: self.length,
+            rigid,
+        }
+    }
+
+    /// Solves the bodies' response to the soft body at its positions (unless solved there
+    /// already) and returns its `½ ιᵀ W ι` (J).
+    pub(super) fn solve(&mut self, body: &DeformableBody, constraints: &BodyConstraints) -> f64 {
+        if !self.coupled || self.solved_at == body.positions {
+            return self.kinetic;
+        }
+        let mut at = self.evaluate(body, constraints);
+        for _ in 0..MAX_ITERATIONS {
+            let residuals = self.residuals(&at.gathered);
+            let largest = residuals.iter().map(|r| r.norm()).fold(0.0, f64::max);
+            if largest <= TOLERANCE * self.scale(&at.gathered) {
+                break;
+            }
+            let directions = self.newton_directions(&at.gathered, &residuals);
+            // The directional derivative of the response's energy, whose gradient is `W G`.
+            let slope: f64 = (0..self.base.len())
+                .map(|p| (inverse_mass(&self.base[p]) * residuals[p]).dot(&directions[p]))
+                .sum();
+            if slope.is_nan() || slope >= 0.0 {
+                break;
+            }
+            let start = self.impulses.clone();
+            match self.line_search(body, constraints, (&start, &directions), at.energy, slope) {
+                Some(next) => at = next,
+                None => {
+                    self.move_to(&start, &directions, 0.0);
+                    break;
+                }
+            }
+        }
+        self.kinetic = self.kinetic_energy();
+        self.solved_at.clone_from(&body.positions);
+        self.kinetic
+    }
+
+    /// Backtracks from the impulses `start` along `directions` until the response's energy falls
+    /// below `energy` (J) by an Armijo fraction of `slope` (J per unit step); `None` if no step
+    /// down to a millionth does.
+    fn line_search(
+        &mut self,
+        body: &DeformableBody,
+        constraints: &BodyConstraints,
+        (start, directions): (&[[DVec3; 2]], &[Vector6<f64>]),
+        energy: f64,
+        slope: f64,
+    ) -> Option<Evaluation> {
+        let mut step = 1.0;
+        while step >= MIN_STEP {
+            self.move_to(start, directions, step);
+            let next = self.evaluate(body, constraints);
+            if next.energy <= energy + ARMIJO * step * slope {
+                return Some(next);
+            }
+            step *= 0.5;
+        }
+        None
+    }
+
+    /// `½ Σ ιᵀ W ι` (J) over the bodies.
+    fn kinetic_energy(&self) -> f64 {
+        self.base
+            .iter()
+            .zip(&self.impulses)
+            .map(|(proxy, impulse)| proxy.kinetic_energy_of(*impulse))
+            .sum()
+    }
+
+    /// The impulses `start + step direction`, and the bodies moving with them.
+    fn move_to(&mut self, start: &[[DVec3; 2]], direction: &[Vector6<f64>], step: f64) {
+        for p in 0..self.base.len() {
+            let next = vector6(start[p]) + direction[p] * step;
+            self.impulses[p] = pair(&next);
+            self.trial[p].nudge_from(&self.base[p], self.impulses[p]);
+        }
+    }
+
+    /// The response's energy and, per body, what the terms against it add up to, at the trial
+    /// velocities (`None` for a body no term acts against).
+    fn evaluate(&self, body: &DeformableBody, constraints: &BodyConstraints) -> Evaluation {
+        let mut energy = self.kinetic_energy();
+        let mut gathered = vec![None; self.base.len()];
+        constraint::for_each_implicit_term(body, constraints, self.step(), &mut |term| {
+            if let Some(partner) = term.partner {
+                energy += term.energy;
+                let j = jacobian(partner.point - self.base[partner.proxy].center_of_mass());
+                let sum = gathered[partner.proxy].get_or_insert_with(Gathered::zero);
+                sum.add(&term, &j);
+            }
+        });
+        Evaluation { energy, gathered }
+    }
+
+    /// Per body, the stationarity residual `G = ι + h Σ J_cᵀ f_c` (N s, N m s).
+    fn residuals(&self, gathered: &[Option<Gathered>]) -> Vec<Vector6<f64>> {
+        (0..self.base.len())
+            .map(|p| {
+                let force = gathered[p].map_or(Vector6::zeros(), |g| g.force);
+                vector6(self.impulses[p]) + force * self.length
+            })
+            .collect()
+    }
+
+    /// The impulses' scale (N s): the largest of every body's `|ι| + h Σ |f_c|`.
+    fn scale(&self, gathered: &[Option<Gathered>]) -> f64 {
+        (0..self.base.len())
+            .map(|p| {
+                let magnitude = gathered[p].map_or(0.0, |g| g.magnitude);
+                vector6(self.impulses[p]).norm() + magnitude * self.length
+            })
+            .fold(f64::MIN_POSITIVE, f64::max)
+    }
+
+    /// Per body, the Newton direction `−(I + h² A W)⁻¹ G`.
+    fn newton_directions(
+        &self,
+        gathered: &[Option<Gathered>],
+        residuals: &[Vector6<f64>],
+    ) -> Vec<Vector6<f64>> {
+        let h2 = self.length * self.length;
+        (0..self.base.len())
+            .map(|p| {
+                let stiffness = gathered[p].map_or(Matrix6::zeros(), |g| g.stiffness);
+                let system = Matrix6::identity() + stiffness * inverse_mass(&self.base[p]) * h2;
+                system
+                    .lu()
+                    .solve(&(-residuals[p]))
+                    .unwrap_or_else(|| -residuals[p])
+            })
+            .collect()
+    }
+}
+
+impl RigidResponse {
+    /// The soft body's Newton direction (m per node) with the bodies' response taken in:
+    /// `direction` solves `K d = r` (`r` the `residual`, `N`) with `factor`, the tangent `K` with
+    /// the bodies held; this returns `(K − U Q Uᵀ)⁻¹ r` by the Woodbury identity,
+    /// `d + Z (I − Q Uᵀ Z)⁻¹ Q Uᵀ d` with `Z = K⁻¹ U`, or `direction` itself when no term acts
+    /// against a dynamic body or the result would not descend.
+    pub(super) fn take_in(
+        &self,
+        body: &DeformableBody,
+        constraints: &BodyConstraints,
+        factor: &Llt<usize, f64>,
+        residual: &[DVec3],
+        direction: Vec<DVec3>,
+    ) -> Vec<DVec3> {
+        if !self.coupled {
+            return direction;
+        }
+        let coupling = self.coupling(body, constraints);
+        if coupling.columns.is_empty() {
+            return direction;
+        }
+        let dot =
+            |a: &[DVec3], b: &[DVec3]| -> f64 { a.iter().zip(b).map(|(x, y)| x.dot(*y)).sum() };
+        let solved: Vec<Vec<DVec3>> = coupling.columns.iter().map(|u| solve(factor, u)).collect();
+        let m = coupling.columns.len();
+        let q = self.compliance(&coupling);
+        let u_z = DMatrix::from_fn(m, m, |i, j| dot(&coupling.columns[i], &solved[j]));
+        let u_d = DVector::from_fn(m, |i, _| dot(&coupling.columns[i], &direction));
+        let system = DMatrix::identity(m, m) - &q * u_z;
+        let Some(weights) = system.lu().solve(&(&q * u_d)) else {
+            return direction;
+        };
+        let mut taken = direction.clone();
+        for (z, weight) in solved.iter().zip(weights.iter()) {
+            for (d, z) in taken.iter_mut().zip(z) {
+                *d += *z * *weight;
+            }
+        }
+        let finite = taken.iter().all(|d| d.is_finite());
+        if finite && dot(residual, &taken) > 0.0 {
+            taken
+        } else {
+            direction
+        }
+    }
+
+    /// The columns of `U = −Σ P_cᵀ T_c J_c` (N/m per node, six per body some term acts against)
+    /// and each such body's `A = Σ J_cᵀ T_c J_c`, at the trial velocities.
+    fn coupling(&self, body: &DeformableBody, constraints: &BodyConstraints) -> Coupling {
+        let n = body.positions.len();
+        let mut coupling = Coupling {
+            bodies: Vec::new(),
+            columns: Vec::new(),
+        };
+        let mut slot_of: Vec<Option<usize>> = vec![None; self.base.len()];
+        constraint::for_each_implicit_term(body, constraints, self.step(), &mut |term| {
+            let Some(partner) = term.partner else {
+                return;
+            };
+            let slot = *slot_of[partner.proxy].get_or_insert_with(|| {
+                coupling.bodies.push((partner.proxy, Matrix6::zeros()));
+                coupling
+                    .columns
+                    .extend(std::iter::repeat_with(|| vec![DVec3::ZERO; n]).take(6));
+                coupling.bodies.len() - 1
+            });
+            let j = jacobian(partner.point - self.base[partner.proxy].center_of_mass());
+            let t = matrix(&term.tangent);
+            coupling.bodies[slot].1 += j.transpose() * t * j;
+            let block = -(t * j);
+            for (&node, &w) in term.at.nodes.iter().zip(term.at.weights) {
+                if body.pinned[node as usize] {
+                    continue;
+                }
+                for k in 0..6 {
+                    let c = block.column(k);
+                    coupling.columns[6 * slot + k][node as usize] +=
+                        DVec3::new(c[0], c[1], c[2]) * w;
+                }
+            }
+        });
+        coupling
+    }
+
+    /// `Q` (block diagonal, six rows per body of `coupling`): each body's
+    /// `h² (I + h² W A)⁻¹ W`, its displacement over the step per unit force.
+    fn compliance(&self, coupling: &Coupling) -> DMatrix<f64> {
+        let m = coupling.columns.len();
+        let h2 = self.length * self.length;
+        let mut q = DMatrix::zeros(m, m);
+        for (slot, (proxy, stiffness)) in coupling.bodies.iter().enumerate() {
+            let w = inverse_mass(&self.base[*proxy]);
+            let system = Matrix6::identity() + w * stiffness * h2;
+            if let Some(block) = system.lu().solve(&(w * h2)) {
+                q.view_mut((6 * slot, 6 * slot), (6, 6)).copy_from(&block);
+            }
+        }
+        q
+    }
+}
+
+/// How the soft body's nodes couple through the dynamic bodies: per body its index among the
+/// proxies and its `A` (N/m), and the columns of `U` (N/m per node), six per body.
+struct Coupling {
+    bodies: Vec<(usize, Matrix6<f64>)>,
+    columns: Vec<Vec<DVec3>>,
+}

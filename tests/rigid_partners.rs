@@ -1,0 +1,337 @@
+//! Dynamic rigid bodies touching or glued to soft bodies, under every integrator: the coupled
+//! system's energy never rises (rigid bodies included), a strike without restitution never
+//! rebounds faster than it came, and light and heavy partners (mass ratios 1e-6 to 1e6) stay
+//! where the statics puts them.
+//!
+//! The energy of the whole system is the soft bodies' kinetic, elastic and gravitational energy
+//! plus the rigid bodies' kinetic energy and their gravitational energy at the position half a
+//! (coupling sub)step back along their velocity, which rapier's symplectic Euler step keeps
+//! exactly in free flight (so that the check sees only what the coupling adds).
+
+use rapier_fvm::glamx::Vec3;
+use rapier_fvm::prelude::*;
+use rapier_fvm::world::FvmWorld;
+use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder, RigidBodyHandle, SharedShape};
+
+const GRAVITY: DVec3 = DVec3::new(0.0, -9.81, 0.0);
+
+/// The energy (J) of `world`: every soft body's kinetic, elastic and gravitational energy, and
+/// every dynamic rigid body's kinetic and (half a frame back) gravitational energy.
+fn coupled_energy(world: &FvmWorld) -> f64 {
+    let soft: f64 = world
+        .soft_bodies
+        .iter()
+        .map(|(_, b)| b.kinetic_energy() + b.elastic_energy() + b.gravity_potential_energy(GRAVITY))
+        .sum();
+    // rapier steps the rigid bodies in coupling substeps of `h`.
+    let h = f64::from(world.physics.integration_parameters.dt) / f64::from(world.coupling.substeps);
+    let rigid: f64 = world
+        .physics
+        .bodies
+        .iter()
+        .filter(|(_, b)| b.is_dynamic())
+        .map(|(_, b)| {
+            let mass = f64::from(b.mass());
+            let v = b.linvel().as_dvec3();
+            let w = b.angvel().as_dvec3();
+            let inertia = b.mass_properties().effective_world_inv_inertia;
+            let spin = if w == DVec3::ZERO {
+                0.0
+            } else {
+                // ½ ωᵀ I ω with I the inverse of the world inverse inertia.
+                let i = inertia;
+                let m = DMat3::from_cols_array(
+                    &[
+                        i.m11, i.m12, i.m13, i.m12, i.m22, i.m23, i.m13, i.m23, i.m33,
+                    ]
+                    .map(f64::from),
+                );
+                0.5 * w.dot(m.inverse() * w)
+            };
+            let com = b.center_of_mass().as_dvec3() - v * (h / 2.0);
+            0.5 * mass * v.length_squared() + spin - mass * GRAVITY.dot(com)
+        })
+        .sum();
+    soft + rigid
+}
+
+fn soft_block(half: f64, cells: usize, centre: DVec3, young: f64, density: f64) -> DeformableBody {
+    let material = Material::new(MaterialModel::StableNeoHookean, young, 0.3, density).unwrap();
+    let mut body = DeformableBodyBuilder::new(
+        mesh::cuboid(DVec3::splat(half), [cells; 3]).unwrap(),
+        material,
+    )
+    .damping(RayleighDamping::stiffness_proportional(2e-3, material.lame()).unwrap())
+    .translation(centre)
+    .build()
+    .unwrap();
+    body.friction = 0.8;
+    body
+}
+
+/// A world with a fixed ground (friction 0.8) and `integrator` forced (or the automatic choice).
+fn world_with_ground(integrator: Option<IntegratorKind>) -> FvmWorld {
+    let mut world = FvmWorld::default();
+    world.coupling.integrator.force = integrator;
+    world.physics.insert_collider(
+        ColliderBuilder::new(SharedShape::halfspace(Vec3::Y)).friction(0.8),
+        None,
+    );
+    world
+}
+
+/// What a run did: the largest rise of the coupled energy above its start (J), and per frame
+/// whether every soft body's step was refused for needing too many explicit substeps.
+struct Run {
+    energy_rise: f64,
+    refused_frames: usize,
+    frames: usize,
+}
+
+impl Run {
+    /// Whether every frame was refused with [`Error::TooManySubsteps`] (a scene too stiff for
+    /// the forced explicit integrator): a clear error rather than a wrong motion.
+    fn all_refused(&self) -> bool {
+        self.refused_frames == self.frames
+    }
+}
+
+/// Steps `world` for `frames`, calling `each` after every frame; a step that fails with anything
+/// but [`Error::TooManySubsteps`] fails the test.
+fn run(world: &mut FvmWorld, frames: usize, mut each: impl FnMut(&FvmWorld)) -> Run {
+    let start = coupled_energy(world);
+    let mut run = Run {
+        energy_rise: 0.0,
+        refused_frames: 0,
+        frames,
+    };
+    for _ in 0..frames {
+        let mut refused = false;
+        for (handle, outcome) in world.step() {
+            match outcome {
+                Ok(_) => {}
+                Err(Error::TooManySubsteps { .. }) => refused = true,
+                Err(error) => panic!("{handle:?}: {error}"),
+            }
+        }
+        run.refused_frames += usize::from(refused);
+        run.energy_rise = run.energy_rise.max(coupled_energy(world) - start);
+        each(world);
+    }
+    run
+}
+
+/// The tolerance (J) on the coupled energy's rise in a world whose bodies weigh `weight` (N)
+/// and span `height` (m), carrying kinetic energy `kinetic` (J): rapier keeps the rigid bodies'
+/// state in f32, whose relative rounding (6e-8) over the frames' handful of operations leaves
+/// the energy exact to about 1e-6 of its scale. Everything the coupling could add is far above.
+fn energy_tolerance(weight: f64, height: f64, kinetic: f64) -> f64 {
+    1e-6 * (weight * height + kinetic)
+}
+
+/// The integrators every case runs under: the automatic choice, forced implicit, forced
+/// explicit.
+const INTEGRATORS: [Option<IntegratorKind>; 3] = [
+    None,
+    Some(IntegratorKind::Implicit),
+    Some(IntegratorKind::Explicit),
+];
+
+fn box_on_block(
+    integrator: Option<IntegratorKind>,
+    box_mass: f64,
+    young: f64,
+) -> (FvmWorld, RigidBodyHandle) {
+    let mut world = world_with_ground(integrator);
+    world.soft_bodies.insert(soft_block(
+        0.05,
+        4,
+        DVec3::new(0.0, 0.05, 0.0),
+        young,
+        1000.0,
+    ));
+    let half = 0.02f32;
+    let density = box_mass as f32 / (8.0 * half * half * half);
+    let (rigid, _) = world.physics.insert(
+        RigidBodyBuilder::dynamic().translation(Vec3::new(0.01, 0.1 + half + 5e-4, 0.0)),
+        ColliderBuilder::cuboid(half, half, half)
+            .density(density)
+            .friction(0.8),
+    );
+    (world, rigid)
+}
+
+/// A ball of `ball_mass` (kg, radius 2 cm) flying at 3 m/s into a free 10 cm soft cube (1 kg,
+/// E = `young`) without gravity, restitution 0; returns the run, the ball's speed away from the
+/// cube's centre of mass at the end (m/s).
+fn strike(integrator: Option<IntegratorKind>, ball_mass: f64, young: f64) -> (Run, f64) {
+    let mut world = FvmWorld::default();
+    world.coupling.integrator.force = integrator;
+    world.physics.gravity = Vec3::ZERO;
+    let cube = world
+        .soft_bodies
+        .insert(soft_block(0.05, 4, DVec3::ZERO, young, 1000.0));
+    let radius = 0.02f32;
+    let density = ball_mass as f32 / (4.0 / 3.0 * std::f32::consts::PI * radius.powi(3));
+    let (ball, _) = world.physics.insert(
+        RigidBodyBuilder::dynamic()
+            .translation(Vec3::new(-0.1, 0.01, 0.0))
+            .linvel(Vec3::new(3.0, 0.0, 0.0)),
+        ColliderBuilder::ball(radius)
+            .density(density)
+            .restitution(0.0),
+    );
+    let run = run(&mut world, 40, |_| {});
+    let away = {
+        let soft = &world.soft_bodies[cube];
+        let velocity = soft.linear_momentum() / soft.total_mass();
+        let ball = &world.physics.bodies[ball];
+        let direction = (ball.translation().as_dvec3() - soft.center_of_mass()).normalize();
+        (ball.linvel().as_dvec3() - velocity).dot(direction)
+    };
+    (run, away)
+}
+
+/// A 20 cm soft rope (1 x 1 cm, 20 g, clamped at the top) with a ball of `ratio` times its mass
+/// glued below its end, hanging at rest, its Young's modulus chosen so that the static stretch
+/// is 1 % of its length; returns the run and the ball's drop below the unstretched end (m)
+/// at the end, with the expected static stretch (m).
+fn hanging(integrator: Option<IntegratorKind>, ratio: f64) -> (Run, f64, f64) {
+    let mut world = FvmWorld::default();
+    world.coupling.integrator.force = integrator;
+    let (length, side) = (0.2, 0.01);
+    let rope_mass = 0.02;
+    let density = rope_mass / (length * side * side);
+    let ball_mass = ratio * rope_mass;
+    let load = (ball_mass + rope_mass / 2.0) * 9.81;
+    let young = load / (0.01 * side * side);
+    let material = Material::new(MaterialModel::StableNeoHookean, young, 0.3, density).unwrap();
+    let mesh = mesh::cuboid(DVec3::new(side / 2.0, length / 2.0, side / 2.0), [2, 20, 2]).unwrap();
+    let top = mesh.nodes_where(|p| p.y >= length / 2.0 - 1e-9);
+    let bottom = mesh.nodes_where(|p| p.y <= -length / 2.0 + 1e-9);
+    let rope = DeformableBodyBuilder::new(mesh, material)
+        .damping(RayleighDamping::stiffness_proportional(0.01, material.lame()).unwrap())
+        .translation(DVec3::new(0.0, -length / 2.0, 0.0))
+        .pinned_nodes(top)
+        .build()
+        .unwrap();
+    let radius = 0.01f64;
+    let ball_density = ball_mass / (4.0 / 3.0 * std::f64::consts::PI * radius.powi(3));
+    let centre = DVec3::new(0.0, -(length + radius + 1e-3), 0.0);
+    let (ball, _) = world.physics.insert(
+        RigidBodyBuilder::dynamic().translation(centre.as_vec3()),
+        ColliderBuilder::ball(radius as f32).density(ball_density as f32),
+    );
+    let rope = world.soft_bodies.insert(rope);
+    world.attach(rope, bottom, ball).unwrap();
+    let run = run(&mut world, 60, |_| {});
+    let drop = centre.y - f64::from(world.physics.bodies[ball].translation().y);
+    (run, drop, 0.01 * length)
+}
+
+#[test]
+fn boxes_light_and_heavy_rest_on_a_soft_block_under_every_integrator() {
+    // A 4 cm rigid box of 1 g to 10 kg placed 0.5 mm above a 10 cm soft block (E = 1e6 or 1e9
+    // Pa, 1 kg) on the ground, 2 s. It must settle on the block: never rise more than 1 mm
+    // above where it was placed (it was thrown up to 777 m when an implicit step froze it), end
+    // within 5 mm of it (the block's compression under 10 kg is about 1.5 mm) and within 1 mm
+    // sideways, with the whole system's energy never above its start (tolerance: f32 rounding,
+    // see `energy_tolerance`). The explicit integrator cannot step the 1e9 Pa block at 1/60 s:
+    // it must refuse every frame.
+    for integrator in INTEGRATORS {
+        for (mass, young) in [
+            (1e-3, 1e9),
+            (1e-2, 1e9),
+            (0.1, 1e9),
+            (0.1, 1e6),
+            (2.0, 1e6),
+            (10.0, 1e6),
+        ] {
+            let (mut world, rigid) = box_on_block(integrator, mass, young);
+            let start = world.physics.bodies[rigid].translation().as_dvec3();
+            let mut highest = f64::NEG_INFINITY;
+            let run = run(&mut world, 120, |w| {
+                highest = highest.max(f64::from(w.physics.bodies[rigid].translation().y));
+            });
+            let end = world.physics.bodies[rigid].translation().as_dvec3();
+            let tolerance = energy_tolerance((mass + 1.0) * 9.81, 0.15, 0.0);
+            println!(
+                "{integrator:?}, {mass} kg on E = {young:e}: energy rise {:.2e} J (tolerance {tolerance:.1e}), refused {}/{}, highest {:+.3} mm, end {:+.3?} mm",
+                run.energy_rise,
+                run.refused_frames,
+                run.frames,
+                (highest - start.y) * 1e3,
+                (end - start) * 1e3
+            );
+            if integrator == Some(IntegratorKind::Explicit) && young >= 1e9 {
+                assert!(run.all_refused());
+                continue;
+            }
+            assert_eq!(run.refused_frames, 0);
+            assert!(run.energy_rise <= tolerance);
+            assert!(highest - start.y < 1e-3);
+            assert!((end.y - start.y).abs() < 5e-3);
+            assert!(DVec3::new(end.x - start.x, 0.0, end.z - start.z).length() < 1e-3);
+        }
+    }
+}
+
+#[test]
+fn a_ball_striking_a_soft_cube_without_restitution_never_leaves_faster_than_it_came() {
+    // A 2 cm ball of 1 g to 1 t at 3 m/s into a free 10 cm soft cube (1 kg) without gravity,
+    // restitution 0, 40 frames. Its speed away from the cube's centre of mass afterwards is at
+    // most its approach speed (the cube's elasticity may push it back, the contact adds nothing;
+    // an implicit step with the ball frozen sent it off at up to 99 m/s), and the system's
+    // energy never rises above its start (tolerance: f32 rounding). The explicit integrator must
+    // refuse the 1e9 Pa cube.
+    for integrator in INTEGRATORS {
+        for (mass, young) in [(1e-3, 1e6), (1.0, 1e6), (1e3, 1e6), (1e-3, 1e9), (1.0, 1e9)] {
+            let (run, away) = strike(integrator, mass, young);
+            let tolerance = energy_tolerance(0.0, 0.0, 0.5 * mass * 9.0);
+            println!(
+                "{integrator:?}, {mass} kg into E = {young:e}: energy rise {:.2e} J (tolerance {tolerance:.1e}), refused {}/{}, leaving at {away:.3} m/s",
+                run.energy_rise, run.refused_frames, run.frames
+            );
+            if integrator == Some(IntegratorKind::Explicit) && young >= 1e9 {
+                assert!(run.all_refused());
+                continue;
+            }
+            assert_eq!(run.refused_frames, 0);
+            assert!(run.energy_rise <= tolerance);
+            assert!(away <= 3.0);
+        }
+    }
+}
+
+#[test]
+fn a_ball_hanging_from_a_soft_rope_stretches_it_as_the_statics_says_at_every_mass_ratio() {
+    // A ball of 1e-6 to 1e6 times a 20 g rope's mass, glued to its end, released at rest; the
+    // rope's modulus is set so that the static stretch, (M + m/2) g L / (E A), is 2 mm. After
+    // 1 s the ball's drop must be that stretch within 3 % (the Neo-Hookean law at 1 % strain
+    // and the rope's lateral contraction differ from the linear estimate by about 1 %; an
+    // implicit step with the ball frozen dropped an 80 t ball 2.17 m), and the system's energy
+    // never rises above its start (tolerance: f32 rounding). The explicit integrator cannot step
+    // the stiff ropes the heavy balls need at 1/60 s: it must refuse them every frame.
+    for integrator in INTEGRATORS {
+        for ratio in [1e-6, 1e-3, 1.0, 1e3, 1e6] {
+            let (run, drop, expected) = hanging(integrator, ratio);
+            let weight = (ratio + 1.0) * 0.02 * 9.81;
+            let tolerance = energy_tolerance(weight, 0.25, 0.0);
+            println!(
+                "{integrator:?}, ratio {ratio:e}: energy rise {:.2e} J (tolerance {tolerance:.1e}), refused {}/{}, drop {:.4} mm vs {:.4} mm",
+                run.energy_rise,
+                run.refused_frames,
+                run.frames,
+                drop * 1e3,
+                expected * 1e3
+            );
+            if run.all_refused() && integrator == Some(IntegratorKind::Explicit) {
+                assert!(ratio >= 1e3, "only the stiff ropes are refused");
+                continue;
+            }
+            assert_eq!(run.refused_frames, 0);
+            assert!(run.energy_rise <= tolerance);
+            assert!((drop / expected - 1.0).abs() < 0.03);
+        }
+    }
+}
