@@ -1,7 +1,9 @@
 //! Invariants of the internal forces on random states of a distorted mesh:
 //! they sum to zero and carry no net torque (1e-12 relative), they are the negative gradient of
 //! the elastic energy (central finite differences, 1e-6 relative), the stress differential used by
-//! the Newton solver is the derivative of the stress (1e-6), and damping never adds energy.
+//! the Newton solver is the derivative of the stress (1e-6), and damping never adds energy. The
+//! derivative checks run at ν = 0.3 or 0.35 and at the auxetic ν = -0.5 and -0.99, near rest,
+//! crushed and inverted.
 
 mod common;
 
@@ -15,7 +17,18 @@ use rapier_fvm::prelude::*;
 /// A body of `mesh` (E = 1e6 Pa, ν = 0.35, damped) with its nodes moved randomly by up to
 /// `amplitude` (m) and random velocities up to 1 m/s per component.
 fn randomized(mesh: TetMesh, model: MaterialModel, seed: u64, amplitude: f64) -> DeformableBody {
-    let material = Material::new(model, 1e6, 0.35, 1000.0).unwrap();
+    randomized_at(mesh, model, 0.35, seed, amplitude)
+}
+
+/// [`randomized`] with Poisson's ratio `nu`.
+fn randomized_at(
+    mesh: TetMesh,
+    model: MaterialModel,
+    nu: f64,
+    seed: u64,
+    amplitude: f64,
+) -> DeformableBody {
+    let material = Material::new(model, 1e6, nu, 1000.0).unwrap();
     let damping = RayleighDamping::new(300.0, 200.0).unwrap();
     let mut body = DeformableBodyBuilder::new(mesh, material)
         .damping(damping)
@@ -33,9 +46,17 @@ fn randomized(mesh: TetMesh, model: MaterialModel, seed: u64, amplitude: f64) ->
 
 /// A 4 x 2 x 2-cell (80-tetrahedron) bar, randomized.
 fn random_body(model: MaterialModel, seed: u64, amplitude: f64) -> DeformableBody {
-    let mesh = mesh::cuboid(DVec3::new(0.2, 0.1, 0.1), [4, 2, 2]).unwrap();
-    randomized(mesh, model, seed, amplitude)
+    random_body_at(model, 0.35, seed, amplitude)
 }
+
+/// [`random_body`] with Poisson's ratio `nu`.
+fn random_body_at(model: MaterialModel, nu: f64, seed: u64, amplitude: f64) -> DeformableBody {
+    let mesh = mesh::cuboid(DVec3::new(0.2, 0.1, 0.1), [4, 2, 2]).unwrap();
+    randomized_at(mesh, model, nu, seed, amplitude)
+}
+
+/// Auxetic Poisson's ratios, where the stable Neo-Hookean energy has its compression term.
+const AUXETIC: [f64; 2] = [-0.5, -0.99];
 
 fn sums(body: &mut DeformableBody) -> (DVec3, DVec3, f64, f64) {
     let positions = body.positions().to_vec();
@@ -108,8 +129,9 @@ fn linear_model_forces_balance_for_rotation_free_deformation() {
 
 #[test]
 fn forces_are_the_negative_gradient_of_the_elastic_energy() {
-    for model in MODELS {
-        let mut body = random_body(model, 11, 0.01);
+    let auxetic = AUXETIC.map(|nu| (MaterialModel::StableNeoHookean, nu));
+    for (model, nu) in MODELS.map(|model| (model, 0.35)).into_iter().chain(auxetic) {
+        let mut body = random_body_at(model, nu, 11, 0.01);
         body.velocities_mut().fill(DVec3::ZERO);
         let forces = body.internal_forces().to_vec();
         let largest = forces.iter().map(|f| f.length()).fold(0.0, f64::max);
@@ -127,16 +149,20 @@ fn forces_are_the_negative_gradient_of_the_elastic_energy() {
                 worst = worst.max((finite_difference - forces[n][axis]).abs() / largest);
             }
         }
-        println!("{model:?}: worst |f + dE/dx| / max|f| = {worst:.2e}");
-        assert!(worst < 1e-6, "{model:?}: {worst:e}");
+        println!("{model:?}, ν = {nu}: worst |f + dE/dx| / max|f| = {worst:.2e}");
+        assert!(worst < 1e-6, "{model:?}, ν = {nu}: {worst:e}");
     }
 }
 
-/// Checks `first_piola_differential` against central differences of `first_piola`.
+/// Checks `first_piola_differential` against central differences of `first_piola`, near rest and
+/// crushed to 0.35 in every direction.
 fn check_differential(model: &impl HyperelasticModel, name: &str, rng: &mut Lcg) {
     let mut worst: f64 = 0.0;
-    for _ in 0..20 {
-        let f = DMat3::IDENTITY + DMat3::from_cols(rng.vector(), rng.vector(), rng.vector()) * 0.3;
+    for sample in 0..20 {
+        let size = if sample % 2 == 0 { 1.0 } else { 0.35 };
+        let f = (DMat3::IDENTITY
+            + DMat3::from_cols(rng.vector(), rng.vector(), rng.vector()) * 0.3)
+            * size;
         let df = DMat3::from_cols(rng.vector(), rng.vector(), rng.vector());
         let h = 1e-6;
         let numeric =
@@ -158,76 +184,76 @@ fn check_differential(model: &impl HyperelasticModel, name: &str, rng: &mut Lcg)
 
 #[test]
 fn stress_differentials_match_finite_differences() {
-    let lame = Material::new(MaterialModel::Linear, 1e6, 0.3, 1.0)
-        .unwrap()
-        .lame();
     let mut rng = Lcg(5);
-    check_differential(&LinearElastic(lame), "linear", &mut rng);
-    check_differential(&StVenantKirchhoff(lame), "StVK", &mut rng);
-    check_differential(&Corotated(lame), "corotated", &mut rng);
-    check_differential(&StableNeoHookean::new(lame), "stable Neo-Hookean", &mut rng);
+    for nu in [0.3].into_iter().chain(AUXETIC) {
+        let lame = Material::new(MaterialModel::Linear, 1e6, nu, 1.0)
+            .unwrap()
+            .lame();
+        let name = |model: &str| format!("{model}, ν = {nu}");
+        check_differential(&LinearElastic(lame), &name("linear"), &mut rng);
+        check_differential(&StVenantKirchhoff(lame), &name("StVK"), &mut rng);
+        check_differential(&Corotated(lame), &name("corotated"), &mut rng);
+        let neo = StableNeoHookean::new(lame);
+        check_differential(&neo, &name("stable Neo-Hookean"), &mut rng);
+    }
 }
 
 #[test]
 fn stress_is_the_derivative_of_the_energy_density() {
-    let lame = Material::new(MaterialModel::Linear, 1e6, 0.3, 1.0)
-        .unwrap()
-        .lame();
     let mut rng = Lcg(9);
-    type EnergyAndStress<'a> = &'a dyn Fn(&DMat3) -> (f64, DMat3);
-    let models: [(&str, EnergyAndStress); 4] = [
-        ("linear", &|f| {
-            (
-                LinearElastic(lame).energy_density(f),
-                LinearElastic(lame).first_piola(f),
-            )
-        }),
-        ("StVK", &|f| {
-            (
-                StVenantKirchhoff(lame).energy_density(f),
-                StVenantKirchhoff(lame).first_piola(f),
-            )
-        }),
-        ("corotated", &|f| {
-            (
-                Corotated(lame).energy_density(f),
-                Corotated(lame).first_piola(f),
-            )
-        }),
-        ("stable Neo-Hookean", &|f| {
-            let m = StableNeoHookean::new(lame);
-            (m.energy_density(f), m.first_piola(f))
-        }),
-    ];
-    for (name, model) in models {
-        // Include an inverted gradient (negative determinant): the robust models must stay smooth.
-        for flip in [1.0, -1.0] {
+    for nu in [0.3].into_iter().chain(AUXETIC) {
+        let lame = Material::new(MaterialModel::Linear, 1e6, nu, 1.0)
+            .unwrap()
+            .lame();
+        // Near rest, inverted (negative determinant: the robust models must stay smooth), and
+        // crushed to 0.35 in every direction (J about 0.04, the auxetic compression term's range).
+        for (flip, size) in [(1.0, 1.0), (-1.0, 1.0), (1.0, 0.35), (-1.0, 0.35)] {
             let f = DMat3::from_diagonal(DVec3::new(1.0, 1.0, flip))
                 * (DMat3::IDENTITY
-                    + DMat3::from_cols(rng.vector(), rng.vector(), rng.vector()) * 0.2);
-            let (_, stress) = model(&f);
-            let h = 1e-6;
-            let mut worst: f64 = 0.0;
-            for c in 0..3 {
-                for r in 0..3 {
-                    let mut plus = f;
-                    plus.col_mut(c)[r] += h;
-                    let mut minus = f;
-                    minus.col_mut(c)[r] -= h;
-                    let derivative = (model(&plus).0 - model(&minus).0) / (2.0 * h);
-                    worst = worst.max((derivative - stress.col(c)[r]).abs());
-                }
-            }
-            let scale = stress
-                .to_cols_array()
-                .iter()
-                .fold(0.0f64, |m, x| m.max(x.abs()));
-            println!(
-                "{name} (det F sign {flip}): worst |dΨ/dF - P| / max|P| = {:.2e}",
-                worst / scale
+                    + DMat3::from_cols(rng.vector(), rng.vector(), rng.vector()) * 0.2)
+                * size;
+            check_stress(
+                lame,
+                &f,
+                &format!("ν = {nu}, det F sign {flip}, size {size}"),
             );
-            assert!(worst < 1e-6 * scale, "{name}");
         }
+    }
+}
+
+/// Checks every model's `first_piola` at `f` against central differences of `energy_density`.
+fn check_stress(lame: LameParameters, f: &DMat3, case: &str) {
+    type EnergyAndStress<'a> = &'a dyn Fn(&DMat3) -> (f64, DMat3);
+    fn of(model: &impl HyperelasticModel) -> impl Fn(&DMat3) -> (f64, DMat3) + '_ {
+        |f| (model.energy_density(f), model.first_piola(f))
+    }
+    let (linear, stvk) = (LinearElastic(lame), StVenantKirchhoff(lame));
+    let (corotated, neo) = (Corotated(lame), StableNeoHookean::new(lame));
+    let models: [(&str, EnergyAndStress); 4] = [
+        ("linear", &of(&linear)),
+        ("StVK", &of(&stvk)),
+        ("corotated", &of(&corotated)),
+        ("stable Neo-Hookean", &of(&neo)),
+    ];
+    for (name, model) in models {
+        let (_, stress) = model(f);
+        let h = 1e-6;
+        let mut worst: f64 = 0.0;
+        for c in 0..3 {
+            for r in 0..3 {
+                let (mut plus, mut minus) = (*f, *f);
+                plus.col_mut(c)[r] += h;
+                minus.col_mut(c)[r] -= h;
+                let derivative = (model(&plus).0 - model(&minus).0) / (2.0 * h);
+                worst = worst.max((derivative - stress.col(c)[r]).abs());
+            }
+        }
+        let scale = largest(stress);
+        println!(
+            "{name} ({case}): worst |dΨ/dF - P| / max|P| = {:.2e}",
+            worst / scale
+        );
+        assert!(worst < 1e-6 * scale, "{name} ({case})");
     }
 }
 
@@ -239,13 +265,16 @@ fn simd_mesh_loop_matches_the_scalar_kernel() {
     // 80 tetrahedra (one chunk), 20 250 (three chunks of the parallel loop, the last block
     // padded) and a 29 184-tetrahedron ball (block-structured, renumbered in spatial order).
     // A St. Venant–Kirchhoff bar crushed and inverted in places (4 cm moves on 5 cm cells)
-    // sends blocks below its compression threshold through the lane-by-lane fallback.
+    // sends blocks below its compression threshold through the lane-by-lane fallback; auxetic
+    // stable Neo-Hookean bars, compressed in places, exercise its compression term's lanes.
     let crushed = random_body(MaterialModel::StVenantKirchhoff, 31, 0.04);
     assert!(crushed.inverted_tet_count() > 0);
+    let auxetic = AUXETIC.map(|nu| random_body_at(MaterialModel::StableNeoHookean, nu, 22, 0.02));
     let bodies = MODELS
         .map(|model| random_body(model, 21, 0.01))
         .into_iter()
         .chain([crushed])
+        .chain(auxetic)
         .chain([randomized(
             mesh::cuboid(DVec3::new(0.3, 0.3, 0.05), [27, 30, 5]).unwrap(),
             MaterialModel::StVenantKirchhoff,
@@ -327,12 +356,13 @@ fn forces_are_bit_identical_whatever_the_thread_count() {
 #[test]
 fn every_model_has_the_linear_elastic_tangent_at_rest() {
     // dP at F = I must be λ tr(dF) I + μ (dF + dFᵀ) for every model (this checks, among others,
-    // the stable Neo-Hookean's λ' = λ + μ), to round-off.
-    let lame = Material::new(MaterialModel::Linear, 1e6, 0.3, 1.0)
-        .unwrap()
-        .lame();
+    // the stable Neo-Hookean's λ' = λ + μ, and that its compression term for ν < 0 leaves the
+    // tangent at rest alone), to round-off.
     let mut rng = Lcg(17);
-    for _ in 0..10 {
+    for nu in [0.3].into_iter().chain(AUXETIC).cycle().take(12) {
+        let lame = Material::new(MaterialModel::Linear, 1e6, nu, 1.0)
+            .unwrap()
+            .lame();
         let df = DMat3::from_cols(rng.vector(), rng.vector(), rng.vector());
         let expected = LinearElastic(lame).first_piola_differential(&DMat3::IDENTITY, &df);
         let scale = expected
@@ -358,7 +388,7 @@ fn every_model_has_the_linear_elastic_tangent_at_rest() {
                 .to_cols_array()
                 .iter()
                 .fold(0.0f64, |m, x| m.max(x.abs()));
-            assert!(error < 1e-12 * scale, "{name}: {error:e}");
+            assert!(error < 1e-12 * scale, "{name}, ν = {nu}: {error:e}");
         }
     }
 }

@@ -4,7 +4,8 @@
 //! Contract of every model: a strain energy density `Ψ(F)` (J/m^3) of the deformation gradient
 //! `F = dX/dp`, its first Piola–Kirchhoff stress `P = ∂Ψ/∂F` (Pa) and the differential
 //! `dP = ∂P/∂F : dF` (Pa) used by Newton solvers. All models agree with linear elasticity
-//! `σ = λ tr(ε) I + 2 μ ε` for small strains.
+//! `σ = λ tr(ε) I + 2 μ ε` for small strains, and every model's energy is non-negative for every
+//! `F` (inverted ones included) and every admissible `ν`, zero with zero stress at rest.
 
 mod corotated;
 mod diagonal;
@@ -80,7 +81,8 @@ pub enum MaterialModel {
     Corotated,
     /// Stable Neo-Hookean (Smith, de Goes and Kim 2018, in the form of Kim and Eberle's course
     /// notes): rotation-exact, resists volume change at large strain and stays defined for inverted
-    /// elements. The most robust choice for large deformation.
+    /// elements. The most robust choice for large deformation. For `ν < 0` a compression term
+    /// keeps its energy non-negative (see [`StableNeoHookean`]).
     #[default]
     StableNeoHookean,
 }

@@ -8,11 +8,12 @@
 //! | linear | `tr(ε) = tr(F) - 3` | `μ dev(ε) : dev(ε)` |
 //! | St. Venant–Kirchhoff | `tr(G) = (‖F‖² - 3)/2` | `μ dev(G) : dev(G)` |
 //! | corotated | `tr(S) - 3`, `F = R S` | `μ dev(S - I) : dev(S - I)` |
-//! | stable Neo-Hookean | `J - 1` | `μ/2 (I_C - 3) - μ (J - 1) + μ/6 (J - 1)²` |
+//! | stable Neo-Hookean | `J - 1` | `μ/2 (I_C - 3) - μ (J - 1) + μ/6 (J - 1)² + c(J)` |
 //!
 //! In every case `m` is the volume strain to first order and `Ψ_rest` is, at small strain, the
 //! deviatoric energy `μ dev(ε) : dev(ε)` of linear elasticity, which does not resist volume
-//! change; for the linear and corotated models it is non-negative at any strain. St.
+//! change (the stable Neo-Hookean compression term `c(J)` of `ν < 0`, see [`StableNeoHookean`], is
+//! of third order); for the linear and corotated models it is non-negative at any strain. St.
 //! Venant–Kirchhoff's `Ψ_rest` is `Ψ - K/2 tr(G)²`, with `Ψ` its inversion-safe energy: beyond its
 //! compression threshold (see [`StVenantKirchhoff`]) that continued energy and the raw `tr(G)`
 //! part differ, so with nodal averaging its resistance to inversion comes from `Ψ_rest` alone and
@@ -131,7 +132,9 @@ impl VolumetricTerm for StableNeoHookean {
     }
 
     fn energy_density_without_volumetric(&self, f: &DMat3) -> f64 {
-        self.shear_energy_density(f) + self.mu / 6.0 * self.volume_change(f).powi(2)
+        let x = self.volume_change(f);
+        let energy = self.shear_energy_density(f) + self.mu / 6.0 * x.powi(2);
+        self.compression(x).map_or(energy, |c| energy + c[0])
     }
 }
 

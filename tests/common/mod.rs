@@ -106,38 +106,44 @@ pub const OBJECTIVE_MODELS: [MaterialModel; 3] = [
     MaterialModel::StableNeoHookean,
 ];
 
-/// Vertical tip deflection (m) of an inextensible, shear-rigid cantilever under its own weight at
-/// any rotation (the elastica): `EI θ'' = -q (L - s) cos θ`, `θ(0) = 0`, `θ'(L) = 0`, solved by
-/// shooting on `θ'(0)` with fourth-order Runge–Kutta (2000 steps) and bisection.
-pub fn elastica_tip_deflection(young_modulus: f64) -> f64 {
-    let load = DENSITY * SIDE * SIDE * GRAVITY / (young_modulus * second_moment());
-    let steps = 2000;
-    let ds = LENGTH / steps as f64;
+/// Vertical tip deflection (m) of an inextensible, shear-rigid cantilever of `length` (m) under
+/// its own weight at any rotation (the elastica), given its weight per length over its bending
+/// stiffness, `load = q / (E I)` (1/m³): along the arc length `s`, `θ'' = -load (L - s) cos θ`
+/// with `θ(0) = 0` (clamped) and `θ'(L) = 0` (free end), and the deflection `y' = sin θ`. Solved by
+/// shooting on `θ'(0)`, integrating `(θ, θ', y)` with fourth-order Runge–Kutta in 2000 steps,
+/// and bisecting on the sign of `θ'(L)`.
+pub fn elastica_tip_deflection(load: f64, length: f64) -> f64 {
+    elastica_tip_deflection_in(load, length, 2000)
+}
+
+/// [`elastica_tip_deflection`] with `steps` Runge–Kutta steps.
+pub fn elastica_tip_deflection_in(load: f64, length: f64, steps: usize) -> f64 {
+    let ds = length / steps as f64;
+    // The state (θ, θ', y) and its rate at arc length `s`.
+    let rate = |s: f64, [theta, curvature, _]: [f64; 3]| {
+        [curvature, -load * (length - s) * theta.cos(), theta.sin()]
+    };
+    let step = |s: f64, state: [f64; 3], k: [f64; 3], h: f64| {
+        rate(s, std::array::from_fn(|i| state[i] + h * k[i]))
+    };
     // Integrates from the clamp with curvature `k0`; returns (θ'(L), tip deflection).
     let shoot = |k0: f64| {
-        let rhs = |s: f64, theta: f64| -load * (LENGTH - s) * theta.cos();
-        let (mut theta, mut kappa, mut deflection) = (0.0f64, k0, 0.0);
+        let mut state = [0.0, k0, 0.0];
         for i in 0..steps {
             let s = i as f64 * ds;
-            let (t1, k1) = (kappa, rhs(s, theta));
-            let (t2, k2) = (
-                kappa + 0.5 * ds * k1,
-                rhs(s + 0.5 * ds, theta + 0.5 * ds * t1),
-            );
-            let (t3, k3) = (
-                kappa + 0.5 * ds * k2,
-                rhs(s + 0.5 * ds, theta + 0.5 * ds * t2),
-            );
-            let (t4, k4) = (kappa + ds * k3, rhs(s + ds, theta + ds * t3));
-            let next_theta = theta + ds / 6.0 * (t1 + 2.0 * t2 + 2.0 * t3 + t4);
-            deflection += 0.5 * ds * (theta.sin() + next_theta.sin());
-            theta = next_theta;
-            kappa += ds / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+            let k1 = rate(s, state);
+            let k2 = step(s + 0.5 * ds, state, k1, 0.5 * ds);
+            let k3 = step(s + 0.5 * ds, state, k2, 0.5 * ds);
+            let k4 = step(s + ds, state, k3, ds);
+            state = std::array::from_fn(|j| {
+                state[j] + ds / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j])
+            });
         }
-        (kappa, deflection)
+        (state[1], state[2])
     };
-    // θ'(L) grows with θ'(0) = k0 from negative (k0 = 0) to positive (k0 = q L² / 2 + margin).
-    let (mut low, mut high) = (0.0, load * LENGTH * LENGTH);
+    // θ'(L) grows with θ'(0) = k0 from negative (k0 = 0) to positive (k0 = load L², twice the
+    // largest clamp curvature load L²/2).
+    let (mut low, mut high) = (0.0, load * length * length);
     for _ in 0..100 {
         let mid = 0.5 * (low + high);
         if shoot(mid).0 < 0.0 {

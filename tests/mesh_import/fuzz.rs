@@ -2,13 +2,15 @@
 //! of their headers must give a mesh or a typed error, never a panic.
 
 use super::bytes;
+use super::file_numbers::assert_mesh_is_the_files;
 use proptest::prelude::*;
 use rapier_fvm::FileLocation;
-use rapier_fvm::mesh::import::{RawMesh, SurfaceOptions, gmsh, surface, tetgen, vtk};
+use rapier_fvm::mesh::import::{SurfaceOptions, gmsh, surface, tetgen, vtk};
 use rapier_fvm::prelude::*;
 
 // Fuzzing: arbitrary bytes and mutations of the valid files, for every reader. Each must
-// return Ok or a typed error, never panic (a panic fails the test). The number of executions
+// return Ok or a typed error, never panic (a panic fails the test); a mesh must be the file's
+// (its tetrahedra, nodes and volume, see `file_numbers`). The number of executions
 // is `cases` of each property below; the total is printed by `fuzz_execution_count`.
 
 /// Cases per fuzz property.
@@ -26,8 +28,9 @@ fn run_reader(reader: usize, data: &[u8]) {
         _ => located(surface::parse_stl(data, "fuzz.stl", 1.0))
             .and_then(|s| surface::fill(&s, &SurfaceOptions { cells_across: 4 })),
     };
-    match result.and_then(RawMesh::into_mesh) {
-        Ok(mesh) => assert!(mesh.tet_count() > 0),
+    let outcome = result.and_then(|raw| Ok((raw.clone(), raw.into_mesh()?)));
+    match outcome {
+        Ok((raw, mesh)) => assert_mesh_is_the_files(&raw, &mesh),
         Err(Error::MeshImport { .. } | Error::InvalidSetting { .. }) => {}
         Err(other) => panic!("untyped import error {other:?}"),
     }

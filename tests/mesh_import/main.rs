@@ -1,12 +1,13 @@
 //! Mesh import: each format read from real files (written by gmsh and meshio, see
-//! `tools/make_test_meshes.py`) against closed-form values, the formats against each other,
-//! typed errors for malformed files, and fuzzing of every reader.
+//! `tools/make_test_meshes.py`) against closed-form values, the formats against each other and
+//! the files' own numbers, typed errors for malformed files, and fuzzing of every reader.
 
 use rapier_fvm::mesh::import::{self, RawMesh, SurfaceOptions, gmsh, tetgen, vtk};
 use rapier_fvm::prelude::*;
 use rapier_fvm::{FileLocation, ImportErrorKind};
 use std::path::PathBuf;
 
+mod file_numbers;
 mod filling;
 mod fuzz;
 mod malformed;
