@@ -442,6 +442,23 @@ pub(crate) fn factorize(
     Llt::try_new_with_symbolic(symbolic, stiffness.as_faer(), Side::Lower).map_err(|_| indefinite)
 }
 
+/// Solves `K u_k = rhs_k` for every column `rhs_k` (per-node vectors) in one pass over the
+/// factor.
+pub(crate) fn solve_columns(factor: &Llt<usize, f64>, columns: &[Vec<DVec3>]) -> Vec<Vec<DVec3>> {
+    let Some(n) = columns.first().map(Vec::len) else {
+        return Vec::new();
+    };
+    let mut x = faer::Mat::<f64>::from_fn(3 * n, columns.len(), |i, k| columns[k][i / 3][i % 3]);
+    factor.solve_in_place(x.as_mut());
+    (0..columns.len())
+        .map(|k| {
+            (0..n)
+                .map(|a| DVec3::new(x[(3 * a, k)], x[(3 * a + 1, k)], x[(3 * a + 2, k)]))
+                .collect()
+        })
+        .collect()
+}
+
 /// Solves `K u = rhs` for per-node vectors.
 pub(crate) fn solve(factor: &Llt<usize, f64>, rhs: &[DVec3]) -> Vec<DVec3> {
     let mut x = Col::<f64>::from_fn(3 * rhs.len(), |i| rhs[i / 3][i % 3]);

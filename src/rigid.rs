@@ -137,8 +137,13 @@ impl RigidProxy {
     /// over the trace of its inverse effective mass there; infinite for a body contact impulses
     /// do not move.
     pub(crate) fn least_effective_mass(&self, point: DVec3) -> f64 {
-        let w = self.inverse_mass_matrix(point);
-        (w.x_axis.x + w.y_axis.y + w.z_axis.z).recip()
+        // tr(diag(1/m) − [r]× I⁻¹ [r]×) = Σ 1/m + |r|² tr(I⁻¹) − rᵀ I⁻¹ r.
+        let r = point - self.com;
+        let i = &self.inv_inertia;
+        let trace = self.inv_mass.element_sum()
+            + r.length_squared() * (i.x_axis.x + i.y_axis.y + i.z_axis.z)
+            - r.dot(*i * r);
+        trace.recip()
     }
 
     /// The 3 x 3 inverse effective mass (1/kg) of the body at `point` (m): the change of the

@@ -23,7 +23,7 @@ mod rigid_response;
 
 use super::{PreviousStep, SolverWorkspace};
 use crate::Error;
-use crate::assembly::{Stiffness, solve};
+use crate::assembly::Stiffness;
 use crate::body::DeformableBody;
 use crate::chord::{self, Chord};
 use crate::constraint::{self, BodyConstraints};
@@ -388,12 +388,10 @@ impl ImplicitIntegrator {
                 })
                 .flatten();
             let (direction, search) = match reusable {
-                Some(factor) => {
-                    let direction = solve(factor, &residual);
-                    let direction =
-                        incremental.take_in_rigid_response(body, factor, &residual, direction);
-                    (direction, Search::Short)
-                }
+                Some(factor) => (
+                    incremental.reused_direction(body, factor, &residual),
+                    Search::Short,
+                ),
                 None => (
                     self.exact_direction(
                         body,
@@ -499,7 +497,8 @@ impl ImplicitIntegrator {
         }
         let mut direction = solution.direction;
         if let Some(factor) = &solution.factor {
-            direction = incremental.take_in_rigid_response(body, factor, residual, direction);
+            direction =
+                incremental.take_in_rigid_response(body, (factor, false), residual, direction);
         }
         if let Some(factor) = solution.factor
             && self.reuse_factorization

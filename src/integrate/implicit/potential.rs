@@ -8,7 +8,7 @@
 
 use super::ImplicitScheme;
 use super::rigid_response::RigidResponse;
-use crate::assembly::Stiffness;
+use crate::assembly::{Stiffness, solve};
 use crate::body::DeformableBody;
 use crate::constraint::{self, BodyConstraints};
 use crate::damping::RayleighDamping;
@@ -238,12 +238,25 @@ impl Potential<'_> {
         constraint::add_implicit_tangents(body, self.constraints, rigid.step(), stiffness);
     }
 
-    /// The Newton direction `direction` (m per node), solved with `factor`, with the rigid
-    /// bodies' response taken in (see [`RigidResponse::take_in`]).
-    pub(super) fn take_in_rigid_response(
+    /// The Newton direction (m per node) for `residual` (N) solved with `factor`, an earlier
+    /// iteration's, with the rigid bodies' response taken in.
+    pub(super) fn reused_direction(
         &self,
         body: &DeformableBody,
         factor: &Llt<usize, f64>,
+        residual: &[DVec3],
+    ) -> Vec<DVec3> {
+        let direction = solve(factor, residual);
+        self.take_in_rigid_response(body, (factor, true), residual, direction)
+    }
+
+    /// The Newton direction `direction` (m per node), solved with `factor` (the one of the last
+    /// call if `true`), with the rigid bodies' response taken in (see
+    /// [`RigidResponse::take_in`]).
+    pub(super) fn take_in_rigid_response(
+        &self,
+        body: &DeformableBody,
+        factor: (&Llt<usize, f64>, bool),
         residual: &[DVec3],
         direction: Vec<DVec3>,
     ) -> Vec<DVec3> {

@@ -20,23 +20,28 @@
 //! per body). At `ι*`, `ι = −h Σ J_cᵀ f_c`: exactly the opposite of the impulses the terms give
 //! the soft body, which is what the bodies receive when the step's impulses are recorded.
 
-use crate::assembly::solve;
+use crate::assembly::solve_columns;
 use crate::body::DeformableBody;
 use crate::constraint::{self, BodyConstraints, ImplicitTerm};
 use crate::contact::ImplicitStep;
 use crate::rigid::RigidProxy;
 use faer::sparse::linalg::solvers::Llt;
 use rapier3d::glamx::{DMat3, DVec3};
-use rapier3d::na::{DMatrix, DVector, Matrix3, Matrix3x6, Matrix6, Vector3, Vector6};
+use rapier3d::na::{DMatrix, DVector, Matrix3, Matrix6, Vector6};
 
 /// Newton iterations (line-search halvings included) of one body-response solve at most.
 const MAX_ITERATIONS: usize = 60;
 /// The response is solved when its stationarity residual is below this fraction of the impulses'
-/// scale.
-const TOLERANCE: f64 = 1e-11;
+/// scale, or below [`FLOOR`] of it when a Newton iteration no longer halves it (its round-off
+/// floor, about 1e-11 of the scale for the stiffest springs).
+const TOLERANCE: f64 = 1e-12;
+const FLOOR: f64 = 1e-8;
 /// The line search's sufficient decrease (Armijo) fraction and smallest step.
 const ARMIJO: f64 = 1e-4;
 const MIN_STEP: f64 = 1e-6;
+
+/// Columns of per-node vectors (a tall matrix, one `Vec` per column).
+type Columns = Vec<Vec<DVec3>>;
 
 /// The rigid bodies' response within one implicit substep.
 pub(super) struct RigidResponse {
@@ -51,37 +56,72 @@ pub(super) struct RigidResponse {
     kinetic: f64,
     /// Whether some term acts against a dynamic body (none: nothing to solve).
     coupled: bool,
+    /// The last Newton direction's columns of `U` and `Z = K⁻¹ U` (see
+    /// [`RigidResponse::take_in`]).
+    solved_columns: Option<(Columns, Columns)>,
     /// The effective step `ĥ` and the step's length `h` (s).
     effective: f64,
     length: f64,
 }
 
-/// What the terms against one body add up to at the trial velocities.
+/// What the terms against one body add up to at the trial velocities, in 3 x 3 blocks (linear
+/// part first, then angular).
 #[derive(Clone, Copy)]
 struct Gathered {
-    /// `Σ J_cᵀ f_c` (N, N m).
-    force: Vector6<f64>,
-    /// `A = Σ J_cᵀ T_c J_c` (N/m in the body's coordinates).
-    stiffness: Matrix6<f64>,
+    /// `Σ J_cᵀ f_c`: the force (N) and its moment about the centre of mass (N m).
+    force: [DVec3; 2],
+    /// `A = Σ J_cᵀ T_c J_c` (N/m, N, N m).
+    stiffness: [[DMat3; 2]; 2],
     /// `Σ |f_c|` (N): the scale of the force.
     magnitude: f64,
+}
+
+/// `[r]×`, the matrix of `v ↦ r × v`.
+fn cross_matrix(r: DVec3) -> DMat3 {
+    DMat3::from_cols(
+        DVec3::new(0.0, r.z, -r.y),
+        DVec3::new(-r.z, 0.0, r.x),
+        DVec3::new(r.y, -r.x, 0.0),
+    )
 }
 
 impl Gathered {
     fn zero() -> Self {
         Self {
-            force: Vector6::zeros(),
-            stiffness: Matrix6::zeros(),
+            force: [DVec3::ZERO; 2],
+            stiffness: [[DMat3::ZERO; 2]; 2],
             magnitude: 0.0,
         }
     }
 
-    /// Adds `term`, whose point moves with the body by `j`.
-    fn add(&mut self, term: &ImplicitTerm, j: &Matrix3x6<f64>) {
-        let f = term.force;
-        self.force += j.transpose() * Vector3::new(f.x, f.y, f.z);
-        self.stiffness += j.transpose() * matrix(&term.tangent) * j;
-        self.magnitude += f.length();
+    /// Adds `term`, whose point is at `arm` (m) from the body's centre of mass: with
+    /// `J = [I | −[r]×]`, `Jᵀ f = (f, r × f)` and `Jᵀ T J` has the blocks `T`, `−T [r]×`,
+    /// `[r]× T` and `−[r]× T [r]×`.
+    fn add(&mut self, term: &ImplicitTerm, arm: DVec3) {
+        let (t, c) = (term.tangent, cross_matrix(arm));
+        self.force[0] += term.force;
+        self.force[1] += arm.cross(term.force);
+        let tc = t * c;
+        self.stiffness[0][0] += t;
+        self.stiffness[0][1] -= tc;
+        self.stiffness[1][0] += c * t;
+        self.stiffness[1][1] -= c * tc;
+        self.magnitude += term.force.length();
+    }
+
+    fn force(&self) -> Vector6<f64> {
+        vector6(self.force)
+    }
+
+    fn stiffness(&self) -> Matrix6<f64> {
+        let mut a = Matrix6::zeros();
+        for (i, row) in self.stiffness.iter().enumerate() {
+            for (j, block) in row.iter().enumerate() {
+                a.fixed_view_mut::<3, 3>(3 * i, 3 * j)
+                    .copy_from(&matrix(block));
+            }
+        }
+        a
     }
 }
 
@@ -101,16 +141,6 @@ fn vector6(v: [DVec3; 2]) -> Vector6<f64> {
 
 fn pair(v: &Vector6<f64>) -> [DVec3; 2] {
     [DVec3::new(v[0], v[1], v[2]), DVec3::new(v[3], v[4], v[5])]
-}
-
-/// `J = [I | −[r]×]` (3 x 6): how a point at arm `r` (m) moves with the body's translation and
-/// rotation.
-fn jacobian(arm: DVec3) -> Matrix3x6<f64> {
-    let mut j = Matrix3x6::zeros();
-    j.fixed_view_mut::<3, 3>(0, 0).fill_with_identity();
-    let cross = Matrix3::new(0.0, -arm.z, arm.y, arm.z, 0.0, -arm.x, -arm.y, arm.x, 0.0);
-    j.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-cross));
-    j
 }
 
 /// The body's `W` (6 x 6): inverse mass per axis and world inverse inertia.
@@ -134,6 +164,7 @@ impl RigidResponse {
             base,
             solved_at: Vec::new(),
             kinetic: 0.0,
+            solved_columns: None,
             effective,
             length,
         }
@@ -164,12 +195,18 @@ impl RigidResponse {
             return self.kinetic;
         }
         let mut at = self.evaluate(body, constraints);
+        let mut previous = f64::INFINITY;
         for _ in 0..MAX_ITERATIONS {
             let residuals = self.residuals(&at.gathered);
             let largest = residuals.iter().map(|r| r.norm()).fold(0.0, f64::max);
-            if largest <= TOLERANCE * self.scale(&at.gathered) {
+            // Solved, or on its round-off floor: small, and Newton no longer halves it.
+            let scale = self.scale(&at.gathered);
+            if largest <= TOLERANCE * scale
+                || (largest <= FLOOR * scale && largest > 0.5 * previous)
+            {
                 break;
             }
+            previous = largest;
             let directions = self.newton_directions(&at.gathered, &residuals);
             // The directional derivative of the response's energy, whose gradient is `W G`.
             let slope: f64 = (0..self.base.len())
@@ -241,9 +278,9 @@ impl RigidResponse {
         constraint::for_each_implicit_term(body, constraints, self.step(), &mut |term| {
             if let Some(partner) = term.partner {
                 energy += term.energy;
-                let j = jacobian(partner.point - self.base[partner.proxy].center_of_mass());
+                let arm = partner.point - self.base[partner.proxy].center_of_mass();
                 let sum = gathered[partner.proxy].get_or_insert_with(Gathered::zero);
-                sum.add(&term, &j);
+                sum.add(&term, arm);
             }
         });
         Evaluation { energy, gathered }
@@ -253,7 +290,7 @@ impl RigidResponse {
     fn residuals(&self, gathered: &[Option<Gathered>]) -> Vec<Vector6<f64>> {
         (0..self.base.len())
             .map(|p| {
-                let force = gathered[p].map_or(Vector6::zeros(), |g| g.force);
+                let force = gathered[p].map_or(Vector6::zeros(), |g| g.force());
                 vector6(self.impulses[p]) + force * self.length
             })
             .collect()
@@ -278,7 +315,7 @@ impl RigidResponse {
         let h2 = self.length * self.length;
         (0..self.base.len())
             .map(|p| {
-                let stiffness = gathered[p].map_or(Matrix6::zeros(), |g| g.stiffness);
+                let stiffness = gathered[p].map_or(Matrix6::zeros(), |g| g.stiffness());
                 let system = Matrix6::identity() + stiffness * inverse_mass(&self.base[p]) * h2;
                 system
                     .lu()
@@ -295,11 +332,14 @@ impl RigidResponse {
     /// the bodies held; this returns `(K − U Q Uᵀ)⁻¹ r` by the Woodbury identity,
     /// `d + Z (I − Q Uᵀ Z)⁻¹ Q Uᵀ d` with `Z = K⁻¹ U`, or `direction` itself when no term acts
     /// against a dynamic body or the result would not descend.
+    ///
+    /// `Z` is kept for the next call: when that one solves with the same factorization
+    /// (`same_factor`, a reused one) and finds the same `U`, it skips the solves.
     pub(super) fn take_in(
-        &self,
+        &mut self,
         body: &DeformableBody,
         constraints: &BodyConstraints,
-        factor: &Llt<usize, f64>,
+        (factor, same_factor): (&Llt<usize, f64>, bool),
         residual: &[DVec3],
         direction: Vec<DVec3>,
     ) -> Vec<DVec3> {
@@ -312,13 +352,17 @@ impl RigidResponse {
         }
         let dot =
             |a: &[DVec3], b: &[DVec3]| -> f64 { a.iter().zip(b).map(|(x, y)| x.dot(*y)).sum() };
-        let solved: Vec<Vec<DVec3>> = coupling.columns.iter().map(|u| solve(factor, u)).collect();
+        let solved = match self.solved_columns.take() {
+            Some((columns, solved)) if same_factor && columns == coupling.columns => solved,
+            _ => solve_columns(factor, &coupling.columns),
+        };
         let m = coupling.columns.len();
         let q = self.compliance(&coupling);
         let u_z = DMatrix::from_fn(m, m, |i, j| dot(&coupling.columns[i], &solved[j]));
         let u_d = DVector::from_fn(m, |i, _| dot(&coupling.columns[i], &direction));
         let system = DMatrix::identity(m, m) - &q * u_z;
         let Some(weights) = system.lu().solve(&(&q * u_d)) else {
+            self.solved_columns = Some((coupling.columns, solved));
             return direction;
         };
         let mut taken = direction.clone();
@@ -327,6 +371,7 @@ impl RigidResponse {
                 *d += *z * *weight;
             }
         }
+        self.solved_columns = Some((coupling.columns, solved));
         let finite = taken.iter().all(|d| d.is_finite());
         if finite && dot(residual, &taken) > 0.0 {
             taken
@@ -349,24 +394,29 @@ impl RigidResponse {
                 return;
             };
             let slot = *slot_of[partner.proxy].get_or_insert_with(|| {
-                coupling.bodies.push((partner.proxy, Matrix6::zeros()));
+                coupling.bodies.push((partner.proxy, Gathered::zero()));
                 coupling
                     .columns
                     .extend(std::iter::repeat_with(|| vec![DVec3::ZERO; n]).take(6));
                 coupling.bodies.len() - 1
             });
-            let j = jacobian(partner.point - self.base[partner.proxy].center_of_mass());
-            let t = matrix(&term.tangent);
-            coupling.bodies[slot].1 += j.transpose() * t * j;
-            let block = -(t * j);
+            let arm = partner.point - self.base[partner.proxy].center_of_mass();
+            coupling.bodies[slot].1.add(&term, arm);
+            // −T J = [−T | T [r]×], column by column.
+            let tc = term.tangent * cross_matrix(arm);
+            let block: [DVec3; 6] = std::array::from_fn(|k| {
+                if k < 3 {
+                    -term.tangent.col(k)
+                } else {
+                    tc.col(k - 3)
+                }
+            });
             for (&node, &w) in term.at.nodes.iter().zip(term.at.weights) {
                 if body.pinned[node as usize] {
                     continue;
                 }
-                for k in 0..6 {
-                    let c = block.column(k);
-                    coupling.columns[6 * slot + k][node as usize] +=
-                        DVec3::new(c[0], c[1], c[2]) * w;
+                for (k, column) in block.iter().enumerate() {
+                    coupling.columns[6 * slot + k][node as usize] += *column * w;
                 }
             }
         });
@@ -379,9 +429,9 @@ impl RigidResponse {
         let m = coupling.columns.len();
         let h2 = self.length * self.length;
         let mut q = DMatrix::zeros(m, m);
-        for (slot, (proxy, stiffness)) in coupling.bodies.iter().enumerate() {
+        for (slot, (proxy, gathered)) in coupling.bodies.iter().enumerate() {
             let w = inverse_mass(&self.base[*proxy]);
-            let system = Matrix6::identity() + w * stiffness * h2;
+            let system = Matrix6::identity() + w * gathered.stiffness() * h2;
             if let Some(block) = system.lu().solve(&(w * h2)) {
                 q.view_mut((6 * slot, 6 * slot), (6, 6)).copy_from(&block);
             }
@@ -391,8 +441,9 @@ impl RigidResponse {
 }
 
 /// How the soft body's nodes couple through the dynamic bodies: per body its index among the
-/// proxies and its `A` (N/m), and the columns of `U` (N/m per node), six per body.
+/// proxies and what its terms add up to (its `A`), and the columns of `U` (N/m per node), six per
+/// body.
 struct Coupling {
-    bodies: Vec<(usize, Matrix6<f64>)>,
-    columns: Vec<Vec<DVec3>>,
+    bodies: Vec<(usize, Gathered)>,
+    columns: Columns,
 }
