@@ -43,6 +43,9 @@ pub enum ImportErrorKind {
     IndexOutOfRange,
     /// A number is NaN or infinite, or becomes infinite once scaled.
     NonFinite,
+    /// A coordinate is finite but lies beyond ±[`MAX_COORDINATE`](crate::mesh::MAX_COORDINATE)
+    /// m once scaled.
+    CoordinateOutOfRange,
     /// An element type that cannot be used: quadratic tetrahedra, or volume elements other than
     /// tetrahedra (hexahedra, prisms, pyramids) mixed in.
     UnsupportedElement,
@@ -73,6 +76,18 @@ pub enum Error {
     /// A node coordinate is NaN or infinite.
     #[error("node {node} has a non-finite coordinate {position:?}")]
     NonFiniteCoordinate {
+        /// Index of the offending node.
+        node: usize,
+        /// Its coordinates (m).
+        position: [f64; 3],
+    },
+    /// A node coordinate is finite but beyond ±[`MAX_COORDINATE`](crate::mesh::MAX_COORDINATE)
+    /// (m), where the products of coordinates the element computations form overflow.
+    #[error(
+        "node {node} at {position:?} m lies beyond ±{max:e} m, where the element computations overflow",
+        max = crate::mesh::MAX_COORDINATE
+    )]
+    CoordinateOutOfRange {
         /// Index of the offending node.
         node: usize,
         /// Its coordinates (m).
@@ -145,6 +160,18 @@ pub enum Error {
         /// Its signed rest volume (m^3).
         volume: f64,
     },
+    /// A tetrahedron is too small for `f64`: the smallest volume it may have before counting as
+    /// degenerate, `1e-12 l³` with `l` its longest edge, is not a normal number (`l` below about
+    /// `3e-99` m), so its volume and everything computed from it would lose their precision.
+    #[error(
+        "tetrahedron {tet} is too small for f64: its longest edge is {longest_edge:e} m, and volumes at that scale are denormal numbers"
+    )]
+    TetTooSmall {
+        /// Index of the offending tetrahedron.
+        tet: usize,
+        /// Its longest edge (m).
+        longest_edge: f64,
+    },
     /// A tetrahedron has negative rest volume (its nodes are ordered clockwise).
     /// [`TetMesh::new_reoriented`](crate::mesh::TetMesh::new_reoriented) fixes the ordering.
     #[error(
@@ -177,6 +204,43 @@ pub enum Error {
         /// Number of nodes in the body.
         node_count: usize,
     },
+    /// A list of nodal values (positions, velocities) given to a body has the wrong length.
+    #[error("{given} values were given for a body of {node_count} nodes")]
+    WrongNodeCount {
+        /// Number of values given.
+        given: usize,
+        /// Number of nodes in the body.
+        node_count: usize,
+    },
+    /// A node velocity given to a body, or found on it before a step, is NaN or infinite.
+    #[error("node {node} has a non-finite velocity {velocity:?} m/s")]
+    NonFiniteVelocity {
+        /// Index of the offending node.
+        node: usize,
+        /// Its velocity (m/s).
+        velocity: [f64; 3],
+    },
+    /// A node speed given to a body, or found on it before a step, exceeds the speed of light
+    /// ([`SPEED_OF_LIGHT`](crate::body::SPEED_OF_LIGHT)): no state of the Newtonian mechanics
+    /// the step integrates.
+    #[error(
+        "node {node} moves at {speed:e} m/s, faster than light ({c} m/s): beyond the Newtonian mechanics the step integrates",
+        c = crate::body::SPEED_OF_LIGHT
+    )]
+    SpeedOutOfRange {
+        /// Index of the offending node.
+        node: usize,
+        /// Its speed (m/s).
+        speed: f64,
+    },
+    /// A non-zero velocity was given to a pinned node, which the integrators hold at rest.
+    #[error("node {node} is pinned: its velocity is held at zero, not {velocity:?} m/s")]
+    PinnedNodeVelocity {
+        /// Index of the pinned node.
+        node: usize,
+        /// The velocity given (m/s).
+        velocity: [f64; 3],
+    },
     /// A rigid body handle given to a soft body (attachment) is not in the rigid-body set.
     #[error("the rigid body is not in the rigid-body set")]
     UnknownRigidBody,
@@ -192,6 +256,15 @@ pub enum Error {
         value: f64,
         /// What it must satisfy.
         reason: &'static str,
+    },
+    /// The memory for a mesh cannot be had: the allocator refused it (a generator asked for
+    /// more cells than the machine holds).
+    #[error("cannot allocate {bytes} bytes for {what}")]
+    AllocationFailed {
+        /// What the memory was for.
+        what: &'static str,
+        /// The bytes asked for.
+        bytes: u64,
     },
     /// A material or damping constant is outside its physical range.
     #[error("invalid material parameter `{parameter}` = {value}: {reason}")]

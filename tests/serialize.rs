@@ -124,7 +124,7 @@ fn a_file_breaking_a_bodys_rules_is_refused_with_a_typed_error() {
                     .expect("velocities are a list")
                     .pop();
             }),
-            "one entry per node",
+            "63 values were given for a body of 64 nodes",
         ),
         (
             "a pinned node beyond the mesh",

@@ -1,13 +1,13 @@
 //! [`DeformableBodyBuilder`]: the rapier-style way to describe a soft body before creating it.
 
-use super::{BodySurface, DeformableBody, lumped_masses};
+use super::{BodySurface, DeformableBody, SPEED_OF_LIGHT, lumped_masses};
 use crate::Error;
 use crate::damping::RayleighDamping;
 use crate::element::{ElementShape, Elements, PressureBasis, QuadraticElements};
 use crate::embedding::Embedding;
 use crate::fvm::{FvmMesh, NodalAveraging, VolumetricTreatment};
 use crate::material::Material;
-use crate::mesh::{QuadraticHexMesh, QuadraticTetMesh, SUB_TETS, TetMesh};
+use crate::mesh::{QuadraticHexMesh, QuadraticTetMesh, SUB_TETS, TetMesh, check_position};
 use rapier3d::dynamics::CoefficientCombineRule;
 use rapier3d::geometry::InteractionGroups;
 use rapier3d::glamx::{DQuat, DVec3};
@@ -343,13 +343,16 @@ impl DeformableBodyBuilder {
     /// # Errors
     /// [`Error::NodeOutOfRange`] for a pinned node that does not exist;
     /// [`Error::NonFiniteInput`] for a non-finite velocity or translation or a zero rotation;
+    /// [`Error::CoordinateOutOfRange`] naming the first node the placement puts beyond
+    /// ±[`MAX_COORDINATE`](crate::mesh::MAX_COORDINATE);
     /// [`Error::SliverTet`] for a tetrahedron below the minimum quality (of the subdivision, for
     /// quadratic elements); [`Error::InvertedTet`] for a quadratic element whose rest map folds;
     /// [`Error::UnsupportedOption`] for nodal averaging on quadratic elements;
     /// [`Error::OutsideSimulationMesh`] naming a vertex of the embedded mesh that no element
     /// carries;
-    /// [`Error::InvalidSetting`] for a minimum quality outside `[0, 1)` or a negative or
-    /// non-finite friction or restitution.
+    /// [`Error::InvalidSetting`] for a minimum quality outside `[0, 1)`, a negative or
+    /// non-finite friction or restitution, or a velocity faster than
+    /// [`SPEED_OF_LIGHT`](crate::body::SPEED_OF_LIGHT).
     pub fn build(self) -> Result<DeformableBody, Error> {
         self.check_settings()?;
         let pinned = self.pinned_flags()?;
@@ -453,13 +456,24 @@ impl DeformableBodyBuilder {
                 return Err(Error::NonFiniteInput { parameter });
             }
         }
+        let speed = self.linvel.length();
+        if speed > SPEED_OF_LIGHT {
+            return Err(Error::InvalidSetting {
+                parameter: "linvel",
+                value: speed,
+                reason: "no node may move faster than light (299792458 m/s)",
+            });
+        }
         let rotation = self.rotation.normalize();
-        let positions = self
+        let positions: Vec<DVec3> = self
             .mesh
             .positions()
             .iter()
             .map(|p| rotation * *p + self.translation)
             .collect();
+        for (node, &position) in positions.iter().enumerate() {
+            check_position(node, position)?;
+        }
         let velocities = pinned
             .iter()
             .map(|&pinned| if pinned { DVec3::ZERO } else { self.linvel })

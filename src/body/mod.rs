@@ -1,15 +1,19 @@
 //! Soft bodies: a mesh, a material, and the state that moves: nodal positions (m), velocities
-//! (m/s) and lumped masses (kg), plus pinned (Dirichlet) nodes.
+//! (m/s) and lumped masses (kg), plus pinned (Dirichlet) nodes. The state is set through checked
+//! setters ([`DeformableBody::set_positions`], [`DeformableBody::set_node_velocity`], ...) or
+//! raw slices; a step refuses a state it cannot take ([`DeformableBody::check_state`]).
 
 mod builder;
 #[cfg(feature = "serde-serialize")]
 mod record;
 mod set;
+mod state;
 mod stress;
 mod surface;
 
 pub use builder::{DEFAULT_FRICTION, DEFAULT_MIN_ELEMENT_QUALITY, DeformableBodyBuilder};
 pub use set::{DeformableBodyHandle, DeformableBodySet};
+pub use state::SPEED_OF_LIGHT;
 pub(crate) use surface::BodySurface;
 
 use crate::damping::RayleighDamping;
@@ -145,7 +149,10 @@ impl DeformableBody {
         &self.positions
     }
 
-    /// Mutable world positions of the nodes (m). Editing the state restarts two-step integrators.
+    /// Mutable world positions of the nodes (m), unchecked: a step refuses a body left with a
+    /// position NaN, infinite or beyond ±[`MAX_COORDINATE`](crate::mesh::MAX_COORDINATE) (see
+    /// [`DeformableBody::check_state`]); [`DeformableBody::set_positions`] refuses it at once.
+    /// Editing the state restarts two-step integrators.
     pub fn positions_mut(&mut self) -> &mut [DVec3] {
         self.state_edits += 1;
         &mut self.positions
@@ -156,7 +163,10 @@ impl DeformableBody {
         &self.velocities
     }
 
-    /// Mutable node velocities (m/s). Editing the state restarts two-step integrators.
+    /// Mutable node velocities (m/s), unchecked: a step refuses a body left with a velocity NaN,
+    /// infinite or faster than [`SPEED_OF_LIGHT`] (see [`DeformableBody::check_state`]);
+    /// [`DeformableBody::set_velocities`] refuses it at once. The integrators hold pinned nodes
+    /// at rest, whatever is written here. Editing the state restarts two-step integrators.
     pub fn velocities_mut(&mut self) -> &mut [DVec3] {
         self.state_edits += 1;
         &mut self.velocities

@@ -101,24 +101,19 @@ impl TryFrom<BodyRecord> for DeformableBody {
             .user_data(record.user_data)
             .build()?;
         let nodes = body.node_count();
-        for (parameter, state) in [
-            ("positions", &record.positions),
-            ("velocities", &record.velocities),
-        ] {
-            if state.len() != nodes {
-                return Err(Error::InvalidSetting {
-                    parameter,
-                    value: state.len() as f64,
-                    reason: "a body's state needs one entry per node",
+        for given in [record.positions.len(), record.velocities.len()] {
+            if given != nodes {
+                return Err(Error::WrongNodeCount {
+                    given,
+                    node_count: nodes,
                 });
-            }
-            if state.iter().any(|x| !x.is_finite()) {
-                return Err(Error::NonFiniteInput { parameter });
             }
         }
         body.positions = record.positions;
         body.velocities = record.velocities;
         body.state_edits = record.state_edits;
+        // The state a step would take: written by one, or set through the raw slices.
+        body.check_state()?;
         Ok(body)
     }
 }

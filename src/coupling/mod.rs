@@ -170,7 +170,10 @@ impl SoftCoupling {
     /// A frame of `dt = 0` (a pause) only lets rapier apply changes, and steps no deformable
     /// body. A negative or non-finite `dt`, or zero [`SoftCoupling::substeps`], steps nothing,
     /// rapier included, and every deformable body's result is the error
-    /// ([`Error::InvalidTimeStep`], [`Error::InvalidSetting`]).
+    /// ([`Error::InvalidTimeStep`], [`Error::InvalidSetting`]). A body whose state a step cannot
+    /// take (a position or velocity made NaN, infinite or absurd through the raw slices, see
+    /// [`DeformableBody::check_state`]) is not stepped and its result is that error, every frame
+    /// until its state is fixed.
     pub fn step(
         &mut self,
         pipeline: &mut PhysicsPipeline,
@@ -336,9 +339,10 @@ impl SoftCoupling {
     }
 
     /// One coupling substep of `h` (s) of the bodies whose `outcomes` are not yet an error: each
-    /// finds its contacts with the colliders, bodies touching each other are grouped and stepped
-    /// together, the others alone, and the impulses they gave rigid bodies go to rapier and to
-    /// the loads. Each body's outcome becomes its last report or its error.
+    /// whose state passes [`DeformableBody::check_state`] finds its contacts with the colliders
+    /// (the others keep their state and take its error), bodies touching each other are grouped
+    /// and stepped together, the others alone, and the impulses they gave rigid bodies go to
+    /// rapier and to the loads. Each body's outcome becomes its last report or its error.
     fn step_soft_bodies(
         &mut self,
         soft_bodies: &mut DeformableBodySet,
@@ -355,14 +359,17 @@ impl SoftCoupling {
                 if matches!(outcome, Some(Err(_))) {
                     continue;
                 }
-                if let Err(error) = self.links.entry(*handle).constraints.detect_among(
-                    &soft_bodies[*handle],
-                    &views,
-                    &lookup,
-                    h,
-                    gravity,
-                    &self.contact,
-                ) {
+                let body = &soft_bodies[*handle];
+                if let Err(error) = body.check_state().and_then(|()| {
+                    self.links.entry(*handle).constraints.detect_among(
+                        body,
+                        &views,
+                        &lookup,
+                        h,
+                        gravity,
+                        &self.contact,
+                    )
+                }) {
                     *outcome = Some(Err(error));
                 }
             }

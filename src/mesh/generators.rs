@@ -24,7 +24,9 @@ const SPHERE_CORE: f64 = 0.4;
 /// each split into five tetrahedra.
 ///
 /// # Errors
-/// [`Error::InvalidGeneratorParameter`] for a zero cell count or a non-positive, non-finite extent.
+/// [`Error::InvalidGeneratorParameter`] for a zero cell count, a non-positive, non-finite extent
+/// or more nodes than 32-bit indices address; [`Error::AllocationFailed`] when the machine cannot
+/// hold the mesh.
 ///
 /// # Example
 /// ```
@@ -54,8 +56,9 @@ pub fn cuboid(half_extents: DVec3, cells: [usize; 3]) -> Result<TetMesh, Error> 
 /// hexahedron; each is split into twelve tetrahedra around its centre.
 ///
 /// # Errors
-/// [`Error::InvalidGeneratorParameter`] for fewer than 2 cells across, zero cells along, or a
-/// non-positive, non-finite size.
+/// [`Error::InvalidGeneratorParameter`] for fewer than 2 cells across, zero cells along, a
+/// non-positive, non-finite size or more nodes than 32-bit indices address;
+/// [`Error::AllocationFailed`] when the machine cannot hold the mesh.
 pub fn cylinder(
     radius: f64,
     half_height: f64,
@@ -68,11 +71,13 @@ pub fn cylinder(
     check_cells_along(cells_along)?;
     let core = (cells_across / 2).max(1);
     let layers = (cells_across / 4).max(1);
-    check_node_budget(block_node_bound(&[
-        [core, cells_along, core],
-        [4 * core, cells_along, layers],
-    ]))?;
-    let mut hexes = HexMesher::new(radius.max(half_height));
+    let mut hexes = HexMesher::with_capacity(
+        radius.max(half_height),
+        &[
+            (1, [core, cells_along, core]),
+            (4, [core, cells_along, layers]),
+        ],
+    )?;
     let height = |t: f64| (2.0 * t - 1.0) * half_height;
     // The core: a straight box of half-size r/2 in x and z.
     hexes.add_block([core, cells_along, core], |u| {
@@ -110,15 +115,15 @@ pub fn cylinder(
 /// into twelve tetrahedra around its centre.
 ///
 /// # Errors
-/// [`Error::InvalidGeneratorParameter`] for fewer than 2 cells across or a non-positive,
-/// non-finite radius.
+/// [`Error::InvalidGeneratorParameter`] for fewer than 2 cells across, a non-positive,
+/// non-finite radius or more nodes than 32-bit indices address; [`Error::AllocationFailed`] when
+/// the machine cannot hold the mesh.
 pub fn sphere(radius: f64, cells_across: usize) -> Result<TetMesh, Error> {
     check_length("radius", radius)?;
     check_cells_across(cells_across)?;
     let core = ((cells_across as f64 * 0.4).round() as usize).max(1);
     let layers = ((core as f64 * 0.6).round() as usize).max(1);
-    check_node_budget(block_node_bound(&[[core; 3], [core, 6 * core, layers]]))?;
-    let mut hexes = HexMesher::new(radius);
+    let mut hexes = HexMesher::with_capacity(radius, &[(1, [core; 3]), (6, [core, core, layers])])?;
     hexes.add_block([core; 3], |u| {
         (u * 2.0 - DVec3::ONE) * (SPHERE_CORE * radius)
     });
@@ -143,7 +148,7 @@ pub fn sphere(radius: f64, cells_across: usize) -> Result<TetMesh, Error> {
 }
 
 /// Refuses meshes whose node count would not fit the 32-bit node indices.
-fn check_node_budget(nodes: f64) -> Result<(), Error> {
+pub(super) fn check_node_budget(nodes: f64) -> Result<(), Error> {
     if nodes <= f64::from(u32::MAX) {
         Ok(())
     } else {
@@ -155,17 +160,17 @@ fn check_node_budget(nodes: f64) -> Result<(), Error> {
     }
 }
 
-/// Upper bound on the nodes of a block-structured mesh: every block's lattice nodes plus one
-/// centre node per cell.
-fn block_node_bound(blocks: &[[usize; 3]]) -> f64 {
-    blocks
-        .iter()
-        .map(|b| {
-            let cells: f64 = b.iter().map(|&c| c as f64).product();
-            let nodes: f64 = b.iter().map(|&c| c as f64 + 1.0).product();
-            cells + nodes
-        })
-        .sum()
+/// An empty vector with room for `count` items of `T`, or [`Error::AllocationFailed`] naming
+/// `what` if the memory cannot be had (a mesh of more cells than the machine holds).
+pub(super) fn reserve<T>(count: usize, what: &'static str) -> Result<Vec<T>, Error> {
+    let mut items = Vec::new();
+    items
+        .try_reserve_exact(count)
+        .map_err(|_| Error::AllocationFailed {
+            what,
+            bytes: (count as u64).saturating_mul(std::mem::size_of::<T>() as u64),
+        })?;
+    Ok(items)
 }
 
 fn check_length(parameter: &'static str, value: f64) -> Result<(), Error> {
@@ -227,6 +232,15 @@ fn lattice(cells: [usize; 3], map: impl Fn(DVec3) -> DVec3) -> Result<TetMesh, E
     }
     let [nx, ny, nz] = cells;
     check_node_budget(cells.iter().map(|&c| c as f64 + 1.0).product())?;
+    // Within the node budget, the cell count fits (nx ny nz < (nx+1)(ny+1)(nz+1) <= u32::MAX);
+    // five tetrahedra per cell may not, in a 32-bit usize.
+    let tet_count = (nx * ny * nz).checked_mul(FIVE_TET_SPLIT.len()).ok_or(
+        Error::InvalidGeneratorParameter {
+            parameter: "cells",
+            value: 5.0 * (nx * ny * nz) as f64,
+            reason: "the mesh would have more tetrahedra than this platform can count",
+        },
+    )?;
     let node = |i: usize, j: usize, k: usize| (i + (nx + 1) * (j + (ny + 1) * k)) as u32;
     let lattice_point = |i: usize, j: usize, k: usize| {
         DVec3::new(
@@ -235,7 +249,7 @@ fn lattice(cells: [usize; 3], map: impl Fn(DVec3) -> DVec3) -> Result<TetMesh, E
             2.0 * k as f64 / nz as f64 - 1.0,
         )
     };
-    let mut lattice_points = Vec::with_capacity((nx + 1) * (ny + 1) * (nz + 1));
+    let mut lattice_points = reserve((nx + 1) * (ny + 1) * (nz + 1), "the mesh's nodes")?;
     for k in 0..=nz {
         for j in 0..=ny {
             for i in 0..=nx {
@@ -243,7 +257,7 @@ fn lattice(cells: [usize; 3], map: impl Fn(DVec3) -> DVec3) -> Result<TetMesh, E
             }
         }
     }
-    let mut tets = Vec::with_capacity(5 * nx * ny * nz);
+    let mut tets = reserve(tet_count, "the mesh's tetrahedra")?;
     for k in 0..nz {
         for j in 0..ny {
             for i in 0..nx {
@@ -263,4 +277,23 @@ fn lattice(cells: [usize; 3], map: impl Fn(DVec3) -> DVec3) -> Result<TetMesh, E
         }
     }
     TetMesh::new(lattice_points.into_iter().map(map).collect(), tets)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_reservation_no_allocator_can_serve_is_an_error_not_an_abort() {
+        // 2^60 tetrahedra of 16 bytes: past `isize::MAX` bytes, refused before any allocation;
+        // the 2^64 bytes asked for saturate the count.
+        let error = reserve::<[u32; 4]>(1 << 60, "the mesh's tetrahedra").unwrap_err();
+        assert_eq!(
+            error,
+            Error::AllocationFailed {
+                what: "the mesh's tetrahedra",
+                bytes: u64::MAX,
+            }
+        );
+    }
 }

@@ -2,6 +2,7 @@
 //! merged by position, and each hexahedron is split into twelve tetrahedra around a centre node,
 //! each face along the diagonal through its lowest-numbered node so that neighbours agree.
 
+use super::generators::{check_node_budget, reserve};
 use crate::Error;
 use crate::mesh::{TetMesh, signed_volume};
 use rapier3d::glamx::DVec3;
@@ -28,14 +29,37 @@ pub(super) struct HexMesher {
 }
 
 impl HexMesher {
-    /// An empty mesher for shapes of size about `scale` (m).
-    pub(super) fn new(scale: f64) -> Self {
-        Self {
-            resolution: scale / f64::from(1u32 << 30),
-            positions: Vec::new(),
-            node_at: HashMap::new(),
-            tets: Vec::new(),
+    /// An empty mesher for shapes of size about `scale` (m), with room for `blocks`: each
+    /// `(copies, cells)` is that many blocks of `cells` hexahedra.
+    ///
+    /// # Errors
+    /// [`Error::InvalidGeneratorParameter`] if the blocks could have more nodes than 32-bit
+    /// indices address; [`Error::AllocationFailed`] if the machine cannot hold them.
+    pub(super) fn with_capacity(scale: f64, blocks: &[(usize, [usize; 3])]) -> Result<Self, Error> {
+        // Every block's lattice nodes plus a centre node per cell: shared nodes counted twice.
+        let (mut nodes, mut cells) = (0.0, 0.0);
+        for &(copies, block) in blocks {
+            let block_cells: f64 = block.iter().map(|&c| c as f64).product();
+            let block_nodes: f64 = block.iter().map(|&c| c as f64 + 1.0).product();
+            nodes += copies as f64 * (block_nodes + block_cells);
+            cells += copies as f64 * block_cells;
         }
+        check_node_budget(nodes)?;
+        // Within the node budget the node count fits a usize; twelve tetrahedra per cell may not
+        // in a 32-bit one, where `as` saturates and the reservation fails.
+        let mut node_at = HashMap::new();
+        node_at
+            .try_reserve(nodes as usize)
+            .map_err(|_| Error::AllocationFailed {
+                what: "the mesh's node lookup",
+                bytes: nodes as u64 * std::mem::size_of::<([i64; 3], u32)>() as u64,
+            })?;
+        Ok(Self {
+            resolution: scale / f64::from(1u32 << 30),
+            positions: reserve(nodes as usize, "the mesh's nodes")?,
+            node_at,
+            tets: reserve((12.0 * cells) as usize, "the mesh's tetrahedra")?,
+        })
     }
 
     /// Adds a block of `cells` hexahedra whose nodes are `map(u)` for `u` on the regular lattice

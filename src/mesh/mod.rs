@@ -12,24 +12,25 @@ pub mod import;
 mod quadratic;
 mod quadratic_hex;
 mod surface;
+mod validate;
 
 pub use generators::{cuboid, cylinder, sphere};
 pub use quadratic::QuadraticTetMesh;
 pub(crate) use quadratic::SUB_TETS;
 pub use quadratic_hex::QuadraticHexMesh;
+pub use validate::MAX_COORDINATE;
+pub(crate) use validate::{DEGENERATE_RELATIVE_VOLUME, check_position};
+use validate::{check_element_volume, name_parent_element, validate_topology};
 
 use crate::Error;
 use rapier3d::glamx::DVec3;
 
-/// Relative volume below which a tetrahedron counts as degenerate: `|V| <= 1e-12 * l^3`, with `l`
-/// the tetrahedron's longest edge.
-pub(crate) const DEGENERATE_RELATIVE_VOLUME: f64 = 1e-12;
-
 /// A validated tetrahedral mesh in its rest configuration.
 ///
-/// Every tetrahedron refers to existing, distinct nodes, has finite coordinates and a positive
-/// rest volume. Construction never panics: each defect is an [`Error`] naming the offending node or
-/// tetrahedron.
+/// Every tetrahedron refers to existing, distinct nodes, every coordinate is finite and within
+/// ±[`MAX_COORDINATE`] m, and every tetrahedron has a positive rest volume, a normal `f64` above
+/// `1e-12 l³` (`l` its longest edge). Construction never panics: each defect is an [`Error`]
+/// naming the offending node or tetrahedron.
 ///
 /// # Example
 /// ```
@@ -76,14 +77,15 @@ impl TetMesh {
     /// Builds a mesh from rest positions (m) and tetrahedra (node indices), rejecting any defect.
     ///
     /// # Errors
-    /// [`Error::EmptyMesh`], [`Error::NonFiniteCoordinate`], [`Error::NodeIndexOutOfRange`],
-    /// [`Error::RepeatedNode`], [`Error::UnreferencedNode`], [`Error::DegenerateTet`] or
-    /// [`Error::InvertedTet`], naming the first offending node or tetrahedron.
+    /// [`Error::EmptyMesh`], [`Error::NonFiniteCoordinate`], [`Error::CoordinateOutOfRange`],
+    /// [`Error::NodeIndexOutOfRange`], [`Error::RepeatedNode`], [`Error::UnreferencedNode`],
+    /// [`Error::TetTooSmall`], [`Error::DegenerateTet`] or [`Error::InvertedTet`], naming the
+    /// first offending node or tetrahedron.
     pub fn new(positions: Vec<DVec3>, tets: Vec<[u32; 4]>) -> Result<Self, Error> {
         validate_topology(&positions, &tets)?;
         for (tet, nodes) in tets.iter().enumerate() {
             let volume = signed_volume(&positions, nodes);
-            check_not_degenerate(&positions, nodes, tet, volume)?;
+            check_element_volume(&positions, nodes, tet, volume)?;
             if volume < 0.0 {
                 return Err(Error::InvertedTet { tet, volume });
             }
@@ -104,7 +106,7 @@ impl TetMesh {
         let mut flipped = 0;
         for (tet, nodes) in tets.iter_mut().enumerate() {
             let volume = signed_volume(&positions, nodes);
-            check_not_degenerate(&positions, nodes, tet, volume)?;
+            check_element_volume(&positions, nodes, tet, volume)?;
             if volume < 0.0 {
                 nodes.swap(2, 3);
                 flipped += 1;
@@ -207,21 +209,6 @@ impl TetMesh {
     }
 }
 
-/// An error of a subdivision's tetrahedron re-addressed to the element `parent(tet)` it lies in.
-fn name_parent_element(error: Error, parent: impl Fn(usize) -> usize) -> Error {
-    match error {
-        Error::InvertedTet { tet, volume } => Error::InvertedTet {
-            tet: parent(tet),
-            volume,
-        },
-        Error::DegenerateTet { tet, volume } => Error::DegenerateTet {
-            tet: parent(tet),
-            volume,
-        },
-        other => other,
-    }
-}
-
 /// Signed volume of a tetrahedron (m^3): positive when positively oriented.
 pub(crate) fn signed_volume(positions: &[DVec3], tet: &[u32; 4]) -> f64 {
     let [a, b, c, d] = tet.map(|i| positions[i as usize]);
@@ -239,64 +226,4 @@ fn min_tet_altitude(positions: &[DVec3], tet: &[u32; 4]) -> f64 {
             3.0 * volume / area
         })
         .fold(f64::INFINITY, f64::min)
-}
-
-/// Checks that the mesh is not empty, its coordinates finite, and every element of `N` nodes
-/// refers to existing, distinct nodes, with every node used.
-fn validate_topology<const N: usize>(positions: &[DVec3], tets: &[[u32; N]]) -> Result<(), Error> {
-    if positions.is_empty() || tets.is_empty() {
-        return Err(Error::EmptyMesh {
-            nodes: positions.len(),
-            tets: tets.len(),
-        });
-    }
-    if let Some(node) = positions.iter().position(|p| !p.is_finite()) {
-        return Err(Error::NonFiniteCoordinate {
-            node,
-            position: positions[node].to_array(),
-        });
-    }
-    let mut referenced = vec![false; positions.len()];
-    for (tet, nodes) in tets.iter().enumerate() {
-        if let Some(&node) = nodes.iter().find(|&&n| n as usize >= positions.len()) {
-            return Err(Error::NodeIndexOutOfRange {
-                tet,
-                node,
-                node_count: positions.len(),
-            });
-        }
-        for i in 0..N {
-            if nodes[i + 1..].contains(&nodes[i]) {
-                return Err(Error::RepeatedNode {
-                    tet,
-                    node: nodes[i],
-                });
-            }
-            referenced[nodes[i] as usize] = true;
-        }
-    }
-    match referenced.iter().position(|&r| !r) {
-        Some(node) => Err(Error::UnreferencedNode { node }),
-        None => Ok(()),
-    }
-}
-
-fn check_not_degenerate(
-    positions: &[DVec3],
-    nodes: &[u32; 4],
-    tet: usize,
-    volume: f64,
-) -> Result<(), Error> {
-    let p = nodes.map(|i| positions[i as usize]);
-    let mut longest_edge_sq: f64 = 0.0;
-    for i in 0..4 {
-        for j in i + 1..4 {
-            longest_edge_sq = longest_edge_sq.max(p[i].distance_squared(p[j]));
-        }
-    }
-    let scale = longest_edge_sq * longest_edge_sq.sqrt();
-    if volume.abs() <= DEGENERATE_RELATIVE_VOLUME * scale {
-        return Err(Error::DegenerateTet { tet, volume });
-    }
-    Ok(())
 }

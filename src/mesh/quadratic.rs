@@ -78,7 +78,8 @@ impl QuadraticTetMesh {
     ///
     /// # Errors
     /// Those of [`QuadraticTetMesh::new`], e.g. [`Error::InvertedTet`] for an element that
-    /// a midpoint moved too far folds.
+    /// a midpoint moved too far folds; [`Error::InvalidGeneratorParameter`] if the mid-edge nodes
+    /// would take the node count past what 32-bit indices address.
     pub fn from_linear_curved(
         mesh: &TetMesh,
         curve: impl Fn(DVec3, DVec3) -> Option<DVec3>,
@@ -92,27 +93,35 @@ impl QuadraticTetMesh {
         }
         let mut positions = mesh.positions().to_vec();
         let mut midpoints: HashMap<[u32; 2], u32> = HashMap::new();
-        let elements = mesh
-            .tets()
-            .iter()
-            .map(|tet| {
-                let mut nodes = [0u32; NODES];
-                nodes[..4].copy_from_slice(tet);
-                for (k, [i, j]) in EDGES.iter().enumerate() {
-                    let edge = [tet[*i].min(tet[*j]), tet[*i].max(tet[*j])];
-                    nodes[4 + k] = *midpoints.entry(edge).or_insert_with(|| {
-                        let [a, b] = edge.map(|n| positions[n as usize]);
-                        let curved = boundary_edges
-                            .contains(&edge)
-                            .then(|| curve(a, b))
-                            .flatten();
-                        positions.push(curved.unwrap_or(0.5 * (a + b)));
-                        positions.len() as u32 - 1
-                    });
+        let mut elements = Vec::with_capacity(mesh.tet_count());
+        for tet in mesh.tets() {
+            let mut nodes = [0u32; NODES];
+            nodes[..4].copy_from_slice(tet);
+            for (k, [i, j]) in EDGES.iter().enumerate() {
+                let edge = [tet[*i].min(tet[*j]), tet[*i].max(tet[*j])];
+                if let Some(&node) = midpoints.get(&edge) {
+                    nodes[4 + k] = node;
+                    continue;
                 }
-                nodes
-            })
-            .collect();
+                let node = u32::try_from(positions.len()).map_err(|_| {
+                    Error::InvalidGeneratorParameter {
+                        parameter: "mesh",
+                        value: positions.len() as f64,
+                        reason: "the quadratic mesh would have more nodes than 32-bit indices \
+                                 address",
+                    }
+                })?;
+                let [a, b] = edge.map(|n| positions[n as usize]);
+                let curved = boundary_edges
+                    .contains(&edge)
+                    .then(|| curve(a, b))
+                    .flatten();
+                positions.push(curved.unwrap_or(0.5 * (a + b)));
+                midpoints.insert(edge, node);
+                nodes[4 + k] = node;
+            }
+            elements.push(nodes);
+        }
         Self::new(positions, elements)
     }
 

@@ -42,7 +42,8 @@ impl QuadraticHexMesh {
     /// without cells, or more nodes than a mesh can index.
     pub fn cuboid(half_extents: DVec3, cells: [usize; 3]) -> Result<Self, Error> {
         // The lattice of every element's nodes is the tetrahedral box of twice the cells.
-        let subdivided = super::cuboid(half_extents, cells.map(|c| 2 * c))?;
+        // Saturating: a count that overflows is refused by the node budget all the same.
+        let subdivided = super::cuboid(half_extents, cells.map(|c| c.saturating_mul(2)))?;
         let [nx, ny, nz] = cells;
         let node =
             |i: usize, j: usize, k: usize| (i + (2 * nx + 1) * (j + (2 * ny + 1) * k)) as u32;

@@ -194,8 +194,9 @@ pub(super) fn obj_error_line(data: &[u8]) -> Option<usize> {
 }
 
 /// The line of the first `v` statement of the OBJ text `data` whose position (divided by its
-/// `w`, times `scale`) is not finite, or `None`.
-pub(super) fn obj_non_finite_line(data: &[u8], scale: f64) -> Option<usize> {
+/// `w`, times `scale`) is not finite or beyond ±[`MAX_COORDINATE`](crate::mesh::MAX_COORDINATE),
+/// or `None`.
+pub(super) fn obj_bad_vertex_line(data: &[u8], scale: f64) -> Option<usize> {
     lines(data).find_map(|(number, line)| {
         let mut words = line?.split_whitespace();
         if words.next() != Some("v") {
@@ -206,7 +207,10 @@ pub(super) fn obj_non_finite_line(data: &[u8], scale: f64) -> Option<usize> {
             4 => values[3],
             _ => 1.0,
         };
-        let bad = values.len() >= 3 && values[..3].iter().any(|x| !(x / w * scale).is_finite());
+        let bad = values.len() >= 3
+            && values[..3]
+                .iter()
+                .any(|x| !super::coordinate_usable(x / w * scale));
         bad.then_some(number)
     })
 }
@@ -284,12 +288,13 @@ pub(super) fn stl_error_location(data: &[u8]) -> Option<FileLocation> {
 }
 
 /// Where the first vertex of the STL file `data` lies whose coordinates times `scale` are not
-/// finite: its `vertex` line (ASCII) or its offset (binary); `None` if there is none.
-pub(super) fn stl_non_finite_location(data: &[u8], scale: f64) -> Option<FileLocation> {
+/// finite or beyond ±[`MAX_COORDINATE`](crate::mesh::MAX_COORDINATE): its `vertex` line (ASCII)
+/// or its offset (binary); `None` if there is none.
+pub(super) fn stl_bad_vertex_location(data: &[u8], scale: f64) -> Option<FileLocation> {
     let bad = |coordinates: &[f32]| {
         coordinates
             .iter()
-            .any(|&x| !(f64::from(x) * scale).is_finite())
+            .any(|&x| !super::coordinate_usable(f64::from(x) * scale))
     };
     if stl_is_ascii(data) {
         return lines(data).find_map(|(number, line)| {

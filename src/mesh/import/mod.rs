@@ -86,9 +86,13 @@ impl RawMesh {
     ///
     /// # Errors
     /// [`Error::MeshImport`] of kind [`ImportErrorKind::NoTetrahedra`] for a mesh without
-    /// tetrahedra, [`ImportErrorKind::IndexOutOfRange`] for an index past `positions`, and
-    /// [`ImportErrorKind::InvalidMesh`] naming the element's place in the file when
-    /// [`TetMesh::new_reoriented`] rejects it (a degenerate or repeated-node tetrahedron).
+    /// tetrahedra, [`ImportErrorKind::IndexOutOfRange`] for an index past `positions`,
+    /// [`ImportErrorKind::NonFinite`] or [`ImportErrorKind::CoordinateOutOfRange`] at the first
+    /// tetrahedron using a node that is not finite or beyond
+    /// ±[`MAX_COORDINATE`](crate::mesh::MAX_COORDINATE) m (the readers refuse those at the node's
+    /// own line), and [`ImportErrorKind::InvalidMesh`] naming the element's place in the file
+    /// when [`TetMesh::new_reoriented`] rejects it (a degenerate, too small or repeated-node
+    /// tetrahedron).
     pub fn into_mesh(self) -> Result<TetMesh, Error> {
         if !self.mid_edge_nodes.is_empty() {
             return Ok(self.into_quadratic_mesh()?.subdivided().clone());
@@ -165,8 +169,11 @@ impl RawMesh {
                     ));
                 };
                 if *slot == UNUSED {
+                    let position = self.positions[node as usize];
+                    crate::mesh::check_position(node as usize, position)
+                        .map_err(|e| self.coordinate_error(t, &e))?;
                     *slot = positions.len() as u32;
-                    positions.push(self.positions[node as usize]);
+                    positions.push(position);
                 }
                 nodes[k] = *slot;
             }
@@ -196,12 +203,28 @@ impl RawMesh {
     fn invalid(&self, e: Error) -> Error {
         let at = match e {
             Error::DegenerateTet { tet, .. }
+            | Error::TetTooSmall { tet, .. }
             | Error::RepeatedNode { tet, .. }
             | Error::InvertedTet { tet, .. }
             | Error::NonConformingEdge { tet, .. } => self.location(tet),
             _ => FileLocation::Whole,
         };
         self.error(at, ImportErrorKind::InvalidMesh, e.to_string())
+    }
+
+    /// [`ImportErrorKind::NonFinite`] or [`ImportErrorKind::CoordinateOutOfRange`] for the
+    /// coordinate error `e` of a node (numbered as in `positions`) that tetrahedron `tet` is the
+    /// first to use, at that tetrahedron's place in the file.
+    fn coordinate_error(&self, tet: usize, e: &Error) -> Error {
+        let kind = match e {
+            Error::NonFiniteCoordinate { .. } => ImportErrorKind::NonFinite,
+            _ => ImportErrorKind::CoordinateOutOfRange,
+        };
+        self.error(
+            self.location(tet),
+            kind,
+            format!("tetrahedron {tet} uses {e}"),
+        )
     }
 }
 
@@ -329,6 +352,33 @@ fn read_file(path: &Path) -> Result<Vec<u8>, Error> {
         path: path.display().to_string(),
         message: e.to_string(),
     })
+}
+
+/// What is wrong with a node read as `p` (file units) once times `scale` (m per file unit), if
+/// anything: the kind, and the words that follow "... times the scale" in a message. A node
+/// must be finite and within ±[`MAX_COORDINATE`](crate::mesh::MAX_COORDINATE) m, as a
+/// [`TetMesh`] requires; the readers say so at the node's line.
+fn scaled_defect(p: DVec3, scale: f64) -> Option<(ImportErrorKind, String)> {
+    let scaled = p * scale;
+    if !scaled.is_finite() {
+        Some((ImportErrorKind::NonFinite, "is not finite".into()))
+    } else if !coordinate_usable(scaled.abs().max_element()) {
+        Some((
+            ImportErrorKind::CoordinateOutOfRange,
+            format!(
+                "lies beyond ±{:e} m, where the element computations overflow",
+                crate::mesh::MAX_COORDINATE
+            ),
+        ))
+    } else {
+        None
+    }
+}
+
+/// Whether a scaled coordinate (m) is finite and within
+/// ±[`MAX_COORDINATE`](crate::mesh::MAX_COORDINATE).
+fn coordinate_usable(x: f64) -> bool {
+    x.abs() <= crate::mesh::MAX_COORDINATE
 }
 
 /// [`Error::InvalidSetting`] unless `scale` (m per file unit) is finite and positive.

@@ -259,16 +259,15 @@ pub(super) fn finite(source: &Source<'_>, value: f64, what: &str) -> Result<f64,
     }
 }
 
-/// `p * scale` if finite, else a [`ImportErrorKind::NonFinite`] error.
+/// `p * scale` if a mesh can use it, else an [`ImportErrorKind::NonFinite`] or
+/// [`ImportErrorKind::CoordinateOutOfRange`] error at the cursor.
 pub(super) fn scaled(source: &Source<'_>, p: DVec3, scale: f64) -> Result<DVec3, Error> {
-    let scaled = p * scale;
-    if scaled.is_finite() {
-        Ok(scaled)
-    } else {
-        Err(source.error(
-            ImportErrorKind::NonFinite,
-            format!("the coordinates {p} times the scale {scale} are not finite"),
-        ))
+    match super::scaled_defect(p, scale) {
+        None => Ok(p * scale),
+        Some((kind, problem)) => Err(source.error(
+            kind,
+            format!("the node at {p} times the scale {scale} {problem}"),
+        )),
     }
 }
 

@@ -2,16 +2,17 @@
 //!
 //! Both give a [`Surface`] of welded vertices (m) and triangles; OBJ polygons are triangulated,
 //! its objects and groups joined, its material libraries never opened. A file the crate
-//! rejects, a face referring to a missing vertex and a coordinate that is not finite once scaled
-//! are errors; since neither crate says where, the file is scanned again to find the line (or,
-//! in binary STL, the byte offset) at fault.
+//! rejects, a face referring to a missing vertex and a coordinate that is not finite once scaled,
+//! or beyond ±[`MAX_COORDINATE`](crate::mesh::MAX_COORDINATE) m, are errors; since neither crate
+//! says where, the file is scanned again to find the line (or, in binary STL, the byte offset) at
+//! fault.
 
 use super::Surface;
 use crate::Error;
 use crate::error::{FileLocation, ImportErrorKind};
-use crate::mesh::import::check_scale;
 use crate::mesh::import::locate;
 use crate::mesh::import::text::Source;
+use crate::mesh::import::{check_scale, scaled_defect};
 use rapier3d::glamx::DVec3;
 use std::collections::HashMap;
 
@@ -37,7 +38,7 @@ pub fn parse_obj(data: &[u8], path: &str, scale: f64) -> Result<Surface, Error> 
         for p in model.mesh.positions.chunks_exact(3) {
             let p = DVec3::new(p[0], p[1], p[2]);
             let vertex = scaled_vertex(&source, p, scale, || {
-                locate::obj_non_finite_line(data, scale)
+                locate::obj_bad_vertex_line(data, scale)
                     .map_or(FileLocation::Whole, FileLocation::Line)
             })?;
             let key = vertex.to_array().map(f64::to_bits);
@@ -130,7 +131,7 @@ pub fn parse_stl(data: &[u8], path: &str, scale: f64) -> Result<Surface, Error> 
         .map(|v| {
             let p = DVec3::new(f64::from(v[0]), f64::from(v[1]), f64::from(v[2]));
             scaled_vertex(&source, p, scale, || {
-                locate::stl_non_finite_location(data, scale).unwrap_or(FileLocation::Whole)
+                locate::stl_bad_vertex_location(data, scale).unwrap_or(FileLocation::Whole)
             })
         })
         .collect::<Result<Vec<_>, _>>()?;
@@ -156,25 +157,24 @@ pub fn parse_stl(data: &[u8], path: &str, scale: f64) -> Result<Surface, Error> 
     })
 }
 
-/// `p * scale` if finite, else a [`ImportErrorKind::NonFinite`] error at the place `locate`
-/// finds (called only then: it scans the file).
+/// `p * scale` if a mesh can use it, else an [`ImportErrorKind::NonFinite`] or
+/// [`ImportErrorKind::CoordinateOutOfRange`] error at the place `locate` finds (called only
+/// then: it scans the file).
 fn scaled_vertex(
     source: &Source<'_>,
     p: DVec3,
     scale: f64,
     locate: impl FnOnce() -> FileLocation,
 ) -> Result<DVec3, Error> {
-    let scaled = p * scale;
-    if scaled.is_finite() {
-        Ok(scaled)
-    } else {
-        Err(source.error_at(
+    match scaled_defect(p, scale) {
+        None => Ok(p * scale),
+        Some((kind, problem)) => Err(source.error_at(
             locate(),
-            ImportErrorKind::NonFinite,
+            kind,
             format!(
-                "vertex [{:?}, {:?}, {:?}] times the scale {scale:?} is not finite",
+                "vertex [{:?}, {:?}, {:?}] times the scale {scale:?} {problem}",
                 p.x, p.y, p.z
             ),
-        ))
+        )),
     }
 }

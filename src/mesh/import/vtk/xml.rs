@@ -13,7 +13,7 @@ use crate::Error;
 use crate::error::{FileLocation, ImportErrorKind};
 use crate::mesh::import::locate::{self, PieceLines, VtuLines};
 use crate::mesh::import::text::Source;
-use crate::mesh::import::{RawMesh, check_scale};
+use crate::mesh::import::{RawMesh, check_scale, scaled_defect};
 use rapier3d::glamx::DVec3;
 use vtkio::model::{DataSet, IOBuffer, Piece, UnstructuredGridPiece, VertexNumbers};
 
@@ -175,18 +175,17 @@ impl Grid<'_> {
         }
         for p in coordinates.chunks_exact(3) {
             let p = DVec3::new(p[0], p[1], p[2]);
-            let scaled = p * scale;
-            if !scaled.is_finite() {
+            if let Some((kind, problem)) = scaled_defect(p, scale) {
                 return Err(source.error_at(
                     points,
-                    ImportErrorKind::NonFinite,
+                    kind,
                     format!(
-                        "point {} of piece {number} is {p}, not finite times the scale {scale}",
+                        "point {} of piece {number} is {p}, which times the scale {scale} {problem}",
                         self.positions.len() as u64 - first_point
                     ),
                 ));
             }
-            self.positions.push(scaled);
+            self.positions.push(p * scale);
         }
         Ok(())
     }
