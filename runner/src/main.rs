@@ -6,7 +6,7 @@ use clap::{Parser, Subcommand};
 use rapier_fvm::integrate::SymplecticEuler;
 use rapier_fvm::material::{Material, MaterialModel};
 use rapier_fvm::mesh::import::{self, SurfaceOptions};
-use rapier_fvm_runner::scene::Scene;
+use rapier_fvm_runner::scene::{MemoryBudget, Scene};
 use rapier_fvm_runner::sim::{self, RunOptions};
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -48,6 +48,11 @@ enum Command {
         /// Hides the progress bar.
         #[arg(long)]
         quiet: bool,
+        /// The most memory the soft bodies may need, in GB (10⁹ bytes); default the memory
+        /// available (MemAvailable in /proc/meminfo, 8 GB where that is unknown). A scene whose
+        /// meshes are estimated to need more is refused, with the estimate, before any is built.
+        #[arg(long, value_name = "GB")]
+        memory_limit: Option<f64>,
     },
     /// Reports a mesh file's size, volume, quality and stable explicit time step.
     ///
@@ -95,7 +100,8 @@ fn main() -> ExitCode {
             out,
             duration,
             quiet,
-        } => run(scene, out, duration, !quiet),
+            memory_limit,
+        } => run(scene, out, duration, !quiet, memory_limit),
         Command::Check {
             mesh,
             scale,
@@ -114,9 +120,25 @@ fn main() -> ExitCode {
     }
 }
 
-/// `run`: runs the scene and prints a summary.
-fn run(scene: PathBuf, out: PathBuf, duration: Option<f64>, progress: bool) -> Result<(), String> {
-    let scene = Scene::load(&scene).map_err(|e| e.to_string())?;
+/// `run`: runs the scene, its soft bodies within `memory_limit` GB if given, and prints a
+/// summary.
+fn run(
+    scene: PathBuf,
+    out: PathBuf,
+    duration: Option<f64>,
+    progress: bool,
+    memory_limit: Option<f64>,
+) -> Result<(), String> {
+    let budget = match memory_limit {
+        None => MemoryBudget::available(),
+        Some(gb) if gb.is_finite() && gb > 0.0 => MemoryBudget::given(gb * 1e9),
+        Some(gb) => {
+            return Err(format!(
+                "--memory-limit must be a positive, finite number of GB, got {gb}"
+            ));
+        }
+    };
+    let scene = Scene::load_within(&scene, budget).map_err(|e| e.to_string())?;
     let options = RunOptions {
         out: out.clone(),
         duration,

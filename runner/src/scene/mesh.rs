@@ -172,8 +172,18 @@ impl MeshSpec {
             .map_err(|e| source.error(&format!("{key}.cuboid"), e.to_string()))
     }
 
+    /// Whether the mesh is a surface file (`.obj`, `.stl`), filled with tetrahedra when built.
+    pub(crate) fn is_surface_file(&self) -> bool {
+        self.file.as_deref().is_some_and(|file| {
+            matches!(
+                import::Format::from_path(std::path::Path::new(file)),
+                Some(import::Format::Obj | import::Format::Stl)
+            )
+        })
+    }
+
     /// How a surface file is filled.
-    fn surface_options(&self) -> import::SurfaceOptions {
+    pub(crate) fn surface_options(&self) -> import::SurfaceOptions {
         import::SurfaceOptions {
             cells_across: self
                 .cells_across

@@ -11,6 +11,9 @@
 //! - [`settings`]: `[contact]`, `[integrator]` and `[output]`;
 //! - [`probe`]: `[[probe]]` entries sampled every frame.
 //!
+//! Its soft bodies must fit in memory: [`budget`] estimates what their meshes need from their
+//! cell counts and refuses a scene that would need more than there is.
+//!
 //! `assets/scenes/README.md` lists every key with its unit and default.
 //!
 //! Reading a scene ([`Scene::load`]) fails with a [`SceneError`] naming the file, the line and
@@ -18,6 +21,7 @@
 //! values and references to bodies that do not exist. Keys left out take the documented
 //! defaults; a key given a wrong value is never replaced by one.
 
+pub mod budget;
 mod check;
 mod error;
 pub mod material;
@@ -28,6 +32,7 @@ pub mod settings;
 pub mod soft_body;
 pub mod world;
 
+pub use budget::MemoryBudget;
 pub use error::{SceneError, SceneSource};
 
 use check::Checker;
@@ -68,14 +73,28 @@ pub struct Scene {
     /// The file and its text, to place later errors (a mesh file that cannot be read).
     #[serde(skip)]
     pub source: SceneSource,
+    /// The memory the soft bodies may take, checked when the scene is read and as its mesh files
+    /// are read (see [`budget`]).
+    #[serde(skip)]
+    pub budget: MemoryBudget,
 }
 
 impl Scene {
-    /// Reads, parses and checks the scene file at `path`.
+    /// Reads, parses and checks the scene file at `path`, its soft bodies against the memory
+    /// available ([`MemoryBudget::available`]).
     ///
     /// # Errors
-    /// A [`SceneError`] if the file cannot be read or the scene is malformed.
+    /// A [`SceneError`] if the file cannot be read, the scene is malformed or its soft bodies
+    /// would need more memory than there is.
     pub fn load(path: impl AsRef<Path>) -> Result<Self, SceneError> {
+        Self::load_within(path, MemoryBudget::available())
+    }
+
+    /// [`Scene::load`] with the soft bodies checked against `budget`.
+    ///
+    /// # Errors
+    /// Those of [`Scene::load`].
+    pub fn load_within(path: impl AsRef<Path>, budget: MemoryBudget) -> Result<Self, SceneError> {
         let path = path.as_ref();
         let text = std::fs::read_to_string(path).map_err(|e| SceneError {
             file: path.to_path_buf(),
@@ -83,15 +102,28 @@ impl Scene {
             key: None,
             message: format!("cannot read the scene: {e}"),
         })?;
-        Self::parse(path, text)
+        Self::parse_within(path, text, budget)
     }
 
     /// Parses and checks `text`, the content of the scene file `path` (used for messages and to
-    /// resolve the mesh files it names).
+    /// resolve the mesh files it names), its soft bodies against the memory available.
     ///
     /// # Errors
-    /// A [`SceneError`] if the scene is malformed.
+    /// A [`SceneError`] if the scene is malformed or its soft bodies would need more memory
+    /// than there is.
     pub fn parse(path: impl AsRef<Path>, text: String) -> Result<Self, SceneError> {
+        Self::parse_within(path, text, MemoryBudget::available())
+    }
+
+    /// [`Scene::parse`] with the soft bodies checked against `budget`.
+    ///
+    /// # Errors
+    /// Those of [`Scene::parse`].
+    pub fn parse_within(
+        path: impl AsRef<Path>,
+        text: String,
+        budget: MemoryBudget,
+    ) -> Result<Self, SceneError> {
         let source = SceneSource {
             path: path.as_ref().to_path_buf(),
             text,
@@ -116,6 +148,7 @@ impl Scene {
             }
         })?;
         scene.source = source;
+        scene.budget = budget;
         scene.check()?;
         Ok(scene)
     }
@@ -171,6 +204,7 @@ impl Scene {
             probe_names.push(&probe.name);
             probe.check(&format!("probe[{i}]"), &soft, &rigid, &mut c);
         }
+        budget::check(&self.soft_body, &self.budget, &mut c);
         c.finish()
     }
 }

@@ -1,9 +1,11 @@
 //! A [`Scene`] made into a world: soft bodies meshed, placed, pinned and attached, rigid bodies
 //! and their colliders inserted, probes bound to the bodies they read.
 
+use super::meshes::BodyMeshes;
 use super::probe::Probe;
+use crate::scene::budget::MemoryUse;
 use crate::scene::rigid_body::{RigidBodySpec, RigidKind, ShapeSpec};
-use crate::scene::soft_body::{ElementsSpec, SoftBodySpec, VolumetricSpec};
+use crate::scene::soft_body::{SoftBodySpec, VolumetricSpec};
 use crate::scene::{Scene, SceneError, SceneSource};
 use rapier_fvm::body::{DeformableBodyBuilder, DeformableBodyHandle};
 use rapier_fvm::fvm::VolumetricTreatment;
@@ -53,7 +55,9 @@ impl Simulation {
     ///
     /// # Errors
     /// A [`SceneError`] at the key whose mesh file cannot be read, whose region holds no node,
-    /// or that the library refuses (a mesh with sliver elements, say).
+    /// whose mesh takes the soft bodies past the scene's
+    /// [`MemoryBudget`](crate::scene::MemoryBudget) (counted as the meshes are read, before a
+    /// body is built of them), or that the library refuses (a mesh with sliver elements, say).
     pub fn build(scene: &Scene) -> Result<Self, SceneError> {
         let source = &scene.source;
         let mut world = FvmWorld::default();
@@ -72,13 +76,15 @@ impl Simulation {
             });
         }
         let mut soft = Vec::new();
+        let mut memory = MemoryUse::new(scene.budget);
         for (i, spec) in scene.soft_body.iter().enumerate() {
+            let key = format!("soft_body[{i}]");
             soft.push(insert_soft(
                 &mut world,
                 spec,
                 &rigid,
-                &format!("soft_body[{i}]"),
-                source,
+                (&key, source),
+                &mut memory,
             )?);
         }
         let mut simulation = Self {
@@ -194,26 +200,21 @@ fn shape(spec: &RigidBodySpec, key: &str, source: &SceneSource) -> Result<Shared
     })
 }
 
-/// Builds, inserts and attaches a soft body.
+/// Builds, inserts and attaches a soft body, `key` in the scene of `source`, once its meshes
+/// fit in `memory`.
 fn insert_soft(
     world: &mut FvmWorld,
     spec: &SoftBodySpec,
     rigid: &[RigidEntry],
-    key: &str,
-    source: &SceneSource,
+    (key, source): (&str, &SceneSource),
+    memory: &mut MemoryUse,
 ) -> Result<SoftEntry, SceneError> {
-    let mesh_key = format!("{key}.mesh");
-    let (mesh, quadratic, cage) = match spec.elements {
-        ElementsSpec::Linear => (spec.mesh.build(&mesh_key, source)?, None, None),
-        ElementsSpec::Quadratic => {
-            let quadratic = spec.mesh.build_quadratic(&mesh_key, source)?;
-            (quadratic.subdivided().clone(), Some(quadratic), None)
-        }
-        ElementsSpec::QuadraticHex => {
-            let cage = spec.mesh.build_cage(&mesh_key, source)?;
-            (cage.subdivided().clone(), None, Some(cage))
-        }
-    };
+    let BodyMeshes {
+        mesh,
+        quadratic,
+        cage,
+        embedded,
+    } = BodyMeshes::build(spec, (key, source), memory)?;
     let library = |key: String| move |e: rapier_fvm::Error| source.error(&key, e.to_string());
     let material = spec
         .material
@@ -245,8 +246,8 @@ fn insert_soft(
         (_, Some(cage)) => DeformableBodyBuilder::quadratic_hex(cage, material),
         _ => DeformableBodyBuilder::new(mesh, material),
     };
-    if let Some(embedded) = &spec.embedded {
-        builder = builder.embedded(embedded.build(&format!("{key}.embedded"), source)?);
+    if let Some(fine) = embedded {
+        builder = builder.embedded(fine);
     }
     let mut builder = builder
         .translation(DVec3::from_array(spec.translation))

@@ -10,6 +10,7 @@
 //! | `plots/<probe>.png` | each probe against time |
 
 mod build;
+mod meshes;
 mod probe;
 mod report;
 mod run;

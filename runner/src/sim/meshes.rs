@@ -1,0 +1,60 @@
+//! A soft body's meshes built from its description: the elements' mesh (linear tetrahedra, or
+//! the quadratic tetrahedra or the cage of hexahedra with their subdivision) and the embedded
+//! mesh, each counted against the scene's memory budget as soon as it is built, before a body
+//! is made of it, so that a mesh file too big for the machine is refused with the estimate.
+
+use crate::scene::budget::{MemoryUse, MeshCount};
+use crate::scene::soft_body::{ElementsSpec, SoftBodySpec};
+use crate::scene::{SceneError, SceneSource};
+use rapier_fvm::mesh::{QuadraticHexMesh, QuadraticTetMesh, TetMesh};
+
+/// The meshes of a soft body.
+pub(super) struct BodyMeshes {
+    /// The linear tetrahedra: the elements, or the subdivision of the quadratic ones.
+    pub(super) mesh: TetMesh,
+    /// The quadratic tetrahedra, for a body of them.
+    pub(super) quadratic: Option<QuadraticTetMesh>,
+    /// The cage of quadratic hexahedra, for a body of them.
+    pub(super) cage: Option<QuadraticHexMesh>,
+    /// The fine mesh the elements carry, if any.
+    pub(super) embedded: Option<TetMesh>,
+}
+
+impl BodyMeshes {
+    /// The meshes of `spec`, `key` in the scene of `source`, each added to `memory` once built
+    /// and refused if it takes the scene past its budget.
+    pub(super) fn build(
+        spec: &SoftBodySpec,
+        (key, source): (&str, &SceneSource),
+        memory: &mut MemoryUse,
+    ) -> Result<Self, SceneError> {
+        let mesh_key = format!("{key}.mesh");
+        let (mesh, quadratic, cage) = match spec.elements {
+            ElementsSpec::Linear => (spec.mesh.build(&mesh_key, source)?, None, None),
+            ElementsSpec::Quadratic => {
+                let quadratic = spec.mesh.build_quadratic(&mesh_key, source)?;
+                (quadratic.subdivided().clone(), Some(quadratic), None)
+            }
+            ElementsSpec::QuadraticHex => {
+                let cage = spec.mesh.build_cage(&mesh_key, source)?;
+                (cage.subdivided().clone(), None, Some(cage))
+            }
+        };
+        let hexahedra = cage.as_ref().map_or(0, QuadraticHexMesh::element_count);
+        memory.add(MeshCount::of(&mesh, hexahedra), &mesh_key, source)?;
+        let embedded_key = format!("{key}.embedded");
+        let embedded = match &spec.embedded {
+            Some(embedded) => Some(embedded.build(&embedded_key, source)?),
+            None => None,
+        };
+        if let Some(fine) = &embedded {
+            memory.add(MeshCount::of(fine, 0), &embedded_key, source)?;
+        }
+        Ok(Self {
+            mesh,
+            quadratic,
+            cage,
+            embedded,
+        })
+    }
+}
