@@ -1,4 +1,4 @@
-//! Issue 21: a scene whose soft bodies would not fit in memory is refused with its estimate,
+//! A scene whose soft bodies would not fit in memory is refused with its estimate,
 //! by the checker for generated meshes and by the build for mesh files, before anything is
 //! allocated for them; and the estimates count what the generators make.
 

@@ -1,4 +1,4 @@
-//! Issue 21: a body's state set from outside is checked. The setters refuse NaN, infinite and
+//! A body's state set from outside is checked. The setters refuse NaN, infinite and
 //! absurd positions and velocities naming the node; a state made so through the raw slices is
 //! refused by every step, naming the node, with nothing moved.
 

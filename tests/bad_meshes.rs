@@ -1,4 +1,4 @@
-//! Issue 21: meshes `f64` cannot compute with are refused when they are built or read, naming
+//! Meshes `f64` cannot compute with are refused when they are built or read, naming
 //! the node or the tetrahedron (and, from a file, the file, the line and the kind), and the
 //! generators refuse cell counts their indices cannot address instead of overflowing.
 
