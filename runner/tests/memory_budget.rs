@@ -235,32 +235,20 @@ fn run_refuses_a_scene_too_big_in_one_line_and_takes_a_limit() {
     assert!(!out.exists(), "nothing was written");
     let small = scratch("small.toml", &scene(&cuboid([20; 3]), ""));
     let small = small.to_str().unwrap();
-    let output = rapier_fvm(&[
-        "run",
-        small,
-        "--out",
-        out.to_str().unwrap(),
-        "--memory-limit",
-        "0.05",
-    ]);
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    assert_eq!(output.status.code(), Some(1), "{stderr}");
-    assert!(
-        stderr.contains("the 0.050 GB allowed by --memory-limit"),
-        "{stderr}"
-    );
-    let output = rapier_fvm(&[
-        "run",
-        small,
-        "--out",
-        out.to_str().unwrap(),
-        "--memory-limit",
-        "nan",
-    ]);
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    assert_eq!(output.status.code(), Some(1), "{stderr}");
-    assert!(
-        stderr.contains("--memory-limit must be a positive"),
-        "{stderr}"
-    );
+    for (limit, message) in [
+        ("0.05", "the 0.050 GB allowed by --memory-limit"),
+        ("nan", "--memory-limit must be a positive"),
+    ] {
+        let output = rapier_fvm(&[
+            "run",
+            small,
+            "--out",
+            out.to_str().unwrap(),
+            "--memory-limit",
+            limit,
+        ]);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(1), "{stderr}");
+        assert!(stderr.contains(message), "{stderr}");
+    }
 }
