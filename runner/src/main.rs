@@ -49,7 +49,7 @@ enum Command {
         #[arg(long)]
         quiet: bool,
         /// The most memory the soft bodies may need, in GB (10⁹ bytes); default the memory
-        /// available (MemAvailable in /proc/meminfo, 8 GB where that is unknown). A scene whose
+        /// available (`MemAvailable` in `/proc/meminfo`, 8 GB where that is unknown). A scene whose
         /// meshes are estimated to need more is refused, with the estimate, before any is built.
         #[arg(long, value_name = "GB")]
         memory_limit: Option<f64>,
