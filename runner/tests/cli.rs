@@ -1,24 +1,10 @@
 //! The `rapier-fvm` binary: help, exit codes, and one-line errors without a panic.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
-fn rapier_fvm(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_rapier-fvm"))
-        .args(args)
-        .current_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
-        .output()
-        .expect("the binary runs")
-}
-
-/// A scratch file `name` with `content`.
-fn scratch(name: &str, content: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("cli");
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join(name);
-    std::fs::write(&path, content).unwrap();
-    path
-}
+use common::{rapier_fvm, scratch};
+use std::path::Path;
+use std::process::Output;
 
 /// Asserts a failure with status 1 and one line on stderr mentioning `words`.
 fn assert_one_line_error(output: &Output, words: &str) {
@@ -57,6 +43,7 @@ fn a_missing_scene_fails_in_one_line() {
 #[test]
 fn a_malformed_scene_fails_in_one_line_with_file_line_and_key() {
     let path = scratch(
+        "cli",
         "malformed.toml",
         "[world]\nduration = 1.0\ngravty = [0, -9.81, 0]\n",
     );
@@ -67,6 +54,7 @@ fn a_malformed_scene_fails_in_one_line_with_file_line_and_key() {
 #[test]
 fn a_malformed_mesh_fails_in_one_line() {
     let path = scratch(
+        "cli",
         "broken.msh",
         "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 2\n",
     );

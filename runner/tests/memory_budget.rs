@@ -9,8 +9,11 @@ use rapier_fvm_runner::scene::mesh::MeshSpec;
 use rapier_fvm_runner::scene::soft_body::ElementsSpec;
 use rapier_fvm_runner::scene::{MemoryBudget, Scene, SceneError};
 use rapier_fvm_runner::sim::{self, RunOptions};
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::path::Path;
+
+mod common;
+
+use common::{rapier_fvm, scratch};
 
 /// A scene of one cube of `mesh` (a TOML inline table) and `extra` lines in its soft body.
 fn scene(mesh: &str, extra: &str) -> String {
@@ -205,24 +208,13 @@ fn the_memory_available_is_read_on_linux() {
     }
 }
 
-fn rapier_fvm(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_rapier-fvm"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
-
-fn scratch(name: &str, content: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("memory_budget_cli");
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join(name);
-    std::fs::write(&path, content).unwrap();
-    path
-}
-
 #[test]
 fn run_refuses_a_scene_too_big_in_one_line_and_takes_a_limit() {
-    let big = scratch("big.toml", &scene(&cuboid([1500; 3]), ""));
+    let big = scratch(
+        "memory_budget_cli",
+        "big.toml",
+        &scene(&cuboid([1500; 3]), ""),
+    );
     let out = big.with_extension("out");
     let output = rapier_fvm(&["run", big.to_str().unwrap(), "--out", out.to_str().unwrap()]);
     let stderr = String::from_utf8_lossy(&output.stderr);
@@ -233,7 +225,11 @@ fn run_refuses_a_scene_too_big_in_one_line_and_takes_a_limit() {
         "{stderr}"
     );
     assert!(!out.exists(), "nothing was written");
-    let small = scratch("small.toml", &scene(&cuboid([20; 3]), ""));
+    let small = scratch(
+        "memory_budget_cli",
+        "small.toml",
+        &scene(&cuboid([20; 3]), ""),
+    );
     let small = small.to_str().unwrap();
     for (limit, message) in [
         ("0.05", "the 0.050 GB allowed by --memory-limit"),
