@@ -1,5 +1,6 @@
-//! Pieces shared by the Newton solvers (static equilibrium, implicit integration): the residual
-//! norm and a backtracking line search that guarantees the minimized energy decreases.
+//! Pieces shared by the Newton solvers (static equilibrium, implicit integration of a body or of
+//! bodies touching each other): the residual norm and a backtracking line search that guarantees
+//! the minimized energy decreases, over any [`Configuration`] of nodes.
 
 use crate::Error;
 use crate::body::DeformableBody;
@@ -15,6 +16,30 @@ pub(crate) fn check_tolerance(tolerance: f64) -> Result<(), Error> {
             value: tolerance,
             reason: "must be positive and finite",
         })
+    }
+}
+
+/// What Newton moves: the positions (m) of a set of nodes, one body's or a group's, in a fixed
+/// order.
+pub(crate) trait Configuration {
+    /// The positions (m), in order.
+    fn copy_positions(&self) -> Vec<DVec3>;
+    /// Sets the positions to `start + alpha direction` (m).
+    fn place(&mut self, start: &[DVec3], direction: &[DVec3], alpha: f64);
+    /// Sets the positions to `positions` (m).
+    fn set(&mut self, positions: &[DVec3]) {
+        self.place(positions, positions, 0.0);
+    }
+}
+
+impl Configuration for DeformableBody {
+    fn copy_positions(&self) -> Vec<DVec3> {
+        self.positions.clone()
+    }
+    fn place(&mut self, start: &[DVec3], direction: &[DVec3], alpha: f64) {
+        for ((x, x0), s) in self.positions.iter_mut().zip(start).zip(direction) {
+            *x = *x0 + *s * alpha;
+        }
     }
 }
 
@@ -38,14 +63,14 @@ pub(crate) enum Search {
 /// One Newton update of `body`'s positions along `direction` from where the minimized energy
 /// is `energy_now` (J), searching as `search` says. Returns the new residual and energy, or
 /// `None` (positions unchanged) if no step descends.
-pub(crate) fn descend(
-    body: &mut DeformableBody,
+pub(crate) fn descend<C: Configuration>(
+    body: &mut C,
     residual: &[DVec3],
     energy_now: f64,
     direction: &[DVec3],
     search: Search,
-    energy: impl Fn(&DeformableBody) -> f64,
-    mut residual_at: impl FnMut(&mut DeformableBody) -> Vec<DVec3>,
+    energy: impl Fn(&C) -> f64,
+    mut residual_at: impl FnMut(&mut C) -> Vec<DVec3>,
 ) -> Option<(Vec<DVec3>, f64)> {
     let smallest = match search {
         Search::Thorough => MIN_STEP,
@@ -57,20 +82,18 @@ pub(crate) fn descend(
     if search == Search::Short {
         return None;
     }
-    let start = body.positions.clone();
+    let start = body.copy_positions();
     let current = norm(residual);
     let mut alpha = 1.0;
     while alpha >= MIN_STEP {
-        for ((x, x0), s) in body.positions.iter_mut().zip(&start).zip(direction) {
-            *x = *x0 + *s * alpha;
-        }
+        body.place(&start, direction, alpha);
         let next = residual_at(body);
         if norm(&next) < current {
             return Some((next, energy(body)));
         }
         alpha *= 0.5;
     }
-    body.positions.copy_from_slice(&start);
+    body.set(&start);
     None
 }
 
@@ -82,16 +105,16 @@ const MIN_STEP: f64 = 1.0 / 1024.0;
 /// `smallest` that satisfies the Armijo condition, so that the energy decreases. Returns the
 /// energy there, or `None`, with the positions put back, if no such step exists (the direction
 /// no longer descends above round-off).
-fn line_search(
-    body: &mut DeformableBody,
+fn line_search<C: Configuration>(
+    body: &mut C,
     residual: &[DVec3],
     initial: f64,
     direction: &[DVec3],
-    energy: impl Fn(&DeformableBody) -> f64,
+    energy: impl Fn(&C) -> f64,
     smallest: f64,
 ) -> Option<f64> {
     const ARMIJO: f64 = 1e-4;
-    let start = body.positions.clone();
+    let start = body.copy_positions();
     let slope: f64 = -residual
         .iter()
         .zip(direction)
@@ -103,15 +126,13 @@ fn line_search(
     let round_off = 1e-12 * initial.abs();
     let mut alpha = 1.0;
     while alpha >= smallest {
-        for ((x, x0), s) in body.positions.iter_mut().zip(&start).zip(direction) {
-            *x = *x0 + *s * alpha;
-        }
+        body.place(&start, direction, alpha);
         let value = energy(body);
         if value <= initial + ARMIJO * alpha * slope + round_off {
             return Some(value);
         }
         alpha *= 0.5;
     }
-    body.positions.copy_from_slice(&start);
+    body.set(&start);
     None
 }

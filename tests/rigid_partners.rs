@@ -277,6 +277,58 @@ fn boxes_light_and_heavy_rest_on_a_soft_block_under_every_integrator() {
 }
 
 #[test]
+fn a_box_rests_on_a_stack_of_two_soft_blocks_under_every_integrator() {
+    // The boxes of the test above, 0.1 and 2 kg, on a stack of two 10 cm soft blocks (E = 1e6
+    // Pa, 1 kg each) on the ground, 2 s: the blocks touch each other and step together (one
+    // implicit system under forced implicit steps, the box a rigid partner of the top block).
+    // The same bounds: never more than 1 mm above where it was placed, at the end within 5 mm
+    // of it (the stack's compression under 2 kg is about 0.6 mm) and within 1 mm sideways, the
+    // whole system's energy never above its start (f32 rounding, see `energy_tolerance`).
+    for integrator in INTEGRATORS {
+        for mass in [0.1, 2.0] {
+            let mut world = world_with_ground(integrator);
+            for centre in [0.05, 0.1505] {
+                world.soft_bodies.insert(soft_block(
+                    0.05,
+                    4,
+                    DVec3::new(0.0, centre, 0.0),
+                    1e6,
+                    1000.0,
+                ));
+            }
+            let half = 0.02f32;
+            let density = mass as f32 / (8.0 * half * half * half);
+            let (rigid, _) = world.physics.insert(
+                RigidBodyBuilder::dynamic().translation(Vec3::new(0.01, 0.2005 + half + 5e-4, 0.0)),
+                ColliderBuilder::cuboid(half, half, half)
+                    .density(density)
+                    .friction(0.8),
+            );
+            let start = world.physics.bodies[rigid].translation().as_dvec3();
+            let mut highest = f64::NEG_INFINITY;
+            let run = run(&mut world, 120, |w| {
+                highest = highest.max(f64::from(w.physics.bodies[rigid].translation().y));
+            });
+            let end = world.physics.bodies[rigid].translation().as_dvec3();
+            let tolerance = energy_tolerance((mass + 2.0) * 9.81, 0.25, 0.0);
+            println!(
+                "{integrator:?}, {mass} kg on two blocks: energy rise {:.2e} J (tolerance {tolerance:.1e}), refused {}/{}, highest {:+.3} mm, end {:+.3?} mm",
+                run.energy_rise,
+                run.refused_frames,
+                run.frames,
+                (highest - start.y) * 1e3,
+                (end - start) * 1e3
+            );
+            assert_eq!(run.refused_frames, 0);
+            assert!(run.energy_rise <= tolerance);
+            assert!(highest - start.y < 1e-3);
+            assert!((end.y - start.y).abs() < 5e-3);
+            assert!(DVec3::new(end.x - start.x, 0.0, end.z - start.z).length() < 1e-3);
+        }
+    }
+}
+
+#[test]
 fn a_ball_striking_a_soft_cube_without_restitution_never_leaves_faster_than_it_came() {
     // A 2 cm ball of 1 g to 1 t at 3 m/s into a free 10 cm soft cube (1 kg) without gravity,
     // restitution 0, 40 frames. Its speed away from the cube's centre of mass afterwards is at

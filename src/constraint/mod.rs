@@ -26,8 +26,10 @@
 //! position relative to where the body carries its own point over the step, at the velocity the
 //! step gives the body: a dynamic body's response is part of the step's solve
 //! (`integrate::implicit::rigid_response`), so that the coupled system's energy cannot grow.
-//! Contacts between soft bodies have an explicit side only: bodies touching each other are
-//! stepped together explicitly.
+//! Contacts between soft bodies are solved with both bodies' nodes: explicitly in the same
+//! sweeps, implicitly as one system whose potential adds each contact's penalty and friction on
+//! the node relative to the other body's triangle (`contact::JointContacts`,
+//! `integrate::implicit::group`).
 
 mod set;
 

@@ -10,7 +10,8 @@
 
 use super::surface_tree::SurfaceTree;
 use super::{
-    Coefficients, ContactSettings, ContactSides, SoftPoint, SurfaceCoefficients, VelocityConstraint,
+    BodyPoint, Coefficients, ContactSettings, ContactSides, ContactTarget, NodeContact, Obstacle,
+    SoftPoint, SurfaceCoefficients, VelocityConstraint,
 };
 use crate::body::DeformableBody;
 use crate::stencil::node_inverse_mass;
@@ -97,6 +98,27 @@ pub(crate) fn detect_between(
         }
     }
     contacts
+}
+
+impl BetweenContact {
+    /// The contact in the numbering of a group whose body `k` has its first node at
+    /// `offsets[k]`: the node against the other body's triangle point, as a self-contact of the
+    /// group (see [`super::joint`]).
+    pub(super) fn in_group(&self, offsets: &[u32]) -> NodeContact {
+        let triangle_offset = offsets[self.triangle_body];
+        let triangle = self.on_triangle.nodes.map(|n| n + triangle_offset);
+        NodeContact::new(
+            BodyPoint::Node(self.node + offsets[self.node_body]),
+            ContactTarget::OwnSurface { triangle },
+            self.point,
+            self.normal,
+            self.coefficients,
+            Obstacle::OwnTriangle(SoftPoint {
+                nodes: triangle,
+                weights: self.on_triangle.weights,
+            }),
+        )
+    }
 }
 
 /// The two bodies `i` and `j` (distinct) of `bodies`, both mutable.

@@ -40,6 +40,7 @@
 mod between;
 mod corner;
 mod detect;
+mod joint;
 mod node_contact;
 mod penalty;
 mod self_contact;
@@ -56,6 +57,7 @@ pub(crate) use corner::{
 };
 use detect::nearest_surface_point;
 pub(crate) use detect::{ColliderView, collider_impulses, detect, force_on_collider};
+pub(crate) use joint::{GroupNodes, JointContacts};
 use node_contact::Obstacle;
 pub use node_contact::{BodyPoint, ContactTarget, NodeContact};
 pub(crate) use penalty::{

@@ -22,7 +22,7 @@ use crate::stencil::Stencil;
 use rapier3d::glamx::{DMat3, DVec3};
 
 /// A contact's point as the implicit terms see it.
-enum ContactPoint<'a> {
+pub(super) enum ContactPoint<'a> {
     /// The surface point itself, against a collider.
     Own(Stencil<'a>),
     /// A node relative to its own triangle's contact point, placed at the contact plane's point
@@ -36,7 +36,7 @@ enum ContactPoint<'a> {
 
 impl ContactPoint<'_> {
     /// The nodes the point moves with and their weights.
-    fn stencil(&self) -> Stencil<'_> {
+    pub(super) fn stencil(&self) -> Stencil<'_> {
         match self {
             Self::Own(stencil) => *stencil,
             Self::Relative { nodes, weights, .. } => Stencil { nodes, weights },
@@ -44,7 +44,7 @@ impl ContactPoint<'_> {
     }
 
     /// The point's position (m) with the nodes at `x`.
-    fn position(&self, x: &[DVec3]) -> DVec3 {
+    pub(super) fn position(&self, x: &[DVec3]) -> DVec3 {
         match self {
             Self::Own(stencil) => stencil.interpolate(x),
             Self::Relative { origin, .. } => self.stencil().interpolate(x) + *origin,
@@ -53,7 +53,7 @@ impl ContactPoint<'_> {
 }
 
 /// The point of `contact` the implicit terms act on; `embedding` is the body's.
-fn contact_point<'a>(
+pub(super) fn contact_point<'a>(
     contact: &'a NodeContact,
     embedding: Option<&'a Embedding>,
 ) -> ContactPoint<'a> {

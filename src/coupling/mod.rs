@@ -13,9 +13,10 @@
 //! 3. **Support.** Rigid bodies that rapier's narrow phase finds touching something are held in
 //!    place within the soft step: otherwise they would fall freely there, the ground that holds
 //!    them acting only in rapier's step.
-//! 4. **Soft step.** Bodies touching each other step together, explicitly, so that their
-//!    contacts are solved in the same sweeps with both bodies' nodes; the others step alone by
-//!    [`SoftCoupling::integrator`].
+//! 4. **Soft step.** Bodies touching each other step together, so that their contacts are
+//!    solved with both bodies' nodes: explicitly in the same sweeps, or, when the implicit
+//!    integrator is forced (or the explicit frame would take too many substeps), as one implicit
+//!    system; the others step alone by [`SoftCoupling::integrator`].
 //! 5. **Exchange.** The impulses the soft step gave dynamic rigid bodies are handed to rapier at
 //!    the nodes, and summed into the frame's [`RigidLoad`]s.
 //! 6. **Rigid step.** rapier steps the rigid bodies over `h`, with the frame's
@@ -402,10 +403,12 @@ impl SoftCoupling {
                         .step(step.body, step.constraints, step.workspace, h, gravity),
                 ]
             } else {
-                match self
-                    .integrator
-                    .step_together(&mut steps, &mut contacts, h, gravity)
-                {
+                match self.integrator.step_together(
+                    &mut steps,
+                    (&mut contacts, &self.contact),
+                    h,
+                    gravity,
+                ) {
                     Ok(reports) => reports.into_iter().map(Ok).collect(),
                     Err(error) => vec![Err(error); steps.len()],
                 }

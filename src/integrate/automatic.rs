@@ -15,7 +15,7 @@ use super::{
 use crate::Error;
 use crate::body::DeformableBody;
 use crate::constraint::BodyConstraints;
-use crate::contact::BetweenContact;
+use crate::contact::{BetweenContact, ContactSettings};
 use crate::material::MaterialModel;
 use rapier3d::glamx::DVec3;
 
@@ -204,16 +204,19 @@ impl AutomaticIntegrator {
     }
 
     /// Advances soft `bodies` touching each other through `between` (indices into `bodies`)
-    /// by `frame_dt` (s) together, explicitly, whatever the choice or the forced integrator:
-    /// their contacts are solved in the explicit sweeps with both bodies' nodes. A report per
-    /// body, in order.
+    /// by `frame_dt` (s) together, with `settings` for the contacts between them: forced
+    /// implicit, as one implicit system; otherwise explicitly, their contacts solved in the
+    /// explicit sweeps with both bodies' nodes, and, unless explicit is forced, redone as one
+    /// implicit system when the explicit frame would take more than `max_substeps` or gave a
+    /// non-finite state. A report per body, in order.
     ///
     /// # Errors
-    /// Those of [`SymplecticEuler::step`]; every body is then left as it was.
+    /// Those of [`SymplecticEuler::step`] or [`ImplicitIntegrator::step`], whichever ran last;
+    /// every body is then left as it was.
     pub(crate) fn step_together(
         &self,
         bodies: &mut [BodyInStep<'_>],
-        between: &mut [BetweenContact],
+        (between, settings): (&mut [BetweenContact], &ContactSettings),
         frame_dt: f64,
         gravity: DVec3,
     ) -> Result<Vec<AutomaticReport>, Error> {
@@ -221,18 +224,45 @@ impl AutomaticIntegrator {
             .iter()
             .map(|step| self.predict(step.body, frame_dt))
             .collect();
-        let reports = self
-            .explicit
-            .step_together(bodies, between, frame_dt, gravity)?;
+        let explicit = match self.force {
+            Some(IntegratorKind::Implicit) => None,
+            _ => Some(
+                self.explicit
+                    .step_together(bodies, between, frame_dt, gravity),
+            ),
+        };
+        let (explicit, fell_back) = match explicit {
+            Some(Ok(reports)) => (Some(reports), false),
+            Some(Err(Error::TooManySubsteps { .. } | Error::NonFiniteState { .. }))
+                if self.force.is_none() =>
+            {
+                (None, true)
+            }
+            Some(Err(error)) => return Err(error),
+            None => (None, false),
+        };
+        let reports: Vec<(Option<StepReport>, Option<ImplicitReport>)> = match explicit {
+            Some(reports) => reports.into_iter().map(|r| (Some(r), None)).collect(),
+            None => self
+                .implicit
+                .step_together(bodies, between, settings, (frame_dt, gravity))?
+                .into_iter()
+                .map(|r| (None, Some(r)))
+                .collect(),
+        };
         Ok(reports
             .into_iter()
             .zip(predictions)
-            .map(|(report, prediction)| AutomaticReport {
-                choice: IntegratorKind::Explicit,
+            .map(|((explicit, implicit), prediction)| AutomaticReport {
+                choice: if explicit.is_some() {
+                    IntegratorKind::Explicit
+                } else {
+                    IntegratorKind::Implicit
+                },
                 prediction,
-                explicit: Some(report),
-                implicit: None,
-                fell_back: false,
+                explicit,
+                implicit,
+                fell_back,
             })
             .collect())
     }

@@ -18,6 +18,7 @@
 //! cutting the out-of-balance force tenfold per iteration, iterations solve with it instead of
 //! assembling and factoring anew ([`crate::chord`]). Both schemes are stable at any step length.
 
+mod group;
 mod potential;
 mod rigid_response;
 
@@ -158,6 +159,21 @@ struct Outcome {
 }
 
 impl ImplicitReport {
+    /// The report of a frame of `substeps` before any: nothing done, converged.
+    fn empty(substeps: u32) -> Self {
+        Self {
+            substeps,
+            newton_iterations: 0,
+            linear_iterations: 0,
+            reused_factorizations: 0,
+            factorizations: 0,
+            projected_tangents: 0,
+            relative_residual: 0.0,
+            converged: true,
+            inverted_tets: 0,
+        }
+    }
+
     /// Counts a substep's Newton solve in the report.
     fn add(&mut self, outcome: &Outcome) {
         self.newton_iterations += outcome.iterations;
@@ -209,17 +225,7 @@ impl ImplicitIntegrator {
         constraints.save();
         let history = workspace.history(body).cloned();
         let h = frame_dt / f64::from(self.substeps);
-        let mut report = ImplicitReport {
-            substeps: self.substeps,
-            newton_iterations: 0,
-            linear_iterations: 0,
-            reused_factorizations: 0,
-            factorizations: 0,
-            projected_tangents: 0,
-            relative_residual: 0.0,
-            converged: true,
-            inverted_tets: 0,
-        };
+        let mut report = ImplicitReport::empty(self.substeps);
         let mut stiffness = workspace.take_tangent(body);
         let uncoupled = constraint::uncoupled_pairs(body, constraints, &stiffness);
         if !uncoupled.is_empty()
@@ -293,25 +299,16 @@ impl ImplicitIntegrator {
         h: f64,
         gravity: DVec3,
     ) -> Result<Outcome, Error> {
-        let start = StepStart::new(body, solver.last_step.as_ref(), h, gravity, self.scheme);
-        // The rigid bodies touched fall too, as rapier will make them (unless held); their
-        // response to the soft body is part of the solve.
-        for proxy in &mut constraints.rigid_proxies {
-            proxy.fall(gravity, h);
-        }
-        let response = RigidResponse::new(constraints.rigid_proxies.clone(), start.h, h);
-        for kind in constraint::IMPLICIT {
-            kind.begin(body, constraints, response.start());
-        }
-        // Newton starts from the inertial prediction `x̂` (free flight: the warm start that makes
-        // smooth motion cost one iteration), or from where the body is when that is the lower
-        // potential (a prediction deep inside an obstacle or crushing elements).
-        body.velocities.fill(DVec3::ZERO);
+        let (start, response) =
+            self.begin_substep(body, constraints, solver.last_step.as_ref(), (h, gravity));
         let incremental = Potential {
             start: &start,
             constraints,
             rigid: RefCell::new(response),
         };
+        // Newton starts from the inertial prediction `x̂` (free flight: the warm start that makes
+        // smooth motion cost one iteration), or from where the body is when that is the lower
+        // potential (a prediction deep inside an obstacle or crushing elements).
         let here = incremental.energy(body);
         body.positions.clone_from(&start.target);
         let mut potential = incremental.energy(body);
@@ -321,25 +318,32 @@ impl ImplicitIntegrator {
             potential = here;
         }
         let outcome = self.minimize(body, solver, &incremental, potential)?;
-        let mut response = incremental.rigid.into_inner();
-        response.solve(body, constraints);
-        for kind in constraint::IMPLICIT {
-            kind.record_impulses(body, constraints, response.step());
-        }
-        for n in 0..body.positions.len() {
-            body.velocities[n] = if body.pinned[n] {
-                DVec3::ZERO
-            } else {
-                (body.positions[n] - start.anchor[n]) / start.h
-            };
-        }
-        solver.last_step = Some(PreviousStep {
-            h,
-            positions: start.positions,
-            velocities: start.velocities,
-            edits: body.state_edits(),
-        });
+        let response = incremental.rigid.into_inner();
+        solver.last_step = Some(end_substep(body, constraints, start, response, h));
         Ok(outcome)
+    }
+
+    /// Readies `body` and its `constraints` for an implicit substep of `h` (s) under `gravity`
+    /// (m/s²) after `previous`: the step's start, and the touched rigid bodies' response, at
+    /// rest. The rigid bodies fall, as rapier will make them (unless held); the constraints
+    /// begin the step; the body's velocities are zeroed (the potential holds them).
+    fn begin_substep(
+        &self,
+        body: &mut DeformableBody,
+        constraints: &mut BodyConstraints,
+        previous: Option<&PreviousStep>,
+        (h, gravity): (f64, DVec3),
+    ) -> (StepStart, RigidResponse) {
+        let start = StepStart::new(body, previous, h, gravity, self.scheme);
+        for proxy in &mut constraints.rigid_proxies {
+            proxy.fall(gravity, h);
+        }
+        let response = RigidResponse::new(constraints.rigid_proxies.clone(), start.h, h);
+        for kind in constraint::IMPLICIT {
+            kind.begin(body, constraints, response.start());
+        }
+        body.velocities.fill(DVec3::ZERO);
+        (start, response)
     }
 
     /// Newton's method on the step's incremental potential, from the body's current positions,
@@ -508,6 +512,35 @@ impl ImplicitIntegrator {
             solver.chord.remember(&solver.stiffness);
         }
         Ok(direction)
+    }
+}
+
+/// Ends an implicit substep of `h` (s) from `start` at the body's positions: the rigid bodies'
+/// `response` is solved there, every constraint records its impulses, and the velocities become
+/// `(x − a)/ĥ`. Returns the substep's start, for the next one.
+fn end_substep(
+    body: &mut DeformableBody,
+    constraints: &mut BodyConstraints,
+    start: StepStart,
+    mut response: RigidResponse,
+    h: f64,
+) -> PreviousStep {
+    response.solve(body, constraints);
+    for kind in constraint::IMPLICIT {
+        kind.record_impulses(body, constraints, response.step());
+    }
+    for n in 0..body.positions.len() {
+        body.velocities[n] = if body.pinned[n] {
+            DVec3::ZERO
+        } else {
+            (body.positions[n] - start.anchor[n]) / start.h
+        };
+    }
+    PreviousStep {
+        h,
+        positions: start.positions,
+        velocities: start.velocities,
+        edits: body.state_edits(),
     }
 }
 

@@ -7,7 +7,7 @@
 //! the Newton tangent; the new velocity is `(x − a)/ĥ`.
 
 use super::ImplicitScheme;
-use super::rigid_response::RigidResponse;
+use super::rigid_response::{Placement, RigidResponse};
 use crate::assembly::{Stiffness, solve};
 use crate::body::DeformableBody;
 use crate::constraint::{self, BodyConstraints};
@@ -260,8 +260,31 @@ impl Potential<'_> {
         residual: &[DVec3],
         direction: Vec<DVec3>,
     ) -> Vec<DVec3> {
+        let placement = Placement {
+            offset: 0,
+            total: body.positions.len(),
+        };
+        self.take_in_placed(body, factor, placement, residual, direction)
+    }
+
+    /// [`Potential::take_in_rigid_response`] for a body placed among the nodes of a group solved
+    /// as one system: `residual`, `direction` and `factor` are the system's.
+    pub(super) fn take_in_placed(
+        &self,
+        body: &DeformableBody,
+        factor: (&Llt<usize, f64>, bool),
+        placement: Placement,
+        residual: &[DVec3],
+        direction: Vec<DVec3>,
+    ) -> Vec<DVec3> {
         let mut rigid = self.rigid.borrow_mut();
         rigid.solve(body, self.constraints);
-        rigid.take_in(body, self.constraints, factor, residual, direction)
+        rigid.take_in(
+            (body, self.constraints),
+            factor,
+            placement,
+            residual,
+            direction,
+        )
     }
 }

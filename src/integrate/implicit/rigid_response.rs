@@ -28,6 +28,7 @@ use crate::rigid::RigidProxy;
 use faer::sparse::linalg::solvers::Llt;
 use rapier3d::glamx::{DMat3, DVec3};
 use rapier3d::na::{DMatrix, DVector, Matrix3, Matrix6, Vector6};
+use std::borrow::Cow;
 
 /// Newton iterations (line-search halvings included) of one body-response solve at most.
 const MAX_ITERATIONS: usize = 60;
@@ -335,11 +336,15 @@ impl RigidResponse {
     ///
     /// `Z` is kept for the next call: when that one solves with the same factorization
     /// (`same_factor`, a reused one) and finds the same `U`, it skips the solves.
+    ///
+    /// In a group of bodies solved as one system, `residual`, `direction` and the factorization
+    /// are the system's, and `placement` says where the body's nodes sit among its nodes: the
+    /// correction then moves every body of the group, as the system couples them.
     pub(super) fn take_in(
         &mut self,
-        body: &DeformableBody,
-        constraints: &BodyConstraints,
+        (body, constraints): (&DeformableBody, &BodyConstraints),
         (factor, same_factor): (&Llt<usize, f64>, bool),
+        placement: Placement,
         residual: &[DVec3],
         direction: Vec<DVec3>,
     ) -> Vec<DVec3> {
@@ -354,12 +359,16 @@ impl RigidResponse {
             |a: &[DVec3], b: &[DVec3]| -> f64 { a.iter().zip(b).map(|(x, y)| x.dot(*y)).sum() };
         let solved = match self.solved_columns.take() {
             Some((columns, solved)) if same_factor && columns == coupling.columns => solved,
-            _ => solve_columns(factor, &coupling.columns),
+            _ => solve_columns(factor, &placement.embed(&coupling.columns)),
         };
         let m = coupling.columns.len();
         let q = self.compliance(&coupling);
-        let u_z = DMatrix::from_fn(m, m, |i, j| dot(&coupling.columns[i], &solved[j]));
-        let u_d = DVector::from_fn(m, |i, _| dot(&coupling.columns[i], &direction));
+        // `U` is zero outside the body's own nodes.
+        let own = placement.offset..placement.offset + body.positions.len();
+        let u_z = DMatrix::from_fn(m, m, |i, j| {
+            dot(&coupling.columns[i], &solved[j][own.clone()])
+        });
+        let u_d = DVector::from_fn(m, |i, _| dot(&coupling.columns[i], &direction[own.clone()]));
         let system = DMatrix::identity(m, m) - &q * u_z;
         let Some(weights) = system.lu().solve(&(&q * u_d)) else {
             self.solved_columns = Some((coupling.columns, solved));
@@ -437,6 +446,33 @@ impl RigidResponse {
             }
         }
         q
+    }
+}
+
+/// Where a body's nodes sit among the nodes of the system a Newton direction solves: from node
+/// `offset` on, of `total` (the body alone: `0` of its own count).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Placement {
+    pub(super) offset: usize,
+    pub(super) total: usize,
+}
+
+impl Placement {
+    /// The body's `columns` (per node of the body) as columns of the system, zero elsewhere.
+    fn embed<'c>(&self, columns: &'c [Vec<DVec3>]) -> Cow<'c, [Vec<DVec3>]> {
+        if columns.iter().all(|column| column.len() == self.total) {
+            return Cow::Borrowed(columns);
+        }
+        Cow::Owned(
+            columns
+                .iter()
+                .map(|column| {
+                    let mut embedded = vec![DVec3::ZERO; self.total];
+                    embedded[self.offset..self.offset + column.len()].copy_from_slice(column);
+                    embedded
+                })
+                .collect(),
+        )
     }
 }
 

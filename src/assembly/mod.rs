@@ -9,6 +9,8 @@
 //! Venant–Kirchhoff and Neo-Hookean are indefinite under compression); the projection stiffens
 //! the rotational directions of a stressed element, so exact tangents are used where they exist.
 
+mod joint;
+
 use crate::Error;
 use crate::body::DeformableBody;
 use crate::element::deformation_gradient;

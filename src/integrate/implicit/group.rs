@@ -1,0 +1,485 @@
+//! An implicit step of soft bodies touching each other, solved as one system: the group's
+//! incremental potential is the sum of its bodies' (each with its own contacts, attachments and
+//! rigid partners, see [`super::potential`]) plus the contacts between them (see
+//! [`crate::contact::JointContacts`]), and Newton minimizes it over every body's nodes at once.
+//! The tangent is the bodies' tangents side by side with the blocks coupling each contact's node
+//! and triangle ([`Stiffness::joint`]), factored whole; the rigid partners' response of each
+//! body is taken into the direction with that factorization. Each step assembles and factors
+//! anew (no reuse of factorizations across iterations) and solves directly, whatever
+//! [`ImplicitIntegrator::linear_solver`] says; the scheme is BDF2 only when every body of the
+//! group has the history for it, backward Euler otherwise, so that all take the same `ĥ`.
+
+use super::potential::Potential;
+use super::rigid_response::{Placement, RigidResponse};
+use super::{ImplicitIntegrator, ImplicitReport, Outcome, end_substep};
+use crate::Error;
+use crate::assembly::Stiffness;
+use crate::body::DeformableBody;
+use crate::constraint::{self, BodyConstraints};
+use crate::contact::{BetweenContact, ContactSettings, GroupNodes, JointContacts};
+use crate::integrate::{BodyInStep, PreviousStep};
+use crate::linear_solver::{Method, solve_newton_system};
+use crate::newton::{Configuration, Search, descend, norm};
+use rapier3d::glamx::DVec3;
+use std::cell::RefCell;
+
+/// The group's bodies as Newton moves them, their nodes numbered body after body.
+struct Group<'s, 'b> {
+    bodies: &'s mut [&'b mut DeformableBody],
+    /// Each body's first node in the group's numbering, then the group's node count.
+    offsets: Vec<usize>,
+    masses: Vec<f64>,
+    pinned: Vec<bool>,
+}
+
+impl Configuration for Group<'_, '_> {
+    fn copy_positions(&self) -> Vec<DVec3> {
+        self.bodies
+            .iter()
+            .flat_map(|body| body.positions.iter().copied())
+            .collect()
+    }
+
+    fn place(&mut self, start: &[DVec3], direction: &[DVec3], alpha: f64) {
+        for (k, body) in self.bodies.iter_mut().enumerate() {
+            let range = self.offsets[k]..self.offsets[k + 1];
+            body.place(&start[range.clone()], &direction[range], alpha);
+        }
+    }
+}
+
+impl Group<'_, '_> {
+    /// The group's node count.
+    fn node_count(&self) -> usize {
+        *self.offsets.last().unwrap_or(&0)
+    }
+
+    /// The group's node `node` as a node of its body.
+    fn body_node(&self, node: usize) -> usize {
+        let body = self.offsets.partition_point(|&first| first <= node) - 1;
+        node - self.offsets[body]
+    }
+}
+
+/// The group's incremental potential: its bodies' and the contacts between them.
+struct GroupPotential<'a> {
+    members: Vec<Potential<'a>>,
+    between: &'a JointContacts,
+    /// The effective step `ĥ` (s) every body of the group takes.
+    effective: f64,
+}
+
+impl GroupPotential<'_> {
+    /// `E` (J) with the bodies where `group` has them.
+    fn energy(&self, group: &Group) -> f64 {
+        let own: f64 = self
+            .members
+            .iter()
+            .zip(group.bodies.iter())
+            .map(|(member, body)| member.energy(body))
+            .sum();
+        let positions = group.copy_positions();
+        let mut between = 0.0;
+        self.between
+            .for_each_term(nodes(group, &positions), self.effective, |_, e, _, _| {
+                between += e;
+            });
+        own + between
+    }
+
+    /// `−∇E` (N per node of the group), zero on pinned nodes; `forces` is each body's scratch
+    /// for its internal forces.
+    fn residual(&self, group: &mut Group, forces: &mut [Vec<DVec3>]) -> Vec<DVec3> {
+        let mut residual = Vec::with_capacity(group.node_count());
+        for ((member, body), forces) in self.members.iter().zip(group.bodies.iter_mut()).zip(forces)
+        {
+            residual.extend(member.residual(body, forces));
+        }
+        let positions = group.copy_positions();
+        self.between.for_each_term(
+            nodes(group, &positions),
+            self.effective,
+            |at, _, force, _| {
+                for (&node, w) in at.nodes.iter().zip(at.weights) {
+                    if !group.pinned[node as usize] {
+                        residual[node as usize] += force * *w;
+                    }
+                }
+            },
+        );
+        residual
+    }
+
+    /// Fills `joint` with the group's tangent (N/m): each body's assembled on its own pattern in
+    /// `parts` (`inertia` its `m/ĥ²` per node), side by side, plus the contacts' blocks; element
+    /// stress tangents projected to be positive semi-definite if `project`.
+    fn assemble(
+        &self,
+        group: &Group,
+        (joint, parts): (&mut Stiffness, &mut [Stiffness]),
+        inertia: &[Vec<f64>],
+        project: bool,
+    ) {
+        joint.values.fill(0.0);
+        for (k, member) in self.members.iter().enumerate() {
+            member.assemble(group.bodies[k], &mut parts[k], &inertia[k], project);
+            joint.add_part(&parts[k], group.offsets[k]);
+        }
+        let positions = group.copy_positions();
+        self.between.for_each_term(
+            nodes(group, &positions),
+            self.effective,
+            |at, _, _, tangent| {
+                joint.add_stencil_block(at, &tangent, &group.pinned);
+            },
+        );
+    }
+
+    /// The force scale the tolerance is relative to (N): the bodies' scales (see
+    /// [`Potential::force_scale`]) combined, or the initial out-of-balance force if larger.
+    fn force_scale(&self, group: &Group, initial_residual: &[DVec3]) -> f64 {
+        let squares: f64 = self
+            .members
+            .iter()
+            .enumerate()
+            .map(|(k, member)| {
+                let own = &initial_residual[group.offsets[k]..group.offsets[k + 1]];
+                member.force_scale(group.bodies[k], own).powi(2)
+            })
+            .sum();
+        squares.sqrt().max(norm(initial_residual))
+    }
+}
+
+/// The group's nodes with positions `positions` (m).
+fn nodes<'a>(group: &'a Group, positions: &'a [DVec3]) -> GroupNodes<'a> {
+    GroupNodes {
+        positions,
+        masses: &group.masses,
+        pinned: &group.pinned,
+    }
+}
+
+/// What the group's steps keep across substeps: the contacts between the bodies, each body's
+/// tangent on its own pattern, and the group's tangent.
+struct GroupSolver {
+    between: JointContacts,
+    parts: Vec<Stiffness>,
+    joint: Stiffness,
+    /// Each body's first node in the group's numbering, then the group's node count.
+    offsets: Vec<usize>,
+}
+
+impl GroupSolver {
+    /// The solver of `bodies` touching through `between`: each body's tangent from its
+    /// workspace, widened where its constraints or the contacts couple nodes its mesh does not.
+    fn new(
+        bodies: &mut [BodyInStep<'_>],
+        between: &[BetweenContact],
+        settings: &ContactSettings,
+    ) -> Self {
+        let mut offsets = vec![0];
+        for step in bodies.iter() {
+            offsets.push(offsets[offsets.len() - 1] + step.body.positions.len());
+        }
+        let first_nodes: Vec<u32> = offsets.iter().map(|&o| o as u32).collect();
+        let between = JointContacts::new(between, &first_nodes, settings);
+        let body_of = |node: u32| offsets.partition_point(|&first| first <= node as usize) - 1;
+        let (mut own, mut cross): (Vec<Vec<[u32; 2]>>, Vec<[u32; 2]>) =
+            (vec![Vec::new(); bodies.len()], Vec::new());
+        for [a, b] in between.coupled_pairs() {
+            let (ka, kb) = (body_of(a), body_of(b));
+            if ka == kb {
+                let first = offsets[ka] as u32;
+                own[ka].push([a - first, b - first]);
+            } else {
+                cross.push([a, b]);
+            }
+        }
+        let parts: Vec<Stiffness> = bodies
+            .iter_mut()
+            .zip(own)
+            .map(|(step, own)| {
+                let mut tangent = step.workspace.take_tangent(step.body);
+                let mut missing =
+                    constraint::uncoupled_pairs(step.body, step.constraints, &tangent);
+                missing.extend(own.into_iter().filter(|&[a, b]| !tangent.couples(a, b)));
+                missing.sort_unstable();
+                missing.dedup();
+                if !missing.is_empty()
+                    && let Some(widened) = tangent.widened(&missing)
+                {
+                    tangent = widened;
+                }
+                tangent
+            })
+            .collect();
+        let refs: Vec<&Stiffness> = parts.iter().collect();
+        let joint = Stiffness::joint(&refs, &cross)
+            .expect("the contacts couple nodes of the group's bodies, ordered");
+        Self {
+            between,
+            parts,
+            joint,
+            offsets,
+        }
+    }
+
+    /// Gives each body's tangent back to its workspace.
+    fn give_back(self, bodies: &mut [BodyInStep<'_>]) {
+        for (step, part) in bodies.iter_mut().zip(self.parts) {
+            step.workspace.tangent = Some(part);
+        }
+    }
+}
+
+impl ImplicitIntegrator {
+    /// Advances soft `bodies` touching each other through `between` (indices into `bodies`) by
+    /// `frame_dt` (s) under `gravity` (m/s²) as one system (see the module documentation), with
+    /// `settings` for the contacts between them. A report per body, in order; the Newton counts
+    /// are the group's.
+    ///
+    /// # Errors
+    /// Those of [`ImplicitIntegrator::step`]; every body is then left as it was.
+    pub(crate) fn step_together(
+        &self,
+        bodies: &mut [BodyInStep<'_>],
+        between: &[BetweenContact],
+        settings: &ContactSettings,
+        (frame_dt, gravity): (f64, DVec3),
+    ) -> Result<Vec<ImplicitReport>, Error> {
+        Error::check_step(frame_dt, gravity)?;
+        self.check()?;
+        let mut histories = Vec::with_capacity(bodies.len());
+        for step in bodies.iter_mut() {
+            step.save();
+            histories.push(step.workspace.history(step.body).cloned());
+        }
+        let mut solver = GroupSolver::new(bodies, between, settings);
+        let h = frame_dt / f64::from(self.substeps);
+        let mut report = ImplicitReport::empty(self.substeps);
+        let mut last: Vec<Option<PreviousStep>> = histories.clone();
+        let mut failure = None;
+        for _ in 0..self.substeps {
+            match self.substep_together(bodies, &mut solver, &mut last, (h, gravity)) {
+                Ok(outcome) => report.add(&outcome),
+                Err(error) => {
+                    failure = Some(error);
+                    break;
+                }
+            }
+        }
+        solver.give_back(bodies);
+        let failure = failure.or_else(|| {
+            bodies
+                .iter()
+                .find_map(|step| step.body.first_non_finite_node())
+                .map(|node| Error::NonFiniteState { node })
+        });
+        if let Some(error) = failure {
+            for (step, history) in bodies.iter_mut().zip(histories) {
+                step.restore();
+                step.workspace.previous_step = history;
+            }
+            return Err(error);
+        }
+        Ok(bodies
+            .iter_mut()
+            .zip(last)
+            .map(|(step, last)| {
+                step.workspace.previous_step = last;
+                ImplicitReport {
+                    inverted_tets: step.body.inverted_tet_count(),
+                    ..report
+                }
+            })
+            .collect())
+    }
+
+    /// One substep of `h` (s) of the group: `last` holds each body's last substep start, and is
+    /// updated.
+    fn substep_together(
+        &self,
+        bodies: &mut [BodyInStep<'_>],
+        solver: &mut GroupSolver,
+        last: &mut [Option<PreviousStep>],
+        (h, gravity): (f64, DVec3),
+    ) -> Result<Outcome, Error> {
+        // One `ĥ` for all: two-step only if every body can.
+        let bdf2 = last.iter().all(|p| p.as_ref().is_some_and(|p| p.h == h));
+        let mut starts = Vec::with_capacity(bodies.len());
+        let mut responses = Vec::with_capacity(bodies.len());
+        for (step, previous) in bodies.iter_mut().zip(last.iter()) {
+            let previous = previous.as_ref().filter(|_| bdf2);
+            let (start, response) =
+                self.begin_substep(step.body, step.constraints, previous, (h, gravity));
+            starts.push(start);
+            responses.push(response);
+        }
+        let (mut body_refs, constraints): (Vec<&mut DeformableBody>, Vec<&mut BodyConstraints>) =
+            bodies
+                .iter_mut()
+                .map(|step| (&mut *step.body, &mut *step.constraints))
+                .unzip();
+        let mut group = Group {
+            masses: body_refs.iter().flat_map(|b| b.masses.clone()).collect(),
+            pinned: body_refs.iter().flat_map(|b| b.pinned.clone()).collect(),
+            bodies: &mut body_refs,
+            offsets: solver.offsets.clone(),
+        };
+        let effective = starts[0].h;
+        let positions = group.copy_positions();
+        solver
+            .between
+            .lag_friction(nodes(&group, &positions), effective);
+        let potential = GroupPotential {
+            members: starts
+                .iter()
+                .zip(&constraints)
+                .zip(responses)
+                .map(|((start, constraints), response)| Potential {
+                    start,
+                    constraints,
+                    rigid: RefCell::new(response),
+                })
+                .collect(),
+            between: &solver.between,
+            effective,
+        };
+        let outcome = self.minimize_group(
+            &mut group,
+            &potential,
+            (&mut solver.joint, &mut solver.parts),
+        );
+        let responses: Vec<RigidResponse> = potential
+            .members
+            .into_iter()
+            .map(|member| member.rigid.into_inner())
+            .collect();
+        let outcome = outcome?;
+        for (((body, constraints), (start, response)), last) in body_refs
+            .into_iter()
+            .zip(constraints)
+            .zip(starts.into_iter().zip(responses))
+            .zip(last.iter_mut())
+        {
+            *last = Some(end_substep(body, constraints, start, response, h));
+        }
+        Ok(outcome)
+    }
+
+    /// Newton's method on the group's potential, from the inertial prediction or from where
+    /// the bodies are, whichever is lower (as [`ImplicitIntegrator::step`] does for one body).
+    fn minimize_group(
+        &self,
+        group: &mut Group,
+        potential: &GroupPotential,
+        (joint, parts): (&mut Stiffness, &mut [Stiffness]),
+    ) -> Result<Outcome, Error> {
+        let here = potential.energy(group);
+        let starts: Vec<DVec3> = potential
+            .members
+            .iter()
+            .flat_map(|m| m.start.positions.iter().copied())
+            .collect();
+        let targets: Vec<DVec3> = potential
+            .members
+            .iter()
+            .flat_map(|m| m.start.target.iter().copied())
+            .collect();
+        group.set(&targets);
+        let mut energy = potential.energy(group);
+        if energy.is_nan() || energy > here {
+            group.set(&starts);
+            energy = here;
+        }
+        let inertia: Vec<Vec<f64>> = group
+            .bodies
+            .iter()
+            .map(|body| {
+                let h = potential.effective;
+                body.masses.iter().map(|m| m / (h * h)).collect()
+            })
+            .collect();
+        let mut forces: Vec<Vec<DVec3>> = group.bodies.iter().map(|_| Vec::new()).collect();
+        let mut residual = potential.residual(group, &mut forces);
+        let reference = potential.force_scale(group, &residual);
+        let mut history: Vec<f64> = Vec::new();
+        let mut outcome = Outcome::start();
+        loop {
+            let relative = norm(&residual) / reference;
+            outcome.residual = relative;
+            if !relative.is_finite() {
+                let at = residual.iter().position(|r| !r.is_finite()).unwrap_or(0);
+                return Err(Error::NonFiniteState {
+                    node: group.body_node(at),
+                });
+            }
+            if let Some(converged) = self.stop(relative, &history, outcome.iterations) {
+                outcome.converged = converged;
+                return Ok(outcome);
+            }
+            history.push(relative);
+            let direction = self.group_direction(
+                group,
+                potential,
+                (&mut *joint, &mut *parts),
+                (&inertia, &residual),
+                &mut outcome,
+            )?;
+            let next = descend(
+                group,
+                &residual,
+                energy,
+                &direction,
+                Search::Thorough,
+                |group| potential.energy(group),
+                |group| potential.residual(group, &mut forces),
+            );
+            outcome.iterations += 1;
+            match next {
+                Some((next, value)) => (residual, energy) = (next, value),
+                None => return Ok(outcome),
+            }
+        }
+    }
+
+    /// The Newton direction (m per node of the group) of the group's exact tangent (projected
+    /// where it is not positive definite), with each body's rigid partners' response taken in.
+    fn group_direction(
+        &self,
+        group: &Group,
+        potential: &GroupPotential,
+        (joint, parts): (&mut Stiffness, &mut [Stiffness]),
+        (inertia, residual): (&[Vec<f64>], &[DVec3]),
+        outcome: &mut Outcome,
+    ) -> Result<Vec<DVec3>, Error> {
+        let solution = solve_newton_system(
+            Method::Direct,
+            self.tolerance / outcome.residual,
+            joint,
+            residual,
+            outcome.iterations,
+            |joint, project| potential.assemble(group, (joint, &mut *parts), inertia, project),
+        )?;
+        outcome.factorizations += solution.factorizations;
+        outcome.projected_tangents += usize::from(solution.projected);
+        let mut direction = solution.direction;
+        if let Some(factor) = &solution.factor {
+            for (k, member) in potential.members.iter().enumerate() {
+                let placement = Placement {
+                    offset: group.offsets[k],
+                    total: group.node_count(),
+                };
+                direction = member.take_in_placed(
+                    group.bodies[k],
+                    (factor, false),
+                    placement,
+                    residual,
+                    direction,
+                );
+            }
+        }
+        Ok(direction)
+    }
+}
