@@ -214,7 +214,10 @@ fn soft_bodies_collide(force: Option<IntegratorKind>) {
     assert!(struck_momentum.x > 0.2 * p0.x);
     // Neither integrator may create energy at the contact (restitution 0, damped bodies): the
     // energy never rises above its start beyond the round-off of its sums (1e-9 relative).
-    assert!(highest <= e0 * (1.0 + 1e-9), "energy rose to {highest} J from {e0} J");
+    assert!(
+        highest <= e0 * (1.0 + 1e-9),
+        "energy rose to {highest} J from {e0} J"
+    );
     assert!((p1 - p0).length() <= 1e-6 * p0.length());
     assert!((l1 - l0).length() <= world.coupling.contact.margin * struck_momentum.length());
 }

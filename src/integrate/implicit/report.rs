@@ -1,0 +1,93 @@
+//! What an implicit frame did: per frame the [`ImplicitReport`] a user reads, per substep the
+//! Newton solve's [`Outcome`] it sums.
+
+/// What one implicit frame step did.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ImplicitReport {
+    /// Substeps taken.
+    pub substeps: u32,
+    /// Newton iterations over all substeps, those that reused a factorization included.
+    pub newton_iterations: usize,
+    /// Conjugate gradient iterations over all substeps (zero when every system was solved by
+    /// the direct method).
+    pub linear_iterations: usize,
+    /// Newton iterations that solved with an earlier factorization instead of assembling and
+    /// factoring the tangent (see [`ImplicitIntegrator::reuse_factorization`](super::ImplicitIntegrator::reuse_factorization)); included in
+    /// `newton_iterations`.
+    pub reused_factorizations: usize,
+    /// Numeric Cholesky factorizations of the Newton system (two in an iteration whose exact
+    /// tangent failed to factor and whose projected tangent was factored; none for systems
+    /// solved by the conjugate gradient or with a reused factorization).
+    pub factorizations: usize,
+    /// Newton iterations whose exact tangent was not positive definite (the Cholesky
+    /// factorization failed or the conjugate gradient met negative curvature), so that the
+    /// tangent with element stress tangents projected to be positive semi-definite was solved.
+    pub projected_tangents: usize,
+    /// Largest final relative residual over the substeps.
+    pub relative_residual: f64,
+    /// Whether every substep met the tolerance.
+    pub converged: bool,
+    /// Tetrahedra inverted (zero or negative volume) at the end of the frame.
+    pub inverted_tets: usize,
+}
+
+/// What one substep's Newton solve did.
+pub(super) struct Outcome {
+    /// Newton iterations.
+    pub(super) iterations: usize,
+    /// Conjugate gradient iterations.
+    pub(super) linear_iterations: usize,
+    /// Iterations that reused an earlier factorization.
+    pub(super) reused_factorizations: usize,
+    /// Numeric Cholesky factorizations.
+    pub(super) factorizations: usize,
+    /// Iterations that solved the projected tangent.
+    pub(super) projected_tangents: usize,
+    /// Final relative residual.
+    pub(super) residual: f64,
+    /// Whether the tolerance was met.
+    pub(super) converged: bool,
+}
+
+impl ImplicitReport {
+    /// The report of a frame of `substeps` before any: nothing done, converged.
+    pub(super) fn empty(substeps: u32) -> Self {
+        Self {
+            substeps,
+            newton_iterations: 0,
+            linear_iterations: 0,
+            reused_factorizations: 0,
+            factorizations: 0,
+            projected_tangents: 0,
+            relative_residual: 0.0,
+            converged: true,
+            inverted_tets: 0,
+        }
+    }
+
+    /// Counts a substep's Newton solve in the report.
+    pub(super) fn add(&mut self, outcome: &Outcome) {
+        self.newton_iterations += outcome.iterations;
+        self.linear_iterations += outcome.linear_iterations;
+        self.reused_factorizations += outcome.reused_factorizations;
+        self.factorizations += outcome.factorizations;
+        self.projected_tangents += outcome.projected_tangents;
+        self.relative_residual = self.relative_residual.max(outcome.residual);
+        self.converged &= outcome.converged;
+    }
+}
+
+impl Outcome {
+    /// No iteration yet; the residual and convergence are set on return.
+    pub(super) fn start() -> Self {
+        Self {
+            iterations: 0,
+            linear_iterations: 0,
+            reused_factorizations: 0,
+            factorizations: 0,
+            projected_tangents: 0,
+            residual: f64::NAN,
+            converged: false,
+        }
+    }
+}
