@@ -172,17 +172,7 @@ impl AutomaticIntegrator {
             }
             IntegratorKind::Implicit => None,
         };
-        let (explicit, fell_back) = match explicit {
-            Some(Ok(report)) => (Some(report), false),
-            // The explicit frame left the body as it was: redo it implicitly, unless forced.
-            Some(Err(Error::TooManySubsteps { .. } | Error::NonFiniteState { .. }))
-                if self.force.is_none() =>
-            {
-                (None, true)
-            }
-            Some(Err(error)) => return Err(error),
-            None => (None, false),
-        };
+        let (explicit, fell_back) = self.explicit_outcome(explicit)?;
         let implicit = match explicit {
             Some(_) => None,
             None => Some(
@@ -201,6 +191,28 @@ impl AutomaticIntegrator {
             implicit,
             fell_back,
         })
+    }
+
+    /// What an explicit frame (if one ran) leaves: its report, and whether the frame must be
+    /// redone implicitly because it would take too many substeps or gave a non-finite state
+    /// (the explicit integrator then left the bodies as they were), unless a choice is forced.
+    ///
+    /// # Errors
+    /// The explicit frame's other errors, and those two when explicit is forced.
+    fn explicit_outcome<T>(
+        &self,
+        explicit: Option<Result<T, Error>>,
+    ) -> Result<(Option<T>, bool), Error> {
+        match explicit {
+            Some(Ok(report)) => Ok((Some(report), false)),
+            Some(Err(Error::TooManySubsteps { .. } | Error::NonFiniteState { .. }))
+                if self.force.is_none() =>
+            {
+                Ok((None, true))
+            }
+            Some(Err(error)) => Err(error),
+            None => Ok((None, false)),
+        }
     }
 
     /// Advances soft `bodies` touching each other through `between` (indices into `bodies`)
@@ -231,16 +243,7 @@ impl AutomaticIntegrator {
                     .step_together(bodies, between, frame_dt, gravity),
             ),
         };
-        let (explicit, fell_back) = match explicit {
-            Some(Ok(reports)) => (Some(reports), false),
-            Some(Err(Error::TooManySubsteps { .. } | Error::NonFiniteState { .. }))
-                if self.force.is_none() =>
-            {
-                (None, true)
-            }
-            Some(Err(error)) => return Err(error),
-            None => (None, false),
-        };
+        let (explicit, fell_back) = self.explicit_outcome(explicit)?;
         let reports: Vec<(Option<StepReport>, Option<ImplicitReport>)> = match explicit {
             Some(reports) => reports.into_iter().map(|r| (Some(r), None)).collect(),
             None => self
