@@ -43,7 +43,7 @@ pub enum ImportErrorKind {
     IndexOutOfRange,
     /// A number is NaN or infinite, or becomes infinite once scaled.
     NonFinite,
-    /// A coordinate is finite but lies beyond ±[`MAX_COORDINATE`](crate::mesh::MAX_COORDINATE)
+    /// A coordinate is finite but lies beyond ±[`MAX_COORDINATE`](crate::limits::MAX_COORDINATE)
     /// m once scaled.
     CoordinateOutOfRange,
     /// An element type that cannot be used: quadratic tetrahedra, or volume elements other than
@@ -81,11 +81,11 @@ pub enum Error {
         /// Its coordinates (m).
         position: [f64; 3],
     },
-    /// A node coordinate is finite but beyond ±[`MAX_COORDINATE`](crate::mesh::MAX_COORDINATE)
+    /// A node coordinate is finite but beyond ±[`MAX_COORDINATE`](crate::limits::MAX_COORDINATE)
     /// (m), where the products of coordinates the element computations form overflow.
     #[error(
         "node {node} at {position:?} m lies beyond ±{max:e} m, where the element computations overflow",
-        max = crate::mesh::MAX_COORDINATE
+        max = crate::limits::MAX_COORDINATE
     )]
     CoordinateOutOfRange {
         /// Index of the offending node.
@@ -221,11 +221,11 @@ pub enum Error {
         velocity: [f64; 3],
     },
     /// A node speed given to a body, or found on it before a step, exceeds the speed of light
-    /// ([`SPEED_OF_LIGHT`](crate::body::SPEED_OF_LIGHT)): no state of the Newtonian mechanics
+    /// ([`SPEED_OF_LIGHT`](crate::limits::SPEED_OF_LIGHT)): no state of the Newtonian mechanics
     /// the step integrates.
     #[error(
         "node {node} moves at {speed:e} m/s, faster than light ({c} m/s): beyond the Newtonian mechanics the step integrates",
-        c = crate::body::SPEED_OF_LIGHT
+        c = crate::limits::SPEED_OF_LIGHT
     )]
     SpeedOutOfRange {
         /// Index of the offending node.

@@ -91,6 +91,7 @@ mod error;
 pub mod fvm;
 pub mod integrate;
 mod lanes;
+mod limits;
 pub mod linear_solver;
 pub mod material;
 pub mod mesh;

@@ -12,17 +12,9 @@
 
 use super::DeformableBody;
 use crate::Error;
+pub use crate::limits::SPEED_OF_LIGHT;
 use crate::mesh::check_position;
 use rapier3d::glamx::DVec3;
-
-/// The speed of light in vacuum (m/s): no node may move faster.
-///
-/// Reason: no material point does, and the Newtonian mechanics the step integrates has lost its
-/// meaning long before. Such a speed is not a state the step can resolve: on a 10 cm rubber cube
-/// under the default [`FvmWorld`](crate::world::FvmWorld), one node at 1e10 m/s (or 1e30 m/s)
-/// overflowed the explicit attempt, and the implicit fallback ended its frame at rest, the speed
-/// gone without an error.
-pub const SPEED_OF_LIGHT: f64 = 299_792_458.0;
 
 impl DeformableBody {
     /// Sets every node's world position (m), one per node; pinned nodes are held where they are

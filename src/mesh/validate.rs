@@ -7,17 +7,8 @@
 //! Every defect is an [`Error`] naming the first offending node or tetrahedron.
 
 use crate::Error;
+pub use crate::limits::MAX_COORDINATE;
 use rapier3d::glamx::DVec3;
-
-/// The largest coordinate magnitude a mesh or a body may have (m).
-///
-/// Reason: the element computations multiply up to three coordinate differences (volumes,
-/// `(b - a) × (c - a) · (d - a)`; an edge cubed in the degeneracy test), then scale them by
-/// material constants and densities. Two nodes within ±1e100 m are at most `2√3·1e100 ≈ 3.5e100`
-/// m apart, so a product of three such lengths stays below `4.2e301`, seven orders of magnitude
-/// under `f64::MAX ≈ 1.8e308`, which leaves room for the constants. A node at `-9e307` m, by
-/// contrast, overflows the first difference and makes its tetrahedron's volume NaN.
-pub const MAX_COORDINATE: f64 = 1e100;
 
 /// Relative volume below which a tetrahedron counts as degenerate: `|V| <= 1e-12 * l^3`, with `l`
 /// the tetrahedron's longest edge.
