@@ -86,7 +86,14 @@ impl BodyConstraints {
     ) -> Result<&[NodeContact], Error> {
         let glued: Vec<(RigidBodyHandle, u32)> =
             self.attachments.iter().map(|a| (a.body, a.node)).collect();
-        let found = contact::detect(body, &glued, colliders, frame_dt, gravity, settings)?;
+        let found = contact::detect(
+            body,
+            (&glued, &self.contacts.nodes),
+            colliders,
+            frame_dt,
+            gravity,
+            settings,
+        )?;
         let mut proxies = found.proxies;
         attachment::ready(&mut self.attachments, &mut proxies, rigid);
         self.rigid_proxies = proxies;

@@ -5,6 +5,7 @@
 //! rigid vertices are tested against the boundary triangles. Also the force the contacts exerted
 //! on any collider.
 
+use super::entry::{LastContact, entered_surface_point};
 use super::{
     BodyPoint, Coefficients, ContactSet, ContactSettings, ContactTarget, CornerContact,
     NodeContact, Obstacle, SurfaceCoefficients, corner, surface_tree,
@@ -13,9 +14,10 @@ use crate::Error;
 use crate::body::DeformableBody;
 use crate::rigid::RigidProxy;
 use rapier3d::dynamics::RigidBodyHandle;
-use rapier3d::geometry::{ColliderHandle, InteractionGroups, Shape, SharedShape};
+use rapier3d::geometry::{ColliderHandle, InteractionGroups, Ray, Shape, SharedShape};
 use rapier3d::glamx::DVec3;
 use rapier3d::math::Pose;
+use std::collections::HashMap;
 
 /// A collider as detection sees it, made once per step for every deformable body (by the
 /// coupling, from rapier's sets): its shape and pose, bounds, collision groups and coefficients,
@@ -47,14 +49,15 @@ pub(crate) struct Detection {
 /// (s) under `gravity` (m/s²) (see
 /// [`BodyConstraints::detect_contacts`](crate::constraint::BodyConstraints::detect_contacts));
 /// `glued` lists the rigid bodies and the nodes glued to them, which do not touch their
-/// colliders.
+/// colliders; `previous` are the contacts of the last detection, whose points' paths since then
+/// tell the face a point entered a collider by (see [`super::entry`]).
 ///
 /// # Errors
 /// [`Error::InvalidTimeStep`], [`Error::NonFiniteInput`] or [`Error::InvalidSetting`] for a bad
 /// step, gravity or setting.
 pub(crate) fn detect(
     body: &DeformableBody,
-    glued: &[(RigidBodyHandle, u32)],
+    (glued, previous): (&[(RigidBodyHandle, u32)], &[NodeContact]),
     colliders: &[ColliderView],
     frame_dt: f64,
     gravity: DVec3,
@@ -72,6 +75,7 @@ pub(crate) fn detect(
     let mut tree = None;
     let mut corners = Vec::new();
     let contact_points = contact_points(body);
+    let last = last_contacts(previous);
     for view in colliders {
         if !body.collision_groups.test(view.groups) {
             continue;
@@ -79,7 +83,8 @@ pub(crate) fn detect(
         let near = near_collider(body, glued, view, reach);
         let mut proxy = None;
         for &at in &contact_points {
-            let Some(contact) = node_contact_with(body, &near, at) else {
+            let Some(contact) = node_contact_with(body, &near, (at, last.get(&(at, view.handle))))
+            else {
                 continue;
             };
             if proxy.is_none() {
@@ -138,7 +143,7 @@ fn near_collider<'a>(
 fn node_contact_with(
     body: &DeformableBody,
     near: &NearCollider<'_>,
-    at: BodyPoint,
+    (at, last): (BodyPoint, Option<&LastContact>),
 ) -> Option<NodeContact> {
     let stencil = at.stencil(body.embedding.as_ref());
     if stencil.nodes.iter().all(|&n| body.pinned[n as usize])
@@ -152,9 +157,9 @@ fn node_contact_with(
     if (x + reach).cmplt(lo).any() || (x - reach).cmpgt(hi).any() {
         return None;
     }
-    let (point, normal, distance) = nearest_surface_point(near.shape.as_ref(), near.pose, x)?;
+    let (point, normal, distance) = entered_surface_point(near.shape.as_ref(), near.pose, x, last)?;
     (distance <= near.reach).then(|| {
-        NodeContact::new(
+        let mut contact = NodeContact::new(
             at,
             ContactTarget::Collider(near.handle),
             point,
@@ -165,8 +170,41 @@ fn node_contact_with(
                 pose: *near.pose,
                 proxy: None,
             },
-        )
+        );
+        contact.detected_at = x;
+        contact.depth_limit = 0.5 * thickness(near.shape.as_ref(), near.pose, point, normal);
+        contact
     })
+}
+
+/// The thickness (m) of `shape` at `pose` along the inward normal from its surface `point` with
+/// outward unit `normal`: where a ray from there leaves it; infinite when none does (a
+/// half-space).
+fn thickness(shape: &dyn Shape, pose: &Pose, point: DVec3, normal: DVec3) -> f64 {
+    let start = point - normal * ROUND_OFF_DISTANCE;
+    let ray = Ray::new(start.as_vec3(), (-normal).as_vec3());
+    shape
+        .cast_ray(pose, &ray, f32::MAX, false)
+        .map_or(f64::INFINITY, |time| f64::from(time) + ROUND_OFF_DISTANCE)
+}
+
+/// What the `contacts` of the last detection saw of each point's contact with each collider.
+fn last_contacts(contacts: &[NodeContact]) -> HashMap<(BodyPoint, ColliderHandle), LastContact> {
+    contacts
+        .iter()
+        .filter_map(|c| match (&c.target, &c.obstacle) {
+            (ContactTarget::Collider(handle), Obstacle::Collider { pose, .. }) => Some((
+                (c.at, *handle),
+                LastContact {
+                    at: c.detected_at,
+                    pose: *pose,
+                    point: c.point,
+                    normal: c.normal,
+                },
+            )),
+            _ => None,
+        })
+        .collect()
 }
 
 /// The points contacts with colliders are detected for: the surface vertices of the embedded

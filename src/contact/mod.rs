@@ -40,6 +40,7 @@
 mod between;
 mod corner;
 mod detect;
+mod entry;
 mod joint;
 mod node_contact;
 mod penalty;

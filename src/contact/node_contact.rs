@@ -28,7 +28,7 @@ pub enum ContactTarget {
 }
 
 /// Where on a soft body a contact acts.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum BodyPoint {
     /// A simulation node.
     Node(u32),
@@ -83,6 +83,13 @@ pub struct NodeContact {
     /// position at the start of the step (m).
     pub(super) lagged_normal_force: f64,
     pub(super) slip_origin: DVec3,
+    /// Where the point was when the contact was found (m): the next detection's path starts
+    /// there (see [`super::entry`]).
+    pub(super) detected_at: DVec3,
+    /// How deep (m) the point may go behind its plane before it is past the middle of the
+    /// collider: half the collider's thickness along the normal there (infinite for a
+    /// half-space or an own triangle).
+    pub(super) depth_limit: f64,
 }
 
 /// The far side of a contact.
@@ -135,6 +142,8 @@ impl NodeContact {
             constraint: VelocityConstraint::default(),
             lagged_normal_force: 0.0,
             slip_origin: DVec3::ZERO,
+            detected_at: point,
+            depth_limit: f64::INFINITY,
         }
     }
 
@@ -145,6 +154,13 @@ impl NodeContact {
             *slot = proxy;
         }
         self
+    }
+
+    /// Whether the point, at `x` (m), is further behind its plane than half the collider's
+    /// thickness: past the middle of a thin wall, so that a step which ends so is too long for
+    /// the penalty to resolve.
+    pub(super) fn past_middle(&self, x: DVec3) -> bool {
+        -self.gap(x) > self.depth_limit
     }
 
     /// Signed distance (m) of position `x` from the contact plane, negative inside.
@@ -185,14 +201,21 @@ impl NodeContact {
         )
     }
 
-    /// Moves the plane to the collider's surface point nearest to `x` (m), if defined there, or
-    /// to an own triangle's contact point where its nodes are now (`positions`, m).
+    /// Moves the plane to the collider's surface point nearest to `x` (m), if defined there and
+    /// facing the side the point entered from, or to an own triangle's contact point where its
+    /// nodes are now (`positions`, m).
     pub(super) fn refresh(&mut self, x: DVec3, positions: &[DVec3]) {
         match &self.obstacle {
             Obstacle::Collider { shape, pose, .. } => {
                 if let Some((point, normal, _)) = nearest_surface_point(&**shape, pose, x) {
-                    self.point = point;
-                    self.normal = normal;
+                    // Behind its plane with the nearest face looking the other way: past the
+                    // middle of a thin wall, or through it; the plane it entered by stays (see
+                    // `super::entry`).
+                    let behind = (x - self.point).dot(self.normal) < 0.0;
+                    if !(behind && normal.dot(self.normal) < 0.0) {
+                        self.point = point;
+                        self.normal = normal;
+                    }
                 }
             }
             Obstacle::OwnTriangle(point) => {

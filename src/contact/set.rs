@@ -3,6 +3,7 @@
 //! found with and are enforced by.
 
 use super::{ContactSettings, CornerContact, NodeContact, Obstacle};
+use crate::body::DeformableBody;
 use rapier3d::glamx::DVec3;
 
 /// The contacts one detection found for a body.
@@ -25,6 +26,19 @@ impl ContactSet {
                 .nodes
                 .iter()
                 .any(|c| matches!(c.obstacle, Obstacle::OwnTriangle(_)))
+    }
+
+    /// Whether a surface point of `body` is behind its collider contact's plane by more than
+    /// half the collider's thickness there (see [`NodeContact::past_middle`]): the step that
+    /// left it so was too long for the contact to hold.
+    pub(crate) fn past_middle(&self, body: &DeformableBody) -> bool {
+        self.nodes.iter().any(|c| {
+            matches!(c.obstacle, Obstacle::Collider { .. })
+                && c.past_middle(
+                    c.at.stencil(body.embedding.as_ref())
+                        .interpolate(&body.positions),
+                )
+        })
     }
 
     /// Zeroes the impulses the contacts gave over the last step.

@@ -43,6 +43,11 @@ use std::cell::RefCell;
 /// descent is still progress.
 const STALL_CEILING: f64 = 1e-4;
 
+/// A frame is redone in up to this many times [`ImplicitIntegrator::substeps`] while a surface
+/// point ends it past the middle of the collider it touches (see
+/// [`ImplicitIntegrator::substeps`]).
+const MAX_CONTACT_REFINEMENT: u32 = 64;
+
 /// Which implicit scheme [`ImplicitIntegrator`] uses.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[cfg_attr(
@@ -82,7 +87,11 @@ pub struct ImplicitIntegrator {
     /// left, keeps its last iterate (each accepted iterate lowered the incremental potential) and
     /// is reported as unconverged.
     pub max_newton_iterations: usize,
-    /// Equal substeps per frame (at least 1); each costs a Newton solve.
+    /// Equal substeps per frame (at least 1); each costs a Newton solve. A frame that leaves a
+    /// surface point behind its contact plane by more than half the thickness of the collider
+    /// it touches (a fast body pressed past the middle of a thin wall, where the penalty of a
+    /// long step is too soft to hold it) is redone in twice as many, and so on up to 64 times
+    /// as many: the report's `substeps` says how many were taken.
     pub substeps: u32,
     /// How each Newton iteration's linear system is solved.
     pub linear_solver: LinearSolver,
@@ -125,6 +134,34 @@ impl ImplicitIntegrator {
     /// [`Error::IndefiniteStiffness`] if a linear system cannot be factored;
     /// [`Error::NonFiniteState`] if the step produced a NaN. On error the body is left as it was.
     pub fn step(
+        &self,
+        body: &mut DeformableBody,
+        constraints: &mut BodyConstraints,
+        workspace: &mut SolverWorkspace,
+        frame_dt: f64,
+        gravity: DVec3,
+    ) -> Result<ImplicitReport, Error> {
+        let before = workspace.previous_step.clone();
+        let mut refined = *self;
+        loop {
+            let report =
+                refined.step_in_substeps(body, constraints, workspace, frame_dt, gravity)?;
+            let limit = self.substeps.saturating_mul(MAX_CONTACT_REFINEMENT);
+            if refined.substeps >= limit || !constraints.contacts.past_middle(body) {
+                return Ok(report);
+            }
+            // A point ended past the middle of the collider it touches: the frame is redone in
+            // twice the substeps.
+            workspace.restore_state(body);
+            constraints.restore();
+            workspace.previous_step.clone_from(&before);
+            refined.substeps = refined.substeps.saturating_mul(2).min(limit);
+        }
+    }
+
+    /// [`ImplicitIntegrator::step`] in [`ImplicitIntegrator::substeps`], however deep the
+    /// contacts end.
+    fn step_in_substeps(
         &self,
         body: &mut DeformableBody,
         constraints: &mut BodyConstraints,
