@@ -135,8 +135,28 @@ pub struct ImplicitReport {
     pub relative_residual: f64,
     /// Whether every substep met the tolerance.
     pub converged: bool,
+    /// Substeps whose Newton solve stopped short of the tolerance on its round-off floor: a
+    /// relative residual at most 1e-4 that three iterations could not cut by 10 % (very stiff
+    /// or nearly incompressible material against a small load). Not converged, not failed.
+    pub stalled_substeps: u32,
+    /// Substeps whose Newton solve failed: it ran out of iterations, or no descent was left,
+    /// with the relative residual above the tolerance and not on a round-off stall. The step
+    /// keeps its last iterate (which lowered the incremental potential) but is not a solution
+    /// of the implicit equations.
+    pub failed_substeps: u32,
     /// Tetrahedra inverted (zero or negative volume) at the end of the frame.
     pub inverted_tets: usize,
+}
+
+/// How a substep's Newton solve ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Stop {
+    /// The tolerance was met.
+    Converged,
+    /// The residual sat on its round-off floor (see [`ImplicitReport::stalled_substeps`]).
+    Stalled,
+    /// Out of iterations, or no descent left, above the tolerance.
+    Failed,
 }
 
 /// What one substep's Newton solve did.
@@ -153,8 +173,8 @@ struct Outcome {
     projected_tangents: usize,
     /// Final relative residual.
     residual: f64,
-    /// Whether the tolerance was met.
-    converged: bool,
+    /// How the solve ended.
+    stop: Stop,
 }
 
 impl ImplicitReport {
@@ -166,7 +186,9 @@ impl ImplicitReport {
         self.factorizations += outcome.factorizations;
         self.projected_tangents += outcome.projected_tangents;
         self.relative_residual = self.relative_residual.max(outcome.residual);
-        self.converged &= outcome.converged;
+        self.converged &= outcome.stop == Stop::Converged;
+        self.stalled_substeps += u32::from(outcome.stop == Stop::Stalled);
+        self.failed_substeps += u32::from(outcome.stop == Stop::Failed);
     }
 }
 
@@ -180,7 +202,7 @@ impl Outcome {
             factorizations: 0,
             projected_tangents: 0,
             residual: f64::NAN,
-            converged: false,
+            stop: Stop::Failed,
         }
     }
 }
@@ -218,6 +240,8 @@ impl ImplicitIntegrator {
             projected_tangents: 0,
             relative_residual: 0.0,
             converged: true,
+            stalled_substeps: 0,
+            failed_substeps: 0,
             inverted_tets: 0,
         };
         let mut stiffness = workspace.take_tangent(body);
@@ -375,8 +399,8 @@ impl ImplicitIntegrator {
                 let node = residual.iter().position(|r| !r.is_finite()).unwrap_or(0);
                 return Err(Error::NonFiniteState { node });
             }
-            if let Some(converged) = self.stop(relative, &history, outcome.iterations) {
-                outcome.converged = converged;
+            if let Some(stop) = self.stop(relative, &history, outcome.iterations) {
+                outcome.stop = stop;
                 return finish(solver, outcome);
             }
             history.push(relative);
@@ -427,7 +451,13 @@ impl ImplicitIntegrator {
             outcome.iterations += 1;
             match next {
                 Some((next, energy)) => (residual, potential) = (next, energy),
-                None => return finish(solver, outcome),
+                None => {
+                    // No descent left: round-off below the stall ceiling, a failure above it.
+                    if outcome.residual <= STALL_CEILING {
+                        outcome.stop = Stop::Stalled;
+                    }
+                    return finish(solver, outcome);
+                }
             }
         }
     }
@@ -454,18 +484,22 @@ impl ImplicitIntegrator {
     }
 
     /// Whether Newton stops at the relative residual `relative` after `iterations`, the earlier
-    /// relative residuals being `history` (newest last): `Some(true)` when it meets the
-    /// tolerance, `Some(false)` when out of iterations or stalled, `None` to go on. A small
+    /// relative residuals being `history` (newest last): how it stops when it meets the
+    /// tolerance, is out of iterations or stalled, `None` to go on. A small
     /// residual that three iterations could not cut by 10 % sits on its round-off floor (very
     /// stiff or nearly incompressible material against a small load).
-    fn stop(&self, relative: f64, history: &[f64], iterations: usize) -> Option<bool> {
+    fn stop(&self, relative: f64, history: &[f64], iterations: usize) -> Option<Stop> {
         if relative <= self.tolerance {
-            return Some(true);
+            return Some(Stop::Converged);
         }
         let stalled = relative <= STALL_CEILING
             && history.len() >= 3
             && relative > 0.9 * history[history.len() - 3];
-        (iterations == self.max_newton_iterations || stalled).then_some(false)
+        if stalled {
+            Some(Stop::Stalled)
+        } else {
+            (iterations == self.max_newton_iterations).then_some(Stop::Failed)
+        }
     }
 
     /// The Newton direction (m per node) of the exact tangent, which the chord keeps for reuse
