@@ -93,7 +93,7 @@ fn depth_in(collider: &Collider, x: DVec3) -> f64 {
 }
 
 /// Whether the point that was at `from` (m) when `collider` was at `then` went through it on its
-/// way to `to` (m), by more than `tolerance` (m).
+/// way to `to` (m), a path longer than `tolerance` (m).
 fn crossed(collider: &Collider, then: &Pose, from: DVec3, to: DVec3, tolerance: f64) -> bool {
     let pose = collider.position();
     // Where the point started, carried along with the collider's motion over the frame.
@@ -106,19 +106,23 @@ fn crossed(collider: &Collider, then: &Pose, from: DVec3, to: DVec3, tolerance: 
     }
     let shape = collider.shape();
     let forward = Ray::new(from.as_vec3(), path.as_vec3());
-    let Some(entry) = shape.cast_ray(pose, &forward, 1.0, true) else {
-        return false;
-    };
     if shape.as_trimesh().is_some() || shape.as_heightfield().is_some() {
+        if shape.cast_ray(pose, &forward, 1.0, false).is_none() {
+            return false;
+        }
         // A surface without interior: through it, and now beyond the tolerance from it.
         let projection = shape.project_point(pose, to.as_vec3(), false);
         return (projection.point.as_dvec3() - to).length() > tolerance;
     }
     let backward = Ray::new(to.as_vec3(), (-path).as_vec3());
-    let Some(exit) = shape.cast_ray(pose, &backward, 1.0, true) else {
+    let (Some(entry), Some(exit)) = (
+        shape.cast_ray_and_get_normal(pose, &forward, 1.0, false),
+        shape.cast_ray_and_get_normal(pose, &backward, 1.0, false),
+    ) else {
         return false;
     };
-    f64::from(1.0 - entry - exit) * path.length() > tolerance
+    // In through one face and out through one facing away from it: to the far side.
+    entry.time_of_impact + exit.time_of_impact < 1.0 && entry.normal.dot(exit.normal) < 0.0
 }
 
 /// Records in `found` the points of `checked` that lie inside the tetrahedra of `other` deeper
@@ -159,7 +163,8 @@ pub(super) fn against_soft(
     }
 }
 
-/// Whether `p` lies inside the tetrahedron `a b c d` (m) of either orientation.
+/// Whether `p` lies inside the tetrahedron `a b c d` (m) of either orientation, or on its
+/// boundary.
 fn contains(a: DVec3, b: DVec3, c: DVec3, d: DVec3, p: DVec3) -> bool {
     let volume = |a: DVec3, b: DVec3, c: DVec3, d: DVec3| (b - a).cross(c - a).dot(d - a);
     let whole = volume(a, b, c, d);
@@ -173,5 +178,5 @@ fn contains(a: DVec3, b: DVec3, c: DVec3, d: DVec3, p: DVec3) -> bool {
         volume(a, b, c, p),
     ]
     .iter()
-    .all(|part| part * whole.signum() > 0.0)
+    .all(|part| part * whole.signum() >= 0.0)
 }
