@@ -101,10 +101,11 @@ fn crossed(collider: &Collider, then: &Pose, from: DVec3, to: DVec3, tolerance: 
         .transform_point(then.inverse_transform_point(from.as_vec3()))
         .as_dvec3();
     let path = to - from;
-    if path.length() <= tolerance {
+    let shape = collider.shape();
+    // A point inside at the start was a penetration then, not a crossing now.
+    if path.length() <= tolerance || shape.project_point(pose, from.as_vec3(), false).is_inside {
         return false;
     }
-    let shape = collider.shape();
     let forward = Ray::new(from.as_vec3(), path.as_vec3());
     if shape.as_trimesh().is_some() || shape.as_heightfield().is_some() {
         if shape.cast_ray(pose, &forward, 1.0, false).is_none() {
