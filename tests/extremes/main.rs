@@ -274,7 +274,15 @@ fn print_table(cases: &[Case]) {
         );
         match &case.outcome {
             Outcome::Refused(error) => println!("    reason: {error}"),
-            Outcome::Unstable(why) => println!("    reason: {why}"),
+            Outcome::Unstable(why) => {
+                println!("    reason: {why}");
+                if let Some(known) = known::KNOWN.iter().find(|k| k.case == case.label) {
+                    println!(
+                        "    known failure: {}; listed as {}",
+                        known.what, known.measured
+                    );
+                }
+            }
             Outcome::Stable => {}
         }
     }

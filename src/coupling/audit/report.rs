@@ -23,7 +23,7 @@ pub struct EnergyCheck {
 impl EnergyCheck {
     /// Whether the bodies gained more energy than the tolerance allows (or it is not finite).
     pub fn gained(&self) -> bool {
-        !(self.gain <= self.tolerance)
+        self.gain.is_nan() || self.tolerance.is_nan() || self.gain > self.tolerance
     }
 }
 
