@@ -144,7 +144,10 @@ impl Audit {
     }
 
     /// Takes the world as it is now as the state the next frame is compared with (before the
-    /// first frame, or after changing the state by hand).
+    /// first frame, or after changing the state by hand). Without a step's results it counts no
+    /// implicit penalty energy: restarting while a body rests on implicit penalties undercounts
+    /// the state's energy by what they hold (a few µJ per contact node at rest), which the next
+    /// frame may show as a gain.
     pub fn restart(&mut self, input: AuditInput<'_>) {
         self.previous = Some(snapshot(&input, &Vec::new()));
     }
