@@ -6,7 +6,10 @@
 
 use crate::Error;
 use crate::body::{DeformableBodyHandle, DeformableBodySet};
-use crate::coupling::{ColliderLoad, RapierSets, RigidLoad, SoftCoupling, SoftStepResults};
+use crate::coupling::{
+    Audit, AuditInput, ColliderLoad, FrameAudit, RapierSets, RigidLoad, SoftCoupling,
+    SoftStepResults,
+};
 use rapier3d::dynamics::RigidBodyHandle;
 use rapier3d::geometry::ColliderHandle;
 use rapier3d::glamx::DVec3;
@@ -205,5 +208,33 @@ impl FvmWorld {
             hooks,
             events,
         )
+    }
+}
+
+/// The audit of a world (see [`crate::coupling::Audit`]), here so that the coupling layer does not
+/// reach up to the world.
+impl<'a> AuditInput<'a> {
+    /// What the audit reads of `world`.
+    pub fn of_world(world: &'a FvmWorld) -> Self {
+        Self {
+            soft_bodies: &world.soft_bodies,
+            coupling: &world.coupling,
+            bodies: &world.physics.bodies,
+            colliders: &world.physics.colliders,
+            gravity: world.physics.gravity.as_dvec3(),
+            dt: f64::from(world.physics.integration_parameters.dt),
+        }
+    }
+}
+
+impl Audit {
+    /// [`Audit::restart`] on `world`.
+    pub fn restart_world(&mut self, world: &FvmWorld) {
+        self.restart(AuditInput::of_world(world));
+    }
+
+    /// [`Audit::check`] on `world`.
+    pub fn check_world(&mut self, world: &FvmWorld, results: &SoftStepResults) -> FrameAudit {
+        self.check(AuditInput::of_world(world), results)
     }
 }

@@ -179,11 +179,41 @@ fn run(
     }
     let s = &report.stability;
     println!(
-        "  stability: non-finite {}, errors {}, inverted elements {}, final state finite {}",
-        s.non_finite, s.any_error, s.inverted_elements, s.final_state_finite
+        "  stability: {}; non-finite {}, errors {}, inverted elements {}, final state finite {}, system energy gained {}",
+        if s.stable { "stable" } else { "NOT STABLE" },
+        s.non_finite,
+        s.any_error,
+        s.inverted_elements,
+        s.final_state_finite,
+        flag(s.system_energy_gained.as_ref())
     );
+    for body in report.soft_bodies.iter().filter(|b| !b.stable) {
+        let f = &body.stability_flags;
+        println!(
+            "  {} not stable: energy gained {}, penetration {}, crossing {}, inverted {}, collapsed {}, Newton failed {}, failed frames {}",
+            body.name,
+            flag(f.energy_gained.as_ref()),
+            flag(f.penetration.as_ref()),
+            flag(f.crossing.as_ref()),
+            flag(f.inverted_elements.as_ref()),
+            flag(f.collapsed_elements.as_ref()),
+            flag(f.newton_failed.as_ref()),
+            body.failed_frames
+        );
+    }
     println!("  written to {}", out.display());
     Ok(())
+}
+
+/// A flag as the summary prints it: `-` when never raised, else its first frame, frame count and
+/// worst value.
+fn flag(flag: Option<&rapier_fvm_runner::sim::Flag>) -> String {
+    flag.map_or(String::from("-"), |f| {
+        format!(
+            "from frame {} in {} frames, worst {:.3e} {}",
+            f.first_frame, f.frames, f.worst, f.unit
+        )
+    })
 }
 
 /// `check`: prints the mesh's quality report.

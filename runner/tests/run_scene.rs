@@ -160,3 +160,69 @@ fn a_cage_reports_its_hexahedra_and_the_fine_mesh_it_carries() {
     assert_eq!(beam.embedded_tets, Some(3200));
     assert!(!report.stability.any_error && report.stability.final_state_finite);
 }
+
+/// Runs `toml` (a scene file's text) for `duration` (s) into the scratch folder `name`; returns
+/// the report as `report.json` holds it.
+fn run_text(name: &str, toml: &str, duration: f64) -> serde_json::Value {
+    let path = scene_path("drop.toml").with_file_name(format!("{name}.toml"));
+    let scene = Scene::parse(&path, toml.to_owned()).unwrap();
+    let out = out_dir(name);
+    let options = RunOptions {
+        out: out.clone(),
+        duration: Some(duration),
+        progress: false,
+    };
+    sim::run(&scene, &options).unwrap();
+    serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap()
+}
+
+/// The audit's flags of a soft body in `report.json`.
+const FLAGS: [&str; 6] = [
+    "energy_gained",
+    "penetration",
+    "crossing",
+    "inverted_elements",
+    "collapsed_elements",
+    "newton_failed",
+];
+
+#[test]
+fn the_report_flags_a_cube_set_half_inside_the_ground_and_calls_it_unstable() {
+    // A 10 cm cube whose centre is 1 cm above a fixed ground: its bottom 4 cm lie inside, far
+    // deeper than the audit's tolerance (a quarter of the 1.67 cm cells' smallest altitude).
+    let text = std::fs::read_to_string(scene_path("drop.toml"))
+        .unwrap()
+        .replace(
+            "translation = [0.0, 0.55, 0.0]",
+            "translation = [0.0, 0.01, 0.0]",
+        );
+    let report = run_text("half_inside", &text, 0.05);
+    let cube = &report["soft_bodies"][0];
+    let penetration = &cube["stability_flags"]["penetration"];
+    assert_eq!(penetration["first_frame"], 1);
+    assert_eq!(penetration["unit"], "m");
+    // The deepest point lies about 4 cm deep and is pushed out by at most 0.1 m/s.
+    let worst = penetration["worst"].as_f64().unwrap();
+    assert!(worst > 0.03 && worst <= 0.04 + 1e-6, "{worst}");
+    assert_eq!(cube["stable"], false);
+    assert_eq!(report["stability"]["stable"], false);
+    assert_eq!(report["stability"]["unstable_bodies"][0], "cube");
+}
+
+#[test]
+fn a_short_drop_reports_every_flag_and_a_verdict_that_follows_them() {
+    let text = std::fs::read_to_string(scene_path("drop.toml")).unwrap();
+    let report = run_text("drop_flags", &text, 0.1);
+    let cube = &report["soft_bodies"][0];
+    let flags = cube["stability_flags"].as_object().unwrap();
+    let mut keys: Vec<&str> = flags.keys().map(String::as_str).collect();
+    keys.sort_unstable();
+    let mut expected = FLAGS.to_vec();
+    expected.sort_unstable();
+    assert_eq!(keys, expected);
+    // The cube falls freely for the whole 0.1 s (it starts 0.5 m up): nothing may be raised.
+    assert!(flags.values().all(serde_json::Value::is_null), "{flags:?}");
+    assert_eq!(cube["stable"], true);
+    assert_eq!(report["stability"]["stable"], true);
+    assert!(report["stability"]["system_energy_gained"].is_null());
+}

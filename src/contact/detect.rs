@@ -225,6 +225,21 @@ fn contact_points(body: &DeformableBody) -> Vec<BodyPoint> {
     }
 }
 
+/// Where each point contacts are detected for (see [`contact_points`]) is in `positions` (m,
+/// one per node of `body`), with the nodes it moves with.
+pub(crate) fn contact_point_positions(
+    body: &DeformableBody,
+    positions: &[DVec3],
+) -> Vec<(DVec3, Vec<u32>)> {
+    contact_points(body)
+        .into_iter()
+        .map(|at| {
+            let stencil = at.stencil(body.embedding.as_ref());
+            (stencil.interpolate(positions), stencil.nodes.to_vec())
+        })
+        .collect()
+}
+
 /// Each contact's collider, the point (m) it acts at, and the mean force (N) it exerted on the
 /// collider over the last step of `dt` (s): node contacts at their points' end-of-step
 /// positions, rigid vertices at the vertices; nodes first, then vertices, in order.

@@ -57,7 +57,9 @@ pub(crate) use corner::{
     lag_corner_friction, prepare_corners, record_corner_impulses, solve_corners,
 };
 use detect::nearest_surface_point;
-pub(crate) use detect::{ColliderView, collider_impulses, detect, force_on_collider};
+pub(crate) use detect::{
+    ColliderView, collider_impulses, contact_point_positions, detect, force_on_collider,
+};
 pub(crate) use joint::{GroupNodes, JointContacts};
 use node_contact::Obstacle;
 pub use node_contact::{BodyPoint, ContactTarget, NodeContact};

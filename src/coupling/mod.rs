@@ -29,12 +29,17 @@
 //! [`SoftCoupling::substep`] runs stages 2 to 5 alone, for a program that steps rapier itself.
 //! [`FvmWorld`](crate::world::FvmWorld) is the same over a [`PhysicsWorld`](rapier3d::pipeline::PhysicsWorld).
 
+mod audit;
 mod bodies;
 mod groups;
 mod kinematic;
 mod loads;
 mod rapier_view;
 
+pub use audit::{
+    Audit, AuditInput, AuditSettings, BodyAudit, EnergyCheck, FrameAudit, PenetrationTarget,
+    Penetrations,
+};
 pub use loads::{ColliderLoad, RigidLoad};
 
 use crate::Error;
@@ -413,12 +418,16 @@ impl SoftCoupling {
                     Err(error) => vec![Err(error); steps.len()],
                 }
             };
-            for ((handle, step), result) in handles.iter().zip(steps).zip(stepped) {
+            for ((handle, step), mut result) in handles.iter().zip(steps).zip(stepped) {
                 if result.is_ok() {
                     self.loads.add_body(*handle, step.body, step.constraints);
                     step.constraints.transfer_contact_impulses(rigid.bodies);
                 }
                 if let Some((_, outcome)) = outcomes.iter_mut().find(|(h, _)| h == handle) {
+                    // A Newton failure in an earlier substep of the frame stays reported.
+                    if let (Some(Ok(earlier)), Ok(report)) = (&*outcome, &mut result) {
+                        report.newton_failed |= earlier.newton_failed;
+                    }
                     *outcome = Some(result);
                 }
             }

@@ -19,6 +19,7 @@ mod writer;
 pub use build::{RigidEntry, Simulation, SoftEntry};
 pub use probe::Probe;
 pub use report::{
-    Files, ProbeReport, Report, RigidBodyReport, Settings, SoftBodyReport, Stability,
+    BodyFlags, Files, Flag, ProbeReport, Report, RigidBodyReport, Settings, SoftBodyReport,
+    Stability,
 };
 pub use run::{RunError, RunOptions, run};

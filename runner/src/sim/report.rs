@@ -3,6 +3,7 @@
 
 use rapier_fvm::Error;
 use rapier_fvm::body::DeformableBody;
+use rapier_fvm::coupling::{BodyAudit, EnergyCheck};
 use rapier_fvm::element::{ElementOrder, ElementShape};
 use rapier_fvm::integrate::{AutomaticReport, IntegratorKind};
 use serde::Serialize;
@@ -101,6 +102,10 @@ pub struct SoftBodyReport {
     pub first_error: Option<String>,
     /// Most inverted tetrahedra at the end of a frame.
     pub max_inverted_tets: usize,
+    /// What the per-frame audit (`rapier_fvm::coupling::Audit`) found for this body.
+    pub stability_flags: BodyFlags,
+    /// Whether no flag was raised and no step failed.
+    pub stable: bool,
     #[serde(skip)]
     explicit_substeps_sum: u64,
 }
@@ -116,9 +121,109 @@ pub struct RigidBodyReport {
     pub mass: f64,
 }
 
+/// A check of the audit that failed at least once: the frame of its first failure, how many
+/// frames it failed in, and the worst value it saw.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Flag {
+    /// The first frame it was raised in (1 is the first frame stepped).
+    pub first_frame: usize,
+    /// Frames it was raised in.
+    pub frames: usize,
+    /// The worst value, in `unit`.
+    pub worst: f64,
+    /// The unit of `worst`.
+    pub unit: &'static str,
+}
+
+impl Flag {
+    /// Raises `flag` at `frame` with `value` (the larger value is the worse).
+    fn raise(flag: &mut Option<Flag>, frame: usize, value: f64, unit: &'static str) {
+        match flag {
+            Some(flag) => {
+                flag.frames += 1;
+                flag.worst = flag.worst.max(value);
+            }
+            None => {
+                *flag = Some(Flag {
+                    first_frame: frame,
+                    frames: 1,
+                    worst: value,
+                    unit,
+                });
+            }
+        }
+    }
+}
+
+/// The audit's flags for a soft body, each `null` when never raised (tolerances: see
+/// `rapier_fvm::coupling::Audit`).
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct BodyFlags {
+    /// The body and the rigid and soft bodies it exchanges energy with gained energy (worst: the
+    /// gain above the previous frame plus the work counted, J).
+    pub energy_gained: Option<Flag>,
+    /// Contact points deeper than the tolerance inside a collider or another soft body (worst:
+    /// the deepest, m).
+    pub penetration: Option<Flag>,
+    /// Contact points that went through a collider over a frame (worst: most in a frame).
+    pub crossing: Option<Flag>,
+    /// Elements of zero or negative volume left after a frame (worst: most in a frame).
+    pub inverted_elements: Option<Flag>,
+    /// Elements below 1 % of their rest volume left after a frame (worst: most in a frame).
+    pub collapsed_elements: Option<Flag>,
+    /// An implicit Newton solve failed (worst: 1 per frame, so `frames` counts them).
+    pub newton_failed: Option<Flag>,
+}
+
+impl BodyFlags {
+    /// Whether any flag is raised.
+    pub fn any(&self) -> bool {
+        self.energy_gained.is_some()
+            || self.penetration.is_some()
+            || self.crossing.is_some()
+            || self.inverted_elements.is_some()
+            || self.collapsed_elements.is_some()
+            || self.newton_failed.is_some()
+    }
+
+    /// Raises the flags `audit` (frame `frame`) calls for.
+    fn record(&mut self, frame: usize, audit: &BodyAudit) {
+        if let Some(energy) = audit.energy.filter(EnergyCheck::gained) {
+            Flag::raise(&mut self.energy_gained, frame, energy.gain, "J");
+        }
+        if audit.penetrates() {
+            let deepest = audit.penetrations.deepest;
+            Flag::raise(&mut self.penetration, frame, deepest, "m");
+        }
+        if audit.crossed() {
+            let crossed = audit.penetrations.crossed as f64;
+            Flag::raise(&mut self.crossing, frame, crossed, "points");
+        }
+        if audit.inverted_elements > 0 {
+            let count = audit.inverted_elements as f64;
+            Flag::raise(&mut self.inverted_elements, frame, count, "elements");
+        }
+        if audit.collapsed_elements > 0 {
+            let count = audit.collapsed_elements as f64;
+            Flag::raise(&mut self.collapsed_elements, frame, count, "elements");
+        }
+        if audit.newton_failed {
+            Flag::raise(&mut self.newton_failed, frame, 1.0, "frames");
+        }
+    }
+}
+
 /// Numerical trouble over the run.
 #[derive(Debug, Clone, Default, Serialize)]
 pub struct Stability {
+    /// The verdict: every soft body stable (no flag raised, no step failed), the whole system's
+    /// energy never gained, and the final state finite.
+    pub stable: bool,
+    /// The soft bodies that are not stable.
+    pub unstable_bodies: Vec<String>,
+    /// The whole coupled system (every soft and dynamic rigid body) gained energy (worst: the
+    /// gain, J).
+    pub system_energy_gained: Option<Flag>,
     /// A step produced a NaN or infinite state (rejected, the state before it kept).
     pub non_finite: bool,
     /// A step failed for any reason.
@@ -161,7 +266,36 @@ pub struct Files {
     pub plots: Vec<String>,
 }
 
+impl Stability {
+    /// Raises the system's energy flag if `system` (frame `frame`) gained.
+    pub(crate) fn record_system(&mut self, frame: usize, system: Option<EnergyCheck>) {
+        if let Some(system) = system.filter(EnergyCheck::gained) {
+            Flag::raise(&mut self.system_energy_gained, frame, system.gain, "J");
+        }
+    }
+
+    /// Sets the verdict from the bodies' records.
+    pub(crate) fn conclude(&mut self, bodies: &mut [SoftBodyReport]) {
+        for body in bodies.iter_mut() {
+            body.stable = !body.stability_flags.any() && body.failed_frames == 0;
+        }
+        self.unstable_bodies = (bodies.iter())
+            .filter(|b| !b.stable)
+            .map(|b| b.name.clone())
+            .collect();
+        self.stable = self.unstable_bodies.is_empty()
+            && self.system_energy_gained.is_none()
+            && self.final_state_finite
+            && !self.any_error;
+    }
+}
+
 impl SoftBodyReport {
+    /// Records what the audit found for the body at `frame`.
+    pub(crate) fn record_audit(&mut self, frame: usize, audit: &BodyAudit) {
+        self.stability_flags.record(frame, audit);
+    }
+
     /// An empty record for a body.
     pub(crate) fn new(name: String, material: String, body: &DeformableBody) -> Self {
         let element_kind = match (body.element_order(), body.element_shape()) {

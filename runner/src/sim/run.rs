@@ -1,5 +1,6 @@
-//! The frame loop: drive the kinematic bodies, step, record each body's outcome, sample the
-//! probes, save frames, then render the pictures and plots and write the report.
+//! The frame loop: drive the kinematic bodies, step, record each body's outcome and what the
+//! per-frame audit finds, sample the probes, save frames, then render the pictures and plots and
+//! write the report with its stability verdict.
 
 use super::build::Simulation;
 use super::report::{ProbeReport, Report, RigidBodyReport, Settings, SoftBodyReport, Stability};
@@ -9,6 +10,7 @@ use crate::scene::rigid_body::RigidKind;
 use crate::scene::world::WorldSpec;
 use crate::scene::{Scene, SceneError};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use rapier_fvm::coupling::Audit;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
@@ -63,6 +65,8 @@ pub fn run(scene: &Scene, options: &RunOptions) -> Result<Report, RunError> {
         })
         .collect();
     let mut stability = Stability::default();
+    let mut audit = Audit::default();
+    audit.restart_world(&sim.world);
     sim.sample_probes(0.0);
     writer.frame(&sim, 0)?;
     let progress = progress_bar(frames, options.progress);
@@ -76,6 +80,13 @@ pub fn run(scene: &Scene, options: &RunOptions) -> Result<Report, RunError> {
         for (handle, outcome) in &outcomes {
             if let Some(i) = sim.soft.iter().position(|e| e.handle == *handle) {
                 bodies[i].record(outcome, &mut stability);
+            }
+        }
+        let found = audit.check_world(&sim.world, &outcomes);
+        stability.record_system(frame, found.system);
+        for (handle, body_audit) in &found.bodies {
+            if let Some(i) = sim.soft.iter().position(|e| e.handle == *handle) {
+                bodies[i].record_audit(frame, body_audit);
             }
         }
         sim.sample_probes(t);
@@ -93,6 +104,7 @@ pub fn run(scene: &Scene, options: &RunOptions) -> Result<Report, RunError> {
             .chain(body.velocities())
             .all(|v| v.is_finite())
     });
+    stability.conclude(&mut bodies);
     let stepping_s = stepping.as_secs_f64();
     let simulated = frames as f64 * dt;
     let report = Report {

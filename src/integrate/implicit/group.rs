@@ -11,7 +11,7 @@
 
 use super::potential::Potential;
 use super::rigid_response::{Placement, RigidResponse};
-use super::{ImplicitIntegrator, ImplicitReport, Outcome, end_substep};
+use super::{ImplicitIntegrator, ImplicitReport, Outcome, STALL_CEILING, Stop, end_substep};
 use crate::Error;
 use crate::assembly::Stiffness;
 use crate::body::DeformableBody;
@@ -415,8 +415,8 @@ impl ImplicitIntegrator {
                     node: group.body_node(at),
                 });
             }
-            if let Some(converged) = self.stop(relative, &history, outcome.iterations) {
-                outcome.converged = converged;
+            if let Some(stop) = self.stop(relative, &history, outcome.iterations) {
+                outcome.stop = stop;
                 return Ok(outcome);
             }
             history.push(relative);
@@ -439,7 +439,13 @@ impl ImplicitIntegrator {
             outcome.iterations += 1;
             match next {
                 Some((next, value)) => (residual, energy) = (next, value),
-                None => return Ok(outcome),
+                None => {
+                    // No descent left: round-off below the stall ceiling, a failure above it.
+                    if outcome.residual <= STALL_CEILING {
+                        outcome.stop = Stop::Stalled;
+                    }
+                    return Ok(outcome);
+                }
             }
         }
     }

@@ -35,7 +35,7 @@ use crate::linear_solver::{LinearSolver, Method, solve_newton_system};
 use crate::newton::{Search, check_tolerance, descend, norm};
 use potential::{Potential, StepStart};
 use rapier3d::glamx::DVec3;
-use report::Outcome;
+use report::{Outcome, Stop};
 use rigid_response::RigidResponse;
 use std::cell::RefCell;
 
@@ -329,8 +329,8 @@ impl ImplicitIntegrator {
                 let node = residual.iter().position(|r| !r.is_finite()).unwrap_or(0);
                 return Err(Error::NonFiniteState { node });
             }
-            if let Some(converged) = self.stop(relative, &history, outcome.iterations) {
-                outcome.converged = converged;
+            if let Some(stop) = self.stop(relative, &history, outcome.iterations) {
+                outcome.stop = stop;
                 return finish(solver, outcome);
             }
             history.push(relative);
@@ -381,7 +381,13 @@ impl ImplicitIntegrator {
             outcome.iterations += 1;
             match next {
                 Some((next, energy)) => (residual, potential) = (next, energy),
-                None => return finish(solver, outcome),
+                None => {
+                    // No descent left: round-off below the stall ceiling, a failure above it.
+                    if outcome.residual <= STALL_CEILING {
+                        outcome.stop = Stop::Stalled;
+                    }
+                    return finish(solver, outcome);
+                }
             }
         }
     }
@@ -408,18 +414,22 @@ impl ImplicitIntegrator {
     }
 
     /// Whether Newton stops at the relative residual `relative` after `iterations`, the earlier
-    /// relative residuals being `history` (newest last): `Some(true)` when it meets the
-    /// tolerance, `Some(false)` when out of iterations or stalled, `None` to go on. A small
+    /// relative residuals being `history` (newest last): how it stops when it meets the
+    /// tolerance, is out of iterations or stalled, `None` to go on. A small
     /// residual that three iterations could not cut by 10 % sits on its round-off floor (very
     /// stiff or nearly incompressible material against a small load).
-    fn stop(&self, relative: f64, history: &[f64], iterations: usize) -> Option<bool> {
+    fn stop(&self, relative: f64, history: &[f64], iterations: usize) -> Option<Stop> {
         if relative <= self.tolerance {
-            return Some(true);
+            return Some(Stop::Converged);
         }
         let stalled = relative <= STALL_CEILING
             && history.len() >= 3
             && relative > 0.9 * history[history.len() - 3];
-        (iterations == self.max_newton_iterations || stalled).then_some(false)
+        if stalled {
+            Some(Stop::Stalled)
+        } else {
+            (iterations == self.max_newton_iterations).then_some(Stop::Failed)
+        }
     }
 
     /// The Newton direction (m per node) of the exact tangent, which the chord keeps for reuse

@@ -1,5 +1,5 @@
 //! What an implicit frame did: per frame the [`ImplicitReport`] a user reads, per substep the
-//! Newton solve's [`Outcome`] it sums.
+//! Newton solve's [`Outcome`] it sums and how it [`Stop`]ped.
 
 /// What one implicit frame step did.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -27,8 +27,28 @@ pub struct ImplicitReport {
     pub relative_residual: f64,
     /// Whether every substep met the tolerance.
     pub converged: bool,
+    /// Substeps whose Newton solve stopped short of the tolerance on its round-off floor: a
+    /// relative residual at most 1e-4 that three iterations could not cut by 10 % (very stiff
+    /// or nearly incompressible material against a small load). Not converged, not failed.
+    pub stalled_substeps: u32,
+    /// Substeps whose Newton solve failed: it ran out of iterations, or no descent was left,
+    /// with the relative residual above the tolerance and not on a round-off stall. The step
+    /// keeps its last iterate (which lowered the incremental potential) but is not a solution
+    /// of the implicit equations.
+    pub failed_substeps: u32,
     /// Tetrahedra inverted (zero or negative volume) at the end of the frame.
     pub inverted_tets: usize,
+}
+
+/// How a substep's Newton solve ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Stop {
+    /// The tolerance was met.
+    Converged,
+    /// The residual sat on its round-off floor (see [`ImplicitReport::stalled_substeps`]).
+    Stalled,
+    /// Out of iterations, or no descent left, above the tolerance.
+    Failed,
 }
 
 /// What one substep's Newton solve did.
@@ -45,8 +65,8 @@ pub(super) struct Outcome {
     pub(super) projected_tangents: usize,
     /// Final relative residual.
     pub(super) residual: f64,
-    /// Whether the tolerance was met.
-    pub(super) converged: bool,
+    /// How the solve ended.
+    pub(super) stop: Stop,
 }
 
 impl ImplicitReport {
@@ -61,6 +81,8 @@ impl ImplicitReport {
             projected_tangents: 0,
             relative_residual: 0.0,
             converged: true,
+            stalled_substeps: 0,
+            failed_substeps: 0,
             inverted_tets: 0,
         }
     }
@@ -73,7 +95,9 @@ impl ImplicitReport {
         self.factorizations += outcome.factorizations;
         self.projected_tangents += outcome.projected_tangents;
         self.relative_residual = self.relative_residual.max(outcome.residual);
-        self.converged &= outcome.converged;
+        self.converged &= outcome.stop == Stop::Converged;
+        self.stalled_substeps += u32::from(outcome.stop == Stop::Stalled);
+        self.failed_substeps += u32::from(outcome.stop == Stop::Failed);
     }
 }
 
@@ -87,7 +111,7 @@ impl Outcome {
             factorizations: 0,
             projected_tangents: 0,
             residual: f64::NAN,
-            converged: false,
+            stop: Stop::Failed,
         }
     }
 }

@@ -1,0 +1,253 @@
+//! The energy side of the audit: `E = Σ_soft (K + Ψ + V_g) + Σ_dynamic rigid (K + V_g)`, measured
+//! at the end of each frame and compared with the previous frame's plus the work kinematic bodies
+//! did on the deformable bodies over the frame, `gain = E_n - (E_{n-1} + W_n)`.
+//!
+//! - Soft bodies: kinetic `Σ m v²/2`, elastic `Ψ` (the material's strain energy), gravitational
+//!   `-Σ m g·x`, and after an implicit step the energy its contact penalties hold, `k g²/2` for
+//!   each node inside its contact plane (`g < 0`), with `k = penalty_factor m / ĥ²` (the node's
+//!   own mass: a dynamic rigid partner's share is left out, so this is a lower bound) and `ĥ`
+//!   the substep's effective step. Embedded contact points' penalties are not counted.
+//! - Dynamic rigid bodies: `m v²/2 + ωᵀ I ω / 2`, and the gravitational energy at the centre of
+//!   mass half a coupling substep back along the velocity, which rapier's symplectic Euler step
+//!   keeps exactly in free flight. Fixed and kinematic bodies carry none.
+//! - Work: a kinematic (or fixed) rigid body a deformable body pushed with the mean force `F` and
+//!   torque `τ` over the frame ([`RigidLoad`](crate::coupling::RigidLoad)) while moving its centre
+//!   of mass by `Δx` and turning by `Δθ` did `W = -(F·Δx + τ·Δθ)` on it. Gravity's work is in the
+//!   gravitational terms. Nothing else is counted: forces the caller applies, joint motors,
+//!   kinematic bodies pushing rigid bodies through rapier's contacts and state set between
+//!   frames all show as gains.
+//!
+//! Bodies exchanging energy are checked together: a *cluster* is a set of deformable bodies and
+//! dynamic rigid bodies joined by contacts and attachments (the rigid bodies each deformable
+//! body's last substep touched or is glued to) or by overlapping bounding boxes (deformable bodies
+//! that may touch), and each deformable body is given its cluster's check.
+
+use super::{AuditInput, EnergyCheck};
+use crate::body::{DeformableBody, DeformableBodyHandle};
+use crate::contact::BodyPoint;
+use crate::coupling::SoftStepResults;
+use crate::integrate::{ImplicitScheme, IntegratorKind, SymplecticEuler};
+use rapier3d::dynamics::{RigidBody, RigidBodyHandle};
+use rapier3d::glamx::{DMat3, DQuat, DVec3};
+use std::collections::HashMap;
+
+/// A member of the coupled system.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub(super) enum Member {
+    /// A deformable body.
+    Soft(DeformableBodyHandle),
+    /// A dynamic rigid body.
+    Rigid(RigidBodyHandle),
+}
+
+/// A member's energy at the end of a frame (J): its total and the part in motion and strain
+/// (kinetic and elastic), which sets the tolerance.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct MemberEnergy {
+    pub(super) total: f64,
+    pub(super) moving: f64,
+    /// What the energy may change by without a gain (J): for a rigid body the f32 rounding of
+    /// its state, `1e-6 (K + m |g| |x|)`; for a deformable body stepped explicitly the
+    /// oscillation of symplectic Euler's measured energy about its conserved shadow energy,
+    /// `(h / h_crit)(K + Ψ)` (a mode of frequency `ω` oscillates by about `hω/2` of its energy,
+    /// and `ω ≤ 2 / h_crit`).
+    pub(super) allowance: f64,
+}
+
+/// Every member's energy (J) now, the deformable bodies' last steps having returned `results`.
+pub(super) fn energies(
+    input: &AuditInput<'_>,
+    results: &SoftStepResults,
+) -> HashMap<Member, MemberEnergy> {
+    let g = input.gravity;
+    let mut all = HashMap::new();
+    for (handle, body) in input.soft_bodies.iter() {
+        let report = results
+            .iter()
+            .find(|(h, _)| *h == handle)
+            .and_then(|(_, r)| r.as_ref().ok());
+        let implicit = report.is_some_and(|r| r.choice == IntegratorKind::Implicit);
+        let penalty = if implicit {
+            penalty_energy(input, handle, body)
+        } else {
+            0.0
+        };
+        let moving = body.kinetic_energy() + body.elastic_energy() + penalty;
+        let total = moving + body.gravity_potential_energy(g);
+        let ratio = report.and_then(|r| r.explicit).map_or(0.0, |e| {
+            e.substep_dt / SymplecticEuler::critical_time_step(body)
+        });
+        all.insert(
+            Member::Soft(handle),
+            MemberEnergy {
+                total,
+                moving,
+                allowance: ratio.min(1.0) * moving,
+            },
+        );
+    }
+    let h = input.dt / f64::from(input.coupling.substeps.max(1));
+    for (handle, body) in input.bodies.iter().filter(|(_, b)| b.is_dynamic()) {
+        all.insert(Member::Rigid(handle), rigid_energy(body, g, h));
+    }
+    all
+}
+
+/// The energy (J) the implicit contact penalties of the deformable body `handle` hold now.
+fn penalty_energy(
+    input: &AuditInput<'_>,
+    handle: DeformableBodyHandle,
+    body: &DeformableBody,
+) -> f64 {
+    let Some(constraints) = input.coupling.constraints(handle) else {
+        return 0.0;
+    };
+    let implicit = &input.coupling.integrator.implicit;
+    let h = input.dt / f64::from(input.coupling.substeps.max(1) * implicit.substeps.max(1));
+    let effective = match implicit.scheme {
+        ImplicitScheme::BackwardEuler => h,
+        ImplicitScheme::Bdf2 => 2.0 * h / 3.0,
+    };
+    let settings = &input.coupling.contact;
+    constraints
+        .contacts()
+        .iter()
+        .filter_map(|contact| match contact.at {
+            BodyPoint::Node(n) => {
+                let n = n as usize;
+                let gap = contact.gap(body.positions()[n]).min(0.0);
+                let stiffness = settings.penalty_stiffness(body.masses()[n], effective);
+                Some(0.5 * stiffness * gap * gap)
+            }
+            BodyPoint::Embedded(_) => None,
+        })
+        .sum()
+}
+
+/// The energy (J) of a dynamic rigid body under gravity `g` (m/s²), its gravitational part half
+/// a substep of `h` (s) back along its velocity.
+fn rigid_energy(body: &RigidBody, g: DVec3, h: f64) -> MemberEnergy {
+    let mass = f64::from(body.mass());
+    let v = body.linvel().as_dvec3();
+    let w = body.angvel().as_dvec3();
+    let spin = if w == DVec3::ZERO {
+        0.0
+    } else {
+        let i = body.mass_properties().effective_world_inv_inertia;
+        let inverse = DMat3::from_cols_array(
+            &[
+                i.m11, i.m12, i.m13, i.m12, i.m22, i.m23, i.m13, i.m23, i.m33,
+            ]
+            .map(f64::from),
+        );
+        // A body with locked rotations has a singular inverse inertia: no spin energy.
+        if inverse.determinant().abs() > 0.0 {
+            0.5 * w.dot(inverse.inverse() * w)
+        } else {
+            0.0
+        }
+    };
+    let com = body.center_of_mass().as_dvec3();
+    let moving = 0.5 * mass * v.length_squared() + spin;
+    let potential = -mass * g.dot(com - v * (h / 2.0));
+    MemberEnergy {
+        total: moving + potential,
+        moving,
+        // f32 keeps about 7 digits of the position and velocity.
+        allowance: 1e-6 * (moving + mass * g.length() * com.length()),
+    }
+}
+
+/// A rigid body's pose at the end of a frame: centre of mass (m) and orientation.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct RigidPose {
+    pub(super) com: DVec3,
+    pub(super) rotation: DQuat,
+}
+
+/// Every rigid body's pose now.
+pub(super) fn rigid_poses(input: &AuditInput<'_>) -> HashMap<RigidBodyHandle, RigidPose> {
+    input
+        .bodies
+        .iter()
+        .map(|(handle, body)| {
+            let rotation = body.position().rotation;
+            (
+                handle,
+                RigidPose {
+                    com: body.center_of_mass().as_dvec3(),
+                    rotation: DQuat::from_xyzw(
+                        f64::from(rotation.x),
+                        f64::from(rotation.y),
+                        f64::from(rotation.z),
+                        f64::from(rotation.w),
+                    ),
+                },
+            )
+        })
+        .collect()
+}
+
+/// The work (J) kinematic and fixed bodies did on the deformable body `soft` over the frame,
+/// from the loads it exerted on them and their motion since `before`.
+pub(super) fn kinematic_work(
+    input: &AuditInput<'_>,
+    soft: DeformableBodyHandle,
+    before: &HashMap<RigidBodyHandle, RigidPose>,
+) -> f64 {
+    input
+        .coupling
+        .rigid_loads()
+        .iter()
+        .filter(|load| load.soft_body == soft)
+        .filter_map(|load| {
+            let body = input.bodies.get(load.rigid_body)?;
+            if body.is_dynamic() {
+                return None;
+            }
+            let then = before.get(&load.rigid_body)?;
+            let rotation = body.position().rotation;
+            let now = DQuat::from_xyzw(
+                f64::from(rotation.x),
+                f64::from(rotation.y),
+                f64::from(rotation.z),
+                f64::from(rotation.w),
+            );
+            let turn = (now * then.rotation.inverse()).to_scaled_axis();
+            let moved = body.center_of_mass().as_dvec3() - then.com;
+            Some(-(load.force.dot(moved) + load.torque.dot(turn)))
+        })
+        .sum()
+}
+
+/// The energy check of `members`: their energy now against `before` plus `work` (J), with the
+/// tolerance `relative` times the energy in motion and strain (the larger of now and before)
+/// plus the members' allowances (now and before: an oscillation may go down then up) plus
+/// `floor` (J). Members absent before count as unchanged.
+pub(super) fn check(
+    members: &[Member],
+    now: &HashMap<Member, MemberEnergy>,
+    before: &HashMap<Member, MemberEnergy>,
+    work: f64,
+    relative: f64,
+    floor: f64,
+) -> EnergyCheck {
+    let (mut energy, mut previous, mut moving, mut allowance) = (0.0, 0.0, 0.0, 0.0);
+    for member in members {
+        let Some(here) = now.get(member) else {
+            continue;
+        };
+        let then = before.get(member).unwrap_or(here);
+        energy += here.total;
+        previous += then.total;
+        moving += here.moving.max(then.moving);
+        allowance += here.allowance + then.allowance;
+    }
+    EnergyCheck {
+        energy,
+        expected: previous + work,
+        work,
+        gain: energy - (previous + work),
+        tolerance: relative * (moving + work.abs()) + allowance + floor,
+    }
+}
