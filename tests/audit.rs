@@ -10,10 +10,12 @@
 //! 1 m/s kick); the clean cases are checked with the same tolerances, and the free fall against
 //! its closed-form energy loss.
 
+mod common;
+
 use rapier_fvm::coupling::{Audit, AuditSettings, FrameAudit, PenetrationTarget};
 use rapier_fvm::glamx::Vec3;
 use rapier_fvm::prelude::*;
-use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder, SharedShape};
+use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder};
 
 /// A 10 cm cube (4 x 4 x 4 cells, E = 1e6 Pa, ν = 0.3, 1000 kg/m³, lightly damped) with its
 /// bottom at `bottom` (m).
@@ -24,17 +26,6 @@ fn cube(bottom: f64) -> DeformableBody {
         .translation(DVec3::new(0.0, bottom + 0.05, 0.0))
         .build()
         .unwrap()
-}
-
-/// A world with a fixed ground half-space (friction 0.8) and `integrator` forced (or automatic).
-fn world_with_ground(integrator: Option<IntegratorKind>) -> FvmWorld {
-    let mut world = FvmWorld::default();
-    world.coupling.integrator.force = integrator;
-    world.physics.insert_collider(
-        ColliderBuilder::new(SharedShape::halfspace(Vec3::Y)).friction(0.8),
-        None,
-    );
-    world
 }
 
 /// Steps `world` `frames` frames under `audit`, returning each frame's findings.
@@ -57,7 +48,7 @@ const INTEGRATORS: [Option<IntegratorKind>; 3] = [
 #[test]
 fn a_cube_resting_on_the_ground_raises_nothing_under_every_integrator() {
     for integrator in INTEGRATORS {
-        let mut world = world_with_ground(integrator);
+        let mut world = common::world_with_ground(integrator);
         let handle = world.soft_bodies.insert(cube(0.0));
         let mut audit = Audit::default();
         audit.restart_world(&world);
@@ -111,7 +102,7 @@ fn a_free_fall_loses_exactly_the_energy_symplectic_euler_loses_and_raises_nothin
 
 #[test]
 fn a_node_set_deep_inside_the_ground_is_a_penetration() {
-    let mut world = world_with_ground(None);
+    let mut world = common::world_with_ground(None);
     let handle = world.soft_bodies.insert(cube(0.0));
     let mut audit = Audit::default();
     let results = world.step();
@@ -203,7 +194,7 @@ fn mirrored_and_flattened_cubes_have_inverted_and_collapsed_elements() {
 
 #[test]
 fn velocities_set_between_frames_are_energy_gained_until_the_audit_restarts() {
-    let mut world = world_with_ground(None);
+    let mut world = common::world_with_ground(None);
     let soft = world.soft_bodies.insert(cube(0.0));
     let (ball, _) = world.physics.insert(
         RigidBodyBuilder::dynamic().translation(Vec3::new(1.0, 0.5, 0.0)),

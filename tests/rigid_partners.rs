@@ -8,10 +8,12 @@
 //! (coupling sub)step back along their velocity, which rapier's symplectic Euler step keeps
 //! exactly in free flight (so that the check sees only what the coupling adds).
 
+mod common;
+
 use rapier_fvm::glamx::Vec3;
 use rapier_fvm::prelude::*;
 use rapier_fvm::world::FvmWorld;
-use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder, RigidBodyHandle, SharedShape};
+use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder, RigidBodyHandle};
 
 const GRAVITY: DVec3 = DVec3::new(0.0, -9.81, 0.0);
 
@@ -67,17 +69,6 @@ fn soft_block(half: f64, cells: usize, centre: DVec3, young: f64, density: f64) 
     .unwrap();
     body.friction = 0.8;
     body
-}
-
-/// A world with a fixed ground (friction 0.8) and `integrator` forced (or the automatic choice).
-fn world_with_ground(integrator: Option<IntegratorKind>) -> FvmWorld {
-    let mut world = FvmWorld::default();
-    world.coupling.integrator.force = integrator;
-    world.physics.insert_collider(
-        ColliderBuilder::new(SharedShape::halfspace(Vec3::Y)).friction(0.8),
-        None,
-    );
-    world
 }
 
 /// What a run did: the largest rise of the coupled energy above its start (J), and per frame
@@ -142,7 +133,7 @@ fn box_on_block(
     box_mass: f64,
     young: f64,
 ) -> (FvmWorld, RigidBodyHandle) {
-    let mut world = world_with_ground(integrator);
+    let mut world = common::world_with_ground(integrator);
     world.soft_bodies.insert(soft_block(
         0.05,
         4,
@@ -314,7 +305,7 @@ fn a_box_rests_on_a_stack_of_two_soft_blocks_under_every_integrator() {
     // whole system's energy never above its start (f32 rounding, see `energy_tolerance`).
     for integrator in INTEGRATORS {
         for mass in [0.1, 2.0] {
-            let mut world = world_with_ground(integrator);
+            let mut world = common::world_with_ground(integrator);
             for centre in [0.05, 0.1505] {
                 world.soft_bodies.insert(soft_block(
                     0.05,

@@ -9,18 +9,10 @@
 //! The weights sum to zero, so node and triangle take equal and opposite forces: the group's
 //! momentum changes only by the out-of-balance force Newton leaves.
 
-use super::penalty::{contact_point, effective_mass, penalty_tangent};
-use super::{BetweenContact, ContactSettings, NodeContact};
+use super::penalty::{NodeSlices, contact_point, for_each_term_at, lag_friction_at};
+use super::{BetweenContact, ContactSettings, ImplicitStep, NodeContact};
 use crate::stencil::Stencil;
 use rapier3d::glamx::{DMat3, DVec3};
-
-/// The nodes of a group, side by side: positions (m), masses (kg) and which are pinned.
-#[derive(Clone, Copy)]
-pub(crate) struct GroupNodes<'a> {
-    pub(crate) positions: &'a [DVec3],
-    pub(crate) masses: &'a [f64],
-    pub(crate) pinned: &'a [bool],
-}
 
 /// The contacts between the bodies of a group, in the group's numbering of nodes.
 pub(crate) struct JointContacts {
@@ -65,17 +57,13 @@ impl JointContacts {
     /// Readies friction for an implicit step of effective length `h` (s) from the nodes where
     /// they are at its start: each contact's friction limit is its penalty force there, and slip
     /// is measured from there.
-    pub(crate) fn lag_friction(&mut self, nodes: GroupNodes, h: f64) {
-        for contact in &mut self.contacts {
-            let point = contact_point(contact, None);
-            let x = point.position(nodes.positions);
-            let mass = effective_mass(&point.stencil(), nodes.masses, nodes.pinned);
-            let normal_force = contact
-                .penalty(x, mass, &self.settings, h)
-                .map_or(0.0, |(stiffness, gap)| -stiffness * gap);
-            contact.lagged_normal_force = normal_force;
-            contact.slip_origin = x;
-        }
+    pub(crate) fn lag_friction(&mut self, nodes: NodeSlices, h: f64) {
+        lag_friction_at(
+            (nodes, None),
+            &mut self.contacts,
+            &self.settings,
+            between_bodies(h),
+        );
     }
 
     /// Calls `each(point, energy (J), force (N), tangent (N/m))` for the penalty and friction of
@@ -83,26 +71,29 @@ impl JointContacts {
     /// node `a` of the point's stencil takes `w_a` of the force.
     pub(crate) fn for_each_term(
         &self,
-        nodes: GroupNodes,
+        nodes: NodeSlices,
         h: f64,
         mut each: impl FnMut(Stencil, f64, DVec3, DMat3),
     ) {
-        for contact in &self.contacts {
-            let point = contact_point(contact, None);
-            let at = point.stencil();
-            let x = point.position(nodes.positions);
-            let mass = effective_mass(&at, nodes.masses, nodes.pinned);
-            if let Some((stiffness, gap)) = contact.penalty(x, mass, &self.settings, h) {
-                each(
-                    at,
-                    0.5 * stiffness * gap * gap,
-                    -contact.normal * (stiffness * gap),
-                    penalty_tangent(stiffness, contact.normal),
-                );
-            }
-            if let Some((energy, force, tangent)) = contact.friction_term(x, &self.settings, h) {
-                each(at, energy, force, tangent);
-            }
-        }
+        let step = between_bodies(h);
+        for_each_term_at(
+            (nodes, None),
+            &self.contacts,
+            &self.settings,
+            step,
+            |at, _, e, f, t| {
+                each(at, e, f, t);
+            },
+        );
+    }
+}
+
+/// An implicit step of effective length `h` (s) as terms between soft bodies see it: no rigid
+/// body, nothing carried.
+fn between_bodies(h: f64) -> ImplicitStep<'static> {
+    ImplicitStep {
+        effective: h,
+        length: h,
+        rigid: &[],
     }
 }

@@ -60,11 +60,11 @@ use detect::nearest_surface_point;
 pub(crate) use detect::{
     ColliderView, collider_impulses, contact_point_positions, detect, force_on_collider,
 };
-pub(crate) use joint::{GroupNodes, JointContacts};
+pub(crate) use joint::JointContacts;
 use node_contact::Obstacle;
 pub use node_contact::{BodyPoint, ContactTarget, NodeContact};
 pub(crate) use penalty::{
-    for_each_contact_stencil, for_each_contact_term, lag_friction, penalty_tangent,
+    NodeSlices, for_each_contact_stencil, for_each_contact_term, lag_friction, penalty_tangent,
     record_penalty_impulses,
 };
 pub(crate) use self_contact::detect_self_contacts;

@@ -164,13 +164,30 @@ pub(crate) fn record_penalty_impulses(
 /// or to the own triangle).
 pub(crate) fn lag_friction(body: &DeformableBody, contacts: &mut ContactSet, step: ImplicitStep) {
     let settings = contacts.settings;
-    for contact in &mut contacts.nodes {
-        let point = contact_point(contact, body.embedding.as_ref());
-        let x = point.position(&body.positions);
-        let mass = effective_mass(&point.stencil(), &body.masses, &body.pinned)
+    let nodes = NodeSlices::of(body);
+    lag_friction_at(
+        (nodes, body.embedding.as_ref()),
+        &mut contacts.nodes,
+        &settings,
+        step,
+    );
+}
+
+/// [`lag_friction`] for `contacts` on the nodes `nodes` (with the body's `embedding`, if its
+/// points are embedded ones), found and enforced with `settings`.
+pub(super) fn lag_friction_at(
+    (nodes, embedding): (NodeSlices, Option<&Embedding>),
+    contacts: &mut [NodeContact],
+    settings: &ContactSettings,
+    step: ImplicitStep,
+) {
+    for contact in contacts {
+        let point = contact_point(contact, embedding);
+        let x = point.position(nodes.positions);
+        let mass = effective_mass(&point.stencil(), nodes.masses, nodes.pinned)
             + carried(contact, &step).mass;
         contact.lagged_normal_force = contact
-            .penalty(x, mass, &settings, step.effective)
+            .penalty(x, mass, settings, step.effective)
             .map_or(0.0, |(stiffness, gap)| -stiffness * gap);
         contact.slip_origin = x;
     }
@@ -193,17 +210,30 @@ pub(crate) fn for_each_contact_term(
     body: &DeformableBody,
     contacts: &ContactSet,
     step: ImplicitStep,
+    each: impl FnMut(Stencil, Option<RigidPoint>, f64, DVec3, DMat3),
+) {
+    let nodes = NodeSlices::of(body);
+    let at = (nodes, body.embedding.as_ref());
+    for_each_term_at(at, &contacts.nodes, &contacts.settings, step, each);
+}
+
+/// [`for_each_contact_term`] for `contacts` on the nodes `nodes` (with the body's `embedding`,
+/// if its points are embedded ones), enforced with `settings`.
+pub(super) fn for_each_term_at(
+    (nodes, embedding): (NodeSlices, Option<&Embedding>),
+    contacts: &[NodeContact],
+    settings: &ContactSettings,
+    step: ImplicitStep,
     mut each: impl FnMut(Stencil, Option<RigidPoint>, f64, DVec3, DMat3),
 ) {
     // Every penalty, then every friction term.
-    for contact in &contacts.nodes {
-        let point = contact_point(contact, body.embedding.as_ref());
+    for contact in contacts {
+        let point = contact_point(contact, embedding);
         let at = point.stencil();
         let obstacle = carried(contact, &step);
-        let mass = effective_mass(&at, &body.masses, &body.pinned) + obstacle.mass;
-        let x = point.position(&body.positions) - obstacle.travel;
-        if let Some((stiffness, gap)) = contact.penalty(x, mass, &contacts.settings, step.effective)
-        {
+        let mass = effective_mass(&at, nodes.masses, nodes.pinned) + obstacle.mass;
+        let x = point.position(nodes.positions) - obstacle.travel;
+        if let Some((stiffness, gap)) = contact.penalty(x, mass, settings, step.effective) {
             each(
                 at,
                 obstacle.partner,
@@ -213,14 +243,32 @@ pub(crate) fn for_each_contact_term(
             );
         }
     }
-    for contact in &contacts.nodes {
-        let point = contact_point(contact, body.embedding.as_ref());
+    for contact in contacts {
+        let point = contact_point(contact, embedding);
         let obstacle = carried(contact, &step);
-        let x = point.position(&body.positions) - obstacle.travel;
-        if let Some((energy, force, tangent)) =
-            contact.friction_term(x, &contacts.settings, step.effective)
-        {
+        let x = point.position(nodes.positions) - obstacle.travel;
+        if let Some((energy, force, tangent)) = contact.friction_term(x, settings, step.effective) {
             each(point.stencil(), obstacle.partner, energy, force, tangent);
+        }
+    }
+}
+
+/// The nodes contact terms act on: positions (m), masses (kg) and which are pinned; one
+/// body's, or a group's side by side (see [`super::joint`]).
+#[derive(Clone, Copy)]
+pub(crate) struct NodeSlices<'a> {
+    pub(crate) positions: &'a [DVec3],
+    pub(crate) masses: &'a [f64],
+    pub(crate) pinned: &'a [bool],
+}
+
+impl<'a> NodeSlices<'a> {
+    /// `body`'s nodes.
+    fn of(body: &'a DeformableBody) -> Self {
+        Self {
+            positions: &body.positions,
+            masses: &body.masses,
+            pinned: &body.pinned,
         }
     }
 }

@@ -1,7 +1,10 @@
 //! Shared fixtures for the integration tests: the reference cantilever and its closed-form values.
 #![allow(dead_code)]
 
+use rapier_fvm::glamx::Vec3;
 use rapier_fvm::prelude::*;
+use rapier_fvm::world::FvmWorld;
+use rapier3d::prelude::{ColliderBuilder, SharedShape};
 
 /// Beam length (m), cross-section side (m), density (kg/m³) and gravity (m/s²) of the reference
 /// cantilever.
@@ -445,4 +448,16 @@ pub fn assert_identical(a: &FvmWorld, b: &FvmWorld) {
         assert_eq!(rigid_a.angvel(), rigid_b.angvel(), "{ha:?}");
     }
     assert_eq!(a.rigid_loads(), b.rigid_loads());
+}
+
+/// A world with a fixed ground half-space below y = 0 (friction 0.8) and `integrator` forced
+/// (or the automatic choice).
+pub fn world_with_ground(integrator: Option<IntegratorKind>) -> FvmWorld {
+    let mut world = FvmWorld::default();
+    world.coupling.integrator.force = integrator;
+    world.physics.insert_collider(
+        ColliderBuilder::new(SharedShape::halfspace(Vec3::Y)).friction(0.8),
+        None,
+    );
+    world
 }

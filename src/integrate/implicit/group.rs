@@ -16,7 +16,7 @@ use crate::Error;
 use crate::assembly::Stiffness;
 use crate::body::DeformableBody;
 use crate::constraint::{self, BodyConstraints};
-use crate::contact::{BetweenContact, ContactSettings, GroupNodes, JointContacts};
+use crate::contact::{BetweenContact, ContactSettings, JointContacts, NodeSlices};
 use crate::integrate::{BodyInStep, PreviousStep};
 use crate::linear_solver::{Method, solve_newton_system};
 use crate::newton::{Configuration, Search, descend, norm};
@@ -152,8 +152,8 @@ impl GroupPotential<'_> {
 }
 
 /// The group's nodes with positions `positions` (m).
-fn nodes<'a>(group: &'a Group, positions: &'a [DVec3]) -> GroupNodes<'a> {
-    GroupNodes {
+fn nodes<'a>(group: &'a Group, positions: &'a [DVec3]) -> NodeSlices<'a> {
+    NodeSlices {
         positions,
         masses: &group.masses,
         pinned: &group.pinned,
