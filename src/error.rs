@@ -305,6 +305,39 @@ pub enum Error {
         /// The configured maximum.
         max: u32,
     },
+    /// A step flattened or inverted an element that was whole when it began (see
+    /// [`integrate::COLLAPSE_RATIO`](crate::integrate::COLLAPSE_RATIO)): the load or impact is
+    /// more than the material can hold at this mesh resolution. The step was refused.
+    #[error(
+        "the step crushed tetrahedron {tet} to {volume_ratio:.2e} of its rest volume; the step was refused and the previous state kept: the load or impact is more than the material can hold at this resolution (a stiffer material, a finer mesh or a slower impact)"
+    )]
+    ElementCrushed {
+        /// The first tetrahedron found crushed.
+        tet: usize,
+        /// Its volume over its rest volume (dimensionless; negative when inverted).
+        volume_ratio: f64,
+    },
+    /// An implicit step's Newton solve did not meet its tolerance, even in the most substeps
+    /// refinement allows. The step was refused.
+    #[error(
+        "the implicit step's Newton solve stopped at a relative residual of {residual:.2e}, short of its tolerance, even in {substeps} substeps per frame; the step was refused and the previous state kept"
+    )]
+    NewtonDidNotConverge {
+        /// The relative residual where it stopped (dimensionless).
+        residual: f64,
+        /// Substeps per frame of the last attempt.
+        substeps: u32,
+    },
+    /// A surface point ended an implicit step past the middle of the collider it touches (too
+    /// fast for the contact to hold), even in the most substeps refinement allows. The step was
+    /// refused.
+    #[error(
+        "a surface point ended the step past the middle of the collider it touches even in {substeps} substeps per frame; the step was refused and the previous state kept"
+    )]
+    ContactNotResolved {
+        /// Substeps per frame of the last attempt.
+        substeps: u32,
+    },
     /// Every node is pinned: there is nothing to solve for.
     #[error("every node is pinned")]
     NoFreeNode,

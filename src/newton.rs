@@ -43,6 +43,47 @@ impl Configuration for DeformableBody {
     }
 }
 
+/// The round-off floor (N) of a residual `residual` (N) at the configuration's positions: how much
+/// the residual changes when every coordinate moves by its own rounding, one unit in the last
+/// place (`ε |x|`, signs alternating in a fixed pseudo-random pattern). Newton's iterates carry at
+/// least that error, so no solve can bring the residual much below it: very stiff or nearly
+/// incompressible material (`K ε |x|` large against the load), or a stiff coupling term. The
+/// positions are put back.
+pub(crate) fn round_off_floor<C: Configuration>(
+    config: &mut C,
+    residual: &[DVec3],
+    mut residual_at: impl FnMut(&mut C) -> Vec<DVec3>,
+) -> f64 {
+    let start = config.copy_positions();
+    // A multiplicative hash of the coordinate's index picks its sign: deterministic, and with
+    // no pattern a smooth residual could cancel.
+    let sign = |i: usize| {
+        if (i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 63 == 0 {
+            1.0
+        } else {
+            -1.0
+        }
+    };
+    let ulps: Vec<DVec3> = start
+        .iter()
+        .enumerate()
+        .map(|(n, x)| {
+            let unit =
+                |c: f64, k: usize| c.abs().max(f64::MIN_POSITIVE) * f64::EPSILON * sign(3 * n + k);
+            DVec3::new(unit(x.x, 0), unit(x.y, 1), unit(x.z, 2))
+        })
+        .collect();
+    config.place(&start, &ulps, 1.0);
+    let moved = residual_at(config);
+    config.set(&start);
+    moved
+        .iter()
+        .zip(residual)
+        .map(|(a, b)| (*a - *b).length_squared())
+        .sum::<f64>()
+        .sqrt()
+}
+
 /// Euclidean norm of a field of per-node vectors.
 pub(crate) fn norm(v: &[DVec3]) -> f64 {
     v.iter().map(|x| x.length_squared()).sum::<f64>().sqrt()
@@ -53,7 +94,7 @@ pub(crate) fn norm(v: &[DVec3]) -> f64 {
 pub(crate) enum Search {
     /// Steps `1, 1/2, …, 1/1024` on the energy; then, when the energy's decrease is lost in its
     /// round-off (close to the solution), the largest step of the same sequence that lowers the
-    /// out-of-balance force.
+    /// out-of-balance force; then the energy again at `1/2048, …, 2⁻³⁰` (see [`DEEP_STEP`]).
     Thorough,
     /// The full step or half of it, on the energy only: for a direction expected to be nearly
     /// the Newton step (from an earlier tangent's factorization).
@@ -72,11 +113,12 @@ pub(crate) fn descend<C: Configuration>(
     energy: impl Fn(&C) -> f64,
     mut residual_at: impl FnMut(&mut C) -> Vec<DVec3>,
 ) -> Option<(Vec<DVec3>, f64)> {
-    let smallest = match search {
-        Search::Thorough => MIN_STEP,
-        Search::Short => 0.5,
+    let steps = match search {
+        Search::Thorough => (1.0, MIN_STEP),
+        Search::Short => (1.0, 0.5),
     };
-    if let Some(accepted) = line_search(body, residual, energy_now, direction, &energy, smallest) {
+    let searched = (residual, energy_now, direction);
+    if let Some(accepted) = line_search(body, searched, &energy, steps) {
         return Some((residual_at(body), accepted));
     }
     if search == Search::Short {
@@ -94,24 +136,30 @@ pub(crate) fn descend<C: Configuration>(
         alpha *= 0.5;
     }
     body.set(&start);
-    None
+    let accepted = line_search(body, searched, &energy, (MIN_STEP / 2.0, DEEP_STEP))?;
+    Some((residual_at(body), accepted))
 }
 
-/// The smallest step fraction the thorough search tries.
+/// The smallest step fraction the thorough search tries first.
 const MIN_STEP: f64 = 1.0 / 1024.0;
 
+/// The smallest step fraction the thorough search tries last, `2⁻³⁰`: a Newton direction
+/// computed where a contact is not yet active (its penalty missing from the tangent) or where
+/// friction slides (no stiffness along the slip) can overshoot by many orders of magnitude, and
+/// a shorter step that still lowers the energy is progress (the next iteration's tangent has
+/// the contact or the sticking friction in it).
+const DEEP_STEP: f64 = 1.0 / 1_073_741_824.0;
+
 /// Moves `body` along `direction` from its current positions, where `energy` (J) is `initial`
-/// and its gradient is `-residual` (N), by the largest step `α` in `1, 1/2, 1/4, …` down to
-/// `smallest` that satisfies the Armijo condition, so that the energy decreases. Returns the
+/// and its gradient is `-residual` (N), by the largest step `α` in `largest, largest/2, …` down
+/// to `smallest` that satisfies the Armijo condition, so that the energy decreases. Returns the
 /// energy there, or `None`, with the positions put back, if no such step exists (the direction
 /// no longer descends above round-off).
 fn line_search<C: Configuration>(
     body: &mut C,
-    residual: &[DVec3],
-    initial: f64,
-    direction: &[DVec3],
+    (residual, initial, direction): (&[DVec3], f64, &[DVec3]),
     energy: impl Fn(&C) -> f64,
-    smallest: f64,
+    (largest, smallest): (f64, f64),
 ) -> Option<f64> {
     const ARMIJO: f64 = 1e-4;
     let start = body.copy_positions();
@@ -124,7 +172,7 @@ fn line_search<C: Configuration>(
     // (Callers measure the load's work from a fixed nearby state, so the energy's size does not
     // depend on where the coordinate origin is.)
     let round_off = 1e-12 * initial.abs();
-    let mut alpha = 1.0;
+    let mut alpha = largest;
     while alpha >= smallest {
         body.place(&start, direction, alpha);
         let value = energy(body);

@@ -557,7 +557,7 @@ fn run_frames(
         let report = integrator
             .step(&mut body, &mut constraints, &mut workspace, dt, gravity())
             .unwrap();
-        assert!(report.converged);
+        assert!(report.converged, "{report:?}");
         reused += report.reused_factorizations;
         factorizations += report.factorizations;
     }

@@ -190,15 +190,17 @@ fn run(
     for body in report.soft_bodies.iter().filter(|b| !b.stable) {
         let f = &body.stability_flags;
         println!(
-            "  {} not stable: energy gained {}, penetration {}, crossing {}, inverted {}, collapsed {}, Newton failed {}, failed frames {}",
+            "  {} not stable: energy gained {}, penetration {}, crossing {}, inverted {}, collapsed {}, refused frames {}{}",
             body.name,
             flag(f.energy_gained.as_ref()),
             flag(f.penetration.as_ref()),
             flag(f.crossing.as_ref()),
             flag(f.inverted_elements.as_ref()),
             flag(f.collapsed_elements.as_ref()),
-            flag(f.newton_failed.as_ref()),
-            body.failed_frames
+            body.failed_frames,
+            body.first_error
+                .as_ref()
+                .map_or(String::new(), |e| format!(" (first: {e})"))
         );
     }
     println!("  written to {}", out.display());

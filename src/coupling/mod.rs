@@ -418,17 +418,16 @@ impl SoftCoupling {
                     Err(error) => vec![Err(error); steps.len()],
                 }
             };
-            for ((handle, step), mut result) in handles.iter().zip(steps).zip(stepped) {
+            for ((handle, step), result) in handles.iter().zip(steps).zip(stepped) {
                 if result.is_ok() {
                     self.loads.add_body(*handle, step.body, step.constraints);
                     step.constraints.transfer_contact_impulses(rigid.bodies);
                 }
                 if let Some((_, outcome)) = outcomes.iter_mut().find(|(h, _)| h == handle) {
-                    // A Newton failure in an earlier substep of the frame stays reported.
-                    if let (Some(Ok(earlier)), Ok(report)) = (&*outcome, &mut result) {
-                        report.newton_failed |= earlier.newton_failed;
+                    // A step refused in an earlier substep of the frame stays reported.
+                    if !matches!(outcome, Some(Err(_))) {
+                        *outcome = Some(result);
                     }
-                    *outcome = Some(result);
                 }
             }
         }

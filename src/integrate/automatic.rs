@@ -88,11 +88,6 @@ pub struct AutomaticReport {
     /// lowered the stability limit partway below what `max_substeps` allows, or the explicit
     /// frame produced a non-finite state.
     pub fell_back: bool,
-    /// Whether an implicit Newton solve of this step failed (see
-    /// [`ImplicitReport::failed_substeps`]): the state is the solver's last iterate, not a
-    /// solution. In the results of [`SoftCoupling::step`](crate::coupling::SoftCoupling::step),
-    /// whether one failed in any coupling substep of the frame.
-    pub newton_failed: bool,
 }
 
 /// Picks, frame by frame, the cheaper of an explicit and an implicit integrator.
@@ -195,7 +190,6 @@ impl AutomaticIntegrator {
             explicit,
             implicit,
             fell_back,
-            newton_failed: implicit.is_some_and(|report| report.failed_substeps > 0),
         })
     }
 
@@ -269,7 +263,6 @@ impl AutomaticIntegrator {
                     IntegratorKind::Implicit
                 },
                 prediction,
-                newton_failed: implicit.is_some_and(|report| report.failed_substeps > 0),
                 explicit,
                 implicit,
                 fell_back,

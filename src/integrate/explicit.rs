@@ -11,7 +11,7 @@
 //! (`β = (φ+2ψ)/(λ+2μ)`), the limit becomes `(2/ω)(sqrt(1+ζ²) - ζ)`. The automatic substep is that
 //! limit times a safety factor.
 
-use super::{BodyInStep, SolverWorkspace};
+use super::{BodyInStep, CrushWatch, SolverWorkspace};
 use crate::Error;
 use crate::body::DeformableBody;
 use crate::constraint::{self, BodyConstraints};
@@ -113,7 +113,9 @@ impl SymplecticEuler {
     /// [`Error::InvalidSetting`] for a zero fixed substep count or a safety factor outside (0, 1];
     /// [`Error::NonFiniteInput`] for a non-finite gravity; [`Error::TooManySubsteps`] when the
     /// stability limit needs more than `max_substeps`; [`Error::NonFiniteState`] if the step
-    /// produced a NaN or infinity. On error the body is left as it was before the call.
+    /// produced a NaN or infinity; [`Error::ElementCrushed`] if it crushed an element (see
+    /// [`COLLAPSE_RATIO`](crate::integrate::COLLAPSE_RATIO)). On error the body is left as it
+    /// was before the call.
     pub fn step(
         &self,
         body: &mut DeformableBody,
@@ -193,6 +195,7 @@ impl SymplecticEuler {
         let mut left = needed as u32;
         let (mut taken, mut elapsed, mut smallest) = (0u32, 0.0, h);
         let mut histories = Vec::with_capacity(bodies.len());
+        let watches: Vec<CrushWatch> = bodies.iter().map(|s| CrushWatch::new(s.body)).collect();
         for step in bodies.iter_mut() {
             step.save();
             histories.push(step.workspace.previous_step.take());
@@ -241,14 +244,25 @@ impl SymplecticEuler {
         if let Some(node) = bodies.iter().find_map(|s| s.body.first_non_finite_node()) {
             return fail(bodies, histories, Error::NonFiniteState { node });
         }
-        Ok(bodies
+        // Substeps below the stability limit of the crushed shape do not undo a crush (the
+        // limit is re-evaluated as elements flatten): a crushed element is the material's
+        // answer to the load, refused at once.
+        let inverted: Result<Vec<usize>, Error> = bodies
             .iter()
-            .map(|step| StepReport {
-                substeps: taken,
-                substep_dt: smallest,
-                inverted_tets: step.body.inverted_tet_count(),
-            })
-            .collect())
+            .zip(&watches)
+            .map(|(step, watch)| watch.check(step.body))
+            .collect();
+        match inverted {
+            Ok(inverted) => Ok(inverted
+                .into_iter()
+                .map(|inverted_tets| StepReport {
+                    substeps: taken,
+                    substep_dt: smallest,
+                    inverted_tets,
+                })
+                .collect()),
+            Err(error) => fail(bodies, histories, error),
+        }
     }
 
     /// The substeps a frame of `frame_dt` (s) takes: the fixed count, or as many as the

@@ -5,12 +5,15 @@
 //! the workspace the solver's caches.
 
 mod automatic;
+mod crush;
 mod explicit;
 mod implicit;
 mod mesh_time_step;
 mod workspace;
 
 pub use automatic::{AutomaticIntegrator, AutomaticReport, CostPrediction, IntegratorKind};
+pub use crush::COLLAPSE_RATIO;
+pub(crate) use crush::CrushWatch;
 pub use explicit::{COURANT_NUMBER, StepReport, Substeps, SymplecticEuler};
 pub use implicit::{ImplicitIntegrator, ImplicitReport, ImplicitScheme};
 pub use mesh_time_step::MeshTimeSteps;

@@ -140,8 +140,6 @@ fn finding(found: &FrameAudit, frame: usize) -> Option<String> {
             "{at}: {} inverted, {} collapsed elements (smallest V/V0 {:.2e})",
             body.inverted_elements, body.collapsed_elements, body.smallest_volume_ratio
         )
-    } else if body.newton_failed {
-        format!("{at}: Newton failed")
     } else {
         format!("{at}: {:?}", body.step_error)
     })

@@ -16,7 +16,7 @@
 //! implicit_substeps = 1      # implicit: Newton solves per frame
 //! scheme = "backward_euler"  # implicit: or "bdf2"
 //! tolerance = 1e-6           # implicit: Newton's relative tolerance
-//! max_newton_iterations = 20
+//! max_newton_iterations = 100 # implicit: per substep; a failed solve redoes the frame in more substeps
 //! reuse_factorization = true # implicit: reuse earlier factorizations while they converge fast
 //!
 //! [output]

@@ -171,8 +171,6 @@ pub struct BodyFlags {
     pub inverted_elements: Option<Flag>,
     /// Elements below 1 % of their rest volume left after a frame (worst: most in a frame).
     pub collapsed_elements: Option<Flag>,
-    /// An implicit Newton solve failed (worst: 1 per frame, so `frames` counts them).
-    pub newton_failed: Option<Flag>,
 }
 
 impl BodyFlags {
@@ -183,7 +181,6 @@ impl BodyFlags {
             || self.crossing.is_some()
             || self.inverted_elements.is_some()
             || self.collapsed_elements.is_some()
-            || self.newton_failed.is_some()
     }
 
     /// Raises the flags `audit` (frame `frame`) calls for.
@@ -206,9 +203,6 @@ impl BodyFlags {
         if audit.collapsed_elements > 0 {
             let count = audit.collapsed_elements as f64;
             Flag::raise(&mut self.collapsed_elements, frame, count, "elements");
-        }
-        if audit.newton_failed {
-            Flag::raise(&mut self.newton_failed, frame, 1.0, "frames");
         }
     }
 }

@@ -11,8 +11,9 @@
 //! 2. **Contacts**: no contact point of a body lies deeper than the penetration tolerance inside
 //!    a collider or another deformable body, and none crossed a collider over the frame.
 //! 3. **Elements**: no element is inverted (`V ≤ 0`) or collapsed (`V < J_min V₀`).
-//! 4. **Solver**: no implicit Newton solve of the frame failed
-//!    ([`AutomaticReport::newton_failed`]).
+//! 4. **Step**: the body's step was not refused ([`BodyAudit::step_error`]): the integrators
+//!    refuse a frame rather than keep one they could not resolve (an implicit Newton solve that
+//!    does not converge in the most substeps allowed, an element crushed, a contact not held).
 //!
 //! Tolerances ([`AuditSettings`]):
 //! - energy: `relative × (K + Ψ + |W|) + allowances + floor`, with `K + Ψ` the kinetic and
@@ -78,7 +79,7 @@ impl Default for AuditSettings {
             energy_relative_tolerance: 1e-3,
             energy_floor: 1e-9,
             penetration_fraction: 0.25,
-            collapse_ratio: 1e-2,
+            collapse_ratio: crate::integrate::COLLAPSE_RATIO,
         }
     }
 }
@@ -231,7 +232,6 @@ impl Audit {
             inverted_elements: elements.inverted,
             collapsed_elements: elements.collapsed,
             smallest_volume_ratio: elements.smallest_ratio,
-            newton_failed: report.is_some_and(|r| r.newton_failed),
             newton_stalled_substeps: report
                 .and_then(|r| r.implicit)
                 .map_or(0, |i| i.stalled_substeps),

@@ -79,14 +79,13 @@ pub struct BodyAudit {
     pub collapsed_elements: usize,
     /// The smallest element volume over rest volume (dimensionless).
     pub smallest_volume_ratio: f64,
-    /// Whether an implicit Newton solve of the frame failed.
-    pub newton_failed: bool,
     /// Implicit substeps of the body's last step whose Newton solve stopped on a round-off stall
     /// (not a failure: see
     /// [`ImplicitReport::stalled_substeps`](crate::integrate::ImplicitReport::stalled_substeps)).
     pub newton_stalled_substeps: u32,
-    /// The error the body's step returned this frame, if any (its state is then the one before
-    /// the failed substep).
+    /// The error the body's step returned this frame, if any: a step refused (a Newton solve
+    /// that refinement could not make converge, an element crushed, ...), its state then the one
+    /// before the refused substep.
     pub step_error: Option<Error>,
 }
 
@@ -117,7 +116,6 @@ impl BodyAudit {
             || self.penetrates()
             || self.crossed()
             || self.has_bad_elements()
-            || self.newton_failed
             || self.step_error.is_some())
     }
 }

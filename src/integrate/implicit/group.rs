@@ -11,7 +11,10 @@
 
 use super::potential::Potential;
 use super::rigid_response::{Placement, RigidResponse};
-use super::{ImplicitIntegrator, ImplicitReport, Outcome, STALL_CEILING, Stop, end_substep};
+use super::{
+    CrushWatch, ImplicitIntegrator, ImplicitReport, MAX_REFINEMENT, Outcome, Stop, end_substep,
+    on_round_off_floor, refinable,
+};
 use crate::Error;
 use crate::assembly::Stiffness;
 use crate::body::DeformableBody;
@@ -19,7 +22,7 @@ use crate::constraint::{self, BodyConstraints};
 use crate::contact::{BetweenContact, ContactSettings, JointContacts, NodeSlices};
 use crate::integrate::{BodyInStep, PreviousStep};
 use crate::linear_solver::{Method, solve_newton_system};
-use crate::newton::{Configuration, Search, descend, norm};
+use crate::newton::{Configuration, Search, descend, norm, round_off_floor};
 use rapier3d::glamx::DVec3;
 use std::cell::RefCell;
 
@@ -236,8 +239,9 @@ impl GroupSolver {
 impl ImplicitIntegrator {
     /// Advances soft `bodies` touching each other through `between` (indices into `bodies`) by
     /// `frame_dt` (s) under `gravity` (m/s²) as one system (see the module documentation), with
-    /// `settings` for the contacts between them. A report per body, in order; the Newton counts
-    /// are the group's.
+    /// `settings` for the contacts between them, refined and refused as
+    /// [`ImplicitIntegrator::step`] refines and refuses a body's frame. A report per body, in
+    /// order; the Newton counts are the group's.
     ///
     /// # Errors
     /// Those of [`ImplicitIntegrator::step`]; every body is then left as it was.
@@ -250,6 +254,35 @@ impl ImplicitIntegrator {
     ) -> Result<Vec<ImplicitReport>, Error> {
         Error::check_step(frame_dt, gravity)?;
         self.check()?;
+        let watches: Vec<CrushWatch> = bodies.iter().map(|s| CrushWatch::new(s.body)).collect();
+        let limit = self.substeps.saturating_mul(MAX_REFINEMENT);
+        let mut refined = *self;
+        loop {
+            let attempt = refined.attempt_together(
+                bodies,
+                (between, settings),
+                (frame_dt, gravity),
+                &watches,
+            );
+            match attempt {
+                Err(error) if refinable(&error) && refined.substeps < limit => {
+                    refined.substeps = refined.substeps.saturating_mul(2).min(limit);
+                }
+                outcome => return outcome,
+            }
+        }
+    }
+
+    /// [`ImplicitIntegrator::step_together`] in [`ImplicitIntegrator::substeps`], refused (every
+    /// body left as it was) at the first failed Newton solve, or when the frame ends with a body
+    /// past a collider's middle or crushing an element its watch did not see crushed.
+    fn attempt_together(
+        &self,
+        bodies: &mut [BodyInStep<'_>],
+        (between, settings): (&[BetweenContact], &ContactSettings),
+        (frame_dt, gravity): (f64, DVec3),
+        watches: &[CrushWatch],
+    ) -> Result<Vec<ImplicitReport>, Error> {
         let mut histories = Vec::with_capacity(bodies.len());
         for step in bodies.iter_mut() {
             step.save();
@@ -262,38 +295,46 @@ impl ImplicitIntegrator {
         let mut failure = None;
         for _ in 0..self.substeps {
             match self.substep_together(bodies, &mut solver, &mut last, (h, gravity)) {
-                Ok(outcome) => report.add(&outcome),
-                Err(error) => {
-                    failure = Some(error);
-                    break;
+                Ok(outcome) => {
+                    report.add(&outcome);
+                    failure = outcome.failure(self.substeps);
                 }
+                Err(error) => failure = Some(error),
+            }
+            if failure.is_some() {
+                break;
             }
         }
         solver.give_back(bodies);
-        let failure = failure.or_else(|| {
-            bodies
+        let checked: Result<Vec<usize>, Error> = match failure {
+            Some(error) => Err(error),
+            None => bodies
                 .iter()
-                .find_map(|step| step.body.first_non_finite_node())
-                .map(|node| Error::NonFiniteState { node })
-        });
-        if let Some(error) = failure {
-            for (step, history) in bodies.iter_mut().zip(histories) {
-                step.restore();
-                step.workspace.previous_step = history;
-            }
-            return Err(error);
-        }
-        Ok(bodies
-            .iter_mut()
-            .zip(last)
-            .map(|(step, last)| {
-                step.workspace.previous_step = last;
-                ImplicitReport {
-                    inverted_tets: step.body.inverted_tet_count(),
-                    ..report
+                .zip(watches)
+                .map(|(step, watch)| self.frame_failure(step.body, step.constraints, watch))
+                .collect(),
+        };
+        match checked {
+            Ok(inverted) => Ok(bodies
+                .iter_mut()
+                .zip(last)
+                .zip(inverted)
+                .map(|((step, last), inverted_tets)| {
+                    step.workspace.previous_step = last;
+                    ImplicitReport {
+                        inverted_tets,
+                        ..report
+                    }
+                })
+                .collect()),
+            Err(error) => {
+                for (step, history) in bodies.iter_mut().zip(histories) {
+                    step.restore();
+                    step.workspace.previous_step = history;
                 }
-            })
-            .collect())
+                Err(error)
+            }
+        }
     }
 
     /// One substep of `h` (s) of the group: `last` holds each body's last substep start, and is
@@ -415,7 +456,13 @@ impl ImplicitIntegrator {
                     node: group.body_node(at),
                 });
             }
-            if let Some(stop) = self.stop(relative, &history, outcome.iterations) {
+            let floor = |group: &mut Group, forces: &mut [Vec<DVec3>]| {
+                round_off_floor(group, &residual, |g| potential.residual(g, forces)) / reference
+            };
+            let stop = self.stop(relative, &history, outcome.iterations, || {
+                floor(group, &mut forces)
+            });
+            if let Some(stop) = stop {
                 outcome.stop = stop;
                 return Ok(outcome);
             }
@@ -440,8 +487,8 @@ impl ImplicitIntegrator {
             match next {
                 Some((next, value)) => (residual, energy) = (next, value),
                 None => {
-                    // No descent left: round-off below the stall ceiling, a failure above it.
-                    if outcome.residual <= STALL_CEILING {
+                    // No descent left: round-off on its floor, a failure above it.
+                    if on_round_off_floor(outcome.residual, || floor(group, &mut forces)) {
                         outcome.stop = Stop::Stalled;
                     }
                     return Ok(outcome);

@@ -25,28 +25,53 @@ mod rigid_response;
 
 pub use report::ImplicitReport;
 
-use super::{PreviousStep, SolverWorkspace};
+use super::{CrushWatch, PreviousStep, SolverWorkspace};
 use crate::Error;
 use crate::assembly::Stiffness;
 use crate::body::DeformableBody;
 use crate::chord::{self, Chord};
 use crate::constraint::{self, BodyConstraints};
 use crate::linear_solver::{LinearSolver, Method, solve_newton_system};
-use crate::newton::{Search, check_tolerance, descend, norm};
+use crate::newton::{Search, check_tolerance, descend, norm, round_off_floor};
 use potential::{Potential, StepStart};
 use rapier3d::glamx::DVec3;
 use report::{Outcome, Stop};
 use rigid_response::RigidResponse;
 use std::cell::RefCell;
 
-/// Newton stops early on a stalled residual only below this relative value; above it, a slow
-/// descent is still progress.
+/// Newton stops early on a stalled residual below this relative value, or within
+/// [`ROUND_OFF_MARGIN`] of its measured round-off floor; above both, a slow descent is still
+/// progress.
 const STALL_CEILING: f64 = 1e-4;
 
-/// A frame is redone in up to this many times [`ImplicitIntegrator::substeps`] while a surface
-/// point ends it past the middle of the collider it touches (see
-/// [`ImplicitIntegrator::substeps`]).
-const MAX_CONTACT_REFINEMENT: u32 = 64;
+/// A residual Newton cannot lower is on its round-off floor when it is within this factor of the
+/// floor measured at the iterate ([`round_off_floor`]): the iterates themselves carry rounding
+/// errors of a few units in the last place, which the one-unit perturbation measures once.
+const ROUND_OFF_MARGIN: f64 = 2.0;
+
+/// Whether a relative residual `relative` that Newton cannot lower sits on its round-off floor:
+/// below [`STALL_CEILING`], or within [`ROUND_OFF_MARGIN`] of the relative floor `floor()`
+/// (evaluated only when needed: it costs a residual).
+fn on_round_off_floor(relative: f64, floor: impl FnOnce() -> f64) -> bool {
+    relative <= STALL_CEILING || relative <= ROUND_OFF_MARGIN * floor()
+}
+
+/// A frame is redone in up to this many times [`ImplicitIntegrator::substeps`] while its Newton
+/// solve fails or a surface point ends it past the middle of the collider it touches (see
+/// [`ImplicitIntegrator::step`]).
+pub const MAX_REFINEMENT: u32 = 64;
+
+/// Whether a frame refused with `error` may succeed in more substeps: a failed Newton solve, a
+/// contact the penalty of a long step could not hold, an element crushed by a step too long to
+/// follow an impact.
+fn refinable(error: &Error) -> bool {
+    matches!(
+        error,
+        Error::NewtonDidNotConverge { .. }
+            | Error::ContactNotResolved { .. }
+            | Error::ElementCrushed { .. }
+    )
+}
 
 /// Which implicit scheme [`ImplicitIntegrator`] uses.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -82,16 +107,20 @@ pub struct ImplicitIntegrator {
     /// Newton stops when the out-of-balance force is below this fraction of the step's force
     /// scale (inertia, gravity and elastic forces) (dimensionless).
     pub tolerance: f64,
-    /// Newton iterations per substep at most (at least 1); a step that has not met the tolerance
-    /// by then, whose residual stops falling (its round-off floor), or along which no descent is
-    /// left, keeps its last iterate (each accepted iterate lowered the incremental potential) and
-    /// is reported as unconverged.
+    /// Newton iterations per substep at most (at least 1); default 100. A substep that has not
+    /// met the tolerance by then, or along which no descent is left, has failed (the frame is
+    /// redone in more substeps, see [`ImplicitIntegrator::substeps`]), unless its residual sits
+    /// on its round-off floor: then it keeps its last iterate (each accepted iterate lowered the
+    /// incremental potential) and is reported as stalled. Smooth motion and rest take one to a
+    /// few iterations; a change between sticking and sliding friction at many contacts takes
+    /// tens (55 measured when two kinematic fingers squeezing a soft cube start to lift it).
     pub max_newton_iterations: usize,
-    /// Equal substeps per frame (at least 1); each costs a Newton solve. A frame that leaves a
-    /// surface point behind its contact plane by more than half the thickness of the collider
-    /// it touches (a fast body pressed past the middle of a thin wall, where the penalty of a
-    /// long step is too soft to hold it) is redone in twice as many, and so on up to 64 times
-    /// as many: the report's `substeps` says how many were taken.
+    /// Equal substeps per frame (at least 1); each costs a Newton solve. A frame whose Newton
+    /// solve fails, that leaves a surface point behind its contact plane by more than half the
+    /// thickness of the collider it touches (a fast body pressed past the middle of a thin wall,
+    /// where the penalty of a long step is too soft to hold it), or that crushes an element, is
+    /// redone in twice as many, and so on up to [`MAX_REFINEMENT`] times as many, then refused:
+    /// the report's `substeps` says how many were taken.
     pub substeps: u32,
     /// How each Newton iteration's linear system is solved.
     pub linear_solver: LinearSolver,
@@ -115,7 +144,7 @@ impl Default for ImplicitIntegrator {
         Self {
             scheme: ImplicitScheme::BackwardEuler,
             tolerance: 1e-6,
-            max_newton_iterations: 20,
+            max_newton_iterations: 100,
             substeps: 1,
             linear_solver: LinearSolver::Automatic,
             reuse_factorization: true,
@@ -126,13 +155,22 @@ impl Default for ImplicitIntegrator {
 impl ImplicitIntegrator {
     /// Advances `body` by `frame_dt` (s) under uniform gravity (m/s²).
     ///
+    /// A frame whose Newton solve fails (out of iterations, or no descent left, above the
+    /// tolerance and off its round-off floor), or that leaves a surface point past the middle of
+    /// the collider it touches, is redone in twice the substeps, and so on up to
+    /// [`MAX_REFINEMENT`] times [`ImplicitIntegrator::substeps`]; past that it is refused.
+    ///
     /// # Errors
     /// [`Error::InvalidTimeStep`] for a non-positive or non-finite `frame_dt`;
     /// [`Error::NonFiniteInput`] for a non-finite gravity; [`Error::InvalidSetting`] for zero
     /// substeps, a non-positive tolerance, zero Newton iterations or an invalid
     /// [`LinearSolver::ConjugateGradient`] setting;
     /// [`Error::IndefiniteStiffness`] if a linear system cannot be factored;
-    /// [`Error::NonFiniteState`] if the step produced a NaN. On error the body is left as it was.
+    /// [`Error::NonFiniteState`] if the step produced a NaN; [`Error::NewtonDidNotConverge`] and
+    /// [`Error::ContactNotResolved`] when refinement could not resolve the frame;
+    /// [`Error::ElementCrushed`] for a frame that crushes an element (see
+    /// [`COLLAPSE_RATIO`](crate::integrate::COLLAPSE_RATIO)). On error the body is left as it
+    /// was.
     pub fn step(
         &self,
         body: &mut DeformableBody,
@@ -142,32 +180,32 @@ impl ImplicitIntegrator {
         gravity: DVec3,
     ) -> Result<ImplicitReport, Error> {
         let before = workspace.previous_step.clone();
+        let watch = CrushWatch::new(body);
+        let limit = self.substeps.saturating_mul(MAX_REFINEMENT);
         let mut refined = *self;
         loop {
-            let report =
-                refined.step_in_substeps(body, constraints, workspace, frame_dt, gravity)?;
-            let limit = self.substeps.saturating_mul(MAX_CONTACT_REFINEMENT);
-            if refined.substeps >= limit || !constraints.contacts.past_middle(body) {
-                return Ok(report);
+            let attempt =
+                refined.step_in_substeps(body, constraints, workspace, (frame_dt, gravity), &watch);
+            match attempt {
+                Err(error) if refinable(&error) && refined.substeps < limit => {
+                    workspace.previous_step.clone_from(&before);
+                    refined.substeps = refined.substeps.saturating_mul(2).min(limit);
+                }
+                outcome => return outcome,
             }
-            // A point ended past the middle of the collider it touches: the frame is redone in
-            // twice the substeps.
-            workspace.restore_state(body);
-            constraints.restore();
-            workspace.previous_step.clone_from(&before);
-            refined.substeps = refined.substeps.saturating_mul(2).min(limit);
         }
     }
 
-    /// [`ImplicitIntegrator::step`] in [`ImplicitIntegrator::substeps`], however deep the
-    /// contacts end.
+    /// [`ImplicitIntegrator::step`] in [`ImplicitIntegrator::substeps`], refused (the body left
+    /// as it was) at the first failed Newton solve, or when the frame ends past a collider's
+    /// middle or crushes an element `watch` did not see crushed at the start.
     fn step_in_substeps(
         &self,
         body: &mut DeformableBody,
         constraints: &mut BodyConstraints,
         workspace: &mut SolverWorkspace,
-        frame_dt: f64,
-        gravity: DVec3,
+        (frame_dt, gravity): (f64, DVec3),
+        watch: &CrushWatch,
     ) -> Result<ImplicitReport, Error> {
         Error::check_step(frame_dt, gravity)?;
         self.check()?;
@@ -197,27 +235,57 @@ impl ImplicitIntegrator {
             last_step: history.clone(),
             forces: std::mem::take(&mut workspace.forces),
         };
+        let mut failure = None;
         for _ in 0..self.substeps {
             match self.substep(body, constraints, &mut solver, h, gravity) {
-                Ok(outcome) => report.add(&outcome),
-                Err(error) => {
-                    workspace.restore_state(body);
-                    constraints.restore();
-                    solver.give_back(workspace, history);
-                    return Err(error);
+                Ok(outcome) => {
+                    report.add(&outcome);
+                    failure = outcome.failure(self.substeps);
                 }
+                Err(error) => failure = Some(error),
+            }
+            if failure.is_some() {
+                break;
             }
         }
+        let checked = match failure {
+            Some(error) => Err(error),
+            None => self.frame_failure(body, constraints, watch),
+        };
+        match checked {
+            Ok(inverted) => {
+                let last = solver.last_step.take();
+                solver.give_back(workspace, last);
+                report.inverted_tets = inverted;
+                Ok(report)
+            }
+            Err(error) => {
+                workspace.restore_state(body);
+                constraints.restore();
+                solver.give_back(workspace, history);
+                Err(error)
+            }
+        }
+    }
+
+    /// What refuses a frame once its substeps are done: a non-finite state, a surface point
+    /// past the middle of the collider it touches, an element crushed by the frame. Otherwise
+    /// the number of inverted tetrahedra.
+    fn frame_failure(
+        &self,
+        body: &DeformableBody,
+        constraints: &BodyConstraints,
+        watch: &CrushWatch,
+    ) -> Result<usize, Error> {
         if let Some(node) = body.first_non_finite_node() {
-            workspace.restore_state(body);
-            constraints.restore();
-            solver.give_back(workspace, history);
             return Err(Error::NonFiniteState { node });
         }
-        let last = solver.last_step.take();
-        solver.give_back(workspace, last);
-        report.inverted_tets = body.inverted_tet_count();
-        Ok(report)
+        if constraints.contacts.past_middle(body) {
+            return Err(Error::ContactNotResolved {
+                substeps: self.substeps,
+            });
+        }
+        watch.check(body)
     }
 
     /// Checks the settings.
@@ -311,7 +379,6 @@ impl ImplicitIntegrator {
             .iter()
             .map(|m| m / (incremental.start.h * incremental.start.h))
             .collect();
-        let start = incremental.start;
         let mut residual = incremental.residual(body, &mut solver.forces);
         let reference = incremental.force_scale(body, &residual);
         // Relative residuals of the earlier iterations, newest last.
@@ -329,35 +396,23 @@ impl ImplicitIntegrator {
                 let node = residual.iter().position(|r| !r.is_finite()).unwrap_or(0);
                 return Err(Error::NonFiniteState { node });
             }
-            if let Some(stop) = self.stop(relative, &history, outcome.iterations) {
+            let floor = |body: &mut DeformableBody, forces: &mut Vec<DVec3>| {
+                round_off_floor(body, &residual, |b| incremental.residual(b, forces)) / reference
+            };
+            let stop = self.stop(relative, &history, outcome.iterations, || {
+                floor(body, &mut solver.forces)
+            });
+            if let Some(stop) = stop {
                 outcome.stop = stop;
                 return finish(solver, outcome);
             }
             history.push(relative);
-            let remaining = self.max_newton_iterations - outcome.iterations;
-            let reusable = (self.reuse_factorization && solver.method == Method::Direct)
-                .then(|| {
-                    let budget = chord::within_budget(relative / self.tolerance, remaining);
-                    solver.chord.factor_for(start.h, budget)
-                })
-                .flatten();
-            let (direction, search) = match reusable {
-                Some(factor) => (
-                    incremental.reused_direction(body, factor, &residual),
-                    Search::Short,
-                ),
-                None => (
-                    self.exact_direction(
-                        body,
-                        solver,
-                        incremental,
-                        &inertia,
-                        &residual,
-                        &mut outcome,
-                    )?,
-                    Search::Thorough,
-                ),
-            };
+            let (direction, search) = self.direction(
+                body,
+                (solver, incremental),
+                (&inertia, &residual),
+                &mut outcome,
+            )?;
             let energy = |body: &DeformableBody| incremental.energy(body);
             let mut next = descend(
                 body,
@@ -382,14 +437,44 @@ impl ImplicitIntegrator {
             match next {
                 Some((next, energy)) => (residual, potential) = (next, energy),
                 None => {
-                    // No descent left: round-off below the stall ceiling, a failure above it.
-                    if outcome.residual <= STALL_CEILING {
+                    // No descent left: round-off on its floor, a failure above it.
+                    if on_round_off_floor(outcome.residual, || floor(body, &mut solver.forces)) {
                         outcome.stop = Stop::Stalled;
                     }
                     return finish(solver, outcome);
                 }
             }
         }
+    }
+
+    /// The Newton direction (m per node) for `residual` (N) at the iteration `outcome` has
+    /// reached, and how far to search along it: with an earlier factorization while the chord
+    /// may reuse one (see [`ImplicitIntegrator::reuse_factorization`]), else with the exact
+    /// tangent (`inertia` its `m/ĥ²` per node).
+    fn direction(
+        &self,
+        body: &DeformableBody,
+        (solver, incremental): (&mut Solver, &Potential),
+        (inertia, residual): (&[f64], &[DVec3]),
+        outcome: &mut Outcome,
+    ) -> Result<(Vec<DVec3>, Search), Error> {
+        let remaining = self.max_newton_iterations - outcome.iterations;
+        let reusable = (self.reuse_factorization && solver.method == Method::Direct)
+            .then(|| {
+                let budget = chord::within_budget(outcome.residual / self.tolerance, remaining);
+                solver.chord.factor_for(incremental.start.h, budget)
+            })
+            .flatten();
+        Ok(match reusable {
+            Some(factor) => (
+                incremental.reused_direction(body, factor, residual),
+                Search::Short,
+            ),
+            None => (
+                self.exact_direction(body, solver, incremental, inertia, residual, outcome)?,
+                Search::Thorough,
+            ),
+        })
     }
 
     /// Tells the chord how a reused iteration from `residual` went: to `next` (its residual), or
@@ -415,21 +500,32 @@ impl ImplicitIntegrator {
 
     /// Whether Newton stops at the relative residual `relative` after `iterations`, the earlier
     /// relative residuals being `history` (newest last): how it stops when it meets the
-    /// tolerance, is out of iterations or stalled, `None` to go on. A small
-    /// residual that three iterations could not cut by 10 % sits on its round-off floor (very
-    /// stiff or nearly incompressible material against a small load).
-    fn stop(&self, relative: f64, history: &[f64], iterations: usize) -> Option<Stop> {
+    /// tolerance, is out of iterations or stalled, `None` to go on. A residual that three
+    /// iterations could not cut by 10 % on its round-off floor (see [`on_round_off_floor`];
+    /// `floor()` the measured floor, relative) is stalled: very stiff or nearly incompressible
+    /// material against a small load. Out of iterations, it is stalled if within
+    /// [`ROUND_OFF_MARGIN`] of the measured floor, failed otherwise.
+    fn stop(
+        &self,
+        relative: f64,
+        history: &[f64],
+        iterations: usize,
+        mut floor: impl FnMut() -> f64,
+    ) -> Option<Stop> {
         if relative <= self.tolerance {
             return Some(Stop::Converged);
         }
-        let stalled = relative <= STALL_CEILING
-            && history.len() >= 3
-            && relative > 0.9 * history[history.len() - 3];
-        if stalled {
-            Some(Stop::Stalled)
-        } else {
-            (iterations == self.max_newton_iterations).then_some(Stop::Failed)
+        let stuck = history.len() >= 3 && relative > 0.9 * history[history.len() - 3];
+        if stuck && on_round_off_floor(relative, &mut floor) {
+            return Some(Stop::Stalled);
         }
+        (iterations == self.max_newton_iterations).then(|| {
+            if relative <= ROUND_OFF_MARGIN * floor() {
+                Stop::Stalled
+            } else {
+                Stop::Failed
+            }
+        })
     }
 
     /// The Newton direction (m per node) of the exact tangent, which the chord keeps for reuse

@@ -1,6 +1,8 @@
 //! What an implicit frame did: per frame the [`ImplicitReport`] a user reads, per substep the
 //! Newton solve's [`Outcome`] it sums and how it [`Stop`]ped.
 
+use crate::Error;
+
 /// What one implicit frame step did.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ImplicitReport {
@@ -28,14 +30,11 @@ pub struct ImplicitReport {
     /// Whether every substep met the tolerance.
     pub converged: bool,
     /// Substeps whose Newton solve stopped short of the tolerance on its round-off floor: a
-    /// relative residual at most 1e-4 that three iterations could not cut by 10 % (very stiff
-    /// or nearly incompressible material against a small load). Not converged, not failed.
+    /// residual that three iterations could not cut by 10 %, or out of iterations, at most 1e-4
+    /// relative or within twice what moving every coordinate by one unit in the last place
+    /// changes it by (very stiff or nearly incompressible material against a small load, a very
+    /// stiff coupling). Not converged, not failed: the frame is taken.
     pub stalled_substeps: u32,
-    /// Substeps whose Newton solve failed: it ran out of iterations, or no descent was left,
-    /// with the relative residual above the tolerance and not on a round-off stall. The step
-    /// keeps its last iterate (which lowered the incremental potential) but is not a solution
-    /// of the implicit equations.
-    pub failed_substeps: u32,
     /// Tetrahedra inverted (zero or negative volume) at the end of the frame.
     pub inverted_tets: usize,
 }
@@ -82,7 +81,6 @@ impl ImplicitReport {
             relative_residual: 0.0,
             converged: true,
             stalled_substeps: 0,
-            failed_substeps: 0,
             inverted_tets: 0,
         }
     }
@@ -97,11 +95,19 @@ impl ImplicitReport {
         self.relative_residual = self.relative_residual.max(outcome.residual);
         self.converged &= outcome.stop == Stop::Converged;
         self.stalled_substeps += u32::from(outcome.stop == Stop::Stalled);
-        self.failed_substeps += u32::from(outcome.stop == Stop::Failed);
     }
 }
 
 impl Outcome {
+    /// The refusal of a substep, of a frame in `substeps`, whose Newton solve failed: it ran out
+    /// of iterations, or no descent was left, above the tolerance and off its round-off floor.
+    pub(super) fn failure(&self, substeps: u32) -> Option<Error> {
+        (self.stop == Stop::Failed).then_some(Error::NewtonDidNotConverge {
+            residual: self.residual,
+            substeps,
+        })
+    }
+
     /// No iteration yet; the residual and convergence are set on return.
     pub(super) fn start() -> Self {
         Self {

@@ -1,0 +1,207 @@
+//! Steps the integrators cannot resolve are refused with a typed error and the state before them
+//! kept, never taken: an impact that flattens elements (the material's answer to the load, which
+//! no substep undoes), and a Newton solve that does not converge in the most substeps refinement
+//! allows. A frame Newton cannot solve in one substep is redone in more, exactly as if that many
+//! had been asked for; a solve on its round-off floor (a stiff, nearly incompressible beam) is
+//! accepted as stalled, not refused.
+
+mod common;
+
+use common::{cantilever, gravity, world_with_ground};
+use rapier_fvm::coupling::Audit;
+use rapier_fvm::integrate::COLLAPSE_RATIO;
+use rapier_fvm::prelude::*;
+
+/// Speed (m/s) of a cube dropped from 0.5 m.
+fn drop_speed() -> f64 {
+    (2.0 * 9.81 * 0.5f64).sqrt()
+}
+
+/// A 10 cm cube (4 cells a side, stable Neo-Hookean, ν = 0.3, 1000 kg/m³) of Young's modulus
+/// `young` (Pa), released 1 mm above the ground at the speed of a 0.5 m drop.
+fn dropped_cube(young: f64) -> DeformableBody {
+    let material = Material::new(MaterialModel::StableNeoHookean, young, 0.3, 1000.0).unwrap();
+    DeformableBodyBuilder::new(mesh::cuboid(DVec3::splat(0.05), [4; 3]).unwrap(), material)
+        .translation(DVec3::new(0.0, 0.051, 0.0))
+        .linvel(DVec3::new(0.0, -drop_speed(), 0.0))
+        .build()
+        .unwrap()
+}
+
+/// The elastic energy density (J/m³) of the stable Neo-Hookean material (`ν ≥ 0`) squeezed to
+/// zero thickness with its sides held, `F = diag(1, 0, 1)`: `Ψ = μ/2 (I_C − 3) − μ (J − 1) +
+/// (λ + μ)/2 (J − 1)²` at `I_C = 2`, `J = 0`, that is `μ + λ/2`. Letting the sides spread lowers
+/// it, so no element can take in more than this before it is flat.
+fn flattening_energy_density(young: f64) -> f64 {
+    let lame = Material::new(MaterialModel::StableNeoHookean, young, 0.3, 1000.0)
+        .unwrap()
+        .lame();
+    lame.mu + lame.lambda / 2.0
+}
+
+/// Runs a cube of `young` (Pa) dropped on the ground for 0.25 s in frames of 1/240 s under
+/// `force` (or the automatic choice); returns the first refusal, after checking that the refused
+/// step was not taken (the body is left as it was before the refused coupling substep: no element
+/// crushed, as the audit sees it) and that the next frame is refused too.
+fn drop_until_refused(young: f64, force: Option<IntegratorKind>) -> Option<Error> {
+    let mut world = world_with_ground(force);
+    world.physics.integration_parameters.dt = 1.0 / 240.0;
+    let cube = world.soft_bodies.insert(dropped_cube(young));
+    let mut audit = Audit::default();
+    audit.restart_world(&world);
+    for _ in 0..60 {
+        let results = world.step();
+        let found = audit.check_world(&world, &results);
+        let body = found.body(cube).unwrap();
+        if let Err(error) = &results[0].1 {
+            assert_eq!(body.inverted_elements, 0, "{force:?}: {error}");
+            assert_eq!(body.collapsed_elements, 0, "{force:?}: {error}");
+            assert!(body.smallest_volume_ratio >= COLLAPSE_RATIO);
+            let again = world.step();
+            assert!(
+                again[0].1.is_err(),
+                "{force:?}: the same frame passed again"
+            );
+            return Some(error.clone());
+        }
+        assert!(body.is_clean(), "{force:?}: {body:?}");
+    }
+    None
+}
+
+#[test]
+fn a_cube_its_material_cannot_stop_is_refused_at_the_impact_and_left_as_it_was() {
+    // At E = 1 kPa the drop's kinetic energy density, ρv²/2 = 4.9 kJ/m³, is 7.3 times what the
+    // material holds flattened (673 J/m³): elements must flatten. Every integrator refuses the
+    // frame that crushes one below 1 % of its rest volume.
+    let kinetic = 0.5 * 1000.0 * drop_speed().powi(2);
+    let capacity = flattening_energy_density(1e3);
+    assert!(
+        kinetic > 7.0 * capacity,
+        "{kinetic} J/m³ vs {capacity} J/m³"
+    );
+    for force in [
+        None,
+        Some(IntegratorKind::Explicit),
+        Some(IntegratorKind::Implicit),
+    ] {
+        let refusal = drop_until_refused(1e3, force);
+        println!("{force:?}: {refusal:?}");
+        match refusal {
+            Some(Error::ElementCrushed { volume_ratio, .. }) => {
+                assert!(volume_ratio < COLLAPSE_RATIO, "{force:?}: {volume_ratio}");
+            }
+            // Refined implicit frames of the crushing impact may end on a Newton solve that
+            // cannot converge instead.
+            Some(Error::NewtonDidNotConverge { substeps, .. }) => {
+                assert_ne!(force, Some(IntegratorKind::Explicit));
+                assert_eq!(substeps, 64);
+            }
+            other => panic!("{force:?}: {other:?}"),
+        }
+    }
+}
+
+#[test]
+fn a_cube_its_material_can_stop_is_not_refused() {
+    // At E = 100 kPa the material holds 67 kJ/m³ flattened, 14 times the drop's 4.9 kJ/m³.
+    let kinetic = 0.5 * 1000.0 * drop_speed().powi(2);
+    assert!(flattening_energy_density(1e5) > 13.0 * kinetic);
+    for force in [
+        None,
+        Some(IntegratorKind::Explicit),
+        Some(IntegratorKind::Implicit),
+    ] {
+        assert_eq!(drop_until_refused(1e5, force), None, "{force:?}");
+    }
+}
+
+/// A cube of 1e5 Pa released stretched by half along x without gravity, stepped by `integrator`
+/// for `frames` frames of 1/60 s; returns the positions and each frame's report.
+fn released_stretched(
+    integrator: &ImplicitIntegrator,
+    frames: usize,
+) -> (Vec<DVec3>, Vec<ImplicitReport>) {
+    let material = Material::new(MaterialModel::StableNeoHookean, 1e5, 0.3, 1000.0).unwrap();
+    let mut body =
+        DeformableBodyBuilder::new(mesh::cuboid(DVec3::splat(0.05), [4; 3]).unwrap(), material)
+            .build()
+            .unwrap();
+    let stretched: Vec<DVec3> = body
+        .positions()
+        .iter()
+        .map(|x| DVec3::new(1.5 * x.x, x.y, x.z))
+        .collect();
+    body.set_positions(&stretched).unwrap();
+    let (mut constraints, mut workspace) = (BodyConstraints::new(), SolverWorkspace::new());
+    let reports = (0..frames)
+        .map(|_| {
+            integrator
+                .step(
+                    &mut body,
+                    &mut constraints,
+                    &mut workspace,
+                    1.0 / 60.0,
+                    DVec3::ZERO,
+                )
+                .unwrap()
+        })
+        .collect();
+    (body.positions().to_vec(), reports)
+}
+
+#[test]
+fn a_frame_newton_cannot_solve_in_one_substep_is_redone_in_more() {
+    // Three Newton iterations cannot meet 1e-9 for the release of a cube stretched by half in
+    // one substep of 1/60 s; in shorter substeps they can. The frame is redone in twice the
+    // substeps until they do, and ends exactly as a frame asked for in that many substeps.
+    let limited = ImplicitIntegrator {
+        max_newton_iterations: 3,
+        tolerance: 1e-9,
+        reuse_factorization: false,
+        ..ImplicitIntegrator::default()
+    };
+    let (refined, reports) = released_stretched(&limited, 1);
+    let substeps = reports[0].substeps;
+    println!("{reports:?}");
+    assert!(substeps > 1 && substeps.is_power_of_two(), "{reports:?}");
+    assert!(reports[0].converged, "{reports:?}");
+    let asked = ImplicitIntegrator {
+        substeps,
+        ..limited
+    };
+    let (direct, direct_reports) = released_stretched(&asked, 1);
+    assert_eq!(direct_reports[0].substeps, substeps);
+    assert_eq!(refined, direct);
+    // Later frames are refined as they need, and converge.
+    let (_, reports) = released_stretched(&limited, 5);
+    assert!(reports.iter().all(|r| r.converged), "{reports:?}");
+}
+
+#[test]
+fn a_stiff_nearly_incompressible_beam_on_its_round_off_floor_is_accepted_as_stalled() {
+    // E = 1e11 Pa, ν = 0.4999: λ = 1.7e14 Pa, so moving the coordinates (up to 1 m) by one unit
+    // in the last place changes the nodal forces by about 1e-3 of the beam's weight. Newton
+    // stops there, a few times 1e-4 above the 1e-6 tolerance: a stall on the round-off floor,
+    // not a failure, and the frame is taken.
+    let material = Material::new(MaterialModel::StableNeoHookean, 1e11, 0.4999, 1000.0).unwrap();
+    let (mut beam, _) = cantilever([20, 2, 2], material);
+    let (mut constraints, mut workspace) = (BodyConstraints::new(), SolverWorkspace::new());
+    let integrator = ImplicitIntegrator::default();
+    let mut stalled = 0;
+    for _ in 0..10 {
+        let report = integrator
+            .step(
+                &mut beam,
+                &mut constraints,
+                &mut workspace,
+                1.0 / 60.0,
+                gravity(),
+            )
+            .unwrap();
+        assert_eq!(report.substeps, 1, "{report:?}");
+        assert!(report.relative_residual < 1e-2, "{report:?}");
+        stalled += report.stalled_substeps;
+    }
+    assert!(stalled > 0, "no frame stopped on its round-off floor");
+}
