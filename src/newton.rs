@@ -92,9 +92,12 @@ pub(crate) fn norm(v: &[DVec3]) -> f64 {
 /// How far a Newton update searches along its direction.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Search {
-    /// Steps `1, 1/2, …, 1/1024` on the energy; then, when the energy's decrease is lost in its
-    /// round-off (close to the solution), the largest step of the same sequence that lowers the
-    /// out-of-balance force; then the energy again at `1/2048, …, 2⁻³⁰` (see [`DEEP_STEP`]).
+    /// Steps `1, 1/2, …, 1/1024` on the energy, a shortened step then moved to the lowest energy
+    /// a golden-section search finds between it and twice it (see [`lowest_along`]); then,
+    /// when the decrease the direction promises is lost in the energy's round-off (close to the
+    /// solution, see [`ENERGY_RESOLUTION`]), the largest step of the same sequence that lowers
+    /// the out-of-balance force; then the energy again at `1/2048, …, 2⁻³⁰` (see
+    /// [`DEEP_STEP`]).
     Thorough,
     /// The full step or half of it, on the energy only: for a direction expected to be nearly
     /// the Newton step (from an earlier tangent's factorization).
@@ -118,16 +121,25 @@ pub(crate) fn descend<C: Configuration>(
         Search::Short => (1.0, 0.5),
     };
     let searched = (residual, energy_now, direction);
-    if let Some(accepted) = line_search(body, searched, &energy, steps) {
+    let start = body.copy_positions();
+    let refine = search == Search::Thorough;
+    if let Some(accepted) = search_energy(body, (&start, searched), &energy, steps, refine) {
         return Some((residual_at(body), accepted));
     }
     if search == Search::Short {
         return None;
     }
-    let start = body.copy_positions();
-    let current = norm(residual);
+    // The out-of-balance force decides only where the energy cannot: where the decrease the
+    // direction promises is lost in the energy's round-off. Elsewhere a step that raises the
+    // energy is not taken, however it changes the force.
+    let promised: f64 = residual.iter().zip(direction).map(|(r, d)| r.dot(*d)).sum();
+    let current = if promised <= ENERGY_RESOLUTION * energy_now.abs() {
+        norm(residual)
+    } else {
+        0.0
+    };
     let mut alpha = 1.0;
-    while alpha >= MIN_STEP {
+    while current > 0.0 && alpha >= MIN_STEP {
         body.place(&start, direction, alpha);
         let next = residual_at(body);
         if norm(&next) < current {
@@ -136,9 +148,32 @@ pub(crate) fn descend<C: Configuration>(
         alpha *= 0.5;
     }
     body.set(&start);
-    let accepted = line_search(body, searched, &energy, (MIN_STEP / 2.0, DEEP_STEP))?;
+    let deep = (MIN_STEP / 2.0, DEEP_STEP);
+    let accepted = search_energy(body, (&start, searched), &energy, deep, true)?;
     Some((residual_at(body), accepted))
 }
+
+/// [`line_search`] over `steps` from `start` (where `body` is), then, if `refine` and the step
+/// it accepted is shorter than the full one, [`lowest_along`]: the energy (J) where `body` ends.
+fn search_energy<C: Configuration>(
+    body: &mut C,
+    (start, searched): (&[DVec3], (&[DVec3], f64, &[DVec3])),
+    energy: &impl Fn(&C) -> f64,
+    steps: (f64, f64),
+    refine: bool,
+) -> Option<f64> {
+    let (alpha, accepted) = line_search(body, searched, energy, steps)?;
+    Some(if refine && alpha < 1.0 {
+        lowest_along(body, (start, searched.2), (alpha, accepted), energy)
+    } else {
+        accepted
+    })
+}
+
+/// The energy decrease (relative to the energy) a direction must promise, `r·d`, for the
+/// energy alone to judge its steps: below it the energy's round-off (about `1e-12` of it, more
+/// for sums of many terms) hides the decrease, and the out-of-balance force judges.
+const ENERGY_RESOLUTION: f64 = 1e-9;
 
 /// The smallest step fraction the thorough search tries first.
 const MIN_STEP: f64 = 1.0 / 1024.0;
@@ -150,17 +185,64 @@ const MIN_STEP: f64 = 1.0 / 1024.0;
 /// the contact or the sticking friction in it).
 const DEEP_STEP: f64 = 1.0 / 1_073_741_824.0;
 
+/// Golden-section evaluations of the energy [`lowest_along`] makes.
+const REFINEMENTS: usize = 16;
+
+/// Moves `body`, placed at the step `alpha` along `direction` from `start` (m) with the energy
+/// `value` (J) there, to the lowest energy (J, returned) among `alpha` and the points a
+/// golden-section search over `[alpha, 2 alpha]` evaluates.
+///
+/// A Newton step the line search shortened crossed something its quadratic model did not see:
+/// a contact's friction turning from sliding one way to sliding the other (a point that should
+/// stick, which the model, flat along the slip, carries past its stick zone of
+/// `stiction_speed h`), or a stiff penalty coming into force. The halvings stop anywhere short
+/// of the rejected step `2 alpha`, and the next iteration, from the same side, meets the same
+/// kink again; the lowest point up to the rejected step lands at it, where the next model sees
+/// the contact stuck or pressed. It has no more energy than `alpha`'s at a longer step, so it
+/// meets the same sufficient decrease.
+fn lowest_along<C: Configuration>(
+    body: &mut C,
+    (start, direction): (&[DVec3], &[DVec3]),
+    (alpha, value): (f64, f64),
+    energy: &impl Fn(&C) -> f64,
+) -> f64 {
+    let at = |step: f64, body: &mut C| {
+        body.place(start, direction, step);
+        energy(body)
+    };
+    let ratio = 0.5 * (5f64.sqrt() - 1.0);
+    let (mut low, mut high) = (alpha, 2.0 * alpha);
+    let mut inner = [high - ratio * (high - low), low + ratio * (high - low)];
+    let mut values = [at(inner[0], body), at(inner[1], body)];
+    for _ in 2..REFINEMENTS {
+        if values[0] < values[1] {
+            high = inner[1];
+            inner = [high - ratio * (high - low), inner[0]];
+            values = [at(inner[0], body), values[0]];
+        } else {
+            low = inner[0];
+            inner = [inner[1], low + ratio * (high - low)];
+            values = [values[1], at(inner[1], body)];
+        }
+    }
+    let (best, lowest) = [(inner[0], values[0]), (inner[1], values[1])]
+        .into_iter()
+        .fold((alpha, value), |a, b| if b.1 < a.1 { b } else { a });
+    body.place(start, direction, best);
+    lowest
+}
+
 /// Moves `body` along `direction` from its current positions, where `energy` (J) is `initial`
 /// and its gradient is `-residual` (N), by the largest step `α` in `largest, largest/2, …` down
 /// to `smallest` that satisfies the Armijo condition, so that the energy decreases. Returns the
-/// energy there, or `None`, with the positions put back, if no such step exists (the direction
-/// no longer descends above round-off).
+/// step and the energy there, or `None`, with the positions put back, if no such step exists
+/// (the direction no longer descends above round-off).
 fn line_search<C: Configuration>(
     body: &mut C,
     (residual, initial, direction): (&[DVec3], f64, &[DVec3]),
     energy: impl Fn(&C) -> f64,
     (largest, smallest): (f64, f64),
-) -> Option<f64> {
+) -> Option<(f64, f64)> {
     const ARMIJO: f64 = 1e-4;
     let start = body.copy_positions();
     let slope: f64 = -residual
@@ -177,7 +259,7 @@ fn line_search<C: Configuration>(
         body.place(&start, direction, alpha);
         let value = energy(body);
         if value <= initial + ARMIJO * alpha * slope + round_off {
-            return Some(value);
+            return Some((alpha, value));
         }
         alpha *= 0.5;
     }

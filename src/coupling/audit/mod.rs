@@ -107,6 +107,8 @@ pub struct AuditInput<'a> {
 #[derive(Debug, Clone, Default)]
 struct Snapshot {
     energies: HashMap<Member, MemberEnergy>,
+    /// The dynamic rigid bodies an implicit soft step moved in the frame.
+    implicitly_moved: Vec<RigidBodyHandle>,
     rigid_poses: HashMap<RigidBodyHandle, RigidPose>,
     collider_poses: HashMap<ColliderHandle, Pose>,
     positions: HashMap<DeformableBodyHandle, Vec<DVec3>>,
@@ -158,11 +160,10 @@ impl Audit {
                     .sum();
                 energy::check(
                     members,
-                    &now.energies,
-                    &before.energies,
+                    (&now.energies, &before.energies),
+                    &now.implicitly_moved,
                     work,
-                    settings.energy_relative_tolerance,
-                    settings.energy_floor,
+                    (settings.energy_relative_tolerance, settings.energy_floor),
                 )
             })
         };
@@ -244,6 +245,7 @@ impl Audit {
 fn snapshot(input: &AuditInput<'_>, results: &SoftStepResults) -> Snapshot {
     Snapshot {
         energies: energy::energies(input, results),
+        implicitly_moved: energy::implicitly_moved(input, results),
         rigid_poses: energy::rigid_poses(input),
         collider_poses: (input.colliders.iter())
             .map(|(handle, collider)| (handle, *collider.position()))

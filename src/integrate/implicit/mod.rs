@@ -62,12 +62,14 @@ fn on_round_off_floor(relative: f64, floor: impl FnOnce() -> f64) -> bool {
 pub const MAX_REFINEMENT: u32 = 64;
 
 /// Whether a frame refused with `error` may succeed in more substeps: a failed Newton solve, a
-/// contact the penalty of a long step could not hold, an element crushed by a step too long to
-/// follow an impact.
+/// Newton system whose factorization broke down (the tangent is positive definite in exact
+/// arithmetic, its inertia `m/ĥ²` growing as the substep shrinks), a contact the penalty of a
+/// long step could not hold, an element crushed by a step too long to follow an impact.
 fn refinable(error: &Error) -> bool {
     matches!(
         error,
         Error::NewtonDidNotConverge { .. }
+            | Error::IndefiniteStiffness { .. }
             | Error::ContactNotResolved { .. }
             | Error::ElementCrushed { .. }
     )

@@ -12,7 +12,8 @@
 //!
 //! For the soft positions `x`, `ι*(x) = argmin ½ ιᵀ W ι + Σ e_c(x_c − h J_c W ι)` is found by
 //! Newton's method with a backtracking line search on six unknowns per body (the penalties and
-//! the lagged friction are convex in the relative position); the soft step minimizes
+//! the lagged friction are convex in the relative position), taking the full step by the
+//! residual once the energy's decrease is lost in its round-off; the soft step minimizes
 //! `E(x) + min_ι(…)`, whose gradient is the terms' forces at `ι*(x)` (the envelope theorem) and
 //! whose Hessian is the tangent with the bodies held less the coupling through them, `U Q Uᵀ`
 //! (`U = −Σ P_cᵀ T_c J_c`, `Q = h² (I + h² W A)⁻¹ W`, `A = Σ J_cᵀ T_c J_c`), which the Newton
@@ -217,7 +218,10 @@ impl RigidResponse {
                 break;
             }
             let start = self.impulses.clone();
-            match self.line_search(body, constraints, (&start, &directions), at.energy, slope) {
+            let next = self
+                .line_search(body, constraints, (&start, &directions), at.energy, slope)
+                .or_else(|| self.closer(body, constraints, (&start, &directions), largest));
+            match next {
                 Some(next) => at = next,
                 None => {
                     self.move_to(&start, &directions, 0.0);
@@ -251,6 +255,26 @@ impl RigidResponse {
             step *= 0.5;
         }
         None
+    }
+
+    /// The full Newton step from the impulses `start` along `directions` if it brings the largest
+    /// stationarity residual below `largest` (N s): close to the solution the energy's decrease,
+    /// `½ Gᵀ W (I + h² A W)⁻¹ G`, falls below the round-off of the terms' energies (each a
+    /// penalty on a gap of micrometres between coordinates of decimetres), and the line search
+    /// can no longer see it, while the residual still falls quadratically. `None` if it does not.
+    fn closer(
+        &mut self,
+        body: &DeformableBody,
+        constraints: &BodyConstraints,
+        (start, directions): (&[[DVec3; 2]], &[Vector6<f64>]),
+        largest: f64,
+    ) -> Option<Evaluation> {
+        self.move_to(start, directions, 1.0);
+        let next = self.evaluate(body, constraints);
+        let after = (self.residuals(&next.gathered).iter())
+            .map(|r| r.norm())
+            .fold(0.0, f64::max);
+        (after < largest).then_some(next)
     }
 
     /// `½ Σ ιᵀ W ι` (J) over the bodies.
