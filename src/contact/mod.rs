@@ -27,8 +27,10 @@
 //! A collider attached to a rigid body takes the body's motion into account (its velocity at the
 //! contact point) and, when the body is dynamic, receives the opposite of every impulse the soft
 //! body gets, at the node's position, so that linear and angular momentum are exchanged exactly.
-//! Within a soft step the rigid bodies are frozen in pose and their velocities follow the
-//! impulses; the total is handed to rapier when the step is accepted.
+//! Within a soft step the rigid bodies' velocities follow the impulses, and the explicit substeps
+//! carry them along at those velocities as they move the nodes, so that a fast body sweeps
+//! through the nodes in its path (it does not wait frozen for rapier's step to jump past them);
+//! the total impulse is handed to rapier when the step is accepted.
 
 //!
 //! A body with [`DeformableBody::self_contact`] on also gets contacts of its surface nodes with its own
@@ -72,7 +74,7 @@ pub(crate) use set::ContactSet;
 use soft_point::SoftPoint;
 pub(crate) use surface_tree::nearest_point_on_triangle;
 use sweep::partners;
-pub(crate) use sweep::{prepare_velocities, solve_velocities};
+pub(crate) use sweep::{advance_planes, prepare_velocities, solve_velocities};
 pub use velocity_constraint::RESTITUTION_THRESHOLD;
 pub(crate) use velocity_constraint::{ContactSides, VelocityConstraint};
 

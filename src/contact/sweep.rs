@@ -103,7 +103,7 @@ pub(crate) fn prepare_velocities(
         let point = contact.at;
         let at = point.stencil(embedding);
         let x = at.interpolate(positions);
-        contact.refresh(x, positions);
+        contact.refresh(x, positions, partners.rigid);
         let gap = contact.gap(x);
         let sides = WithinBody {
             partners: &mut partners,
@@ -118,6 +118,18 @@ pub(crate) fn prepare_velocities(
             || sides.relative_velocity().dot(normal),
             contact.restitution,
         );
+    }
+}
+
+/// Carries the contact planes of colliders on rigid bodies along with the bodies over the
+/// explicit substep of `h` (s), before the proxies move (see [`RigidProxy::advance`]): a plane
+/// the next substep keeps (a point behind a thin collider) is then where its collider is.
+pub(crate) fn advance_planes(contacts: &mut ContactSet, proxies: &[RigidProxy], h: f64) {
+    for contact in &mut contacts.nodes {
+        if let Obstacle::Collider { proxy: Some(p), .. } = contact.obstacle {
+            (contact.point, contact.normal) =
+                proxies[p].plane_after(contact.point, contact.normal, h);
+        }
     }
 }
 
