@@ -101,6 +101,7 @@ impl BodyConstraints {
             nodes: found.nodes,
             corners: found.corners,
             settings: *settings,
+            step: frame_dt,
         };
         if body.self_contact {
             let own = contact::detect_self_contacts(body, found.reach);

@@ -90,14 +90,15 @@ pub(super) fn partners<'a>(
 /// Readies the contacts' velocity constraints for an explicit substep of `h` (s), before the
 /// sweeps of [`solve_velocities`]: each plane moves to the collider's surface point nearest to its
 /// node, and the lowest normal velocity is set so that the node arrives at the plane but does not
-/// cross it within the substep, or, found inside, leaves at most at the depenetration speed.
+/// cross it within the substep, or, found inside, leaves over the detection's step (see
+/// [`super::Depenetration`]).
 pub(crate) fn prepare_velocities(
     body: &mut DeformableBody,
     contacts: &mut ContactSet,
     proxies: &mut [RigidProxy],
     h: f64,
 ) {
-    let depenetration_speed = contacts.settings.depenetration_speed;
+    let depenetration = contacts.depenetration();
     let (positions, embedding, mut partners) = partners(body, proxies);
     for contact in &mut contacts.nodes {
         let point = contact.at;
@@ -112,7 +113,7 @@ pub(crate) fn prepare_velocities(
             x,
         };
         let normal = contact.normal;
-        contact.constraint = VelocityConstraint::new(gap, h, depenetration_speed).bounce(
+        contact.constraint = VelocityConstraint::new(gap, h, depenetration).bounce(
             gap,
             h,
             || sides.relative_velocity().dot(normal),
