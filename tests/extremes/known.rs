@@ -146,16 +146,6 @@ pub const KNOWN: &[Known] = &[
         measured: "frame 3: Newton failed",
     },
     Known {
-        case: "BoxOnBlock(0.001) dt 4.17e-3 automatic",
-        what: "the 1 g box resting on the 1e9 Pa block, stepped explicitly (65 383 substeps per frame), gains energy from the block",
-        measured: "frame 4: coupled energy gained 3.495e-6 J (tolerance 1.5e-7 J)",
-    },
-    Known {
-        case: "BoxOnBlock(0.001) dt 4.17e-3 explicit",
-        what: "the 1 g box resting on the 1e9 Pa block, stepped explicitly (65 383 substeps per frame), gains energy from the block",
-        measured: "frame 4: coupled energy gained 3.495e-6 J (tolerance 1.5e-7 J)",
-    },
-    Known {
         case: "BoxOnBlock(100.0) dt 4.17e-3 implicit",
         what: "the implicit Newton solve with the 100 kg box pressing on the block stops short of its tolerance (box response in the solve: issue 21, item 1)",
         measured: "frame 3: Newton failed",
@@ -199,36 +189,6 @@ pub const KNOWN: &[Known] = &[
         case: "BallOnRope(1000.0) dt 3.33e-2 implicit",
         what: "the 20 kg ball glued to the 20 g rope gains energy under implicit steps (the rope's implicit coupling with a heavy partner: issue 21, item 1)",
         measured: "frame 4: coupled energy gained 4.217e-3 J (tolerance 2.8e-4 J)",
-    },
-    Known {
-        case: "FastBall dt 4.17e-3 automatic",
-        what: "the 30 m/s ball passes through the block's surface nodes: they end on the ball's far side (no continuous contact for rigid bodies pressing into soft ones: issue 21, item 2)",
-        measured: "frame 1: 1 nodes through a collider",
-    },
-    Known {
-        case: "FastBall dt 1.67e-2 automatic",
-        what: "the 30 m/s ball passes through the block's surface nodes: they end on the ball's far side (no continuous contact for rigid bodies pressing into soft ones: issue 21, item 2)",
-        measured: "frame 1: 1 nodes through a collider",
-    },
-    Known {
-        case: "FastBall dt 3.33e-2 automatic",
-        what: "the 30 m/s ball striking the block at 1/30 s frames gains energy from the block's nodes it meets (no continuous contact for a rigid body pressing into soft nodes: issue 21, item 2)",
-        measured: "frame 1: energy gained 4.266e-3 J (tolerance 1.5e-3 J)",
-    },
-    Known {
-        case: "FastBall dt 4.17e-3 explicit",
-        what: "the 30 m/s ball passes through the block's surface nodes: they end on the ball's far side (no continuous contact for rigid bodies pressing into soft ones: issue 21, item 2)",
-        measured: "frame 1: 1 nodes through a collider",
-    },
-    Known {
-        case: "FastBall dt 1.67e-2 explicit",
-        what: "the 30 m/s ball passes through the block's surface nodes: they end on the ball's far side (no continuous contact for rigid bodies pressing into soft ones: issue 21, item 2)",
-        measured: "frame 1: 1 nodes through a collider",
-    },
-    Known {
-        case: "FastBall dt 3.33e-2 explicit",
-        what: "the 30 m/s ball striking the block at 1/30 s frames gains energy from the block's nodes it meets (no continuous contact for a rigid body pressing into soft nodes: issue 21, item 2)",
-        measured: "frame 1: energy gained 4.266e-3 J (tolerance 1.5e-3 J)",
     },
     Known {
         case: "FastBall dt 4.17e-3 implicit",
