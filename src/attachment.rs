@@ -7,8 +7,8 @@
 //! the opposite impulse at the node. The implicit integrator adds a stiff spring to the anchor's
 //! position at the end of the step, `k = penalty_factor m/ĥ²`, to its potential, the anchor
 //! carried by its body at the velocity the step's solve gives it (a dynamic body's response to
-//! the springs and contacts is part of the solve). In both, the body is frozen in pose for the
-//! soft step and its velocity follows the impulses, as for contacts.
+//! the springs and contacts is part of the solve). In both, the body's velocity follows the
+//! impulses, and the anchor moves with it, as for contacts.
 
 use crate::Error;
 use crate::body::DeformableBody;

@@ -1,9 +1,18 @@
 //! The rigid bodies a soft body touches, as the soft step sees them: velocity, centre of mass and
-//! inverse mass, frozen in pose for the step, updated by the contact impulses as they are applied,
-//! and the total impulse to hand back to rapier when the step is accepted.
+//! inverse mass, updated by the contact impulses as they are applied, and the total impulse to
+//! hand back to rapier when the step is accepted.
+//!
+//! An implicit step sees each body at its pose when the step began, carrying what it touches by
+//! its velocity over the step. The explicit substeps move it as they move the nodes
+//! (`x ← x + h v`, at the velocity the sweeps left): the proxy keeps the rigid motion since it
+//! was made, a translation of the centre of mass `c₀ → c` and a turn `R`, and a material point
+//! at `p₀` then is at `c + R (p₀ − c₀)` now. Colliders keep their pose at detection; a node is
+//! taken back into that pose to be projected onto them, and its contact plane carried forward
+//! (see [`RigidProxy::carry`]), so that a fast body sweeps through the nodes in its path within
+//! the soft step instead of jumping over them in rapier's.
 
 use rapier3d::dynamics::{RigidBody, RigidBodyHandle, RigidBodyType};
-use rapier3d::glamx::{DMat3, DVec3};
+use rapier3d::glamx::{DMat3, DQuat, DVec3};
 
 /// The linear velocity of the centre of mass (m/s) and the angular velocity (rad/s) `body` will
 /// have over the coming step of `dt` (s): its velocities, or, for a position-based kinematic
@@ -38,14 +47,19 @@ pub(crate) struct RigidProxy {
     /// Linear velocity (m/s) and angular velocity (rad/s), updated by the contact impulses.
     linvel: DVec3,
     angvel: DVec3,
-    /// World centre of mass (m).
+    /// World centre of mass (m), carried along by the explicit substeps.
     com: DVec3,
+    /// The centre of mass (m) when the proxy was made, and the turn since then.
+    start_com: DVec3,
+    turn: DQuat,
     /// The body's gravity scale if dynamic, zero otherwise.
     fall: f64,
     /// Per-axis inverse mass (1/kg) and world inverse inertia (1/(kg m²)); zero unless dynamic.
     inv_mass: DVec3,
     inv_inertia: DMat3,
-    /// Impulse (N s) and angular impulse about the centre of mass (N m s) received so far.
+    /// Impulse (N s) and angular impulse (N m s) received so far, the latter about the centre of
+    /// mass where the proxy was made: rapier applies them to the body there, and so taken the
+    /// system's angular momentum is exchanged exactly.
     pub(crate) impulse: DVec3,
     pub(crate) angular_impulse: DVec3,
 }
@@ -77,6 +91,8 @@ impl RigidProxy {
             linvel,
             angvel,
             com: props.world_com.as_dvec3(),
+            start_com: props.world_com.as_dvec3(),
+            turn: DQuat::IDENTITY,
             fall,
             inv_mass,
             inv_inertia,
@@ -109,6 +125,53 @@ impl RigidProxy {
                 proxies.len() - 1
             }
         }
+    }
+
+    /// Moves the body along its velocity for `h` (s), as an explicit substep moves the nodes once
+    /// its sweeps are done: the centre of mass by `h v`, the orientation by the turn `h ω`. The
+    /// inverse inertia stays the one of the starting pose (a coupling substep turns a body little).
+    pub(crate) fn advance(&mut self, h: f64) {
+        self.com += self.linvel * h;
+        if self.angvel != DVec3::ZERO {
+            self.turn = (DQuat::from_scaled_axis(self.angvel * h) * self.turn).normalize();
+        }
+    }
+
+    /// Where a plane fixed in the body, through `point` (m) with unit `normal`, is after `h` (s)
+    /// at the body's velocity (as [`RigidProxy::advance`] moves the body).
+    pub(crate) fn plane_after(&self, point: DVec3, normal: DVec3, h: f64) -> (DVec3, DVec3) {
+        let normal = if self.angvel == DVec3::ZERO {
+            normal
+        } else {
+            (DQuat::from_scaled_axis(self.angvel * h) * normal).normalize()
+        };
+        (point + self.velocity_at(point) * h, normal)
+    }
+
+    /// Whether the explicit substeps have moved the body since the proxy was made.
+    pub(crate) fn has_moved(&self) -> bool {
+        self.com != self.start_com || self.turn != DQuat::IDENTITY
+    }
+
+    /// Where the body's material point that was at `point` (m) when the proxy was made is now.
+    pub(crate) fn carry(&self, point: DVec3) -> DVec3 {
+        self.com + self.turn * (point - self.start_com)
+    }
+
+    /// Where the body's material point now at `point` (m) was when the proxy was made: the
+    /// inverse of [`RigidProxy::carry`].
+    pub(crate) fn carry_back(&self, point: DVec3) -> DVec3 {
+        self.start_com + self.turn.inverse() * (point - self.com)
+    }
+
+    /// A direction fixed in the body, `direction` when the proxy was made, now.
+    pub(crate) fn turn(&self, direction: DVec3) -> DVec3 {
+        self.turn * direction
+    }
+
+    /// A direction fixed in the body, `direction` now, when the proxy was made.
+    pub(crate) fn turn_back(&self, direction: DVec3) -> DVec3 {
+        self.turn.inverse() * direction
     }
 
     /// Whether contact impulses move the body (it is dynamic).
@@ -179,7 +242,7 @@ impl RigidProxy {
         self.angvel = base.angvel + dw;
     }
 
-    /// The world centre of mass (m).
+    /// The world centre of mass (m), where the explicit substeps carried it.
     pub(crate) fn center_of_mass(&self) -> DVec3 {
         self.com
     }
@@ -189,12 +252,56 @@ impl RigidProxy {
         (self.inv_mass, self.inv_inertia)
     }
 
-    /// Applies `impulse` (N s) at `point` (m).
+    /// Applies `impulse` (N s) at `point` (m): the body's velocities change by its response about
+    /// the centre of mass where the explicit substeps carried it, and the impulse is recorded
+    /// with its moment about the starting centre of mass. The two differ by
+    /// `(c − c₀) × impulse`, which rapier's step, applying the impulses where the body started,
+    /// turns into a spin the proxy did not have (nothing for a body struck along its path).
     pub(crate) fn apply(&mut self, impulse: DVec3, point: DVec3) {
         let angular = (point - self.com).cross(impulse);
         self.linvel += self.inv_mass * impulse;
         self.angvel += self.inv_inertia * angular;
         self.impulse += impulse;
-        self.angular_impulse += angular;
+        self.angular_impulse += (point - self.start_com).cross(impulse);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rapier3d::dynamics::{RigidBodyBuilder, RigidBodySet};
+    use rapier3d::geometry::{ColliderBuilder, ColliderSet};
+    use rapier3d::math::Vector;
+
+    #[test]
+    fn a_proxy_carries_the_body_s_points_along_its_velocity() {
+        // A 20 cm cube at (1, 2, 3) m moving at (2, -1, 0.5) m/s and turning at 3 rad/s about z,
+        // no impulse: after 10 substeps of 1 ms its centre of mass has moved by 10 ms of its
+        // velocity, and a point fixed in it by that translation and a turn of 0.03 rad about
+        // the centre of mass; taking the point back gives where it started.
+        let mut bodies = RigidBodySet::new();
+        let mut colliders = ColliderSet::new();
+        let handle = bodies.insert(
+            RigidBodyBuilder::dynamic()
+                .translation(Vector::new(1.0, 2.0, 3.0))
+                .linvel(Vector::new(2.0, -1.0, 0.5))
+                .angvel(Vector::new(0.0, 0.0, 3.0)),
+        );
+        colliders.insert_with_parent(ColliderBuilder::cuboid(0.1, 0.1, 0.1), handle, &mut bodies);
+        let mut proxy = RigidProxy::new(handle, &bodies[handle], 1e-2);
+        let start = proxy.center_of_mass();
+        assert!(!proxy.has_moved());
+        for _ in 0..10 {
+            proxy.advance(1e-3);
+        }
+        let point = start + DVec3::new(0.1, -0.05, 0.02);
+        let turn = DQuat::from_rotation_z(0.03);
+        let travel = DVec3::new(2.0, -1.0, 0.5) * 1e-2;
+        let expected = start + travel + turn * (point - start);
+        assert!(proxy.has_moved());
+        assert!((proxy.carry(point) - expected).length() < 1e-12);
+        assert!((proxy.carry_back(proxy.carry(point)) - point).length() < 1e-12);
+        assert!((proxy.turn(DVec3::X) - turn * DVec3::X).length() < 1e-12);
+        assert!((proxy.turn_back(proxy.turn(DVec3::Y)) - DVec3::Y).length() < 1e-12);
     }
 }

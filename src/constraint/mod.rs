@@ -14,8 +14,8 @@
 //!    bodies), once, or [`ContactSettings::velocity_iterations`](crate::contact::ContactSettings::velocity_iterations)
 //!    times when dynamic rigid bodies, self-contacts, rigid vertices or other soft bodies couple
 //!    the constraints;
-//! 4. `ExplicitSide::advance` for every kind (anchors and rigid vertices move with their
-//!    bodies), then `x ← x + h v`.
+//! 4. `ExplicitSide::advance` for every kind (contact planes, anchors and rigid vertices move
+//!    with their bodies), then the rigid proxies move (`RigidProxy::advance`) and `x ← x + h v`.
 //!
 //! An implicit step adds every kind's `ImplicitSide` terms to the incremental potential: an
 //! energy `E_c` (J), its force `-∂E_c/∂x` (N) on a point of the body and its tangent
@@ -139,7 +139,9 @@ impl ExplicitSide for NodeContacts {
     fn sweep(&self, body: &mut DeformableBody, c: &mut BodyConstraints) {
         contact::solve_velocities(body, &mut c.contacts, &mut c.rigid_proxies);
     }
-    fn advance(&self, _body: &mut DeformableBody, _c: &mut BodyConstraints, _h: f64) {}
+    fn advance(&self, _body: &mut DeformableBody, c: &mut BodyConstraints, h: f64) {
+        contact::advance_planes(&mut c.contacts, &c.rigid_proxies, h);
+    }
 }
 
 impl ExplicitSide for CornerContacts {

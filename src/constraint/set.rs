@@ -2,8 +2,8 @@
 //! [`SoftCoupling`](crate::coupling::SoftCoupling), per body handle): the contacts the last
 //! detection found (its surface against colliders and against itself, rigid vertices against its
 //! boundary triangles), the nodes glued to rigid bodies, and the proxies of the rigid bodies
-//! they touch (frozen in pose, their velocities following the impulses). A step saves what it
-//! moves of them and puts it back if it fails.
+//! they touch (their velocities following the impulses, carried along by the explicit substeps;
+//! see [`crate::rigid`]). A step saves what it moves of them and puts it back if it fails.
 
 use crate::Error;
 use crate::attachment::{self, Attachment};
@@ -88,7 +88,7 @@ impl BodyConstraints {
             self.attachments.iter().map(|a| (a.body, a.node)).collect();
         let found = contact::detect(
             body,
-            (&glued, &self.contacts.nodes),
+            (&glued, (&self.contacts.nodes, &self.rigid_proxies)),
             colliders,
             frame_dt,
             gravity,
@@ -101,6 +101,7 @@ impl BodyConstraints {
             nodes: found.nodes,
             corners: found.corners,
             settings: *settings,
+            step: frame_dt,
         };
         if body.self_contact {
             let own = contact::detect_self_contacts(body, found.reach);

@@ -10,8 +10,8 @@
 
 use super::surface_tree::SurfaceTree;
 use super::{
-    BodyPoint, Coefficients, ContactSettings, ContactSides, ContactTarget, NodeContact, Obstacle,
-    SoftPoint, SurfaceCoefficients, VelocityConstraint,
+    BodyPoint, Coefficients, ContactSettings, ContactSides, ContactTarget, Depenetration,
+    NodeContact, Obstacle, SoftPoint, SurfaceCoefficients, VelocityConstraint,
 };
 use crate::body::DeformableBody;
 use crate::stencil::node_inverse_mass;
@@ -31,8 +31,9 @@ pub(crate) struct BetweenContact {
     normal: DVec3,
     /// The two bodies' coefficients, combined.
     coefficients: Coefficients,
-    /// The detection's [`ContactSettings::depenetration_speed`] (m/s).
-    depenetration_speed: f64,
+    /// How it is pushed out when found inside: at most at the detection's
+    /// [`ContactSettings::depenetration_speed`], over its step.
+    depenetration: Depenetration,
     constraint: VelocityConstraint,
 }
 
@@ -90,7 +91,10 @@ pub(crate) fn detect_between(
                         point: hit.point,
                         normal: hit.normal,
                         coefficients,
-                        depenetration_speed: settings.depenetration_speed,
+                        depenetration: Depenetration {
+                            speed: settings.depenetration_speed,
+                            time: dt,
+                        },
                         constraint: VelocityConstraint::default(),
                     });
                 }
@@ -157,7 +161,7 @@ pub(crate) fn prepare_between(
             (node_body.velocities[n] - contact.on_triangle.velocity(&triangle_body.velocities))
                 .dot(contact.normal)
         };
-        contact.constraint = VelocityConstraint::new(gap, h, contact.depenetration_speed).bounce(
+        contact.constraint = VelocityConstraint::new(gap, h, contact.depenetration).bounce(
             gap,
             h,
             normal_speed,

@@ -153,7 +153,7 @@ pub(crate) fn prepare_corners(
     proxies: &[RigidProxy],
     h: f64,
 ) {
-    let depenetration_speed = contacts.settings.depenetration_speed;
+    let depenetration = contacts.depenetration();
     for contact in &mut contacts.corners {
         if let Some((point, normal)) = contact.on_triangle.plane(&body.positions) {
             contact.point = point;
@@ -166,7 +166,7 @@ pub(crate) fn prepare_corners(
                 .map_or(DVec3::ZERO, |p| proxies[p].velocity_at(contact.vertex));
             (vertex_velocity - contact.on_triangle.velocity(&body.velocities)).dot(contact.normal)
         };
-        contact.constraint = VelocityConstraint::new(gap, h, depenetration_speed).bounce(
+        contact.constraint = VelocityConstraint::new(gap, h, depenetration).bounce(
             gap,
             h,
             normal_speed,

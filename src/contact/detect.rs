@@ -49,15 +49,16 @@ pub(crate) struct Detection {
 /// (s) under `gravity` (m/s²) (see
 /// [`BodyConstraints::detect_contacts`](crate::constraint::BodyConstraints::detect_contacts));
 /// `glued` lists the rigid bodies and the nodes glued to them, which do not touch their
-/// colliders; `previous` are the contacts of the last detection, whose points' paths since then
-/// tell the face a point entered a collider by (see [`super::entry`]).
+/// colliders; `previous` are the contacts of the last detection and the rigid proxies of its
+/// step, whose points' paths since then tell the face a point entered a collider by (see
+/// [`super::entry`]).
 ///
 /// # Errors
 /// [`Error::InvalidTimeStep`], [`Error::NonFiniteInput`] or [`Error::InvalidSetting`] for a bad
 /// step, gravity or setting.
 pub(crate) fn detect(
     body: &DeformableBody,
-    (glued, previous): (&[(RigidBodyHandle, u32)], &[NodeContact]),
+    (glued, previous): (&[(RigidBodyHandle, u32)], LastDetection<'_>),
     colliders: &[ColliderView],
     frame_dt: f64,
     gravity: DVec3,
@@ -188,20 +189,31 @@ fn thickness(shape: &dyn Shape, pose: &Pose, point: DVec3, normal: DVec3) -> f64
         .map_or(f64::INFINITY, |time| f64::from(time) + ROUND_OFF_DISTANCE)
 }
 
-/// What the `contacts` of the last detection saw of each point's contact with each collider.
-fn last_contacts(contacts: &[NodeContact]) -> HashMap<(BodyPoint, ColliderHandle), LastContact> {
+/// The contacts of the last detection and the rigid proxies of its step (as the step left
+/// them).
+type LastDetection<'a> = (&'a [NodeContact], &'a [RigidProxy]);
+
+/// What the `contacts` of the last detection saw of each point's contact with each collider,
+/// their planes taken back to the colliders' poses at detection from where the explicit
+/// substeps carried them with the rigid `proxies` of that step (see [`RigidProxy::carry`]).
+fn last_contacts(
+    (contacts, proxies): LastDetection<'_>,
+) -> HashMap<(BodyPoint, ColliderHandle), LastContact> {
     contacts
         .iter()
         .filter_map(|c| match (&c.target, &c.obstacle) {
-            (ContactTarget::Collider(handle), Obstacle::Collider { pose, .. }) => Some((
-                (c.at, *handle),
-                LastContact {
-                    at: c.detected_at,
-                    pose: *pose,
-                    point: c.point,
-                    normal: c.normal,
-                },
-            )),
+            (ContactTarget::Collider(handle), Obstacle::Collider { pose, proxy, .. }) => {
+                let motion = proxy.and_then(|p| proxies.get(p));
+                Some((
+                    (c.at, *handle),
+                    LastContact {
+                        at: c.detected_at,
+                        pose: *pose,
+                        point: motion.map_or(c.point, |m| m.carry_back(c.point)),
+                        normal: motion.map_or(c.normal, |m| m.turn_back(c.normal)),
+                    },
+                ))
+            }
             _ => None,
         })
         .collect()

@@ -27,8 +27,12 @@
 //! A collider attached to a rigid body takes the body's motion into account (its velocity at the
 //! contact point) and, when the body is dynamic, receives the opposite of every impulse the soft
 //! body gets, at the node's position, so that linear and angular momentum are exchanged exactly.
-//! Within a soft step the rigid bodies are frozen in pose and their velocities follow the
-//! impulses; the total is handed to rapier when the step is accepted.
+//! Within a soft step the rigid bodies' velocities follow the impulses, and the explicit substeps
+//! carry them along at those velocities as they move the nodes, so that a fast body sweeps
+//! through the nodes in its path (it does not wait frozen for rapier's step to jump past them);
+//! the total impulse is handed to rapier when the step is accepted. A point found inside a
+//! collider (rapier's step ends a body where the sweep did not quite take it) is pushed out over
+//! the step the contacts were detected for, not within one explicit substep.
 
 //!
 //! A body with [`DeformableBody::self_contact`] on also gets contacts of its surface nodes with its own
@@ -72,9 +76,9 @@ pub(crate) use set::ContactSet;
 use soft_point::SoftPoint;
 pub(crate) use surface_tree::nearest_point_on_triangle;
 use sweep::partners;
-pub(crate) use sweep::{prepare_velocities, solve_velocities};
+pub(crate) use sweep::{advance_planes, prepare_velocities, solve_velocities};
 pub use velocity_constraint::RESTITUTION_THRESHOLD;
-pub(crate) use velocity_constraint::{ContactSides, VelocityConstraint};
+pub(crate) use velocity_constraint::{ContactSides, Depenetration, VelocityConstraint};
 
 use crate::Error;
 use crate::body::DeformableBody;
@@ -105,9 +109,11 @@ pub struct ContactSettings {
     pub margin: f64,
     /// The implicit penalty stiffness in units of a node's `m/h²` (dimensionless).
     pub penalty_factor: f64,
-    /// The speed (m/s) at which explicit contacts push a node found inside a collider back out
-    /// (it entered between detections, e.g. pushed by a rigid body that moved): an impulse, so
-    /// that momentum stays exchanged exactly, rather than a jump of position.
+    /// The most speed (m/s) at which explicit contacts push a node found inside a collider back
+    /// out (it entered between detections, e.g. pushed by a rigid body that moved): an impulse,
+    /// so that momentum stays exchanged exactly, rather than a jump of position. A node leaves at
+    /// the speed that takes it out over the step the contacts were detected for (a coupling
+    /// substep in [`SoftCoupling`](crate::coupling::SoftCoupling)), up to this one.
     pub depenetration_speed: f64,
     /// Sweeps per explicit substep over the contacts and attachments of a body touching dynamic
     /// rigid bodies (at least 1): they are coupled through each rigid body's velocity, and a

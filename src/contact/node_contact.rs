@@ -9,8 +9,9 @@ use super::{
     penalty_tangent,
 };
 use crate::embedding::Embedding;
+use crate::rigid::RigidProxy;
 use crate::stencil::Stencil;
-use rapier3d::geometry::{ColliderHandle, SharedShape};
+use rapier3d::geometry::{ColliderHandle, Shape, SharedShape};
 use rapier3d::glamx::{DMat3, DVec3};
 use rapier3d::math::Pose;
 
@@ -55,9 +56,10 @@ impl BodyPoint {
 
 /// A surface point's contact for the coming frame: the plane through `point` with outward normal
 /// `normal` that the point (a surface node, or a surface vertex of the body's embedded mesh) must
-/// not cross. Against a collider, the explicit integrator re-projects
-/// the node onto the collider's shape (at its pose when detected) every substep to update the
-/// plane; against a triangle of the body's own surface the plane follows the triangle.
+/// not cross. Against a collider, the explicit integrator re-projects the node onto the
+/// collider's shape every substep to update the plane, the shape where its rigid body has carried
+/// it since detection; against a triangle of the body's own surface the plane follows the
+/// triangle.
 #[derive(Clone)]
 pub struct NodeContact {
     /// The point of the soft body in contact.
@@ -203,11 +205,13 @@ impl NodeContact {
 
     /// Moves the plane to the collider's surface point nearest to `x` (m), if defined there and
     /// facing the side the point entered from, or to an own triangle's contact point where its
-    /// nodes are now (`positions`, m).
-    pub(super) fn refresh(&mut self, x: DVec3, positions: &[DVec3]) {
+    /// nodes are now (`positions`, m). A collider is where its rigid body's proxy among `rigid`
+    /// has carried it since detection (see [`RigidProxy::carry`]).
+    pub(super) fn refresh(&mut self, x: DVec3, positions: &[DVec3], rigid: &[RigidProxy]) {
         match &self.obstacle {
-            Obstacle::Collider { shape, pose, .. } => {
-                if let Some((point, normal, _)) = nearest_surface_point(&**shape, pose, x) {
+            Obstacle::Collider { shape, pose, proxy } => {
+                let motion = proxy.map(|p| &rigid[p]);
+                if let Some((point, normal)) = nearest_on_carried(&**shape, pose, motion, x) {
                     // Behind its plane with the nearest face looking the other way: past the
                     // middle of a thin wall, or through it; the plane it entered by stays (see
                     // `super::entry`).
@@ -225,6 +229,24 @@ impl NodeContact {
                 }
             }
         }
+    }
+}
+
+/// The surface point of `shape`, at `pose` when detected and carried since then by `motion` (its
+/// rigid body's proxy, if any), nearest to `x` (m), and the outward unit normal there; `None`
+/// where the normal is undefined. The point is projected in the collider's pose at detection,
+/// which keeps the plane as steady as the node (a pose moved in f32 would jitter the gap by its
+/// rounding).
+fn nearest_on_carried(
+    shape: &dyn Shape,
+    pose: &Pose,
+    motion: Option<&RigidProxy>,
+    x: DVec3,
+) -> Option<(DVec3, DVec3)> {
+    match motion.filter(|m| m.has_moved()) {
+        None => nearest_surface_point(shape, pose, x).map(|(point, normal, _)| (point, normal)),
+        Some(motion) => nearest_surface_point(shape, pose, motion.carry_back(x))
+            .map(|(point, normal, _)| (motion.carry(point), motion.turn(normal))),
     }
 }
 

@@ -2,7 +2,7 @@
 //! its own boundary, rigid vertices against its boundary triangles, and the settings they were
 //! found with and are enforced by.
 
-use super::{ContactSettings, CornerContact, NodeContact, Obstacle};
+use super::{ContactSettings, CornerContact, Depenetration, NodeContact, Obstacle};
 use crate::body::DeformableBody;
 use rapier3d::glamx::DVec3;
 
@@ -15,9 +15,20 @@ pub(crate) struct ContactSet {
     pub(crate) corners: Vec<CornerContact>,
     /// The settings of the detection.
     pub(crate) settings: ContactSettings,
+    /// The step (s) the detection was for: a point found inside is pushed out over it.
+    pub(crate) step: f64,
 }
 
 impl ContactSet {
+    /// How the explicit contacts push a point found inside back out: over the detection's step,
+    /// at most at [`ContactSettings::depenetration_speed`].
+    pub(crate) fn depenetration(&self) -> Depenetration {
+        Depenetration {
+            speed: self.settings.depenetration_speed,
+            time: self.step,
+        }
+    }
+
     /// Whether the set holds self-contacts or rigid corners, for which the automatic integrator
     /// keeps the explicit one (its cost model does not price their implicit terms).
     pub(crate) fn needs_explicit(&self) -> bool {

@@ -90,20 +90,21 @@ pub(super) fn partners<'a>(
 /// Readies the contacts' velocity constraints for an explicit substep of `h` (s), before the
 /// sweeps of [`solve_velocities`]: each plane moves to the collider's surface point nearest to its
 /// node, and the lowest normal velocity is set so that the node arrives at the plane but does not
-/// cross it within the substep, or, found inside, leaves at most at the depenetration speed.
+/// cross it within the substep, or, found inside, leaves over the detection's step (see
+/// [`super::Depenetration`]).
 pub(crate) fn prepare_velocities(
     body: &mut DeformableBody,
     contacts: &mut ContactSet,
     proxies: &mut [RigidProxy],
     h: f64,
 ) {
-    let depenetration_speed = contacts.settings.depenetration_speed;
+    let depenetration = contacts.depenetration();
     let (positions, embedding, mut partners) = partners(body, proxies);
     for contact in &mut contacts.nodes {
         let point = contact.at;
         let at = point.stencil(embedding);
         let x = at.interpolate(positions);
-        contact.refresh(x, positions);
+        contact.refresh(x, positions, partners.rigid);
         let gap = contact.gap(x);
         let sides = WithinBody {
             partners: &mut partners,
@@ -112,12 +113,24 @@ pub(crate) fn prepare_velocities(
             x,
         };
         let normal = contact.normal;
-        contact.constraint = VelocityConstraint::new(gap, h, depenetration_speed).bounce(
+        contact.constraint = VelocityConstraint::new(gap, h, depenetration).bounce(
             gap,
             h,
             || sides.relative_velocity().dot(normal),
             contact.restitution,
         );
+    }
+}
+
+/// Carries the contact planes of colliders on rigid bodies along with the bodies over the
+/// explicit substep of `h` (s), before the proxies move (see [`RigidProxy::advance`]): a plane
+/// the next substep keeps (a point behind a thin collider) is then where its collider is.
+pub(crate) fn advance_planes(contacts: &mut ContactSet, proxies: &[RigidProxy], h: f64) {
+    for contact in &mut contacts.nodes {
+        if let Obstacle::Collider { proxy: Some(p), .. } = contact.obstacle {
+            (contact.point, contact.normal) =
+                proxies[p].plane_after(contact.point, contact.normal, h);
+        }
     }
 }
 

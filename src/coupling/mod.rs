@@ -16,7 +16,13 @@
 //! 4. **Soft step.** Bodies touching each other step together, so that their contacts are
 //!    solved with both bodies' nodes: explicitly in the same sweeps, or, when the implicit
 //!    integrator is forced (or the explicit frame would take too many substeps), as one implicit
-//!    system; the others step alone by [`SoftCoupling::integrator`].
+//!    system; the others step alone by [`SoftCoupling::integrator`]. The explicit substeps carry
+//!    the rigid bodies they touch along at the velocities the impulses leave them, as they move
+//!    the nodes, so that a fast body sweeps through the nodes in its path within the soft step:
+//!    a 2 cm ball at 30 m/s, 3 cm per coupling substep of a 1/240 s frame, meets the nodes it
+//!    strikes instead of jumping past them in rapier's step. This costs nothing more when
+//!    something is fast (no extra coupling substeps); detection reaches twice a collider's travel
+//!    over the substep, up to 1 m.
 //! 5. **Exchange.** The impulses the soft step gave dynamic rigid bodies are handed to rapier at
 //!    the nodes, and summed into the frame's [`RigidLoad`]s.
 //! 6. **Rigid step.** rapier steps the rigid bodies over `h`, with the frame's

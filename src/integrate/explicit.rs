@@ -358,10 +358,15 @@ fn update_velocities(step: &mut BodyInStep<'_>, h: f64, gravity: DVec3) {
     }
 }
 
-/// The substep's position update `x ← x + h v`, after the sweeps.
+/// The substep's position update `x ← x + h v` of the nodes and the rigid bodies touched, after
+/// the sweeps.
 fn update_positions(step: &mut BodyInStep<'_>, h: f64) {
     for kind in constraint::EXPLICIT {
         kind.advance(step.body, step.constraints, h);
+    }
+    // The rigid bodies touched move too, as the nodes do (their colliders with them).
+    for proxy in &mut step.constraints.rigid_proxies {
+        proxy.advance(h);
     }
     let DeformableBody {
         positions,

@@ -1,6 +1,9 @@
 //! The bodies that exchange energy within a frame, checked together: deformable bodies and the
-//! dynamic rigid bodies their last substep touched or is glued to, joined with the deformable
-//! bodies whose bounding boxes, widened by the contact margin, overlap.
+//! dynamic rigid bodies they touched in any substep of the frame (those they handed a load to,
+//! [`SoftCoupling::rigid_loads`](crate::coupling::SoftCoupling::rigid_loads)) or their last
+//! substep touched or is glued to, joined with the deformable bodies whose bounding boxes,
+//! widened by the contact margin, overlap. A ball that strikes a block and is gone by the
+//! frame's last substep still took part in the frame's exchange.
 
 use super::AuditInput;
 use super::energy::Member;
@@ -12,14 +15,21 @@ pub(super) fn clusters(input: &AuditInput<'_>) -> Vec<Vec<Member>> {
     let soft: Vec<_> = input.soft_bodies.iter().collect();
     for (handle, body) in &soft {
         let mut members = vec![Member::Soft(*handle)];
-        if let Some(constraints) = input.coupling.constraints(*handle) {
-            let rigid = (constraints.rigid_proxies.iter().map(|p| p.handle))
-                .chain(constraints.attachments.iter().map(|a| a.body));
-            for rigid in rigid {
-                let dynamic = input.bodies.get(rigid).is_some_and(|b| b.is_dynamic());
-                if dynamic && !members.contains(&Member::Rigid(rigid)) {
-                    members.push(Member::Rigid(rigid));
-                }
+        let loaded = (input.coupling.rigid_loads().iter())
+            .filter(|load| load.soft_body == *handle)
+            .map(|load| load.rigid_body);
+        let linked = input
+            .coupling
+            .constraints(*handle)
+            .into_iter()
+            .flat_map(|c| {
+                (c.rigid_proxies.iter().map(|p| p.handle))
+                    .chain(c.attachments.iter().map(|a| a.body))
+            });
+        for rigid in loaded.chain(linked) {
+            let dynamic = input.bodies.get(rigid).is_some_and(|b| b.is_dynamic());
+            if dynamic && !members.contains(&Member::Rigid(rigid)) {
+                members.push(Member::Rigid(rigid));
             }
         }
         let (lo, hi) = body.position_bounds();

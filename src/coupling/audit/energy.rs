@@ -26,8 +26,8 @@
 //!
 //! Bodies exchanging energy are checked together: a *cluster* is a set of deformable bodies and
 //! dynamic rigid bodies joined by contacts and attachments (the rigid bodies each deformable
-//! body's last substep touched or is glued to) or by overlapping bounding boxes (deformable bodies
-//! that may touch), and each deformable body is given its cluster's check.
+//! body touched in any substep of the frame or is glued to) or by overlapping bounding boxes
+//! (deformable bodies that may touch), and each deformable body is given its cluster's check.
 
 use super::{AuditInput, EnergyCheck};
 use crate::body::{DeformableBody, DeformableBodyHandle};
