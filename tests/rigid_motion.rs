@@ -7,6 +7,7 @@ mod common;
 
 use common::{Lcg, OBJECTIVE_MODELS};
 use rapier_fvm::prelude::*;
+use rapier_fvm::world::FvmWorld;
 
 const YOUNG: f64 = 1e7;
 
@@ -115,5 +116,74 @@ fn linear_model_spurious_energy_under_rotation_matches_its_closed_form() {
             largest / scale
         );
         assert!((energy - expected).abs() <= 1e-9 * expected);
+    }
+}
+
+/// A free 20 x 10 x 6 cm block of stable Neo-Hookean material (E = 1e7 Pa, stiffness damping
+/// 1e-3 s) spinning at 5 rad/s about `axis`, in a world without gravity at the default settings
+/// (frames of 1/60 s, four coupling substeps) with the integrator `force`d or automatic, 10 s:
+/// the relative changes of its angular momentum about its centre of mass (magnitude and
+/// direction together), of its linear momentum (against the spin's momentum scale), and of its
+/// kinetic energy.
+fn spin_for_ten_seconds(axis: DVec3, force: Option<IntegratorKind>) -> (f64, f64, f64) {
+    let material = Material::new(MaterialModel::StableNeoHookean, YOUNG, 0.3, 1000.0).unwrap();
+    let mesh = mesh::cuboid(DVec3::new(0.1, 0.05, 0.03), [6, 3, 2]).unwrap();
+    let mut body = DeformableBodyBuilder::new(mesh, material)
+        .damping(RayleighDamping::stiffness_proportional(1e-3, material.lame()).unwrap())
+        .build()
+        .unwrap();
+    let spin = axis.normalize() * 5.0;
+    let centre = body.center_of_mass();
+    let velocities: Vec<DVec3> = (body.positions().iter())
+        .map(|x| spin.cross(*x - centre))
+        .collect();
+    body.set_velocities(&velocities).unwrap();
+    let angular = |b: &DeformableBody| -> DVec3 {
+        let c = b.center_of_mass();
+        (b.positions().iter().zip(b.velocities()).zip(b.masses()))
+            .map(|((x, v), m)| (*x - c).cross(*v) * *m)
+            .sum()
+    };
+    let (angular0, kinetic0) = (angular(&body), body.kinetic_energy());
+    let mut world = FvmWorld::default();
+    world.physics.gravity = rapier_fvm::glamx::Vec3::ZERO;
+    world.coupling.integrator.force = force;
+    let handle = world.soft_bodies.insert(body);
+    for _ in 0..600 {
+        for (_, outcome) in world.step() {
+            outcome.unwrap();
+        }
+    }
+    let body = &world.soft_bodies[handle];
+    (
+        (angular(body) - angular0).length() / angular0.length(),
+        body.linear_momentum().length() / (body.total_mass() * 5.0 * 0.1),
+        body.kinetic_energy() / kinetic0 - 1.0,
+    )
+}
+
+#[test]
+fn a_free_spinning_body_keeps_its_momentum_and_kinetic_energy_under_every_integrator() {
+    // Backward Euler alone takes most of a spinning body's angular momentum and kinetic energy
+    // (67 % and 89 % in 10 s of 1/60 s steps for this block at E = 1e5 Pa); its numerical
+    // torque, h Σ m v₀ × v₁ per step, is now given back. Spins about the three principal axes
+    // (the middle one, y, unstable: the block tumbles) and an oblique one. Bounds: the angular
+    // momentum within 1e-5 (2 400 implicit solves, each within 1e-6 of its force scale, add up
+    // to a few 1e-6 at most: measured up to 8e-7; the explicit step keeps it to round-off), the
+    // linear momentum within 1e-9 of the spin's momentum scale, the kinetic energy within 0.1 %
+    // (the bound; the spin's stretch, ρ ω² L² / E = 2.5e-5, stores a negligible part of
+    // it; the implicit step's velocities, chords of the turn, settle (h ω)²/4 = 1.1e-4 above
+    // the continuous spin's).
+    let axes = [DVec3::X, DVec3::Y, DVec3::Z, DVec3::new(0.3, 5.0, 0.2)];
+    for force in [None, Some(IntegratorKind::Implicit)] {
+        for axis in axes {
+            let (angular, linear, kinetic) = spin_for_ten_seconds(axis, force);
+            println!(
+                "{force:?}, axis {axis:?}: ΔL/L {angular:.2e}, |P| {linear:.2e}, ΔK/K {kinetic:+.2e}"
+            );
+            assert!(angular < 1e-5, "{force:?}: {angular}");
+            assert!(linear < 1e-9, "{force:?}: {linear}");
+            assert!(kinetic.abs() < 1e-3, "{force:?}: {kinetic}");
+        }
     }
 }

@@ -18,6 +18,7 @@
 //! cutting the out-of-balance force tenfold per iteration, iterations solve with it instead of
 //! assembling and factoring anew ([`crate::chord`]). Both schemes are stable at any step length.
 
+mod angular;
 mod group;
 mod potential;
 mod report;
@@ -575,7 +576,8 @@ impl ImplicitIntegrator {
 
 /// Ends an implicit substep of `h` (s) from `start` at the body's positions: the rigid bodies'
 /// `response` is solved there, every constraint records its impulses, and the velocities become
-/// `(x − a)/ĥ`. Returns the substep's start, for the next one.
+/// `(x − a)/ĥ`, with the angular momentum a backward Euler step drains given back
+/// ([`angular`]). Returns the substep's start, for the next one.
 fn end_substep(
     body: &mut DeformableBody,
     constraints: &mut BodyConstraints,
@@ -593,6 +595,10 @@ fn end_substep(
         } else {
             (body.positions[n] - start.anchor[n]) / start.h
         };
+    }
+    // A backward Euler step (`ĥ = h`) gives back the spin it drained.
+    if start.h == h {
+        angular::give_back(body, &start.velocities, h);
     }
     PreviousStep {
         h,

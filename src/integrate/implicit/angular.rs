@@ -1,0 +1,104 @@
+//! The angular momentum a backward Euler step takes from a body's motion, given back.
+//!
+//! Backward Euler keeps linear momentum exactly (internal forces sum to zero) but not angular
+//! momentum. With `x₁ = x₀ + h v₁` and `m (v₁ − v₀) = h f` per node, `f` every force at `x₁`,
+//! the step ends with `L₁ = Σ m x₁ × v₁ = Σ m x₀ × v₁ = L₀ + h Σ x₀ × f`. The forces' angular
+//! impulse at the arms they act at is `h Σ x₁ × f` (the internal and damping forces of an
+//! objective material have no torque about the configuration they are evaluated in), so the step
+//! falls short by
+//!
+//! `δL = h Σ (x₁ − x₀) × f = h² Σ v₁ × f = h Σ m v₀ × v₁`,
+//!
+//! a numerical torque of order `h²` that drains spin: a free cube spinning at 5 rad/s loses two
+//! thirds of its angular momentum in 10 s of 1/60 s steps. It does not depend on where angular
+//! momentum is measured from, and pinned nodes (at rest) add nothing to it.
+//!
+//! Contract: after a backward Euler step, `δL` is given back as a rigid rotation of the free
+//! nodes, `Δv = δω × (x₁ − c)`, the rotations the pins allow: about the centre of mass `c` with
+//! `I_c δω = δL` when nothing is pinned (linear momentum unchanged: `Σ m Δv = 0`); about a single
+//! pinned point `c`, `I_c δω = δL`; about the line through collinear pinned nodes (a hinge),
+//! `δω = a (a·δL) / I_a`; none when the pins hold every rotation. The step's positions are kept;
+//! only the velocities it ends with change. The deformation's numerical damping is untouched.
+
+use crate::body::DeformableBody;
+use rapier3d::glamx::{DMat3, DVec3};
+
+/// Pinned nodes further than this fraction of the body's size from the line through the two
+/// furthest apart are not collinear (dimensionless).
+const COLLINEAR: f64 = 1e-9;
+
+/// Gives back to `body` the angular momentum a backward Euler step of `h` (s) took, its nodes
+/// having started the step at the velocities `before` (m/s); see the module documentation.
+pub(super) fn give_back(body: &mut DeformableBody, before: &[DVec3], h: f64) {
+    let lost: DVec3 = (0..body.positions.len())
+        .filter(|&n| !body.pinned[n])
+        .map(|n| before[n].cross(body.velocities[n]) * (body.masses[n] * h))
+        .sum();
+    if lost == DVec3::ZERO || !lost.is_finite() {
+        return;
+    }
+    let Some((centre, turn)) = allowed_rotation(body, lost) else {
+        return;
+    };
+    for n in 0..body.positions.len() {
+        if !body.pinned[n] {
+            body.velocities[n] += turn.cross(body.positions[n] - centre);
+        }
+    }
+}
+
+/// The rotation (its centre, m, and angular velocity, rad/s) the pins of `body` allow whose
+/// angular momentum is `lost` (N m s), or `None` when they hold every rotation.
+fn allowed_rotation(body: &DeformableBody, lost: DVec3) -> Option<(DVec3, DVec3)> {
+    let pinned: Vec<DVec3> = (0..body.positions.len())
+        .filter(|&n| body.pinned[n])
+        .map(|n| body.positions[n])
+        .collect();
+    let Some(&first) = pinned.first() else {
+        let centre = body.center_of_mass();
+        return solve(inertia_about(body, centre), lost).map(|turn| (centre, turn));
+    };
+    let far = pinned.iter().copied().max_by(|a, b| {
+        (*a - first)
+            .length_squared()
+            .total_cmp(&(*b - first).length_squared())
+    })?;
+    let span = (far - first).length();
+    let size = (body.positions.iter())
+        .map(|x| (*x - first).length())
+        .fold(f64::MIN_POSITIVE, f64::max);
+    if span <= COLLINEAR * size {
+        return solve(inertia_about(body, first), lost).map(|turn| (first, turn));
+    }
+    let axis = (far - first) / span;
+    let off_line = |p: &DVec3| (*p - first).cross(axis).length() > COLLINEAR * size;
+    if pinned.iter().any(off_line) {
+        return None;
+    }
+    let about_axis: f64 = (0..body.positions.len())
+        .map(|n| body.masses[n] * (body.positions[n] - first).cross(axis).length_squared())
+        .sum();
+    (about_axis > 0.0).then(|| (first, axis * (axis.dot(lost) / about_axis)))
+}
+
+/// The inertia tensor (kg m²) of the body's nodes about `point` (m).
+fn inertia_about(body: &DeformableBody, point: DVec3) -> DMat3 {
+    (body.positions.iter())
+        .zip(&body.masses)
+        .map(|(x, m)| {
+            let r = *x - point;
+            (DMat3::IDENTITY * r.length_squared() - outer(r, r)) * *m
+        })
+        .fold(DMat3::ZERO, |a, b| a + b)
+}
+
+/// `a bᵀ`.
+fn outer(a: DVec3, b: DVec3) -> DMat3 {
+    DMat3::from_cols(a * b.x, a * b.y, a * b.z)
+}
+
+/// `I⁻¹ L`, or `None` for a singular inertia (every node on one line through the point).
+fn solve(inertia: DMat3, momentum: DVec3) -> Option<DVec3> {
+    let trace = inertia.x_axis.x + inertia.y_axis.y + inertia.z_axis.z;
+    (inertia.determinant() > 1e-12 * trace.powi(3)).then(|| inertia.inverse() * momentum)
+}
