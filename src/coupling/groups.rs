@@ -1,7 +1,55 @@
 //! Deformable bodies whose surfaces touch step together: the groups are the connected components
 //! of the graph whose edges are the contacts between bodies (union–find with path halving).
+//! Within a coupling substep the groups share nothing (each body's constraints hold their own
+//! copies of the rigid bodies they touch; rapier's sets are only read), so they step at once, on
+//! rayon's thread pool with the `parallel` feature: the same arithmetic body by body, in any
+//! order, so the results do not depend on the threads.
 
-use crate::contact::BetweenContact;
+use crate::Error;
+use crate::contact::{BetweenContact, ContactSettings};
+use crate::integrate::{AutomaticIntegrator, AutomaticReport, BodyInStep};
+use rapier3d::glamx::DVec3;
+#[cfg(feature = "parallel")]
+use rayon::prelude::*;
+
+/// A group of touching bodies ready to step: the bodies and the contacts between them (indices
+/// into the bodies).
+pub(super) struct GroupStep<'a> {
+    pub(super) bodies: Vec<BodyInStep<'a>>,
+    pub(super) between: Vec<BetweenContact>,
+}
+
+/// Steps every group by `h` (s) under `gravity` (m/s²) with `integrator`, the contacts between
+/// bodies enforced with `settings`: per group, a result per body, in order.
+pub(super) fn step_groups(
+    groups: &mut [GroupStep<'_>],
+    integrator: &AutomaticIntegrator,
+    settings: &ContactSettings,
+    (h, gravity): (f64, DVec3),
+) -> Vec<Vec<Result<AutomaticReport, Error>>> {
+    let step = |group: &mut GroupStep<'_>| step_group(group, integrator, settings, (h, gravity));
+    #[cfg(feature = "parallel")]
+    return groups.par_iter_mut().map(step).collect();
+    #[cfg(not(feature = "parallel"))]
+    groups.iter_mut().map(step).collect()
+}
+
+/// Steps one group: a lone body by itself, touching bodies together.
+fn step_group(
+    group: &mut GroupStep<'_>,
+    integrator: &AutomaticIntegrator,
+    settings: &ContactSettings,
+    (h, gravity): (f64, DVec3),
+) -> Vec<Result<AutomaticReport, Error>> {
+    if let [step] = &mut group.bodies[..] {
+        return vec![integrator.step(step.body, step.constraints, step.workspace, h, gravity)];
+    }
+    let between = (&mut group.between[..], settings);
+    match integrator.step_together(&mut group.bodies, between, h, gravity) {
+        Ok(reports) => reports.into_iter().map(Ok).collect(),
+        Err(error) => vec![Err(error); group.bodies.len()],
+    }
+}
 
 /// The groups of `count` bodies that the contacts `between` them link (directly or through
 /// others), each with its contacts re-indexed to positions in the group: bodies that must step

@@ -52,9 +52,9 @@ use crate::Error;
 use crate::body::{DeformableBody, DeformableBodyHandle, DeformableBodySet};
 use crate::constraint::BodyConstraints;
 use crate::contact::{self, ContactSettings, NodeContact};
-use crate::integrate::{AutomaticIntegrator, AutomaticReport, BodyInStep};
+use crate::integrate::{AutomaticIntegrator, AutomaticReport};
 use bodies::LinkSet;
-use groups::touching_groups;
+use groups::{GroupStep, step_groups, touching_groups};
 use kinematic::KinematicPath;
 use loads::FrameLoads;
 use rapier3d::dynamics::{
@@ -395,45 +395,34 @@ impl SoftCoupling {
             let bodies: Vec<&DeformableBody> = live.iter().map(|&h| &soft_bodies[h]).collect();
             contact::detect_between(&bodies, &self.contact, h, gravity)
         };
-        for (group, mut contacts) in touching_groups(live.len(), between) {
-            let handles: Vec<DeformableBodyHandle> = group.iter().map(|&i| live[i]).collect();
-            let bodies = soft_bodies.get_many_mut(&handles);
-            let mut steps: Vec<BodyInStep> = self
-                .links
-                .many_mut(&handles)
-                .into_iter()
-                .zip(bodies)
-                .map(|(links, body)| links.with(body))
-                .collect();
-            for step in &mut steps {
-                hold_supported_bodies(step.constraints, rigid.bodies, rigid.narrow_phase);
+        let groups = touching_groups(live.len(), between);
+        let handles: Vec<DeformableBodyHandle> = (groups.iter())
+            .flat_map(|(group, _)| group.iter().map(|&i| live[i]))
+            .collect();
+        let mut steps = (self.links.many_mut(&handles).into_iter())
+            .zip(soft_bodies.get_many_mut(&handles))
+            .map(|(links, body)| links.with(body));
+        let mut ready: Vec<GroupStep> = (groups.into_iter())
+            .map(|(group, between)| GroupStep {
+                bodies: steps.by_ref().take(group.len()).collect(),
+                between,
+            })
+            .collect();
+        for step in ready.iter_mut().flat_map(|group| group.bodies.iter_mut()) {
+            hold_supported_bodies(step.constraints, rigid.bodies, rigid.narrow_phase);
+        }
+        let stepped = step_groups(&mut ready, &self.integrator, &self.contact, (h, gravity));
+        let steps = ready.into_iter().flat_map(|group| group.bodies);
+        for ((handle, step), result) in handles.iter().zip(steps).zip(stepped.into_iter().flatten())
+        {
+            if result.is_ok() {
+                self.loads.add_body(*handle, step.body, step.constraints);
+                step.constraints.transfer_contact_impulses(rigid.bodies);
             }
-            let stepped: Vec<Result<AutomaticReport, Error>> = if let [step] = &mut steps[..] {
-                vec![
-                    self.integrator
-                        .step(step.body, step.constraints, step.workspace, h, gravity),
-                ]
-            } else {
-                match self.integrator.step_together(
-                    &mut steps,
-                    (&mut contacts, &self.contact),
-                    h,
-                    gravity,
-                ) {
-                    Ok(reports) => reports.into_iter().map(Ok).collect(),
-                    Err(error) => vec![Err(error); steps.len()],
-                }
-            };
-            for ((handle, step), result) in handles.iter().zip(steps).zip(stepped) {
-                if result.is_ok() {
-                    self.loads.add_body(*handle, step.body, step.constraints);
-                    step.constraints.transfer_contact_impulses(rigid.bodies);
-                }
-                if let Some((_, outcome)) = outcomes.iter_mut().find(|(h, _)| h == handle) {
-                    // A step refused in an earlier substep of the frame stays reported.
-                    if !matches!(outcome, Some(Err(_))) {
-                        *outcome = Some(result);
-                    }
+            if let Some((_, outcome)) = outcomes.iter_mut().find(|(h, _)| h == handle) {
+                // A step refused in an earlier substep of the frame stays reported.
+                if !matches!(outcome, Some(Err(_))) {
+                    *outcome = Some(result);
                 }
             }
         }
