@@ -216,6 +216,31 @@ fn a_region_velocity_box_holding_no_node_is_refused_when_built() {
 }
 
 #[test]
+fn a_momentum_probe_takes_no_rigid_body() {
+    let e = error(broken(
+        "kind = \"contact_force\"",
+        "kind = \"angular_momentum\"",
+    ));
+    assert_names(&e, 26, "probe[0].rigid", "takes no `rigid`");
+    let e = error(broken("kind = \"contact_force\"", "kind = \"momentum\""));
+    assert_names(&e, 26, "probe[0].rigid", "takes no `rigid`");
+}
+
+#[test]
+fn a_contact_force_on_soft_probe_needs_its_soft_body() {
+    let e = error(broken(
+        "kind = \"contact_force\"",
+        "kind = \"contact_force_on_soft\"",
+    ));
+    assert_names(&e, 23, "probe[0]", "needs `body`");
+    let e = error(broken(
+        "kind = \"contact_force\"",
+        "kind = \"contact_force_on_soft\"\nbody = \"ball\"",
+    ));
+    assert_names(&e, 26, "probe[0].body", "no soft body is named \"ball\"");
+}
+
+#[test]
 fn two_mesh_sources_are_refused() {
     let e = error(broken(
         "cells = [2, 2, 2] } }",
