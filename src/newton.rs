@@ -120,7 +120,11 @@ pub(crate) fn descend<C: Configuration>(
         Search::Thorough => (1.0, MIN_STEP),
         Search::Short => (1.0, 0.5),
     };
-    let searched = (residual, energy_now, direction);
+    let searched = Searched {
+        residual,
+        energy: energy_now,
+        direction,
+    };
     let start = body.copy_positions();
     let refine = search == Search::Thorough;
     if let Some(accepted) = search_energy(body, (&start, searched), &energy, steps, refine) {
@@ -153,18 +157,27 @@ pub(crate) fn descend<C: Configuration>(
     Some((residual_at(body), accepted))
 }
 
+/// A Newton update's search: the out-of-balance force (N) and the minimized energy (J) where it
+/// starts, and its direction (m per node).
+#[derive(Clone, Copy)]
+struct Searched<'a> {
+    residual: &'a [DVec3],
+    energy: f64,
+    direction: &'a [DVec3],
+}
+
 /// [`line_search`] over `steps` from `start` (where `body` is), then, if `refine` and the step
 /// it accepted is shorter than the full one, [`lowest_along`]: the energy (J) where `body` ends.
 fn search_energy<C: Configuration>(
     body: &mut C,
-    (start, searched): (&[DVec3], (&[DVec3], f64, &[DVec3])),
+    (start, searched): (&[DVec3], Searched),
     energy: &impl Fn(&C) -> f64,
     steps: (f64, f64),
     refine: bool,
 ) -> Option<f64> {
     let (alpha, accepted) = line_search(body, searched, energy, steps)?;
     Some(if refine && alpha < 1.0 {
-        lowest_along(body, (start, searched.2), (alpha, accepted), energy)
+        lowest_along(body, (start, searched.direction), (alpha, accepted), energy)
     } else {
         accepted
     })
@@ -239,7 +252,11 @@ fn lowest_along<C: Configuration>(
 /// (the direction no longer descends above round-off).
 fn line_search<C: Configuration>(
     body: &mut C,
-    (residual, initial, direction): (&[DVec3], f64, &[DVec3]),
+    Searched {
+        residual,
+        energy: initial,
+        direction,
+    }: Searched,
     energy: impl Fn(&C) -> f64,
     (largest, smallest): (f64, f64),
 ) -> Option<(f64, f64)> {

@@ -34,6 +34,7 @@ fn every_shipped_scene_parses_and_builds() {
         "soft_stack.toml",
         "hanging_rope.toml",
         "showcase.toml",
+        "spinning_block.toml",
     ];
     let folder = scene_path("");
     let mut found: Vec<String> = std::fs::read_dir(&folder)

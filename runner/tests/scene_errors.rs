@@ -135,6 +135,111 @@ fn an_attachment_to_a_missing_body_is_refused() {
     assert_names(&e, 16, "soft_body[0].attach[0].rigid", "\"hook\"");
 }
 
+/// `VALID` with `key` added to the soft body, on line 16.
+fn with_soft_body_key(key: &str) -> String {
+    broken(
+        "translation = [0.0, 0.1, 0.0]",
+        &format!("translation = [0.0, 0.1, 0.0]\n{key}"),
+    )
+}
+
+#[test]
+fn a_non_finite_angular_velocity_is_refused() {
+    let e = error(with_soft_body_key("angvel = [nan, 0.0, 0.0]"));
+    assert_names(&e, 16, "soft_body[0].angvel", "must be finite");
+}
+
+#[test]
+fn an_angular_velocity_of_the_wrong_length_is_refused() {
+    let e = error(with_soft_body_key("angvel = [0.0, 3.0]"));
+    assert_names(
+        &e,
+        16,
+        "soft_body[0].angvel",
+        "expected an array of length 3",
+    );
+}
+
+#[test]
+fn a_region_velocity_faster_than_light_is_refused() {
+    let e = error(with_soft_body_key(
+        "velocity = [{ min = [-1, -1, -1], max = [1, 1, 1], linvel = [4e8, 0, 0] }]",
+    ));
+    assert_names(
+        &e,
+        16,
+        "soft_body[0].velocity[0].linvel",
+        "faster than light",
+    );
+}
+
+#[test]
+fn a_region_velocity_box_upside_down_is_refused() {
+    let e = error(with_soft_body_key(
+        "velocity = [{ min = [1, -1, -1], max = [-1, 1, 1], linvel = [1, 0, 0] }]",
+    ));
+    assert_names(&e, 16, "soft_body[0].velocity[0].max", "below min");
+}
+
+#[test]
+fn a_region_velocity_without_its_velocity_is_refused() {
+    let e = error(with_soft_body_key(
+        "velocity = [{ min = [-1, -1, -1], max = [1, 1, 1] }]",
+    ));
+    assert_names(&e, 16, "soft_body[0].velocity[0]", "missing field `linvel`");
+}
+
+#[test]
+fn an_angular_velocity_for_a_region_is_refused_as_unknown() {
+    let e = error(with_soft_body_key(
+        "velocity = [{ min = [-1, -1, -1], max = [1, 1, 1], linvel = [1, 0, 0], angvel = [0, 0, 1] }]",
+    ));
+    assert_names(
+        &e,
+        16,
+        "soft_body[0].velocity[0].angvel",
+        "unknown field `angvel`",
+    );
+}
+
+#[test]
+fn a_region_velocity_box_holding_no_node_is_refused_when_built() {
+    let text = with_soft_body_key(
+        "velocity = [{ min = [0.5, 0.5, 0.5], max = [1, 1, 1], linvel = [1, 0, 0] }]",
+    );
+    let scene = Scene::parse("scenes/bad.toml", text).unwrap();
+    let e = match rapier_fvm_runner::sim::Simulation::build(&scene) {
+        Ok(_) => panic!("the empty box should be refused"),
+        Err(e) => e,
+    };
+    assert_names(&e, 16, "soft_body[0].velocity[0]", "holds no node");
+}
+
+#[test]
+fn a_momentum_probe_takes_no_rigid_body() {
+    let e = error(broken(
+        "kind = \"contact_force\"",
+        "kind = \"angular_momentum\"",
+    ));
+    assert_names(&e, 26, "probe[0].rigid", "takes no `rigid`");
+    let e = error(broken("kind = \"contact_force\"", "kind = \"momentum\""));
+    assert_names(&e, 26, "probe[0].rigid", "takes no `rigid`");
+}
+
+#[test]
+fn a_contact_force_on_soft_probe_needs_its_soft_body() {
+    let e = error(broken(
+        "kind = \"contact_force\"",
+        "kind = \"contact_force_on_soft\"",
+    ));
+    assert_names(&e, 23, "probe[0]", "needs `body`");
+    let e = error(broken(
+        "kind = \"contact_force\"",
+        "kind = \"contact_force_on_soft\"\nbody = \"ball\"",
+    ));
+    assert_names(&e, 26, "probe[0].body", "no soft body is named \"ball\"");
+}
+
 #[test]
 fn two_mesh_sources_are_refused() {
     let e = error(broken(

@@ -1,5 +1,6 @@
 //! [`DeformableBodyBuilder`]: the rapier-style way to describe a soft body before creating it.
 
+use super::state::check_velocity;
 use super::{BodySurface, DeformableBody, SPEED_OF_LIGHT, lumped_masses};
 use crate::Error;
 use crate::damping::RayleighDamping;
@@ -12,8 +13,8 @@ use rapier3d::dynamics::CoefficientCombineRule;
 use rapier3d::geometry::InteractionGroups;
 use rapier3d::glamx::{DQuat, DVec3};
 
-/// Describes a soft body: its mesh and material, placement, initial velocity, damping and pinned
-/// nodes.
+/// Describes a soft body: its mesh and material, placement, initial velocity (linear, angular,
+/// and per region), damping and pinned nodes.
 ///
 /// # Example
 /// ```
@@ -42,6 +43,10 @@ pub struct DeformableBodyBuilder {
     rotation: DQuat,
     translation: DVec3,
     linvel: DVec3,
+    /// Initial angular velocity (rad/s) about the placed body's centre of mass.
+    angvel: DVec3,
+    /// Nodes given their own initial velocity (m/s), in the order given.
+    region_linvels: Vec<(Vec<u32>, DVec3)>,
     pinned: Vec<u32>,
     user_data: u128,
     min_quality: f64,
@@ -84,6 +89,8 @@ impl DeformableBodyBuilder {
             rotation: DQuat::IDENTITY,
             translation: DVec3::ZERO,
             linvel: DVec3::ZERO,
+            angvel: DVec3::ZERO,
+            region_linvels: Vec::new(),
             pinned: Vec::new(),
             user_data: 0,
             min_quality: DEFAULT_MIN_ELEMENT_QUALITY,
@@ -238,9 +245,65 @@ impl DeformableBodyBuilder {
         self
     }
 
-    /// Initial velocity (m/s) of every node.
+    /// Initial velocity (m/s) of every node (pinned nodes stay at rest); composes with
+    /// [`DeformableBodyBuilder::angvel`].
     pub fn linvel(mut self, linvel: DVec3) -> Self {
         self.linvel = linvel;
+        self
+    }
+
+    /// Initial angular velocity `ω` (rad/s) about the body's centre of mass `c` where the
+    /// translation and rotation place it, as rapier's `RigidBodyBuilder::angvel`: node `i` at `xᵢ`
+    /// starts at `linvel + ω × (xᵢ - c)` (pinned nodes stay at rest). The body then carries the
+    /// angular momentum `I ω` ([`DeformableBody::angular_momentum`]), `I` the inertia tensor of
+    /// its lumped nodal masses about `c`.
+    ///
+    /// # Example
+    /// ```
+    /// use rapier_fvm::prelude::*;
+    ///
+    /// let mesh = mesh::cuboid(DVec3::new(0.2, 0.1, 0.05), [4, 2, 1])?;
+    /// let material = Material::new(MaterialModel::Corotated, 1e5, 0.3, 1000.0)?;
+    /// let block = DeformableBodyBuilder::new(mesh, material)
+    ///     .translation(DVec3::new(0.0, 1.0, 0.0))
+    ///     .linvel(DVec3::new(0.5, 0.0, 0.0))
+    ///     .angvel(DVec3::new(0.0, 0.0, 3.0))
+    ///     .build()?;
+    /// // The spin adds no linear momentum; the angular momentum lies along the spin axis.
+    /// let momentum = block.linear_momentum();
+    /// assert!((momentum - DVec3::new(0.5, 0.0, 0.0) * block.total_mass()).length() < 1e-12);
+    /// let angular = block.angular_momentum();
+    /// assert!(angular.z > 0.0 && angular.x.abs() + angular.y.abs() < 1e-12 * angular.z);
+    /// # Ok::<(), rapier_fvm::Error>(())
+    /// ```
+    pub fn angvel(mut self, angvel: DVec3) -> Self {
+        self.angvel = angvel;
+        self
+    }
+
+    /// Initial velocity (m/s) of `nodes`, in place of the one [`DeformableBodyBuilder::linvel`]
+    /// and [`DeformableBodyBuilder::angvel`] give them: a region of the body set moving on its
+    /// own (pick the nodes with [`TetMesh::nodes_where`]). A later call wins on the nodes two
+    /// calls share; pinned nodes stay at rest.
+    ///
+    /// # Example
+    /// ```
+    /// use rapier_fvm::prelude::*;
+    ///
+    /// let mesh = mesh::cuboid(DVec3::new(0.5, 0.05, 0.05), [10, 1, 1])?;
+    /// let right_half = mesh.nodes_where(|p| p.x > 0.0);
+    /// let material = Material::new(MaterialModel::Corotated, 1e5, 0.3, 1000.0)?;
+    /// let bar = DeformableBodyBuilder::new(mesh, material)
+    ///     .nodes_linvel(right_half, DVec3::new(1.0, 0.0, 0.0))
+    ///     .build()?;
+    /// for (x, v) in bar.positions().iter().zip(bar.velocities()) {
+    ///     assert_eq!(*v, if x.x > 0.0 { DVec3::X } else { DVec3::ZERO });
+    /// }
+    /// # Ok::<(), rapier_fvm::Error>(())
+    /// ```
+    pub fn nodes_linvel(mut self, nodes: impl IntoIterator<Item = u32>, linvel: DVec3) -> Self {
+        self.region_linvels
+            .push((nodes.into_iter().collect(), linvel));
         self
     }
 
@@ -341,8 +404,10 @@ impl DeformableBodyBuilder {
     /// The minimum element quality must lie in `[0, 1)`.
     ///
     /// # Errors
-    /// [`Error::NodeOutOfRange`] for a pinned node that does not exist;
-    /// [`Error::NonFiniteInput`] for a non-finite velocity or translation or a zero rotation;
+    /// [`Error::NodeOutOfRange`] for a pinned node or a node given a velocity
+    /// ([`DeformableBodyBuilder::nodes_linvel`]) that does not exist;
+    /// [`Error::NonFiniteInput`] for a non-finite velocity, angular velocity or translation or a
+    /// zero rotation;
     /// [`Error::CoordinateOutOfRange`] naming the first node the placement puts beyond
     /// ±[`MAX_COORDINATE`](crate::mesh::MAX_COORDINATE);
     /// [`Error::SliverTet`] for a tetrahedron below the minimum quality (of the subdivision, for
@@ -351,17 +416,20 @@ impl DeformableBodyBuilder {
     /// [`Error::OutsideSimulationMesh`] naming a vertex of the embedded mesh that no element
     /// carries;
     /// [`Error::InvalidSetting`] for a minimum quality outside `[0, 1)`, a negative or
-    /// non-finite friction or restitution, or a velocity faster than
-    /// [`SPEED_OF_LIGHT`](crate::body::SPEED_OF_LIGHT).
+    /// non-finite friction or restitution, or a [`DeformableBodyBuilder::linvel`] faster than
+    /// [`SPEED_OF_LIGHT`](crate::body::SPEED_OF_LIGHT); [`Error::SpeedOutOfRange`] naming the
+    /// first node that the angular velocity or a region's velocity sets moving faster than that.
     pub fn build(self) -> Result<DeformableBody, Error> {
         self.check_settings()?;
         let pinned = self.pinned_flags()?;
-        let (positions, velocities) = self.initial_state(&pinned)?;
+        self.check_placement_and_velocity()?;
+        let positions = self.placed_positions()?;
         let subdivision_parents = self
             .quadratic
             .as_ref()
             .map_or_else(Vec::new, |quadratic| quadratic.parents.clone());
         let (elements, masses) = self.elements_and_masses()?;
+        let velocities = self.initial_velocities(&positions, &masses, &pinned)?;
         let embedding = match self.embedded {
             Some(fine) => Some(Embedding::new(
                 fine,
@@ -441,9 +509,10 @@ impl DeformableBodyBuilder {
         Ok(pinned)
     }
 
-    /// The nodes' world positions (m), the rest mesh rotated then translated, and velocities
-    /// (m/s), the initial one on every free node.
-    fn initial_state(&self, pinned: &[bool]) -> Result<(Vec<DVec3>, Vec<DVec3>), Error> {
+    /// Refuses a non-finite translation, rotation or initial velocity, a zero rotation and a
+    /// [`DeformableBodyBuilder::linvel`] faster than light.
+    fn check_placement_and_velocity(&self) -> Result<(), Error> {
+        let regions_finite = (self.region_linvels.iter()).all(|(_, linvel)| linvel.is_finite());
         for (parameter, finite) in [
             ("translation", self.translation.is_finite()),
             (
@@ -451,6 +520,8 @@ impl DeformableBodyBuilder {
                 self.rotation.is_finite() && self.rotation.length() > 0.0,
             ),
             ("linvel", self.linvel.is_finite()),
+            ("angvel", self.angvel.is_finite()),
+            ("nodes_linvel", regions_finite),
         ] {
             if !finite {
                 return Err(Error::NonFiniteInput { parameter });
@@ -464,6 +535,11 @@ impl DeformableBodyBuilder {
                 reason: "no node may move faster than light (299792458 m/s)",
             });
         }
+        Ok(())
+    }
+
+    /// The nodes' world positions (m): the rest mesh rotated, then translated.
+    fn placed_positions(&self) -> Result<Vec<DVec3>, Error> {
         let rotation = self.rotation.normalize();
         let positions: Vec<DVec3> = self
             .mesh
@@ -474,11 +550,47 @@ impl DeformableBodyBuilder {
         for (node, &position) in positions.iter().enumerate() {
             check_position(node, position)?;
         }
-        let velocities = pinned
+        Ok(positions)
+    }
+
+    /// The nodes' initial velocities (m/s): the rigid motion `linvel + angvel × (x - c)` about
+    /// the centre of mass `c` of `positions` (m) weighted by `masses` (kg), the regions' own
+    /// velocities on their nodes, and rest on the `pinned` ones.
+    fn initial_velocities(
+        &self,
+        positions: &[DVec3],
+        masses: &[f64],
+        pinned: &[bool],
+    ) -> Result<Vec<DVec3>, Error> {
+        let center_of_mass = positions
             .iter()
-            .map(|&pinned| if pinned { DVec3::ZERO } else { self.linvel })
+            .zip(masses)
+            .map(|(x, m)| *x * *m)
+            .sum::<DVec3>()
+            / masses.iter().sum::<f64>();
+        let mut velocities: Vec<DVec3> = positions
+            .iter()
+            .map(|x| self.linvel + self.angvel.cross(*x - center_of_mass))
             .collect();
-        Ok((positions, velocities))
+        for (nodes, linvel) in &self.region_linvels {
+            for &node in nodes {
+                let node_count = velocities.len();
+                let velocity = velocities
+                    .get_mut(node as usize)
+                    .ok_or(Error::NodeOutOfRange {
+                        node: node as usize,
+                        node_count,
+                    })?;
+                *velocity = *linvel;
+            }
+        }
+        for (node, (velocity, &pinned)) in velocities.iter_mut().zip(pinned).enumerate() {
+            if pinned {
+                *velocity = DVec3::ZERO;
+            }
+            check_velocity(node, *velocity)?;
+        }
+        Ok(velocities)
     }
 
     /// The elements (linear, with nodal averaging if asked; or quadratic, with the projected

@@ -70,16 +70,46 @@ fn draw(
     Ok(())
 }
 
-/// The range `lo..hi` widened by `fraction` of its length on each side, or to a unit-wide range
-/// around a single value (and `0..1` when there are no values).
+/// The spread, relative to the values' size, below which a series is drawn as a constant: a
+/// conserved quantity (a free body's momentum) varies by round-off of about 1e-15 of its size,
+/// which a range fitted to it would magnify into noise across the whole plot.
+const CONSTANT_SPREAD: f64 = 1e-10;
+
+/// The range `lo..hi` widened by `fraction` of its length on each side, or, for values equal
+/// to within [`CONSTANT_SPREAD`], to a range as wide as their size around them (and `0..1` when
+/// there are no values).
 fn padded(lo: f64, hi: f64, fraction: f64) -> (f64, f64) {
     if lo.partial_cmp(&hi).is_none_or(|o| o.is_gt()) {
         (0.0, 1.0)
-    } else if hi - lo <= f64::EPSILON * lo.abs().max(1e-300) {
-        let half = 0.5 * lo.abs().max(1e-9);
-        (lo - half, hi + half)
+    } else if hi - lo <= CONSTANT_SPREAD * lo.abs().max(hi.abs()) {
+        let middle = 0.5 * (lo + hi);
+        let half = 0.5 * middle.abs().max(1e-9);
+        (middle - half, middle + half)
     } else {
         let pad = (hi - lo) * fraction;
         (lo - pad, hi + pad)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Whether two ranges agree to 1e-12.
+    fn close((a0, a1): (f64, f64), (b0, b1): (f64, f64)) -> bool {
+        (a0 - b0).abs() < 1e-12 && (a1 - b1).abs() < 1e-12
+    }
+
+    #[test]
+    fn values_equal_to_round_off_get_the_range_of_a_constant() {
+        assert!(close(padded(0.42, 0.42, 0.05), (0.21, 0.63)));
+        assert!(close(
+            padded(0.42 - 1e-15, 0.42 + 1e-15, 0.05),
+            (0.21, 0.63)
+        ));
+        // A real change is fitted.
+        assert!(close(padded(0.41, 0.42, 0.05), (0.4095, 0.4205)));
+        assert!(close(padded(0.0, 0.0, 0.05), (-5e-10, 5e-10)));
+        assert_eq!(padded(f64::INFINITY, f64::NEG_INFINITY, 0.05), (0.0, 1.0));
     }
 }

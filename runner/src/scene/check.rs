@@ -3,6 +3,8 @@
 //! does not exist). The first failure is kept, with its key path, and located in the file.
 
 use super::error::{SceneError, SceneSource};
+use rapier_fvm::body::SPEED_OF_LIGHT;
+use rapier_fvm::glamx::DVec3;
 
 /// Collects the first failed check.
 pub(crate) struct Checker<'a> {
@@ -50,6 +52,19 @@ impl<'a> Checker<'a> {
     pub(crate) fn finite_vector(&mut self, key: &str, value: [f64; 3]) {
         if value.iter().any(|v| !v.is_finite()) {
             self.fail(key, format!("must be finite, got {value:?}"));
+        }
+    }
+
+    /// Fails unless `value` (m/s) is finite and no faster than light.
+    pub(crate) fn speed(&mut self, key: &str, value: [f64; 3]) {
+        let speed = DVec3::from_array(value).length();
+        if value.iter().any(|v| !v.is_finite()) {
+            self.fail(key, format!("must be finite, got {value:?}"));
+        } else if speed > SPEED_OF_LIGHT {
+            self.fail(
+                key,
+                format!("{speed:e} m/s is faster than light ({SPEED_OF_LIGHT} m/s)"),
+            );
         }
     }
 

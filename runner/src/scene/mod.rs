@@ -4,8 +4,8 @@
 //! - [`world`]: `[world]` gravity (m/s²), frame step `dt` (s), `duration` (s), coupling
 //!   substeps;
 //! - [`soft_body`]: `[[soft_body]]` entries, with their [`mesh`] (generator or file) and
-//!   [`material`] (model, E in Pa, ν, ρ in kg/m³, Rayleigh damping), placement, friction,
-//!   pinned regions and attachments;
+//!   [`material`] (model, E in Pa, ν, ρ in kg/m³, Rayleigh damping), placement, initial
+//!   velocity (m/s; angular, rad/s; per region), friction, pinned regions and attachments;
 //! - [`rigid_body`]: `[[rigid_body]]` entries: shape, pose, density or mass, velocity, and
 //!   fixed / dynamic / kinematic (keyframed) motion;
 //! - [`settings`]: `[contact]`, `[integrator]` and `[output]`;

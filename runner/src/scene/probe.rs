@@ -22,13 +22,32 @@
 //! component = "y"
 //!
 //! [[probe]]
+//! name = "block pushed by the box"
+//! kind = "contact_force_on_soft" # force (N) on soft `body` from rigid body `rigid`, or from all
+//! body = "block"
+//! rigid = "box"
+//! component = "x"
+//!
+//! [[probe]]
 //! name = "elastic energy"
 //! kind = "energy"           # of soft `body`, or of all soft bodies (J)
 //! energy = "elastic"        # "elastic", "kinetic", "gravity" or "total"
+//!
+//! [[probe]]
+//! name = "block momentum"
+//! kind = "momentum"         # linear momentum Σ m v of soft `body`, or of all (kg m/s)
+//! body = "block"
+//! component = "x"
+//!
+//! [[probe]]
+//! name = "block spin"
+//! kind = "angular_momentum" # Σ m (x - c) × v of soft `body` about its centre of mass c, or of
+//! body = "block"            # all about theirs (N m s)
+//! component = "z"
 //! ```
 //! The contact force is the frame's mean force the soft bodies' contacts and attachments
-//! exerted on the rigid body (`FvmWorld::load_on`). The gravity energy is `-m g·x` summed over
-//! the nodes, zero at the origin.
+//! exerted on the rigid body (`FvmWorld::load_on`); the force on a soft body is its opposite.
+//! The gravity energy is `-m g·x` summed over the nodes, zero at the origin.
 
 use super::check::Checker;
 use serde::Deserialize;
@@ -41,9 +60,11 @@ pub struct ProbeSpec {
     pub name: String,
     /// What it measures.
     pub kind: ProbeKind,
-    /// The soft body (displacement: required; contact force, energy: optional, default all).
+    /// The soft body (displacement, contact force on soft: required; contact force, energy,
+    /// momentum, angular momentum: optional, default all).
     pub body: Option<String>,
-    /// The rigid body (position, velocity, contact force).
+    /// The rigid body (position, velocity, contact force: required; contact force on soft:
+    /// optional, default all).
     pub rigid: Option<String>,
     /// The rest point whose nearest node is followed (m, mesh rest coordinates; displacement).
     pub point: Option<[f64; 3]>,
@@ -66,8 +87,14 @@ pub enum ProbeKind {
     Velocity,
     /// The force soft bodies exert on a rigid body (N).
     ContactForce,
+    /// The force rigid bodies exert on a soft body (N).
+    ContactForceOnSoft,
     /// An energy of soft bodies (J).
     Energy,
+    /// The linear momentum of soft bodies (kg m/s).
+    Momentum,
+    /// The angular momentum of soft bodies about their centre of mass (N m s).
+    AngularMomentum,
 }
 
 /// A component of a vector quantity.
@@ -107,7 +134,10 @@ impl ProbeKind {
             Self::Position => "position",
             Self::Velocity => "velocity",
             Self::ContactForce => "contact_force",
+            Self::ContactForceOnSoft => "contact_force_on_soft",
             Self::Energy => "energy",
+            Self::Momentum => "momentum",
+            Self::AngularMomentum => "angular_momentum",
         }
     }
 
@@ -116,8 +146,10 @@ impl ProbeKind {
         match self {
             Self::Displacement | Self::Position => "m",
             Self::Velocity => "m/s",
-            Self::ContactForce => "N",
+            Self::ContactForce | Self::ContactForceOnSoft => "N",
             Self::Energy => "J",
+            Self::Momentum => "kg m/s",
+            Self::AngularMomentum => "N m s",
         }
     }
 }
@@ -127,12 +159,17 @@ impl ProbeSpec {
     /// exist; `key` is the probe's key path.
     pub(crate) fn check(&self, key: &str, soft: &[&str], rigid: &[&str], c: &mut Checker<'_>) {
         use Need::{Forbidden, Optional, Required};
-        use ProbeKind::{ContactForce, Displacement, Energy, Position, Velocity};
+        use ProbeKind::{
+            AngularMomentum, ContactForce, ContactForceOnSoft, Displacement, Energy, Momentum,
+            Position, Velocity,
+        };
         let (body, rigid_body, point, energy) = match self.kind {
             Displacement => (Required, Forbidden, Required, Forbidden),
             Position | Velocity => (Forbidden, Required, Forbidden, Forbidden),
             ContactForce => (Optional, Required, Forbidden, Forbidden),
+            ContactForceOnSoft => (Required, Optional, Forbidden, Forbidden),
             Energy => (Optional, Forbidden, Forbidden, Required),
+            Momentum | AngularMomentum => (Optional, Forbidden, Forbidden, Forbidden),
         };
         let kind = self.kind.name();
         let presence = [

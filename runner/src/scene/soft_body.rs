@@ -1,5 +1,6 @@
-//! `[[soft_body]]`: a finite-volume soft body: its mesh, material, placement, contact
-//! properties, pinned regions and attachments to rigid bodies.
+//! `[[soft_body]]`: a finite-volume soft body: its mesh, material, placement, initial velocity
+//! (linear, angular and per region), contact properties, pinned regions and attachments to
+//! rigid bodies.
 //!
 //! ```toml
 //! [[soft_body]]
@@ -10,6 +11,7 @@
 //! translation = [0.5, 0.0, 0.0]   # m, default 0
 //! rotation = [0.0, 0.0, 0.0]      # scaled axis (rad), default 0
 //! linvel = [0.0, 0.0, 0.0]        # m/s, default 0
+//! angvel = [0.0, 0.0, 0.0]        # rad/s about the placed centre of mass, default 0
 //! friction = 0.5                  # default 0.5
 //! self_contact = false            # default false
 //! volumetric = "per_element"      # or "nodal_average" / "element_average" (nearly incompressible:
@@ -21,6 +23,8 @@
 //!                                 # use its surface; default none
 //! pinned = [{ min = [-0.51, -1, -1], max = [-0.49, 1, 1] }]         # boxes in rest coordinates
 //! attach = [{ rigid = "ball", min = [-1, -0.26, -1], max = [1, -0.24, 1] }]
+//! velocity = [{ min = [0.4, -1, -1], max = [0.6, 1, 1], linvel = [0, 1, 0] }]
+//!                                 # the box's nodes start at `linvel` (m/s) instead
 //! ```
 //! Regions are boxes `min`..`max` (m) in the mesh's rest coordinates, before the translation and
 //! rotation; each must hold at least one node.
@@ -53,6 +57,10 @@ pub struct SoftBodySpec {
     /// Initial velocity of every node (m/s); default 0.
     #[serde(default)]
     pub linvel: [f64; 3],
+    /// Initial angular velocity (rad/s) about the centre of mass where the translation and
+    /// rotation place the body, added to `linvel`; default 0.
+    #[serde(default)]
+    pub angvel: [f64; 3],
     /// Coulomb friction coefficient of the surface; default 0.5.
     #[serde(default = "default_friction")]
     pub friction: f64,
@@ -73,6 +81,10 @@ pub struct SoftBodySpec {
     /// Regions whose nodes are glued to rigid bodies.
     #[serde(default)]
     pub attach: Vec<AttachmentSpec>,
+    /// Regions whose nodes start at their own velocity, in place of `linvel` and `angvel`; a
+    /// later region wins where two overlap, pinned nodes stay at rest.
+    #[serde(default)]
+    pub velocity: Vec<RegionVelocitySpec>,
 }
 
 fn default_friction() -> f64 {
@@ -127,6 +139,18 @@ pub struct AttachmentSpec {
     pub max: [f64; 3],
 }
 
+/// Nodes of a region given their own initial velocity.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RegionVelocitySpec {
+    /// Lower corner of the region (m, rest coordinates).
+    pub min: [f64; 3],
+    /// Upper corner of the region (m, rest coordinates).
+    pub max: [f64; 3],
+    /// The nodes' initial velocity (m/s).
+    pub linvel: [f64; 3],
+}
+
 impl RegionSpec {
     /// The nodes of `mesh` inside the box (bounds included).
     pub fn nodes(&self, mesh: &TetMesh) -> Vec<u32> {
@@ -135,6 +159,13 @@ impl RegionSpec {
 }
 
 impl AttachmentSpec {
+    /// The nodes of `mesh` inside the box (bounds included).
+    pub fn nodes(&self, mesh: &TetMesh) -> Vec<u32> {
+        nodes_in(mesh, self.min, self.max)
+    }
+}
+
+impl RegionVelocitySpec {
     /// The nodes of `mesh` inside the box (bounds included).
     pub fn nodes(&self, mesh: &TetMesh) -> Vec<u32> {
         nodes_in(mesh, self.min, self.max)
@@ -177,7 +208,8 @@ impl SoftBodySpec {
         }
         c.finite_vector(&format!("{key}.translation"), self.translation);
         c.finite_vector(&format!("{key}.rotation"), self.rotation);
-        c.finite_vector(&format!("{key}.linvel"), self.linvel);
+        c.speed(&format!("{key}.linvel"), self.linvel);
+        c.finite_vector(&format!("{key}.angvel"), self.angvel);
         c.non_negative(&format!("{key}.friction"), self.friction, "dimensionless");
         for (i, region) in self.pinned.iter().enumerate() {
             check_box(&format!("{key}.pinned[{i}]"), region.min, region.max, c);
@@ -191,6 +223,11 @@ impl SoftBodySpec {
                     format!("no rigid body is named {:?}", attachment.rigid),
                 );
             }
+        }
+        for (i, region) in self.velocity.iter().enumerate() {
+            let key = format!("{key}.velocity[{i}]");
+            check_box(&key, region.min, region.max, c);
+            c.speed(&format!("{key}.linvel"), region.linvel);
         }
     }
 }

@@ -1,8 +1,9 @@
-//! A [`Scene`] made into a world: soft bodies meshed, placed, pinned and attached, rigid bodies
-//! and their colliders inserted, probes bound to the bodies they read.
+//! A [`Scene`] made into a world: soft bodies meshed, placed, set moving, pinned and attached,
+//! rigid bodies and their colliders inserted, probes bound to the bodies they read.
 
 use super::meshes::BodyMeshes;
 use super::probe::Probe;
+use super::regions::BodyRegions;
 use crate::scene::budget::MemoryUse;
 use crate::scene::rigid_body::{RigidBodySpec, RigidKind, ShapeSpec};
 use crate::scene::soft_body::{SoftBodySpec, VolumetricSpec};
@@ -220,27 +221,11 @@ fn insert_soft(
         .material
         .material()
         .map_err(library(format!("{key}.material")))?;
-    let mut pinned = Vec::new();
-    for (i, region) in spec.pinned.iter().enumerate() {
-        let nodes = region.nodes(&mesh);
-        if nodes.is_empty() {
-            return Err(source.error(&format!("{key}.pinned[{i}]"), "the box holds no node"));
-        }
-        pinned.extend(nodes);
-    }
-    let mut attachments = Vec::new();
-    for (i, attachment) in spec.attach.iter().enumerate() {
-        let nodes = attachment.nodes(&mesh);
-        let at = format!("{key}.attach[{i}]");
-        if nodes.is_empty() {
-            return Err(source.error(&at, "the box holds no node"));
-        }
-        let body = rigid
-            .iter()
-            .find(|r| r.name == attachment.rigid)
-            .ok_or_else(|| source.error(&format!("{at}.rigid"), "no such rigid body"))?;
-        attachments.push((nodes, body.handle, at));
-    }
+    let BodyRegions {
+        pinned,
+        velocities,
+        attachments,
+    } = BodyRegions::select(spec, &mesh, rigid, (key, source))?;
     let mut builder = match (quadratic, cage) {
         (Some(quadratic), _) => DeformableBodyBuilder::quadratic(quadratic, material),
         (_, Some(cage)) => DeformableBodyBuilder::quadratic_hex(cage, material),
@@ -253,6 +238,7 @@ fn insert_soft(
         .translation(DVec3::from_array(spec.translation))
         .rotation(DVec3::from_array(spec.rotation))
         .linvel(DVec3::from_array(spec.linvel))
+        .angvel(DVec3::from_array(spec.angvel))
         .pinned_nodes(pinned)
         .friction(spec.friction)
         .self_contact(spec.self_contact)
@@ -261,6 +247,9 @@ fn insert_soft(
             VolumetricSpec::NodalAverage => VolumetricTreatment::NodalAverage,
             VolumetricSpec::ElementAverage => VolumetricTreatment::ElementAverage,
         });
+    for (nodes, linvel) in velocities {
+        builder = builder.nodes_linvel(nodes, linvel);
+    }
     if let Some(damping) = &spec.damping {
         builder = builder.damping(
             damping
@@ -271,8 +260,9 @@ fn insert_soft(
     let body = builder.build().map_err(library(key.to_owned()))?;
     let rest = body.positions().to_vec();
     let handle = world.soft_bodies.insert(body);
-    for (nodes, rigid, at) in attachments {
-        world.attach(handle, nodes, rigid).map_err(library(at))?;
+    for attachment in attachments {
+        (world.attach(handle, attachment.nodes, attachment.rigid))
+            .map_err(library(attachment.key))?;
     }
     Ok(SoftEntry {
         name: spec.name.clone(),

@@ -12,6 +12,7 @@
 mod build;
 mod meshes;
 mod probe;
+mod regions;
 mod report;
 mod run;
 mod writer;

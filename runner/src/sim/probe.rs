@@ -4,6 +4,7 @@ use super::build::Simulation;
 use crate::output::TimeSeries;
 use crate::scene::probe::{Component, EnergyKind, ProbeKind, ProbeSpec};
 use crate::scene::{SceneError, SceneSource};
+use rapier_fvm::body::DeformableBody;
 use rapier_fvm::glamx::DVec3;
 
 /// A probe and the samples taken so far.
@@ -38,9 +39,22 @@ enum Target {
         soft: Option<usize>,
         component: Component,
     },
+    ContactForceOnSoft {
+        soft: usize,
+        rigid: Option<usize>,
+        component: Component,
+    },
     Energy {
         soft: Option<usize>,
         energy: EnergyKind,
+    },
+    Momentum {
+        soft: Option<usize>,
+        component: Component,
+    },
+    AngularMomentum {
+        soft: Option<usize>,
+        component: Component,
     },
 }
 
@@ -64,14 +78,19 @@ impl Probe {
                 })
                 .transpose()
         };
-        let rigid = || -> Result<usize, SceneError> {
+        let rigid = || -> Result<Option<usize>, SceneError> {
             spec.rigid
                 .as_deref()
-                .and_then(|n| simulation.rigid_index(n))
-                .ok_or_else(|| source.error(&format!("{key}.rigid"), "no such rigid body"))
+                .map(|n| {
+                    simulation
+                        .rigid_index(n)
+                        .ok_or_else(|| source.error(&format!("{key}.rigid"), "no such rigid body"))
+                })
+                .transpose()
         };
-        let component = spec.component;
         let missing = |field: &str| source.error(key, format!("the probe needs `{field}`"));
+        let one_rigid = || rigid()?.ok_or_else(|| missing("rigid"));
+        let component = spec.component;
         let target = match spec.kind {
             ProbeKind::Displacement => {
                 let soft = soft(&spec.body)?.ok_or_else(|| missing("body"))?;
@@ -85,21 +104,34 @@ impl Probe {
                 }
             }
             ProbeKind::Position => Target::Position {
-                rigid: rigid()?,
+                rigid: one_rigid()?,
                 component,
             },
             ProbeKind::Velocity => Target::Velocity {
-                rigid: rigid()?,
+                rigid: one_rigid()?,
                 component,
             },
             ProbeKind::ContactForce => Target::ContactForce {
-                rigid: rigid()?,
+                rigid: one_rigid()?,
                 soft: soft(&spec.body)?,
+                component,
+            },
+            ProbeKind::ContactForceOnSoft => Target::ContactForceOnSoft {
+                soft: soft(&spec.body)?.ok_or_else(|| missing("body"))?,
+                rigid: rigid()?,
                 component,
             },
             ProbeKind::Energy => Target::Energy {
                 soft: soft(&spec.body)?,
                 energy: spec.energy.ok_or_else(|| missing("energy"))?,
+            },
+            ProbeKind::Momentum => Target::Momentum {
+                soft: soft(&spec.body)?,
+                component,
+            },
+            ProbeKind::AngularMomentum => Target::AngularMomentum {
+                soft: soft(&spec.body)?,
+                component,
             },
         };
         Ok(Self {
@@ -137,31 +169,19 @@ impl Probe {
                 rigid,
                 soft,
                 component,
-            } => {
-                let handle = simulation.rigid[rigid].handle;
-                let force = (simulation.soft.iter().enumerate())
-                    .filter(|(i, _)| soft.is_none_or(|s| s == *i))
-                    .map(|(_, entry)| world.load_on(entry.handle, handle).0)
-                    .sum();
-                pick(force, component)
+            } => pick(load(simulation, soft, Some(rigid)), component),
+            Target::ContactForceOnSoft {
+                soft,
+                rigid,
+                component,
+            } => pick(-load(simulation, Some(soft), rigid), component),
+            Target::Energy { soft, energy } => soft_energy(simulation, soft, energy),
+            Target::Momentum { soft, component } => {
+                let momentum = soft_bodies(simulation, soft).map(|b| b.linear_momentum());
+                pick(momentum.sum(), component)
             }
-            Target::Energy { soft, energy } => {
-                let gravity = world.physics.gravity.as_dvec3();
-                (simulation.soft.iter().enumerate())
-                    .filter(|(i, _)| soft.is_none_or(|s| s == *i))
-                    .map(|(_, entry)| {
-                        let body = &world.soft_bodies[entry.handle];
-                        let elastic = || body.elastic_energy();
-                        let kinetic = || body.kinetic_energy();
-                        let potential = || body.gravity_potential_energy(gravity);
-                        match energy {
-                            EnergyKind::Elastic => elastic(),
-                            EnergyKind::Kinetic => kinetic(),
-                            EnergyKind::Gravity => potential(),
-                            EnergyKind::Total => elastic() + kinetic() + potential(),
-                        }
-                    })
-                    .sum()
+            Target::AngularMomentum { soft, component } => {
+                pick(angular_momentum(simulation, soft), component)
             }
         }
     }
@@ -171,6 +191,68 @@ impl Probe {
         let value = self.value(simulation);
         self.series.samples.push((t, value));
     }
+}
+
+/// The soft bodies of `simulation`: body `soft`, or every one.
+fn soft_bodies(
+    simulation: &Simulation,
+    soft: Option<usize>,
+) -> impl Iterator<Item = &DeformableBody> {
+    (simulation.soft.iter().enumerate())
+        .filter(move |(i, _)| soft.is_none_or(|s| s == *i))
+        .map(|(_, entry)| &simulation.world.soft_bodies[entry.handle])
+}
+
+/// The mean force (N) soft body `soft` (or every one) exerted on rigid body `rigid` (or every
+/// one) over the last frame, through its contacts and attachments.
+fn load(simulation: &Simulation, soft: Option<usize>, rigid: Option<usize>) -> DVec3 {
+    let chosen = |index: Option<usize>, i: usize| index.is_none_or(|s| s == i);
+    let mut force = DVec3::ZERO;
+    for (i, soft_entry) in simulation.soft.iter().enumerate() {
+        for (j, rigid_entry) in simulation.rigid.iter().enumerate() {
+            if chosen(soft, i) && chosen(rigid, j) {
+                force += (simulation.world)
+                    .load_on(soft_entry.handle, rigid_entry.handle)
+                    .0;
+            }
+        }
+    }
+    force
+}
+
+/// The `energy` (J) of soft body `soft`, or of every one.
+fn soft_energy(simulation: &Simulation, soft: Option<usize>, energy: EnergyKind) -> f64 {
+    let gravity = simulation.world.physics.gravity.as_dvec3();
+    soft_bodies(simulation, soft)
+        .map(|body| {
+            let elastic = || body.elastic_energy();
+            let kinetic = || body.kinetic_energy();
+            let potential = || body.gravity_potential_energy(gravity);
+            match energy {
+                EnergyKind::Elastic => elastic(),
+                EnergyKind::Kinetic => kinetic(),
+                EnergyKind::Gravity => potential(),
+                EnergyKind::Total => elastic() + kinetic() + potential(),
+            }
+        })
+        .sum()
+}
+
+/// The angular momentum (N m s) of soft body `soft` about its centre of mass, or of every one
+/// about their common centre of mass `C`: `Σ (L_b + (c_b - C) × p_b)` over the bodies `b`, each
+/// of angular momentum `L_b` about its centre of mass `c_b` and linear momentum `p_b`.
+fn angular_momentum(simulation: &Simulation, soft: Option<usize>) -> DVec3 {
+    let (mut weighted, mut mass) = (DVec3::ZERO, 0.0);
+    for body in soft_bodies(simulation, soft) {
+        weighted += body.center_of_mass() * body.total_mass();
+        mass += body.total_mass();
+    }
+    let center = weighted / mass;
+    soft_bodies(simulation, soft)
+        .map(|body| {
+            body.angular_momentum() + (body.center_of_mass() - center).cross(body.linear_momentum())
+        })
+        .sum()
 }
 
 /// The `component` of `v`.
