@@ -168,6 +168,41 @@ fn a_cube_set_inside_another_soft_cube_is_a_penetration() {
 }
 
 #[test]
+fn a_ball_set_inside_a_soft_cube_is_a_penetration_and_a_glued_one_is_not() {
+    // A free rigid ball of radius 1 cm centred 2 cm below the cube's top face, between its
+    // nodes (none of which it touches): the rigid body went in between the contact points. Glued
+    // to one of the cube's nodes instead (a bone inside flesh), the same ball is where it belongs.
+    for glued in [false, true] {
+        let mut world = FvmWorld::default();
+        world.physics.gravity = Vec3::ZERO;
+        let handle = world.soft_bodies.insert(cube(0.0));
+        let (ball, collider) = world.physics.insert(
+            RigidBodyBuilder::dynamic().translation(Vec3::new(0.0125, 0.08, 0.0125)),
+            ColliderBuilder::ball(0.01),
+        );
+        if glued {
+            let node = world.soft_bodies[handle]
+                .mesh()
+                .nearest_node(DVec3::new(0.0, 0.075, 0.0));
+            world.attach(handle, [node], ball).unwrap();
+        }
+        let found = Audit::default().check_world(&world, &Vec::new());
+        let body = found.body(handle).unwrap();
+        if glued {
+            assert!(!body.penetrates(), "glued: {:?}", body.penetrations);
+        } else {
+            assert!(body.penetrates());
+            assert_eq!(
+                body.penetrations.deepest_in,
+                Some(PenetrationTarget::Collider(collider))
+            );
+            // The centre lies 2 cm below the top face, its nearest boundary.
+            assert!((body.penetrations.deepest - 0.02).abs() < 1e-6);
+        }
+    }
+}
+
+#[test]
 fn mirrored_and_flattened_cubes_have_inverted_and_collapsed_elements() {
     let mut world = FvmWorld::default();
     let handle = world.soft_bodies.insert(cube(0.0));

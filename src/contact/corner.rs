@@ -1,7 +1,8 @@
 //! Rigid corners against soft faces: the vertices of a collider's polyhedral shape (cuboid,
-//! convex polyhedron, triangle mesh, and those within compounds) against the soft body's
-//! boundary triangles, so that a corner or a small box pressing between the nodes of a coarse
-//! mesh is held by the face rather than sinking in until its faces meet nodes.
+//! convex polyhedron, triangle mesh), and the closest points of a rounded one (ball, capsule,
+//! cylinder, cone, see [`super::support`]), alone or within compounds, against the soft body's
+//! boundary triangles, so that a corner, a small box or a small ball pressing between the nodes
+//! of a coarse mesh is held by the face rather than sinking in until its faces meet nodes.
 //!
 //! A vertex within reach of a boundary triangle facing it (see [`SurfaceTree`]) gets a contact
 //! plane through the triangle's nearest point, with the triangle's outward normal. The explicit
@@ -18,7 +19,8 @@
 use super::detect::NearCollider;
 use super::node_contact::lagged_friction;
 use super::penalty::effective_mass;
-use super::surface_tree::SurfaceTree;
+use super::support;
+use super::surface_tree::{SurfaceTree, TrianglePoint};
 use super::{
     Coefficients, ContactSet, ContactSettings, ContactSides, ImplicitStep, SoftPoint,
     VelocityConstraint, penalty_tangent,
@@ -42,9 +44,12 @@ pub(crate) struct CornerContact {
     vertex: DVec3,
     /// The contact point on the soft triangle.
     on_triangle: SoftPoint,
-    /// The contact plane: a point (m) and the triangle's outward unit normal.
+    /// The contact plane: a point (m) and its unit normal, the triangle's outward normal when
+    /// `follows_face` (then turning with it through the step), otherwise fixed at detection (a
+    /// rounded shape on the triangle's edge or corner, see [`super::support`]).
     point: DVec3,
     normal: DVec3,
+    follows_face: bool,
     /// The soft body's and the collider's coefficients, combined.
     coefficients: Coefficients,
     constraint: VelocityConstraint,
@@ -64,17 +69,35 @@ impl CornerContact {
     }
 }
 
+/// Whether `shape` meets the soft faces as [`find_corner_contacts`] finds: by its vertices or
+/// its closest points, alone or within a compound (every shape but a half-space and a height
+/// field).
+pub(crate) fn meets_faces(shape: &dyn Shape) -> bool {
+    has_vertices(shape) || shape.as_support_map().is_some() || shape.as_compound().is_some()
+}
+
 /// Whether `shape` has vertices [`for_each_vertex`] visits.
-pub(crate) fn has_vertices(shape: &dyn Shape) -> bool {
+fn has_vertices(shape: &dyn Shape) -> bool {
     shape.as_cuboid().is_some()
         || shape.as_convex_polyhedron().is_some()
         || shape.as_trimesh().is_some()
-        || shape.as_compound().is_some()
 }
 
-/// Calls `each(vertex, outward)` for the world-space vertices (m) of `shape` at `pose` that have
-/// corners (cuboids, convex polyhedra, triangle meshes, and those within compounds), with the
-/// direction from the shape's centre to the vertex.
+/// Calls `each(part, pose)` for `shape` at `pose`, or for each shape within it at its pose if
+/// it is a compound.
+fn for_each_part(shape: &dyn Shape, pose: &Pose, each: &mut impl FnMut(&dyn Shape, &Pose)) {
+    if let Some(compound) = shape.as_compound() {
+        for (local_pose, part) in compound.shapes() {
+            for_each_part(&**part, &(*pose * *local_pose), each);
+        }
+    } else {
+        each(shape, pose);
+    }
+}
+
+/// Calls `each(vertex, outward)` for the world-space vertices (m) of `shape` at `pose`, a shape
+/// with corners (cuboid, convex polyhedron, triangle mesh), with the direction from the shape's
+/// centre to the vertex.
 fn for_each_vertex(shape: &dyn Shape, pose: &Pose, each: &mut impl FnMut(DVec3, DVec3)) {
     let centre = pose.translation.as_dvec3();
     let mut emit = |local: rapier3d::math::Vector| {
@@ -95,16 +118,13 @@ fn for_each_vertex(shape: &dyn Shape, pose: &Pose, each: &mut impl FnMut(DVec3, 
         polyhedron.points().iter().for_each(|p| emit(*p));
     } else if let Some(mesh) = shape.as_trimesh() {
         mesh.vertices().iter().for_each(|p| emit(*p));
-    } else if let Some(compound) = shape.as_compound() {
-        for (local_pose, part) in compound.shapes() {
-            for_each_vertex(&**part, &(*pose * *local_pose), each);
-        }
     }
 }
 
-/// The contacts of the vertices of `near`'s shape within its reach (m) of `body`'s boundary
-/// triangles in `tree`, skipping triangles with a node glued to the collider's rigid body; their
-/// proxy is left for the caller to set.
+/// The contacts of `near`'s shape within its reach (m) of `body`'s boundary triangles in
+/// `tree`: its vertices' if it has corners, its closest points' if it is rounded (see
+/// [`super::support`]), part by part in a compound; skipping triangles with a node glued to the
+/// collider's rigid body; their proxy is left for the caller to set.
 pub(super) fn find_corner_contacts(
     body: &DeformableBody,
     tree: &SurfaceTree,
@@ -120,26 +140,40 @@ pub(super) fn find_corner_contacts(
         ..
     } = *near;
     let bounds = tree.bounds.loosened(reach as f32);
+    let skipped = |triangle: &[u32; 3]| triangle.iter().any(|n| glued.contains(n));
     let mut found = Vec::new();
-    for_each_vertex(shape.as_ref(), pose, &mut |vertex, outward| {
-        if !bounds.contains_local_point(vertex.as_vec3()) {
-            return;
-        }
-        let skipped = |triangle: &[u32; 3]| triangle.iter().any(|n| glued.contains(n));
-        if let Some(hit) = tree.nearest_facing(body, vertex, outward, reach, skipped) {
-            found.push(CornerContact {
-                collider,
-                proxy: None,
-                vertex,
-                on_triangle: hit.soft_point(),
-                point: hit.point,
-                normal: hit.normal,
-                coefficients,
-                constraint: VelocityConstraint::default(),
-                impulse: DVec3::ZERO,
-                lagged_normal_force: 0.0,
-                slip_origin: DVec3::ZERO,
+    let contact = |vertex: DVec3, hit: TrianglePoint, follows_face: bool| CornerContact {
+        collider,
+        proxy: None,
+        vertex,
+        on_triangle: hit.soft_point(),
+        point: hit.point,
+        normal: hit.normal,
+        follows_face,
+        coefficients,
+        constraint: VelocityConstraint::default(),
+        impulse: DVec3::ZERO,
+        lagged_normal_force: 0.0,
+        slip_origin: DVec3::ZERO,
+    };
+    for_each_part(shape.as_ref(), pose, &mut |part, part_pose| {
+        if has_vertices(part) {
+            for_each_vertex(part, part_pose, &mut |vertex, outward| {
+                if !bounds.contains_local_point(vertex.as_vec3()) {
+                    return;
+                }
+                if let Some(hit) = tree.nearest_facing(body, vertex, outward, reach, skipped) {
+                    found.push(contact(vertex, hit, true));
+                }
             });
+        } else if part.as_support_map().is_some() {
+            support::for_each_support_contact(
+                (body, tree),
+                (part, part_pose),
+                reach,
+                skipped,
+                &mut |c| found.push(contact(c.vertex, c.on_triangle, c.follows_face)),
+            );
         }
     });
     found
@@ -157,7 +191,9 @@ pub(crate) fn prepare_corners(
     for contact in &mut contacts.corners {
         if let Some((point, normal)) = contact.on_triangle.plane(&body.positions) {
             contact.point = point;
-            contact.normal = normal;
+            if contact.follows_face {
+                contact.normal = normal;
+            }
         }
         let gap = (contact.vertex - contact.point).dot(contact.normal);
         let normal_speed = || {
@@ -200,7 +236,7 @@ pub(crate) fn solve_corners(
     for contact in &mut contacts.corners {
         let mut sides = Corner {
             rigid: contact.proxy.map(|p| &mut proxies[p]),
-            vertex: contact.vertex,
+            at: contact.point,
             velocities,
             masses,
             pinned,
@@ -216,7 +252,10 @@ pub(crate) fn solve_corners(
 /// A rigid vertex and a soft triangle, within a sweep.
 struct Corner<'a> {
     rigid: Option<&'a mut RigidProxy>,
-    vertex: DVec3,
+    /// Where the rigid body's side acts (m): the triangle's contact point, where the soft side's
+    /// opposite impulse acts too, so that the exchange keeps angular momentum exactly (the
+    /// vertex lies off it by the gap, and a friction impulse's moment would differ by it).
+    at: DVec3,
     velocities: &'a mut [DVec3],
     masses: &'a [f64],
     pinned: &'a [bool],
@@ -228,20 +267,20 @@ impl ContactSides for Corner<'_> {
         let vertex = self
             .rigid
             .as_ref()
-            .map_or(DVec3::ZERO, |r| r.velocity_at(self.vertex));
+            .map_or(DVec3::ZERO, |r| r.velocity_at(self.at));
         vertex - self.on_triangle.velocity(self.velocities)
     }
 
     fn inverse_mass_along(&self, direction: DVec3) -> f64 {
         self.rigid
             .as_ref()
-            .map_or(0.0, |r| r.inverse_mass_along(self.vertex, direction))
+            .map_or(0.0, |r| r.inverse_mass_along(self.at, direction))
             + self.on_triangle.inverse_mass(self.masses, self.pinned)
     }
 
     fn exchange(&mut self, impulse: DVec3) {
         if let Some(rigid) = self.rigid.as_mut() {
-            rigid.apply(impulse, self.vertex);
+            rigid.apply(impulse, self.at);
         }
         self.on_triangle
             .apply(-impulse, self.velocities, self.masses, self.pinned);

@@ -93,7 +93,7 @@ pub(crate) fn detect(
             }
             nodes.push(contact.with_proxy(proxy));
         }
-        if near.overlaps(bounds) && corner::has_vertices(near.shape.as_ref()) {
+        if near.overlaps(bounds) && corner::meets_faces(near.shape.as_ref()) {
             let tree = tree.get_or_insert_with(|| surface_tree::SurfaceTree::of(body));
             let mut found = corner::find_corner_contacts(body, tree, &near);
             if !found.is_empty() {

@@ -33,7 +33,11 @@
 //! the total impulse is handed to rapier when the step is accepted. A point found inside a
 //! collider (rapier's step ends a body where the sweep did not quite take it) is pushed out over
 //! the step the contacts were detected for, not within one explicit substep.
-
+//!
+//! The vertices of a rigid polyhedral shape (cuboid, convex polyhedron, triangle mesh) and the
+//! closest points of a rounded one (ball, capsule, cylinder, cone) also meet the body's boundary
+//! triangles as corner contacts, so that a small rigid body cannot pass between the nodes of a
+//! coarse mesh.
 //!
 //! A body with [`DeformableBody::self_contact`] on also gets contacts of its surface nodes with its own
 //! boundary triangles away from their neighbourhood, and an [`FvmWorld`](crate::world::FvmWorld)
@@ -51,6 +55,7 @@ mod penalty;
 mod self_contact;
 mod set;
 mod soft_point;
+mod support;
 mod surface_tree;
 mod sweep;
 mod velocity_constraint;

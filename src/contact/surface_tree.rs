@@ -1,5 +1,6 @@
 //! A soft body's boundary triangles, where they are now, in a parry bounding-volume hierarchy:
-//! the nearest triangle facing a point, for self-contact and contact between soft bodies.
+//! the nearest triangle facing a point, for self-contact, contact between soft bodies and rigid
+//! vertices, and the triangles within a box, for rounded rigid shapes' support points.
 
 use super::SoftPoint;
 use crate::body::DeformableBody;
@@ -64,6 +65,13 @@ impl SurfaceTree {
             bvh: Bvh::from_leaves(BvhBuildStrategy::Binned, &leaves),
             bounds,
         }
+    }
+
+    /// The indices of the body's boundary triangles whose bounds overlap the box from `lo` to
+    /// `hi` (m).
+    pub(crate) fn triangles_in(&self, lo: DVec3, hi: DVec3) -> Vec<u32> {
+        let query = Aabb::new(lo.as_vec3(), hi.as_vec3());
+        self.bvh.intersect_aabb(&query).collect()
     }
 
     /// The triangle of `body` (the tree's) nearest to `x` (m) within `reach` (m), among those

@@ -218,6 +218,7 @@ impl Audit {
             &poses,
             &mut penetrations,
         );
+        penetration::colliders_inside(&checked, input.colliders, &mut penetrations);
         for (other_handle, other) in input.soft_bodies.iter() {
             if other_handle != handle {
                 penetration::against_soft(&checked, other, other_handle, &mut penetrations);

@@ -5,7 +5,9 @@
 //! - **Penetration**: a point inside a non-sensor collider whose collision groups interact with
 //!   the body's (not one of a rigid body the point is glued to) deeper than the tolerance, the
 //!   depth being the distance to the collider's surface (parry's point projection); or inside
-//!   another deformable body's tetrahedra deeper than the tolerance below its boundary.
+//!   another deformable body's tetrahedra deeper than the tolerance below its boundary; or a
+//!   convex collider whose centre lies that deep inside the body's own tetrahedra (a rigid body
+//!   that went in between the contact points).
 //! - **Crossing**: a point outside a collider before and after the frame whose straight path over
 //!   the frame, taken in the collider's frame (so that a moving collider is followed), runs
 //!   through the collider's interior for longer than the tolerance (a solid shape), or through
@@ -134,34 +136,69 @@ pub(super) fn against_soft(
     other_handle: DeformableBodyHandle,
     found: &mut Penetrations,
 ) {
-    let body = checked.body;
-    if !body.collision_groups.test(other.collision_groups) {
+    if !checked.body.collision_groups.test(other.collision_groups) {
         return;
     }
-    let (lo, hi) = other.position_bounds();
-    let x = other.positions();
+    let body = checked.body;
     for (point, _) in contact_point_positions(body, body.positions()) {
-        if point.cmplt(lo).any() || point.cmpgt(hi).any() {
-            continue;
-        }
-        let inside = other.mesh().tets().iter().any(|tet| {
-            let [a, b, c, d] = tet.map(|n| x[n as usize]);
-            contains(a, b, c, d, point)
-        });
-        if !inside {
-            continue;
-        }
-        let depth = other
-            .surface
-            .triangles
-            .iter()
-            .filter_map(|t| nearest_point_on_triangle(t.map(|n| x[n as usize]), point))
-            .map(|(_, nearest)| (nearest - point).length())
-            .fold(f64::INFINITY, f64::min);
-        if depth.is_finite() && depth > checked.tolerance {
+        if let Some(depth) = depth_inside(other, point)
+            && depth > checked.tolerance
+        {
             found.add_penetration(depth, PenetrationTarget::SoftBody(other_handle));
         }
     }
+}
+
+/// Records in `found` the colliders inside the body of `checked`: a convex collider (not a
+/// sensor, interacting with the body, of no rigid body a node of it is glued to) whose centre
+/// (its frame's origin, when inside the shape) lies inside the body's tetrahedra deeper than the
+/// tolerance below its boundary, the depth being the centre's (a lower bound of the collider's
+/// own): a rigid body that went into the soft one between its contact points.
+pub(super) fn colliders_inside(
+    checked: &Checked<'_>,
+    colliders: &ColliderSet,
+    found: &mut Penetrations,
+) {
+    let body = checked.body;
+    for (handle, collider) in colliders.iter() {
+        let parent = collider.parent();
+        let glued = (checked.glued.iter()).any(|(rigid, _)| Some(*rigid) == parent);
+        if glued || collider.is_sensor() || !body.collision_groups.test(collider.collision_groups())
+        {
+            continue;
+        }
+        let (shape, pose) = (collider.shape(), collider.position());
+        if shape.as_support_map().is_none() || !shape.contains_point(pose, pose.translation) {
+            continue;
+        }
+        if let Some(depth) = depth_inside(body, pose.translation.as_dvec3())
+            && depth > checked.tolerance
+        {
+            found.add_penetration(depth, PenetrationTarget::Collider(handle));
+        }
+    }
+}
+
+/// How deep (m) `point` lies inside `body`: its distance to the boundary if it is within one of
+/// the body's tetrahedra, `None` otherwise.
+fn depth_inside(body: &DeformableBody, point: DVec3) -> Option<f64> {
+    let (lo, hi) = body.position_bounds();
+    if point.cmplt(lo).any() || point.cmpgt(hi).any() {
+        return None;
+    }
+    let x = body.positions();
+    let inside = body.mesh().tets().iter().any(|tet| {
+        let [a, b, c, d] = tet.map(|n| x[n as usize]);
+        contains(a, b, c, d, point)
+    });
+    if !inside {
+        return None;
+    }
+    let depth = (body.surface.triangles.iter())
+        .filter_map(|t| nearest_point_on_triangle(t.map(|n| x[n as usize]), point))
+        .map(|(_, nearest)| (nearest - point).length())
+        .fold(f64::INFINITY, f64::min);
+    depth.is_finite().then_some(depth)
 }
 
 /// Whether `p` lies inside the tetrahedron `a b c d` (m) of either orientation, or on its

@@ -1,0 +1,245 @@
+//! Rigid shapes against the faces of soft bodies, under the automatic integrator and under forced
+//! implicit steps: rounded ones (balls, cones: no vertices) pressing between the nodes of a
+//! coarse soft body are held by its faces through their closest points, and a box striking a
+//! block corner-first exchanges momentum (exactly in the explicit sweeps).
+
+use rapier_fvm::glamx::Vec3;
+use rapier_fvm::prelude::*;
+use rapier_fvm::world::FvmWorld;
+use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder, SharedShape};
+
+/// A 20 cm soft block (E = 1e6 Pa, ν = 0.3, 1000 kg/m³, friction 0.8, damping time 2e-3 s) of
+/// `cells`³ cells, its bottom face at height `bottom` (m).
+fn coarse_block(cells: usize, bottom: f64) -> DeformableBody {
+    let material = Material::new(MaterialModel::StableNeoHookean, 1e6, 0.3, 1000.0).unwrap();
+    let mut body = DeformableBodyBuilder::new(
+        mesh::cuboid(DVec3::splat(0.1), [cells; 3]).unwrap(),
+        material,
+    )
+    .damping(RayleighDamping::stiffness_proportional(2e-3, material.lame()).unwrap())
+    .translation(DVec3::new(0.0, bottom + 0.1, 0.0))
+    .build()
+    .unwrap();
+    body.friction = 0.8;
+    body
+}
+
+fn step(world: &mut FvmWorld) {
+    for (handle, outcome) in world.step() {
+        outcome.unwrap_or_else(|e| panic!("{handle:?}: {e}"));
+    }
+}
+
+/// The world of each tested integrator: automatic, and forced implicit.
+fn worlds() -> [(&'static str, FvmWorld); 2] {
+    let mut implicit = FvmWorld::default();
+    implicit.coupling.integrator.force = Some(IntegratorKind::Implicit);
+    [("automatic", FvmWorld::default()), ("implicit", implicit)]
+}
+
+#[test]
+fn a_small_ball_rests_on_the_faces_of_a_coarse_soft_block() {
+    // A steel ball of radius 1.5 cm (0.113 kg) on the 20 cm block of 2 x 2 x 2 cells (its top
+    // face's nodes 10 cm apart), dropped from 1 mm above the face within one of its triangles:
+    // no node lies under it, and a ball has no vertex, so only the face's triangles can hold it,
+    // through the ball's point deepest below each (its support point). Settled for 3 s, it must
+    // rest on the surface as the small box of `tests/coupling.rs` does, with the same bounds:
+    // sunk below the face at most the contact margin plus 1 mm, vertical speed below 1 mm/s, the
+    // block carrying its weight within 1 % (static equilibrium). Without the faces' support the
+    // ball falls between the nodes into the block.
+    for (name, mut world) in worlds() {
+        world.coupling.substeps = 16;
+        world.physics.insert_collider(
+            ColliderBuilder::new(SharedShape::halfspace(Vec3::Y)).friction(0.8),
+            None,
+        );
+        let block = world.soft_bodies.insert(coarse_block(2, 0.0));
+        let radius = 0.015f32;
+        let (ball, _) = world.physics.insert(
+            RigidBodyBuilder::dynamic().translation(Vec3::new(0.07, 0.2 + radius + 1e-3, 0.025)),
+            ColliderBuilder::ball(radius).density(8000.0).friction(0.8),
+        );
+        let mass = f64::from(world.physics.bodies[ball].mass());
+        let (mut fastest, mut support) = (0.0f32, 0.0);
+        let frames = 180;
+        for frame in 0..frames {
+            step(&mut world);
+            if frame >= frames - 60 {
+                fastest = fastest.max(world.physics.bodies[ball].linvel().y.abs());
+                support += world.load_on(block, ball).0.y / 60.0;
+            }
+        }
+        let centre = world.physics.bodies[ball].translation();
+        let bottom = f64::from(centre.y - radius);
+        let body = &world.soft_bodies[block];
+        let top_nodes = body.mesh().nodes_where(|p| p.y >= 0.1 - 1e-9);
+        let face = top_nodes
+            .iter()
+            .map(|&n| body.positions()[n as usize].y)
+            .sum::<f64>()
+            / top_nodes.len() as f64;
+        let weight = mass * 9.81;
+        println!(
+            "{name}: ball bottom {:.3} mm vs face {:.3} mm (sunk {:.3} mm), at x {:.2} z {:.2} \
+             mm; vertical speed <= {fastest:.2e} m/s; support {support:.4} N vs weight \
+             {weight:.4} N",
+            bottom * 1e3,
+            face * 1e3,
+            (face - bottom) * 1e3,
+            centre.x * 1e3,
+            centre.z * 1e3,
+        );
+        assert!(
+            face - bottom < world.coupling.contact.margin + 1e-3,
+            "{name}"
+        );
+        assert!(fastest < 1e-3, "{name}");
+        assert!((support / weight - 1.0).abs() < 0.01, "{name}");
+    }
+}
+
+#[test]
+fn a_coarse_soft_block_rests_on_small_fixed_rounded_pedestals() {
+    // The 20 cm block of 3 x 3 x 3 cells (8 kg; its bottom nodes 6.7 cm apart) rests on four
+    // fixed balls of radius 1 cm, or on the points of four cones (radius 1 cm, height 2 cm), at
+    // (±1.5, ±1.5) cm under its centre with nothing else below: no node of the block lies above a
+    // pedestal (the pedestals reach 2.5 cm from the axis, the nearest nodes are 3.3 cm away), so
+    // only the block's bottom triangles, pressed by the pedestals' support points, can hold it.
+    // Settled for 1.5 s, as the cube pedestal of `tests/coupling.rs`, with its bounds: the
+    // pedestals carry the block's weight within 1 % (static equilibrium), and the block stays on
+    // them (its centre above their tops by more than a quarter of its side, where it starts half
+    // a side above). Without the triangles' support the pedestals pass between the nodes.
+    let pedestals = [
+        ("balls", SharedShape::ball(0.01)),
+        ("cones", SharedShape::cone(0.01, 0.01)),
+    ];
+    let top = 0.02;
+    for (shape_name, shape) in pedestals {
+        for (name, mut world) in worlds() {
+            let feet: Vec<_> = [(-1.0, -1.0), (-1.0, 1.0), (1.0, -1.0), (1.0, 1.0)]
+                .map(|(x, z)| {
+                    world.physics.insert_collider(
+                        ColliderBuilder::new(shape.clone())
+                            .translation(Vec3::new(0.015 * x, 0.01, 0.015 * z))
+                            .friction(0.8),
+                        None,
+                    )
+                })
+                .into();
+            let block = world.soft_bodies.insert(coarse_block(3, top + 5e-4));
+            let weight = world.soft_bodies[block].total_mass() * 9.81;
+            let frames = 90;
+            let mut support = 0.0;
+            for frame in 0..frames {
+                step(&mut world);
+                if frame >= frames - 30 {
+                    let load: f64 = (world.collider_loads().iter())
+                        .filter(|load| feet.contains(&load.collider))
+                        .map(|load| -load.force.y)
+                        .sum();
+                    support += load / 30.0;
+                }
+            }
+            let centre = world.soft_bodies[block].center_of_mass();
+            println!(
+                "{shape_name}, {name}: centre {:.3} mm above the pedestals, {:.3} mm off their \
+                 axis; support {support:.4} N vs weight {weight:.4} N",
+                (centre.y - top) * 1e3,
+                centre.x.hypot(centre.z) * 1e3
+            );
+            assert!(
+                (support / weight - 1.0).abs() < 0.01,
+                "{shape_name}, {name}"
+            );
+            assert!(centre.y - top > 0.05, "{shape_name}, {name}");
+        }
+    }
+}
+
+#[test]
+fn a_rigid_box_striking_a_soft_block_corner_first_exchanges_momentum() {
+    // Zero gravity. A free steel cube of 4 cm (0.512 kg), turned so that one corner leads, at
+    // 1 m/s into a 10 cm soft block (1 kg, E = 1e5 Pa, 4 x 4 x 4 cells, at rest) off its centre
+    // line, with friction: its corner meets the block's face between nodes first, then its edges
+    // and faces. Linear momentum is conserved under both integrators (tolerance 1e-6 of the
+    // initial momentum: exact in f64 on the soft side, rapier keeps rigid velocities in f32).
+    // Angular momentum about the origin: the explicit sweeps apply both sides' impulses at the
+    // triangle's point, so it is conserved to the same 1e-6 (times the block's 10 cm); an
+    // implicit step gives the rigid body its impulses where its contact points began the step
+    // and the soft body where they end it, so there it is bounded by how far a point of the cube
+    // travels in a frame, (|v| + |ω| a √3/2) h at most over the run, times the impulse the cube
+    // received. The cube's inertia is isotropic, m a²/6, whatever its orientation.
+    for (name, mut world) in worlds() {
+        world.physics.gravity = Vec3::ZERO;
+        let material = Material::new(MaterialModel::StableNeoHookean, 1e5, 0.3, 1000.0).unwrap();
+        let mut block =
+            DeformableBodyBuilder::new(mesh::cuboid(DVec3::splat(0.05), [4; 3]).unwrap(), material)
+                .damping(RayleighDamping::stiffness_proportional(2e-3, material.lame()).unwrap())
+                .build()
+                .unwrap();
+        block.friction = 0.5;
+        let soft = world.soft_bodies.insert(block);
+        let half = 0.02f32;
+        let turn = rapier_fvm::glamx::Quat::from_rotation_z(std::f32::consts::FRAC_PI_4)
+            * rapier_fvm::glamx::Quat::from_rotation_x(0.6155);
+        let (cube, _) = world.physics.insert(
+            RigidBodyBuilder::dynamic()
+                .translation(Vec3::new(-0.09, 0.015, 0.01))
+                .rotation(turn.to_scaled_axis())
+                .linvel(Vec3::new(1.0, 0.0, 0.0)),
+            ColliderBuilder::cuboid(half, half, half)
+                .density(8000.0)
+                .friction(0.5),
+        );
+        let mass = f64::from(world.physics.bodies[cube].mass());
+        let momenta = |world: &FvmWorld| {
+            let body = &world.soft_bodies[soft];
+            let rigid = &world.physics.bodies[cube];
+            let inertia = mass * f64::from(2.0 * half).powi(2) / 6.0;
+            let (x, v) = (rigid.translation().as_dvec3(), rigid.linvel().as_dvec3());
+            let soft_angular: DVec3 = (body.positions().iter().zip(body.velocities()))
+                .zip(body.masses())
+                .map(|((x, v), m)| x.cross(*v) * *m)
+                .sum();
+            (
+                body.linear_momentum() + v * mass,
+                soft_angular + x.cross(v) * mass + rigid.angvel().as_dvec3() * inertia,
+            )
+        };
+        let (linear0, angular0) = momenta(&world);
+        let velocity0 = world.physics.bodies[cube].linvel().as_dvec3();
+        let dt = f64::from(world.physics.integration_parameters.dt);
+        let reach = f64::from(half) * 3f64.sqrt();
+        let mut travel = 0.0f64;
+        for _ in 0..30 {
+            let rigid = &world.physics.bodies[cube];
+            let speed = rigid.linvel().length() + rigid.angvel().length() * reach as f32;
+            travel = travel.max(f64::from(speed) * dt);
+            step(&mut world);
+        }
+        let (linear, angular) = momenta(&world);
+        let rigid = &world.physics.bodies[cube];
+        let impulse = (rigid.linvel().as_dvec3() - velocity0).length() * mass;
+        let scale = linear0.length();
+        let angular_bound = if name == "implicit" {
+            travel * impulse
+        } else {
+            1e-6 * scale * 0.1
+        };
+        println!(
+            "{name}: cube v = {:?} m/s, ω = {:?} rad/s; Δp = {:.2e} (of {scale:.3} kg m/s), \
+             ΔL = {:.2e} N m s (bound {angular_bound:.1e})",
+            rigid.linvel(),
+            rigid.angvel(),
+            (linear - linear0).length(),
+            (angular - angular0).length(),
+        );
+        assert!(rigid.linvel().x < 0.9, "{name}: the cube struck the block");
+        assert!(
+            rigid.angvel().length() > 0.1,
+            "{name}: the cube was set turning"
+        );
+        assert!((linear - linear0).length() <= 1e-6 * scale, "{name}");
+        assert!((angular - angular0).length() <= angular_bound, "{name}");
+    }
+}
