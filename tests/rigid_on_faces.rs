@@ -3,6 +3,8 @@
 //! coarse soft body are held by its faces through their closest points, and a box striking a
 //! block corner-first exchanges momentum (exactly in the explicit sweeps).
 
+mod common;
+
 use rapier_fvm::glamx::Vec3;
 use rapier_fvm::prelude::*;
 use rapier_fvm::world::FvmWorld;
@@ -60,24 +62,11 @@ fn a_small_ball_rests_on_the_faces_of_a_coarse_soft_block() {
             ColliderBuilder::ball(radius).density(8000.0).friction(0.8),
         );
         let mass = f64::from(world.physics.bodies[ball].mass());
-        let (mut fastest, mut support) = (0.0f32, 0.0);
-        let frames = 180;
-        for frame in 0..frames {
-            step(&mut world);
-            if frame >= frames - 60 {
-                fastest = fastest.max(world.physics.bodies[ball].linvel().y.abs());
-                support += world.load_on(block, ball).0.y / 60.0;
-            }
-        }
+        let (fastest, support) = common::settle_on(&mut world, block, ball, 180);
         let centre = world.physics.bodies[ball].translation();
         let bottom = f64::from(centre.y - radius);
-        let body = &world.soft_bodies[block];
-        let top_nodes = body.mesh().nodes_where(|p| p.y >= 0.1 - 1e-9);
-        let face = top_nodes
-            .iter()
-            .map(|&n| body.positions()[n as usize].y)
-            .sum::<f64>()
-            / top_nodes.len() as f64;
+        // The block's top face under the ball: the mean height of its top nodes.
+        let face = common::mean_height_of_nodes_above(&world.soft_bodies[block], 0.1 - 1e-9);
         let weight = mass * 9.81;
         println!(
             "{name}: ball bottom {:.3} mm vs face {:.3} mm (sunk {:.3} mm), at x {:.2} z {:.2} \
@@ -128,18 +117,7 @@ fn a_coarse_soft_block_rests_on_small_fixed_rounded_pedestals() {
                 .into();
             let block = world.soft_bodies.insert(coarse_block(3, top + 5e-4));
             let weight = world.soft_bodies[block].total_mass() * 9.81;
-            let frames = 90;
-            let mut support = 0.0;
-            for frame in 0..frames {
-                step(&mut world);
-                if frame >= frames - 30 {
-                    let load: f64 = (world.collider_loads().iter())
-                        .filter(|load| feet.contains(&load.collider))
-                        .map(|load| -load.force.y)
-                        .sum();
-                    support += load / 30.0;
-                }
-            }
+            let support = common::settle_on_colliders(&mut world, &feet, 90);
             let centre = world.soft_bodies[block].center_of_mass();
             println!(
                 "{shape_name}, {name}: centre {:.3} mm above the pedestals, {:.3} mm off their \

@@ -461,3 +461,59 @@ pub fn world_with_ground(integrator: Option<IntegratorKind>) -> FvmWorld {
     );
     world
 }
+
+/// The mean height (m) now of the nodes of `body` whose rest height is at least `rest_height`
+/// (m): where a flat top face is, under what rests on it.
+pub fn mean_height_of_nodes_above(body: &DeformableBody, rest_height: f64) -> f64 {
+    let nodes = body.mesh().nodes_where(|p| p.y >= rest_height);
+    nodes
+        .iter()
+        .map(|&n| body.positions()[n as usize].y)
+        .sum::<f64>()
+        / nodes.len() as f64
+}
+
+/// Steps `world` `frames` frames (panicking on a refused step) and returns, over the last 60,
+/// the rigid body `rigid`'s largest vertical speed (m/s) and the mean vertical force (N) the
+/// deformable body `soft` exerted on it.
+pub fn settle_on(
+    world: &mut FvmWorld,
+    soft: DeformableBodyHandle,
+    rigid: rapier3d::prelude::RigidBodyHandle,
+    frames: usize,
+) -> (f32, f64) {
+    let (mut fastest, mut support) = (0.0f32, 0.0);
+    for frame in 0..frames {
+        for (handle, outcome) in world.step() {
+            outcome.unwrap_or_else(|e| panic!("{handle:?}: {e}"));
+        }
+        if frame + 60 >= frames {
+            fastest = fastest.max(world.physics.bodies[rigid].linvel().y.abs());
+            support += world.load_on(soft, rigid).0.y / 60.0;
+        }
+    }
+    (fastest, support)
+}
+
+/// Steps `world` `frames` frames (panicking on a refused step) and returns the mean upward force
+/// (N) the deformable bodies' contacts exerted on the `colliders` together over the last 30.
+pub fn settle_on_colliders(
+    world: &mut FvmWorld,
+    colliders: &[rapier3d::prelude::ColliderHandle],
+    frames: usize,
+) -> f64 {
+    let mut support = 0.0;
+    for frame in 0..frames {
+        for (handle, outcome) in world.step() {
+            outcome.unwrap_or_else(|e| panic!("{handle:?}: {e}"));
+        }
+        if frame + 30 >= frames {
+            let load: f64 = (world.collider_loads().iter())
+                .filter(|load| colliders.contains(&load.collider))
+                .map(|load| -load.force.y)
+                .sum();
+            support += load / 30.0;
+        }
+    }
+    support
+}
