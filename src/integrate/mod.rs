@@ -15,7 +15,7 @@ pub use automatic::{AutomaticIntegrator, AutomaticReport, CostPrediction, Integr
 pub use crush::COLLAPSE_RATIO;
 pub(crate) use crush::CrushWatch;
 pub use explicit::{COURANT_NUMBER, StepReport, Substeps, SymplecticEuler};
-pub use implicit::{ImplicitIntegrator, ImplicitReport, ImplicitScheme};
+pub use implicit::{ImplicitIntegrator, ImplicitReport, ImplicitScheme, MAX_REFINEMENT};
 pub use mesh_time_step::MeshTimeSteps;
 pub(crate) use workspace::PreviousStep;
 pub use workspace::SolverWorkspace;
