@@ -111,7 +111,10 @@ fn closest_points(
 }
 
 /// The barycentric weights of `point` (m) on the triangle `corners`, whose `(b − a) × (c − a)`
-/// is `area` (m²): clamped to the triangle (the point is on it up to round-off).
+/// is `area` (m²): clamped to the triangle (the point is on it up to round-off). In f64, unlike
+/// [`nearest_point_on_triangle`](super::surface_tree::nearest_point_on_triangle)'s f32
+/// projection: that rounding moves the point by 1e-8 of the triangle, which doubled the
+/// angular momentum error of `tests/coupling.rs`'s ball (9.6e-8 against its bound of 1e-7).
 fn weights_of(corners: [DVec3; 3], area: DVec3, point: DVec3) -> [f64; 3] {
     let [a, b, c] = corners;
     let squared = area.length_squared();

@@ -139,9 +139,9 @@ pub(super) fn against_soft(
     if !checked.body.collision_groups.test(other.collision_groups) {
         return;
     }
-    let body = checked.body;
+    let (body, bounds) = (checked.body, other.position_bounds());
     for (point, _) in contact_point_positions(body, body.positions()) {
-        if let Some(depth) = depth_inside(other, point)
+        if let Some(depth) = depth_inside(other, bounds, point)
             && depth > checked.tolerance
         {
             found.add_penetration(depth, PenetrationTarget::SoftBody(other_handle));
@@ -159,7 +159,7 @@ pub(super) fn colliders_inside(
     colliders: &ColliderSet,
     found: &mut Penetrations,
 ) {
-    let body = checked.body;
+    let (body, bounds) = (checked.body, checked.body.position_bounds());
     for (handle, collider) in colliders.iter() {
         let parent = collider.parent();
         let glued = (checked.glued.iter()).any(|(rigid, _)| Some(*rigid) == parent);
@@ -171,7 +171,7 @@ pub(super) fn colliders_inside(
         if shape.as_support_map().is_none() || !shape.contains_point(pose, pose.translation) {
             continue;
         }
-        if let Some(depth) = depth_inside(body, pose.translation.as_dvec3())
+        if let Some(depth) = depth_inside(body, bounds, pose.translation.as_dvec3())
             && depth > checked.tolerance
         {
             found.add_penetration(depth, PenetrationTarget::Collider(handle));
@@ -179,10 +179,9 @@ pub(super) fn colliders_inside(
     }
 }
 
-/// How deep (m) `point` lies inside `body`: its distance to the boundary if it is within one of
-/// the body's tetrahedra, `None` otherwise.
-fn depth_inside(body: &DeformableBody, point: DVec3) -> Option<f64> {
-    let (lo, hi) = body.position_bounds();
+/// How deep (m) `point` lies inside `body`, whose nodes lie within `(lo, hi)` (m): its distance
+/// to the boundary if it is within one of the body's tetrahedra, `None` otherwise.
+fn depth_inside(body: &DeformableBody, (lo, hi): (DVec3, DVec3), point: DVec3) -> Option<f64> {
     if point.cmplt(lo).any() || point.cmpgt(hi).any() {
         return None;
     }
