@@ -125,14 +125,23 @@ pub(crate) fn prepare_velocities(
         let n = attachment.node as usize;
         let x = body.positions[n];
         attachment.drift_velocity = (attachment.anchor - x) * (DRIFT_CORRECTION / h);
-        attachment.effective_mass = (DMat3::IDENTITY * (1.0 / body.masses[n])
-            + proxies[attachment.proxy].inverse_mass_matrix(x))
-        .inverse();
+        let node = if body.pinned[n] {
+            0.0
+        } else {
+            1.0 / body.masses[n]
+        };
+        let proxy = &proxies[attachment.proxy];
+        attachment.effective_mass = if body.pinned[n] && !proxy.is_dynamic() {
+            DMat3::ZERO
+        } else {
+            (DMat3::IDENTITY * node + proxy.inverse_mass_matrix(x)).inverse()
+        };
     }
 }
 
 /// One sweep over the attachments' velocity constraints, after the contacts': each node's
 /// velocity is set to its anchor's plus the drift correction by an impulse shared with the body.
+/// A pinned node keeps its velocity and the body takes the whole correction: it is held there.
 pub(crate) fn solve_velocities(
     body: &mut DeformableBody,
     attachments: &[Attachment],
@@ -147,13 +156,12 @@ pub(crate) fn solve_velocities(
     } = body;
     for attachment in attachments {
         let n = attachment.node as usize;
-        if pinned[n] {
-            continue;
-        }
         let proxy = &mut proxies[attachment.proxy];
         let wanted = proxy.velocity_at(attachment.anchor) + attachment.drift_velocity;
         let impulse = attachment.effective_mass * (wanted - velocities[n]);
-        velocities[n] += impulse / masses[n];
+        if !pinned[n] {
+            velocities[n] += impulse / masses[n];
+        }
         proxy.apply(-impulse, positions[n]);
     }
 }

@@ -180,8 +180,9 @@ impl FvmWorld {
 
     /// Advances the world by one frame, passing `hooks` and `events` to rapier: one
     /// [`SoftCoupling::step`] on the world's own sets. Returns, per deformable body, the report
-    /// of its last substep or the first error it met; a body whose step failed keeps the state
-    /// it had before that substep and skips the rest of the frame.
+    /// of its last substep or the first error it met; a body whose step was refused keeps the
+    /// state it had before that substep for the rest of the frame, holding the rigid bodies it
+    /// touches as a fixed obstacle would.
     pub fn step_with_events(
         &mut self,
         hooks: &dyn PhysicsHooks,

@@ -9,8 +9,11 @@ mod common;
 
 use common::{cantilever, gravity, world_with_ground};
 use rapier_fvm::coupling::Audit;
+use rapier_fvm::glamx::Vec3;
 use rapier_fvm::integrate::COLLAPSE_RATIO;
 use rapier_fvm::prelude::*;
+use rapier_fvm::world::FvmWorld;
+use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder, RigidBodyHandle};
 
 /// Speed (m/s) of a cube dropped from 0.5 m.
 fn drop_speed() -> f64 {
@@ -204,4 +207,91 @@ fn a_stiff_nearly_incompressible_beam_on_its_round_off_floor_is_accepted_as_stal
         stalled += report.stalled_substeps;
     }
     assert!(stalled > 0, "no frame stopped on its round-off floor");
+}
+
+/// A foam block (E = 10 kPa, 20 x 10 x 20 cm, 100 kg/m³) on the ground whose explicit steps are
+/// all refused (it needs hundreds of substeps a frame; one is allowed).
+fn foam_whose_steps_are_refused(world: &mut FvmWorld) -> DeformableBodyHandle {
+    world.coupling.integrator.explicit.max_substeps = 1;
+    let material = Material::new(MaterialModel::Corotated, 1e4, 0.3, 100.0).unwrap();
+    let mesh = mesh::cuboid(DVec3::new(0.1, 0.05, 0.1), [4, 2, 4]).unwrap();
+    let foam = DeformableBodyBuilder::new(mesh, material)
+        .translation(DVec3::new(0.0, 0.05, 0.0))
+        .build()
+        .unwrap();
+    world.soft_bodies.insert(foam)
+}
+
+/// Steps `world` for a second at 1/60 s, every frame refused for the deformable body `soft`
+/// (which must not move); returns the largest distance (m) the rigid body `rigid` strayed from
+/// where it started and the mean force (N) `soft` exerted on it over the last half second.
+fn held_by_refused_body(
+    world: &mut FvmWorld,
+    soft: DeformableBodyHandle,
+    rigid: RigidBodyHandle,
+) -> (f64, DVec3) {
+    let start = world.physics.bodies[rigid].translation().as_dvec3();
+    let rest = world.soft_bodies[soft].positions().to_vec();
+    let (mut strayed, mut support) = (0.0f64, DVec3::ZERO);
+    for frame in 0..60 {
+        let results = world.step();
+        assert!(
+            matches!(results[0].1, Err(Error::TooManySubsteps { .. })),
+            "{:?}",
+            results[0].1
+        );
+        assert_eq!(world.soft_bodies[soft].positions(), &rest[..]);
+        let at = world.physics.bodies[rigid].translation().as_dvec3();
+        strayed = strayed.max((at - start).length());
+        if frame >= 30 {
+            support += world.load_on(soft, rigid).0 / 30.0;
+        }
+    }
+    (strayed, support)
+}
+
+#[test]
+fn a_box_on_a_body_whose_steps_are_refused_is_held_where_it_rests() {
+    // A 10 kg box resting on the refused foam: the foam stays where it was, so the box must meet
+    // it as a fixed obstacle would; without the hold it fell 10 cm through the foam to the
+    // ground in the first 0.15 s. Static equilibrium: the foam carries the box's weight, m g =
+    // 98.1 N (1 %: rapier's solver and the hold's sweeps settle to well within it), and the box
+    // stays within 1 mm of where it was put (the contacts' speculative margin and the
+    // depenetration of what rapier's step pushes in).
+    let mut world = world_with_ground(Some(IntegratorKind::Explicit));
+    let foam = foam_whose_steps_are_refused(&mut world);
+    let mass = 10.0;
+    let (rigid, _) = world.physics.insert(
+        RigidBodyBuilder::dynamic().translation(Vec3::new(0.0, 0.15, 0.0)),
+        ColliderBuilder::cuboid(0.05, 0.05, 0.05).density((mass / 1e-3) as f32),
+    );
+    let (strayed, support) = held_by_refused_body(&mut world, foam, rigid);
+    let weight = mass * 9.81;
+    println!("box strayed {strayed:.2e} m, foam's support {support:?} N vs {weight} N");
+    assert!(strayed < 1e-3);
+    assert!((support.y / weight - 1.0).abs() < 0.01);
+}
+
+#[test]
+fn a_ball_glued_to_a_body_whose_steps_are_refused_is_held_at_its_anchors() {
+    // A 1 kg ball glued to the nodes of one side of the refused foam (not along a line, about
+    // which it would swing), clear of the ground: the anchors hold it where it was (1 mm: the attachments' drift correction) and the foam carries its weight,
+    // 9.81 N (1 %).
+    let mut world = world_with_ground(Some(IntegratorKind::Explicit));
+    let foam = foam_whose_steps_are_refused(&mut world);
+    let side = world.soft_bodies[foam]
+        .mesh()
+        .nodes_where(|p| p.x >= 0.1 - 1e-9);
+    let (radius, mass) = (0.03f32, 1.0);
+    let density = mass / (4.0 / 3.0 * std::f64::consts::PI * f64::from(radius).powi(3));
+    let (ball, _) = world.physics.insert(
+        RigidBodyBuilder::dynamic().translation(Vec3::new(0.14, 0.05, 0.0)),
+        ColliderBuilder::ball(radius).density(density as f32),
+    );
+    world.attach(foam, side, ball).unwrap();
+    let (strayed, support) = held_by_refused_body(&mut world, foam, ball);
+    let weight = mass * 9.81;
+    println!("ball strayed {strayed:.2e} m, foam's support {support:?} N vs {weight} N");
+    assert!(strayed < 1e-3);
+    assert!((support.y / weight - 1.0).abs() < 0.01);
 }

@@ -39,7 +39,7 @@ use crate::assembly::Stiffness;
 use crate::attachment;
 use crate::body::DeformableBody;
 use crate::contact::{self, ImplicitStep};
-use crate::rigid::RigidPoint;
+use crate::rigid::{RigidPoint, RigidProxy};
 use crate::stencil::Stencil;
 use rapier3d::glamx::{DMat3, DVec3};
 
@@ -280,6 +280,41 @@ impl ImplicitSide for Attachments {
     ) {
         // A spring acts on its node alone.
     }
+}
+
+/// Holds the dynamic rigid bodies `constraints` couple to `body` for a substep of `h` (s) under
+/// `gravity` (m/s²) in which the body did not move (its step was refused): they meet it as the
+/// fixed obstacle it was over the substep. One explicit substep's sweeps run with every node
+/// held at rest, so their impulses all go to the rigid bodies' proxies (whose falls are the
+/// sweeps' too): a body pressing on it stops there, a glued one is held at its anchors, and
+/// neither sinks into nor passes through it while its steps are refused. The body is left as it
+/// was; the impulses are handed over as a step's are.
+pub(crate) fn hold_partners(
+    body: &mut DeformableBody,
+    constraints: &mut BodyConstraints,
+    h: f64,
+    gravity: DVec3,
+) {
+    if !constraints.rigid_proxies.iter().any(RigidProxy::is_dynamic) {
+        return;
+    }
+    let n = body.positions.len();
+    let velocities = std::mem::replace(&mut body.velocities, vec![DVec3::ZERO; n]);
+    let pinned = std::mem::replace(&mut body.pinned, vec![true; n]);
+    constraints.contacts.clear_impulses();
+    for proxy in &mut constraints.rigid_proxies {
+        proxy.fall(gravity, h);
+    }
+    for kind in EXPLICIT {
+        kind.prepare(body, constraints, h);
+    }
+    for _ in 0..constraints.contacts.settings.velocity_iterations.max(1) {
+        for kind in EXPLICIT {
+            kind.sweep(body, constraints);
+        }
+    }
+    body.velocities = velocities;
+    body.pinned = pinned;
 }
 
 /// The pairs of nodes `[a, b]` (`a > b`) some implicit term of `constraints` may couple that

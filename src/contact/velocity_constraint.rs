@@ -89,13 +89,17 @@ impl VelocityConstraint {
     }
 
     /// One sweep's correction along the plane's unit `normal` with Coulomb coefficient
-    /// `friction`; returns the impulse (N s) it gave the node.
+    /// `friction`; returns the impulse (N s) it gave the node. Nothing when no impulse moves
+    /// either side (both held: a pinned node, or a held body's node, against a fixed obstacle).
     pub(crate) fn correct(
         &mut self,
         normal: DVec3,
         friction: f64,
         sides: &mut impl ContactSides,
     ) -> DVec3 {
+        if sides.inverse_mass_along(normal) <= 0.0 {
+            return DVec3::ZERO;
+        }
         let normal_speed = sides.relative_velocity().dot(normal);
         let normal_impulse = (self.normal_impulse
             + (self.lowest_speed - normal_speed) / sides.inverse_mass_along(normal))

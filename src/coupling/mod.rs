@@ -50,7 +50,7 @@ pub use loads::{ColliderLoad, RigidLoad};
 
 use crate::Error;
 use crate::body::{DeformableBody, DeformableBodyHandle, DeformableBodySet};
-use crate::constraint::BodyConstraints;
+use crate::constraint::{self, BodyConstraints};
 use crate::contact::{self, ContactSettings, NodeContact};
 use crate::integrate::{AutomaticIntegrator, AutomaticReport};
 use bodies::LinkSet;
@@ -67,8 +67,8 @@ use rapier3d::math::Vector;
 use rapier3d::pipeline::{EventHandler, PhysicsHooks, PhysicsPipeline};
 
 /// Each deformable body's result over a frame: the report of its last substep, or the first
-/// error it met (a body whose step failed keeps the state it had before that substep and skips
-/// the rest of the frame).
+/// error it met (a body whose step was refused keeps the state it had before that substep for the
+/// rest of the frame, holding the rigid bodies it touches as a fixed obstacle would).
 pub type SoftStepResults = Vec<(DeformableBodyHandle, Result<AutomaticReport, Error>)>;
 
 /// What stepping a body gave over a frame so far: nothing yet, its last report, or the error that
@@ -350,11 +350,14 @@ impl SoftCoupling {
         }
     }
 
-    /// One coupling substep of `h` (s) of the bodies whose `outcomes` are not yet an error: each
-    /// whose state passes [`DeformableBody::check_state`] finds its contacts with the colliders
-    /// (the others keep their state and take its error), bodies touching each other are grouped
-    /// and stepped together, the others alone, and the impulses they gave rigid bodies go to
-    /// rapier and to the loads. Each body's outcome becomes its last report or its error.
+    /// One coupling substep of `h` (s): each body whose state passes
+    /// [`DeformableBody::check_state`] finds its contacts with the colliders (the others keep
+    /// their state and take its error), bodies touching each other are grouped and stepped
+    /// together, the others alone, and the impulses they gave rigid bodies go to rapier and to
+    /// the loads. Each body's outcome becomes its last report or its first error. A body whose
+    /// step is refused, in this substep or an earlier one of the frame, stays where it was and
+    /// holds the rigid bodies it touches or is glued to as a fixed obstacle would
+    /// ([`constraint::hold_partners`]): rapier's step must not let them sink into it meanwhile.
     fn step_soft_bodies(
         &mut self,
         soft_bodies: &mut DeformableBodySet,
@@ -364,33 +367,7 @@ impl SoftCoupling {
         gravity: DVec3,
     ) {
         self.links.prune(soft_bodies);
-        let views = rapier_view::collider_views(rigid.colliders, rigid.bodies, h);
-        {
-            let lookup = rapier_view::rigid_lookup(rigid.bodies, h);
-            for (handle, outcome) in outcomes.iter_mut() {
-                if matches!(outcome, Some(Err(_))) {
-                    continue;
-                }
-                let body = &soft_bodies[*handle];
-                if let Err(error) = body.check_state().and_then(|()| {
-                    self.links.entry(*handle).constraints.detect_among(
-                        body,
-                        &views,
-                        &lookup,
-                        h,
-                        gravity,
-                        &self.contact,
-                    )
-                }) {
-                    *outcome = Some(Err(error));
-                }
-            }
-        }
-        let live: Vec<DeformableBodyHandle> = outcomes
-            .iter()
-            .filter(|(_, outcome)| !matches!(outcome, Some(Err(_))))
-            .map(|(handle, _)| *handle)
-            .collect();
+        let (live, held) = self.detect(soft_bodies, &rigid, outcomes, h, gravity);
         let between = {
             let bodies: Vec<&DeformableBody> = live.iter().map(|&h| &soft_bodies[h]).collect();
             contact::detect_between(&bodies, &self.contact, h, gravity)
@@ -415,10 +392,11 @@ impl SoftCoupling {
         let steps = ready.into_iter().flat_map(|group| group.bodies);
         for ((handle, step), result) in handles.iter().zip(steps).zip(stepped.into_iter().flatten())
         {
-            if result.is_ok() {
-                self.loads.add_body(*handle, step.body, step.constraints);
-                step.constraints.transfer_contact_impulses(rigid.bodies);
+            if result.is_err() {
+                constraint::hold_partners(step.body, step.constraints, h, gravity);
             }
+            self.loads.add_body(*handle, step.body, step.constraints);
+            step.constraints.transfer_contact_impulses(rigid.bodies);
             if let Some((_, outcome)) = outcomes.iter_mut().find(|(h, _)| h == handle) {
                 // A step refused in an earlier substep of the frame stays reported.
                 if !matches!(outcome, Some(Err(_))) {
@@ -426,6 +404,53 @@ impl SoftCoupling {
                 }
             }
         }
+        let mut holds = (self.links.many_mut(&held).into_iter())
+            .zip(soft_bodies.get_many_mut(&held))
+            .map(|(links, body)| links.with(body));
+        for (handle, step) in held.iter().zip(holds.by_ref()) {
+            hold_supported_bodies(step.constraints, rigid.bodies, rigid.narrow_phase);
+            constraint::hold_partners(step.body, step.constraints, h, gravity);
+            self.loads.add_body(*handle, step.body, step.constraints);
+            step.constraints.transfer_contact_impulses(rigid.bodies);
+        }
+    }
+
+    /// Finds the contacts of every body of `outcomes` whose state a step can take, and returns
+    /// those to step (no error yet in the frame) and those to hold only (a step refused earlier
+    /// in the frame); a body whose state fails [`DeformableBody::check_state`] or whose
+    /// detection fails takes that error and neither.
+    fn detect(
+        &mut self,
+        soft_bodies: &DeformableBodySet,
+        rigid: &RigidSets<'_>,
+        outcomes: &mut [(DeformableBodyHandle, Outcome)],
+        h: f64,
+        gravity: DVec3,
+    ) -> (Vec<DeformableBodyHandle>, Vec<DeformableBodyHandle>) {
+        let views = rapier_view::collider_views(rigid.colliders, rigid.bodies, h);
+        let lookup = rapier_view::rigid_lookup(rigid.bodies, h);
+        let (mut live, mut held) = (Vec::new(), Vec::new());
+        for (handle, outcome) in outcomes.iter_mut() {
+            let body = &soft_bodies[*handle];
+            let detected = body.check_state().and_then(|()| {
+                self.links.entry(*handle).constraints.detect_among(
+                    body,
+                    &views,
+                    &lookup,
+                    h,
+                    gravity,
+                    &self.contact,
+                )
+            });
+            let refused_before = matches!(outcome, Some(Err(_)));
+            match detected {
+                Err(error) if !refused_before => *outcome = Some(Err(error)),
+                Err(_) => {}
+                Ok(_) if refused_before => held.push(*handle),
+                Ok(_) => live.push(*handle),
+            }
+        }
+        (live, held)
     }
 }
 
