@@ -24,7 +24,11 @@
 //!    something is fast (no extra coupling substeps); detection reaches twice a collider's travel
 //!    over the substep, up to 1 m.
 //! 5. **Exchange.** The impulses the soft step gave dynamic rigid bodies are handed to rapier at
-//!    the nodes, and summed into the frame's [`RigidLoad`]s.
+//!    the nodes, and summed into the frame's [`RigidLoad`]s. A body whose step was refused (in
+//!    this substep or an earlier one of the frame) stays where it was, and the dynamic rigid
+//!    bodies it touches or is glued to get the impulses a fixed obstacle would give them
+//!    (`constraint::hold_partners`): they rest on it or hang from it instead of sinking into it
+//!    during rapier's step.
 //! 6. **Rigid step.** rapier steps the rigid bodies over `h`, with the frame's
 //!    `num_solver_iterations` divided among the substeps (rounded up), so that its solver cost
 //!    per frame is about unchanged.
