@@ -125,16 +125,14 @@ pub(crate) fn prepare_velocities(
         let n = attachment.node as usize;
         let x = body.positions[n];
         attachment.drift_velocity = (attachment.anchor - x) * (DRIFT_CORRECTION / h);
-        let node = if body.pinned[n] {
-            0.0
-        } else {
-            1.0 / body.masses[n]
-        };
         let proxy = &proxies[attachment.proxy];
-        attachment.effective_mass = if body.pinned[n] && !proxy.is_dynamic() {
-            DMat3::ZERO
+        let rigid = proxy.inverse_mass_matrix(x);
+        attachment.effective_mass = if !body.pinned[n] {
+            (DMat3::IDENTITY * (1.0 / body.masses[n]) + rigid).inverse()
+        } else if proxy.is_dynamic() {
+            rigid.inverse()
         } else {
-            (DMat3::IDENTITY * node + proxy.inverse_mass_matrix(x)).inverse()
+            DMat3::ZERO
         };
     }
 }

@@ -97,13 +97,13 @@ impl VelocityConstraint {
         friction: f64,
         sides: &mut impl ContactSides,
     ) -> DVec3 {
-        if sides.inverse_mass_along(normal) <= 0.0 {
+        let inverse_mass = sides.inverse_mass_along(normal);
+        if inverse_mass <= 0.0 {
             return DVec3::ZERO;
         }
         let normal_speed = sides.relative_velocity().dot(normal);
-        let normal_impulse = (self.normal_impulse
-            + (self.lowest_speed - normal_speed) / sides.inverse_mass_along(normal))
-        .max(0.0);
+        let normal_impulse =
+            (self.normal_impulse + (self.lowest_speed - normal_speed) / inverse_mass).max(0.0);
         let pushed = normal * (normal_impulse - self.normal_impulse);
         sides.exchange(pushed);
         self.normal_impulse = normal_impulse;

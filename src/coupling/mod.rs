@@ -56,7 +56,7 @@ use crate::Error;
 use crate::body::{DeformableBody, DeformableBodyHandle, DeformableBodySet};
 use crate::constraint::{self, BodyConstraints};
 use crate::contact::{self, ContactSettings, NodeContact};
-use crate::integrate::{AutomaticIntegrator, AutomaticReport};
+use crate::integrate::{AutomaticIntegrator, AutomaticReport, BodyInStep};
 use bodies::LinkSet;
 use groups::{GroupStep, step_groups, touching_groups};
 use kinematic::KinematicPath;
@@ -394,13 +394,13 @@ impl SoftCoupling {
         }
         let stepped = step_groups(&mut ready, &self.integrator, &self.contact, (h, gravity));
         let steps = ready.into_iter().flat_map(|group| group.bodies);
-        for ((handle, step), result) in handles.iter().zip(steps).zip(stepped.into_iter().flatten())
+        for ((handle, mut step), result) in
+            handles.iter().zip(steps).zip(stepped.into_iter().flatten())
         {
             if result.is_err() {
                 constraint::hold_partners(step.body, step.constraints, h, gravity);
             }
-            self.loads.add_body(*handle, step.body, step.constraints);
-            step.constraints.transfer_contact_impulses(rigid.bodies);
+            hand_over(&mut self.loads, *handle, &mut step, rigid.bodies);
             if let Some((_, outcome)) = outcomes.iter_mut().find(|(h, _)| h == handle) {
                 // A step refused in an earlier substep of the frame stays reported.
                 if !matches!(outcome, Some(Err(_))) {
@@ -408,14 +408,13 @@ impl SoftCoupling {
                 }
             }
         }
-        let mut holds = (self.links.many_mut(&held).into_iter())
+        let holds = (self.links.many_mut(&held).into_iter())
             .zip(soft_bodies.get_many_mut(&held))
             .map(|(links, body)| links.with(body));
-        for (handle, step) in held.iter().zip(holds.by_ref()) {
+        for (handle, mut step) in held.iter().zip(holds) {
             hold_supported_bodies(step.constraints, rigid.bodies, rigid.narrow_phase);
             constraint::hold_partners(step.body, step.constraints, h, gravity);
-            self.loads.add_body(*handle, step.body, step.constraints);
-            step.constraints.transfer_contact_impulses(rigid.bodies);
+            hand_over(&mut self.loads, *handle, &mut step, rigid.bodies);
         }
     }
 
@@ -456,6 +455,18 @@ impl SoftCoupling {
         }
         (live, held)
     }
+}
+
+/// Hands the impulses `step`'s body (`handle`) gave rigid bodies over its substep to rapier's
+/// `bodies` and adds them, and those on colliders, to the frame's `loads`.
+fn hand_over(
+    loads: &mut FrameLoads,
+    handle: DeformableBodyHandle,
+    step: &mut BodyInStep<'_>,
+    bodies: &mut RigidBodySet,
+) {
+    loads.add_body(handle, step.body, step.constraints);
+    step.constraints.transfer_contact_impulses(bodies);
 }
 
 /// Every body of `soft_bodies` with `error`: a frame refused before anything moved.
