@@ -11,15 +11,16 @@
 //! `J = [I | −[r]×]` and `r` the point's arm from the centre of mass.
 //!
 //! For the soft positions `x`, `ι*(x) = argmin ½ ιᵀ W ι + Σ e_c(x_c − h J_c W ι)` is found by
-//! Newton's method with a backtracking line search on six unknowns per body (the penalties and
-//! the lagged friction are convex in the relative position), taking the full step by the
-//! residual once the energy's decrease is lost in its round-off; the soft step minimizes
-//! `E(x) + min_ι(…)`, whose gradient is the terms' forces at `ι*(x)` (the envelope theorem) and
-//! whose Hessian is the tangent with the bodies held less the coupling through them, `U Q Uᵀ`
-//! (`U = −Σ P_cᵀ T_c J_c`, `Q = h² (I + h² W A)⁻¹ W`, `A = Σ J_cᵀ T_c J_c`), which the Newton
-//! direction takes in by the Woodbury identity with the held tangent's factorization (six solves
-//! per body). At `ι*`, `ι = −h Σ J_cᵀ f_c`: exactly the opposite of the impulses the terms give
-//! the soft body, which is what the bodies receive when the step's impulses are recorded.
+//! Newton's method on six unknowns per body with a line search that finds the lowest energy
+//! along a step that overshoots it (the penalties and the lagged friction are convex in the
+//! relative position), taking the full step by the residual once the energy's decrease is lost
+//! in its round-off. The soft step minimizes `E(x) + min_ι(…)`, whose gradient is the terms'
+//! forces at `ι*(x)` (the envelope theorem) and whose Hessian is the tangent with the bodies
+//! held less the coupling through them, `U Q Uᵀ` (`U = −Σ P_cᵀ T_c J_c`,
+//! `Q = h² (I + h² W A)⁻¹ W`, `A = Σ J_cᵀ T_c J_c`), which the Newton direction takes in by the
+//! Woodbury identity with the held tangent's factorization (six solves per body). At `ι*`,
+//! `ι = −h Σ J_cᵀ f_c`: exactly the opposite of the impulses the terms give the soft body, which
+//! is what the bodies receive when the step's impulses are recorded.
 
 use crate::assembly::solve_columns;
 use crate::body::DeformableBody;
@@ -38,9 +39,13 @@ const MAX_ITERATIONS: usize = 60;
 /// floor, about 1e-11 of the scale for the stiffest springs).
 const TOLERANCE: f64 = 1e-12;
 const FLOOR: f64 = 1e-8;
-/// The line search's sufficient decrease (Armijo) fraction and smallest step.
+/// The line search's sufficient decrease (Armijo) and curvature (Wolfe) fractions, its smallest
+/// step, and the width (relative to its high end) to which it narrows the bracket around the
+/// lowest energy along a Newton direction.
 const ARMIJO: f64 = 1e-4;
-const MIN_STEP: f64 = 1e-6;
+const CURVATURE: f64 = 0.9;
+const MIN_STEP: f64 = 1e-12;
+const BRACKET: f64 = 1e-3;
 
 /// Columns of per-node vectors (a tall matrix, one `Vec` per column).
 type Columns = Vec<Vec<DVec3>>;
@@ -210,16 +215,13 @@ impl RigidResponse {
             }
             previous = largest;
             let directions = self.newton_directions(&at.gathered, &residuals);
-            // The directional derivative of the response's energy, whose gradient is `W G`.
-            let slope: f64 = (0..self.base.len())
-                .map(|p| (inverse_mass(&self.base[p]) * residuals[p]).dot(&directions[p]))
-                .sum();
+            let slope = self.slope(&at.gathered, &directions);
             if slope.is_nan() || slope >= 0.0 {
                 break;
             }
             let start = self.impulses.clone();
             let next = self
-                .line_search(body, constraints, (&start, &directions), at.energy, slope)
+                .line_search(body, constraints, (&start, &directions), (at.energy, slope))
                 .or_else(|| self.closer(body, constraints, (&start, &directions), largest));
             match next {
                 Some(next) => at = next,
@@ -234,27 +236,64 @@ impl RigidResponse {
         self.kinetic
     }
 
-    /// Backtracks from the impulses `start` along `directions` until the response's energy falls
-    /// below `energy` (J) by an Armijo fraction of `slope` (J per unit step); `None` if no step
-    /// down to a millionth does.
+    /// Moves the impulses from `start`, where the response's energy is `energy` (J) and falls at
+    /// `slope` (J per unit step), along `directions` to a point of sufficient decrease and
+    /// flattened slope (the strong Wolfe conditions): the full step if it is one, else the
+    /// lowest point on the line, found by the sign of the slope (the energy is convex along it:
+    /// the kinetic part is quadratic and every term convex in the relative position) in the
+    /// bracket `[0, 1]`, narrowed tenfold while its low end is the start (a Newton step from
+    /// where no term acts yet, or not yet stiffly, can overshoot the point where one comes in
+    /// by orders of magnitude, and a backtracking search would creep toward it by a fraction of
+    /// the step each iteration), by halves after, to [`BRACKET`] of its width. Returns the lowest
+    /// point it met if below `energy`, `None` (the impulses left anywhere) if none is.
     fn line_search(
         &mut self,
         body: &DeformableBody,
         constraints: &BodyConstraints,
         (start, directions): (&[[DVec3; 2]], &[Vector6<f64>]),
-        energy: f64,
-        slope: f64,
+        (energy, slope): (f64, f64),
     ) -> Option<Evaluation> {
-        let mut step = 1.0;
-        while step >= MIN_STEP {
+        let mut lowest: Option<(f64, Evaluation)> = None;
+        let (mut low, mut high, mut step) = (0.0, 1.0, 1.0);
+        loop {
             self.move_to(start, directions, step);
             let next = self.evaluate(body, constraints);
-            if next.energy <= energy + ARMIJO * step * slope {
+            let slope_here = self.slope(&next.gathered, directions);
+            let decrease = next.energy <= energy + ARMIJO * step * slope;
+            if decrease && slope_here.abs() <= -CURVATURE * slope {
                 return Some(next);
             }
-            step *= 0.5;
+            if slope_here < 0.0 {
+                low = step;
+            } else {
+                high = step;
+            }
+            if next.energy < lowest.as_ref().map_or(energy, |(_, e)| e.energy) {
+                lowest = Some((step, next));
+            }
+            step = if low == 0.0 {
+                0.1 * high
+            } else if high - low > BRACKET * high {
+                0.5 * (low + high)
+            } else {
+                break;
+            };
+            if step < MIN_STEP {
+                break;
+            }
         }
-        None
+        let (step, found) = lowest?;
+        self.move_to(start, directions, step);
+        Some(found)
+    }
+
+    /// The slope (J per unit step) of the response's energy along `directions`, with what the
+    /// terms add up to where it is taken: its gradient is `W G` per body.
+    fn slope(&self, gathered: &[Option<Gathered>], directions: &[Vector6<f64>]) -> f64 {
+        let residuals = self.residuals(gathered);
+        (0..self.base.len())
+            .map(|p| (inverse_mass(&self.base[p]) * residuals[p]).dot(&directions[p]))
+            .sum()
     }
 
     /// The full Newton step from the impulses `start` along `directions` if it brings the largest
