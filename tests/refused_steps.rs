@@ -213,13 +213,7 @@ fn a_stiff_nearly_incompressible_beam_on_its_round_off_floor_is_accepted_as_stal
 /// all refused (it needs hundreds of substeps a frame; one is allowed).
 fn foam_whose_steps_are_refused(world: &mut FvmWorld) -> DeformableBodyHandle {
     world.coupling.integrator.explicit.max_substeps = 1;
-    let material = Material::new(MaterialModel::Corotated, 1e4, 0.3, 100.0).unwrap();
-    let mesh = mesh::cuboid(DVec3::new(0.1, 0.05, 0.1), [4, 2, 4]).unwrap();
-    let foam = DeformableBodyBuilder::new(mesh, material)
-        .translation(DVec3::new(0.0, 0.05, 0.0))
-        .build()
-        .unwrap();
-    world.soft_bodies.insert(foam)
+    common::insert_foam_block(world, MaterialModel::Corotated)
 }
 
 /// Steps `world` for a second at 1/60 s, every frame refused for the deformable body `soft`

@@ -598,13 +598,7 @@ fn a_heavy_box_crushing_a_foam_block_under_implicit_steps_is_never_thrown_up() {
     // 20 frames, 0.67 m at its highest).
     for mass in [10.0, 1000.0] {
         let mut world = common::world_with_ground(Some(IntegratorKind::Implicit));
-        let material = Material::new(MaterialModel::StableNeoHookean, 1e4, 0.3, 100.0).unwrap();
-        let mesh = mesh::cuboid(DVec3::new(0.1, 0.05, 0.1), [4, 2, 4]).unwrap();
-        let foam = DeformableBodyBuilder::new(mesh, material)
-            .translation(DVec3::new(0.0, 0.05, 0.0))
-            .build()
-            .unwrap();
-        world.soft_bodies.insert(foam);
+        common::insert_foam_block(&mut world, MaterialModel::StableNeoHookean);
         let (rigid, _) = world.physics.insert(
             RigidBodyBuilder::dynamic().translation(Vec3::new(0.0, 0.151, 0.0)),
             ColliderBuilder::cuboid(0.05, 0.05, 0.05).density((mass / 1e-3) as f32),

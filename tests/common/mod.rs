@@ -450,6 +450,18 @@ pub fn assert_identical(a: &FvmWorld, b: &FvmWorld) {
     assert_eq!(a.rigid_loads(), b.rigid_loads());
 }
 
+/// A foam block of `model` (E = 10 kPa, ν = 0.3, 100 kg/m³, 20 x 10 x 20 cm in 4 x 2 x 4 cells)
+/// resting on the ground plane y = 0, inserted into `world`.
+pub fn insert_foam_block(world: &mut FvmWorld, model: MaterialModel) -> DeformableBodyHandle {
+    let material = Material::new(model, 1e4, 0.3, 100.0).unwrap();
+    let mesh = mesh::cuboid(DVec3::new(0.1, 0.05, 0.1), [4, 2, 4]).unwrap();
+    let foam = DeformableBodyBuilder::new(mesh, material)
+        .translation(DVec3::new(0.0, 0.05, 0.0))
+        .build()
+        .unwrap();
+    world.soft_bodies.insert(foam)
+}
+
 /// A world with a fixed ground half-space below y = 0 (friction 0.8) and `integrator` forced
 /// (or the automatic choice).
 pub fn world_with_ground(integrator: Option<IntegratorKind>) -> FvmWorld {

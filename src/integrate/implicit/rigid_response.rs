@@ -215,7 +215,7 @@ impl RigidResponse {
             }
             previous = largest;
             let directions = self.newton_directions(&at.gathered, &residuals);
-            let slope = self.slope(&at.gathered, &directions);
+            let slope = self.slope(&residuals, &directions);
             if slope.is_nan() || slope >= 0.0 {
                 break;
             }
@@ -258,7 +258,7 @@ impl RigidResponse {
         loop {
             self.move_to(start, directions, step);
             let next = self.evaluate(body, constraints);
-            let slope_here = self.slope(&next.gathered, directions);
+            let slope_here = self.slope(&self.residuals(&next.gathered), directions);
             let decrease = next.energy <= energy + ARMIJO * step * slope;
             if decrease && slope_here.abs() <= -CURVATURE * slope {
                 return Some(next);
@@ -287,10 +287,9 @@ impl RigidResponse {
         Some(found)
     }
 
-    /// The slope (J per unit step) of the response's energy along `directions`, with what the
-    /// terms add up to where it is taken: its gradient is `W G` per body.
-    fn slope(&self, gathered: &[Option<Gathered>], directions: &[Vector6<f64>]) -> f64 {
-        let residuals = self.residuals(gathered);
+    /// The slope (J per unit step) of the response's energy along `directions` where the
+    /// stationarity residuals are `residuals`: its gradient is `W G` per body.
+    fn slope(&self, residuals: &[Vector6<f64>], directions: &[Vector6<f64>]) -> f64 {
         (0..self.base.len())
             .map(|p| (inverse_mass(&self.base[p]) * residuals[p]).dot(&directions[p]))
             .sum()
