@@ -173,6 +173,7 @@ fn node_contact_with(
             },
         );
         contact.detected_at = x;
+        contact.load_stiffness = last.map_or(0.0, |last| last.load_stiffness);
         contact.depth_limit = 0.5 * thickness(near.shape.as_ref(), near.pose, point, normal);
         contact
     })
@@ -193,9 +194,10 @@ fn thickness(shape: &dyn Shape, pose: &Pose, point: DVec3, normal: DVec3) -> f64
 /// them).
 type LastDetection<'a> = (&'a [NodeContact], &'a [RigidProxy]);
 
-/// What the `contacts` of the last detection saw of each point's contact with each collider,
-/// their planes taken back to the colliders' poses at detection from where the explicit
-/// substeps carried them with the rigid `proxies` of that step (see [`RigidProxy::carry`]).
+/// What the `contacts` of the last detection saw of each point's contact with each collider
+/// (the stiffness its load called for kept), their planes taken back to the colliders' poses at
+/// detection from where the explicit substeps carried them with the rigid `proxies` of that step
+/// (see [`RigidProxy::carry`]).
 fn last_contacts(
     (contacts, proxies): LastDetection<'_>,
 ) -> HashMap<(BodyPoint, ColliderHandle), LastContact> {
@@ -211,6 +213,7 @@ fn last_contacts(
                         pose: *pose,
                         point: motion.map_or(c.point, |m| m.carry_back(c.point)),
                         normal: motion.map_or(c.normal, |m| m.turn_back(c.normal)),
+                        load_stiffness: c.load_stiffness,
                     },
                 ))
             }

@@ -16,8 +16,12 @@
 //!   contacts (sequential impulses, as rapier's own solver).
 //! - [`ImplicitIntegrator`](crate::integrate::ImplicitIntegrator), as a stiff penalty in the
 //!   incremental potential, `k/2 min(0, g)²` per contact with `g` the signed distance to the plane
-//!   and `k` [`ContactSettings::penalty_factor`] times the node's `m/h²`: the resting penetration
-//!   under a load `w` is `w h²/(factor m)`, micrometres at game steps. Friction is the lagged
+//!   and `k` at least [`ContactSettings::penalty_factor`] times the node's `m/h²`, whose resting
+//!   penetration under a load `w` is `w h²/(factor m)`: micrometres at game steps for a node
+//!   carrying its own weight, millimetres for a light node under a heavy body. A step that
+//!   leaves a point deeper than [`ContactSettings::resting_depth`] behind a collider's plane
+//!   raises that contact's `k` so that its load holds it at half that depth, and is solved
+//!   again; the contact keeps its `k` for as long as it is detected. Friction is the lagged
 //!   dissipation potential of incremental potential contact (Li et al. 2020): the normal force
 //!   is taken from the penalty at the start of the step, and the node's slip relative to the
 //!   surface over the step, `u`, costs `μ λ f(|u|)`, with `f` quadratic below
@@ -74,7 +78,7 @@ use node_contact::Obstacle;
 pub use node_contact::{BodyPoint, ContactTarget, NodeContact};
 pub(crate) use penalty::{
     NodeSlices, for_each_contact_stencil, for_each_contact_term, lag_friction, penalty_tangent,
-    record_penalty_impulses,
+    record_penalty_impulses, stiffen_deep_contacts,
 };
 pub(crate) use self_contact::detect_self_contacts;
 pub(crate) use set::ContactSet;
@@ -112,8 +116,14 @@ pub struct ContactSettings {
     /// Nodes within this distance (m) of a collider, beyond the distance they can travel in the
     /// frame, get a contact.
     pub margin: f64,
-    /// The implicit penalty stiffness in units of a node's `m/h²` (dimensionless).
+    /// The implicit penalty stiffness in units of a node's `m/h²` (dimensionless): the least
+    /// stiffness of a contact, which its load raises (see [`ContactSettings::resting_depth`]).
     pub penalty_factor: f64,
+    /// The deepest (m) an implicit step leaves a point behind its contact plane with a collider
+    /// before the contact's penalty stiffens: a contact whose load presses it deeper has its
+    /// stiffness raised so that the load holds it at half this depth, and the step is solved
+    /// again; the contact keeps that stiffness while it is detected in later frames.
+    pub resting_depth: f64,
     /// The most speed (m/s) at which explicit contacts push a node found inside a collider back
     /// out (it entered between detections, e.g. pushed by a rigid body that moved): an impulse,
     /// so that momentum stays exchanged exactly, rather than a jump of position. A node leaves at
@@ -136,6 +146,7 @@ impl Default for ContactSettings {
         Self {
             margin: 1e-3,
             penalty_factor: 1e3,
+            resting_depth: 1e-3,
             depenetration_speed: 0.1,
             velocity_iterations: 4,
             stiction_speed: 1e-4,
@@ -215,6 +226,13 @@ impl ContactSettings {
                 parameter: "margin",
                 value: self.margin,
                 reason: "must be non-negative and finite (m)",
+            });
+        }
+        if !(self.resting_depth.is_finite() && self.resting_depth > 0.0) {
+            return Err(Error::InvalidSetting {
+                parameter: "resting_depth",
+                value: self.resting_depth,
+                reason: "must be positive and finite (m)",
             });
         }
         if !(self.depenetration_speed.is_finite() && self.depenetration_speed >= 0.0) {

@@ -92,6 +92,9 @@ pub struct NodeContact {
     /// collider: half the collider's thickness along the normal there (infinite for a
     /// half-space or an own triangle).
     pub(super) depth_limit: f64,
+    /// The penalty stiffness (N/m) the contact's load has called for (see
+    /// [`ContactSettings::resting_depth`]); zero until a load presses the point that deep.
+    pub(super) load_stiffness: f64,
 }
 
 /// The far side of a contact.
@@ -146,6 +149,7 @@ impl NodeContact {
             slip_origin: DVec3::ZERO,
             detected_at: point,
             depth_limit: f64::INFINITY,
+            load_stiffness: 0.0,
         }
     }
 
@@ -180,7 +184,34 @@ impl NodeContact {
         h: f64,
     ) -> Option<(f64, f64)> {
         let gap = self.gap(x);
-        (gap < 0.0).then(|| (settings.penalty_stiffness(mass, h), gap))
+        (gap < 0.0).then(|| (self.penalty_stiffness(mass, settings, h), gap))
+    }
+
+    /// The contact's penalty stiffness (N/m) on a point of effective mass `mass` (kg) in an
+    /// implicit step of effective length `h` (s): [`ContactSettings::penalty_factor`] times
+    /// `m/h²`, or what its load has called for if more.
+    pub(crate) fn penalty_stiffness(&self, mass: f64, settings: &ContactSettings, h: f64) -> f64 {
+        settings.penalty_stiffness(mass, h).max(self.load_stiffness)
+    }
+
+    /// Raises the penalty stiffness of the point at `x` (m), of effective mass `mass` (kg), in
+    /// an implicit step of effective length `h` (s), when it lies deeper than
+    /// [`ContactSettings::resting_depth`] behind its plane: to the stiffness at which its present
+    /// force would hold it at half that depth. Returns whether it did.
+    pub(super) fn stiffen_if_deep(
+        &mut self,
+        x: DVec3,
+        mass: f64,
+        settings: &ContactSettings,
+        h: f64,
+    ) -> bool {
+        let depth = -self.gap(x);
+        if depth <= settings.resting_depth {
+            return false;
+        }
+        let stiffness = self.penalty_stiffness(mass, settings, h);
+        self.load_stiffness = stiffness * depth / (0.5 * settings.resting_depth);
+        true
     }
 
     /// The lagged friction dissipation of the node at `x` (m) relative to the surface (its

@@ -158,6 +158,32 @@ pub(crate) fn record_penalty_impulses(
     }
 }
 
+/// Stiffens the penalty of every contact with a collider whose point the implicit `step` (its
+/// rigid bodies at the velocities the step's solve gave them) leaves deeper than
+/// [`ContactSettings::resting_depth`] behind its plane (see [`NodeContact::stiffen_if_deep`]):
+/// the load, not the point's own mass, then sets how deep it rests. Returns whether any was
+/// stiffened (the step must then be solved again).
+pub(crate) fn stiffen_deep_contacts(
+    body: &DeformableBody,
+    contacts: &mut ContactSet,
+    step: ImplicitStep,
+) -> bool {
+    let settings = contacts.settings;
+    let nodes = NodeSlices::of(body);
+    let mut stiffened = false;
+    for contact in &mut contacts.nodes {
+        if !matches!(contact.obstacle, Obstacle::Collider { .. }) {
+            continue;
+        }
+        let point = contact_point(contact, body.embedding.as_ref());
+        let obstacle = carried(contact, &step);
+        let mass = effective_mass(&point.stencil(), nodes.masses, nodes.pinned) + obstacle.mass;
+        let x = point.position(nodes.positions) - obstacle.travel;
+        stiffened |= contact.stiffen_if_deep(x, mass, &settings, step.effective);
+    }
+    stiffened
+}
+
 /// Readies implicit friction for the implicit `step` from the body's positions: each contact's
 /// friction limit is its penalty force there, against the obstacle where it is at the step's
 /// start, and slip is measured from there (relative to the collider's surface as it travels,

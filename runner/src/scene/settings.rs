@@ -4,7 +4,8 @@
 //! ```toml
 //! [contact]
 //! margin = 1e-3              # m
-//! penalty_factor = 1e3       # implicit penalty stiffness in units of m/h²
+//! penalty_factor = 1e3       # implicit penalty stiffness in units of m/h², at least
+//! resting_depth = 1e-3       # m: a contact pressed deeper by its load stiffens
 //! depenetration_speed = 0.1  # m/s
 //! velocity_iterations = 4
 //! stiction_speed = 1e-4      # m/s
@@ -39,8 +40,10 @@ use serde::Deserialize;
 pub struct ContactSpec {
     /// Detection margin (m).
     pub margin: Option<f64>,
-    /// Implicit penalty stiffness in units of a node's `m/h²`.
+    /// Implicit penalty stiffness in units of a node's `m/h²`, at least.
     pub penalty_factor: Option<f64>,
+    /// The depth (m) past which a contact's implicit penalty stiffens under its load.
+    pub resting_depth: Option<f64>,
     /// Speed at which nodes found inside a collider are pushed out (m/s).
     pub depenetration_speed: Option<f64>,
     /// Sweeps per explicit substep over contacts with dynamic bodies.
@@ -56,6 +59,7 @@ impl ContactSpec {
         ContactSettings {
             margin: self.margin.unwrap_or(d.margin),
             penalty_factor: self.penalty_factor.unwrap_or(d.penalty_factor),
+            resting_depth: self.resting_depth.unwrap_or(d.resting_depth),
             depenetration_speed: self.depenetration_speed.unwrap_or(d.depenetration_speed),
             velocity_iterations: self.velocity_iterations.unwrap_or(d.velocity_iterations),
             stiction_speed: self.stiction_speed.unwrap_or(d.stiction_speed),
@@ -74,6 +78,9 @@ impl ContactSpec {
         }
         if let Some(value) = self.penalty_factor {
             c.positive("contact.penalty_factor", value, "dimensionless");
+        }
+        if let Some(value) = self.resting_depth {
+            c.positive("contact.resting_depth", value, "m");
         }
         if self.velocity_iterations == Some(0) {
             c.fail("contact.velocity_iterations", "must be at least 1");

@@ -5,8 +5,9 @@
 //! - Soft bodies: kinetic `Σ m v²/2`, elastic `Ψ` (the material's strain energy), gravitational
 //!   `-Σ m g·x`, and after an implicit step the energy its contact penalties hold, `k g²/2` for
 //!   each node inside its contact plane (`g < 0`), with `k = penalty_factor m / ĥ²` (the node's
-//!   own mass: a dynamic rigid partner's share is left out, so this is a lower bound) and `ĥ`
-//!   the substep's effective step. Embedded contact points' penalties are not counted.
+//!   own mass: a dynamic rigid partner's share is left out, so this is a lower bound) or the
+//!   stiffness the contact's load called for if more, and `ĥ` the substep's effective step.
+//!   Embedded contact points' penalties are not counted.
 //! - Dynamic rigid bodies: `m v²/2 + ωᵀ I ω / 2`, and the gravitational energy `-m g·x` at the
 //!   centre of mass half a coupling substep `h` back along the velocity, `x − v h/2`, which
 //!   rapier's symplectic Euler step keeps exactly in free flight. A body an implicit soft step
@@ -128,7 +129,7 @@ fn penalty_energy(
             BodyPoint::Node(n) => {
                 let n = n as usize;
                 let gap = contact.gap(body.positions()[n]).min(0.0);
-                let stiffness = settings.penalty_stiffness(body.masses()[n], effective);
+                let stiffness = contact.penalty_stiffness(body.masses()[n], settings, effective);
                 Some(0.5 * stiffness * gap * gap)
             }
             BodyPoint::Embedded(_) => None,

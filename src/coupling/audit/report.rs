@@ -1,4 +1,4 @@
-//! What the audit found in a frame: per deformable body and for the whole system.
+//! What the audit found in a frame: per deformable body and for the coupled system.
 
 use crate::Error;
 use crate::body::DeformableBodyHandle;
@@ -123,8 +123,8 @@ impl BodyAudit {
 /// What the audit found after a frame.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FrameAudit {
-    /// The energy check of the whole system: every deformable and dynamic rigid body; `None` on
-    /// the first frame seen.
+    /// The energy check of the coupled system: every deformable body and every dynamic rigid
+    /// body one of them touched or is glued to in the frame; `None` on the first frame seen.
     pub system: Option<EnergyCheck>,
     /// Each deformable body's findings.
     pub bodies: Vec<(DeformableBodyHandle, BodyAudit)>,
@@ -139,7 +139,7 @@ impl FrameAudit {
             .map(|(_, a)| a)
     }
 
-    /// Whether the whole system kept its energy and every body is clean.
+    /// Whether the coupled system kept its energy and every body is clean.
     pub fn is_clean(&self) -> bool {
         !self.system.is_some_and(|e| e.gained()) && self.bodies.iter().all(|(_, a)| a.is_clean())
     }

@@ -12,14 +12,14 @@
 use super::potential::Potential;
 use super::rigid_response::{Placement, RigidResponse};
 use super::{
-    CrushWatch, ImplicitIntegrator, ImplicitReport, MAX_REFINEMENT, Outcome, Stop, end_substep,
-    on_round_off_floor, refinable,
+    CrushWatch, ImplicitIntegrator, ImplicitReport, MAX_REFINEMENT, Outcome, STIFFENING_ROUNDS,
+    Stop, end_substep, on_round_off_floor, refinable,
 };
 use crate::Error;
 use crate::assembly::Stiffness;
 use crate::body::DeformableBody;
 use crate::constraint::{self, BodyConstraints};
-use crate::contact::{BetweenContact, ContactSettings, JointContacts, NodeSlices};
+use crate::contact::{self, BetweenContact, ContactSettings, JointContacts, NodeSlices};
 use crate::integrate::{BodyInStep, PreviousStep};
 use crate::linear_solver::{Method, solve_newton_system};
 use crate::newton::{Configuration, Search, descend, norm, round_off_floor};
@@ -62,6 +62,26 @@ impl Group<'_, '_> {
         let body = self.offsets.partition_point(|&first| first <= node) - 1;
         node - self.offsets[body]
     }
+}
+
+/// Stiffens the contacts with colliders that the group's bodies, at their positions, press
+/// deeper than their resting depth (see [`contact::stiffen_deep_contacts`]), each body's rigid
+/// partners at the velocities their `responses` give them there (those of a body whose contacts
+/// stiffened are to be solved again). Returns whether any did.
+fn stiffen_deep_contacts(
+    group: &Group,
+    constraints: &mut [&mut BodyConstraints],
+    responses: &mut [RigidResponse],
+) -> bool {
+    let mut stiffened = false;
+    for ((body, constraints), response) in group.bodies.iter().zip(constraints).zip(responses) {
+        response.solve(body, constraints);
+        if contact::stiffen_deep_contacts(body, &mut constraints.contacts, response.step()) {
+            response.forget_solution();
+            stiffened = true;
+        }
+    }
+    stiffened
 }
 
 /// The group's incremental potential: its bodies' and the contacts between them.
@@ -357,11 +377,13 @@ impl ImplicitIntegrator {
             starts.push(start);
             responses.push(response);
         }
-        let (mut body_refs, constraints): (Vec<&mut DeformableBody>, Vec<&mut BodyConstraints>) =
-            bodies
-                .iter_mut()
-                .map(|step| (&mut *step.body, &mut *step.constraints))
-                .unzip();
+        let (mut body_refs, mut constraints): (
+            Vec<&mut DeformableBody>,
+            Vec<&mut BodyConstraints>,
+        ) = bodies
+            .iter_mut()
+            .map(|step| (&mut *step.body, &mut *step.constraints))
+            .unzip();
         let mut group = Group {
             masses: body_refs.iter().flat_map(|b| b.masses.clone()).collect(),
             pinned: body_refs.iter().flat_map(|b| b.pinned.clone()).collect(),
@@ -373,31 +395,46 @@ impl ImplicitIntegrator {
         solver
             .between
             .lag_friction(nodes(&group, &positions), effective);
-        let potential = GroupPotential {
-            members: starts
-                .iter()
-                .zip(&constraints)
-                .zip(responses)
-                .map(|((start, constraints), response)| Potential {
-                    start,
-                    constraints,
-                    rigid: RefCell::new(response),
-                })
-                .collect(),
-            between: &solver.between,
-            effective,
-        };
-        let outcome = self.minimize_group(
-            &mut group,
-            &potential,
-            (&mut solver.joint, &mut solver.parts),
-        );
-        let responses: Vec<RigidResponse> = potential
-            .members
-            .into_iter()
-            .map(|member| member.rigid.into_inner())
-            .collect();
-        let outcome = outcome?;
+        let mut solved: Option<Outcome> = None;
+        for round in 0..=STIFFENING_ROUNDS {
+            let potential = GroupPotential {
+                members: starts
+                    .iter()
+                    .zip(&constraints)
+                    .zip(responses)
+                    .map(|((start, constraints), response)| Potential {
+                        start,
+                        constraints,
+                        rigid: RefCell::new(response),
+                    })
+                    .collect(),
+                between: &solver.between,
+                effective,
+            };
+            let parts = (&mut solver.joint, &mut solver.parts[..]);
+            let outcome = if round == 0 {
+                self.minimize_group(&mut group, &potential, parts)
+            } else {
+                let energy = potential.energy(&group);
+                self.newton_group(&mut group, &potential, parts, energy)
+            };
+            responses = (potential.members.into_iter())
+                .map(|member| member.rigid.into_inner())
+                .collect();
+            let outcome = outcome?;
+            let failed = outcome.stop == Stop::Failed;
+            solved = Some(match solved {
+                Some(earlier) => earlier.then(outcome),
+                None => outcome,
+            });
+            if failed
+                || round == STIFFENING_ROUNDS
+                || !stiffen_deep_contacts(&group, &mut constraints, &mut responses)
+            {
+                break;
+            }
+        }
+        let outcome = solved.unwrap_or_else(Outcome::start);
         for (((body, constraints), (start, response)), last) in body_refs
             .into_iter()
             .zip(constraints)
@@ -434,6 +471,18 @@ impl ImplicitIntegrator {
             group.set(&starts);
             energy = here;
         }
+        self.newton_group(group, potential, (joint, parts), energy)
+    }
+
+    /// Newton's method on the group's potential from where the bodies are, where it is
+    /// `energy` (J).
+    fn newton_group(
+        &self,
+        group: &mut Group,
+        potential: &GroupPotential,
+        (joint, parts): (&mut Stiffness, &mut [Stiffness]),
+        mut energy: f64,
+    ) -> Result<Outcome, Error> {
         let inertia: Vec<Vec<f64>> = group
             .bodies
             .iter()

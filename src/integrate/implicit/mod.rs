@@ -32,6 +32,7 @@ use crate::assembly::Stiffness;
 use crate::body::DeformableBody;
 use crate::chord::{self, Chord};
 use crate::constraint::{self, BodyConstraints};
+use crate::contact;
 use crate::linear_solver::{LinearSolver, Method, solve_newton_system};
 use crate::newton::{Search, check_tolerance, descend, norm, round_off_floor};
 use potential::{Potential, StepStart};
@@ -56,6 +57,11 @@ const ROUND_OFF_MARGIN: f64 = 2.0;
 fn on_round_off_floor(relative: f64, floor: impl FnOnce() -> f64) -> bool {
     relative <= STALL_CEILING || relative <= ROUND_OFF_MARGIN * floor()
 }
+
+/// A substep is solved again, its deep contacts stiffened, at most this many times (see
+/// [`ContactSettings::resting_depth`](crate::contact::ContactSettings::resting_depth)): a load
+/// that moves to the neighbours of the stiffened contacts may press them deep in turn.
+const STIFFENING_ROUNDS: usize = 3;
 
 /// A frame is redone in up to this many times [`ImplicitIntegrator::substeps`] while its Newton
 /// solve fails or a surface point ends it past the middle of the collider it touches (see
@@ -338,8 +344,25 @@ impl ImplicitIntegrator {
             body.positions.clone_from(&start.positions);
             potential = here;
         }
-        let outcome = self.minimize(body, solver, &incremental, potential)?;
-        let response = incremental.rigid.into_inner();
+        let mut outcome = self.minimize(body, solver, &incremental, potential)?;
+        let mut response = incremental.rigid.into_inner();
+        for _ in 0..STIFFENING_ROUNDS {
+            response.solve(body, constraints);
+            if outcome.stop == Stop::Failed
+                || !contact::stiffen_deep_contacts(body, &mut constraints.contacts, response.step())
+            {
+                break;
+            }
+            response.forget_solution();
+            let stiffened = Potential {
+                start: &start,
+                constraints,
+                rigid: RefCell::new(response),
+            };
+            let potential = stiffened.energy(body);
+            outcome = outcome.then(self.minimize(body, solver, &stiffened, potential)?);
+            response = stiffened.rigid.into_inner();
+        }
         solver.last_step = Some(end_substep(body, constraints, start, response, h));
         Ok(outcome)
     }

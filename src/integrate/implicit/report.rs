@@ -108,6 +108,20 @@ impl Outcome {
         })
     }
 
+    /// This solve followed by `next`, a solve of the same substep again from where this one
+    /// ended: their iterations added, the last one's residual and stop.
+    pub(super) fn then(self, next: Self) -> Self {
+        Self {
+            iterations: self.iterations + next.iterations,
+            linear_iterations: self.linear_iterations + next.linear_iterations,
+            reused_factorizations: self.reused_factorizations + next.reused_factorizations,
+            factorizations: self.factorizations + next.factorizations,
+            projected_tangents: self.projected_tangents + next.projected_tangents,
+            residual: next.residual,
+            stop: next.stop,
+        }
+    }
+
     /// No iteration yet; the residual and convergence are set on return.
     pub(super) fn start() -> Self {
         Self {

@@ -195,6 +195,12 @@ impl RigidResponse {
         }
     }
 
+    /// Forgets where the response was last solved: the potential changed (a contact stiffened),
+    /// so the next evaluation solves it again even at the same positions.
+    pub(super) fn forget_solution(&mut self) {
+        self.solved_at.clear();
+    }
+
     /// Solves the bodies' response to the soft body at its positions (unless solved there
     /// already) and returns its `½ ιᵀ W ι` (J).
     pub(super) fn solve(&mut self, body: &DeformableBody, constraints: &BodyConstraints) -> f64 {
