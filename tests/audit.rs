@@ -3,12 +3,12 @@
 //!
 //! Tolerances are the audit's defaults (`AuditSettings::default()`): an energy rise of 0.1 % of
 //! the kinetic and elastic energy plus 1e-9 J, plus f32 rounding of rigid bodies and, after
-//! explicit steps, `(h / h_crit)(K + Ψ)` for symplectic Euler's oscillation, a penetration of the larger of the contact margin
-//! (1 mm) and a quarter of the smallest rest altitude (for the 10 cm cubes of 4 cells here,
-//! about 3 mm), a collapse below 1 % of the rest volume. The constructed failures are far
-//! beyond them (a node 20 mm deep, a cube moved 20 cm through a 2 mm wall, volumes at 0.5 %, a
-//! 1 m/s kick); the clean cases are checked with the same tolerances, and the free fall against
-//! its closed-form energy loss.
+//! explicit steps, `(h / h_crit)(K + Ψ)` for symplectic Euler's oscillation, a penetration of
+//! the larger of the contact margin (1 mm) and a quarter of the smallest rest altitude (for the
+//! 10 cm cubes of 4 cells here, about 3 mm), a collapse below 1 % of the rest volume. The
+//! constructed failures are far beyond them (a node 20 mm deep, a cube moved 20 cm through a
+//! 2 mm wall or a 4 mm soft sheet, volumes at 0.5 %, a 1 m/s kick); the clean cases are checked
+//! with the same tolerances, and the free fall against its closed-form energy loss.
 
 mod common;
 
@@ -148,6 +148,66 @@ fn a_cube_moved_through_a_thin_wall_has_crossed_it() {
     // Every boundary node passed through the wall: 4 x 4 x 4 cells have 98 boundary nodes.
     assert_eq!(body.penetrations.crossed, 98);
     assert!(body.crossed() && !body.penetrates());
+}
+
+/// A soft sheet 4 mm thick and 40 cm square across x = 0 (its faces at x = ±2 mm), in a world
+/// without gravity, and a 10 cm cube whose right face touches the sheet's left face.
+fn cube_beside_a_soft_sheet() -> (FvmWorld, DeformableBodyHandle, DeformableBodyHandle) {
+    let mut world = FvmWorld::default();
+    world.physics.gravity = Vec3::ZERO;
+    let material = Material::new(MaterialModel::StableNeoHookean, 1e6, 0.3, 1000.0).unwrap();
+    let mesh = mesh::cuboid(DVec3::new(0.002, 0.2, 0.2), [1, 8, 8]).unwrap();
+    let sheet = DeformableBodyBuilder::new(mesh, material).build().unwrap();
+    let sheet = world.soft_bodies.insert(sheet);
+    let cube = world.soft_bodies.insert(cube(-0.05));
+    let beside: Vec<DVec3> = (world.soft_bodies[cube].positions().iter())
+        .map(|x| DVec3::new(x.x - 0.052, x.y, x.z))
+        .collect();
+    world.soft_bodies[cube].set_positions(&beside).unwrap();
+    (world, sheet, cube)
+}
+
+/// Moves every node of `body` in `world` by `shift` (m).
+fn shift_body(world: &mut FvmWorld, body: DeformableBodyHandle, shift: DVec3) {
+    let moved: Vec<DVec3> = (world.soft_bodies[body].positions().iter())
+        .map(|x| *x + shift)
+        .collect();
+    world.soft_bodies[body].set_positions(&moved).unwrap();
+}
+
+#[test]
+fn a_cube_moved_through_a_thin_soft_sheet_has_crossed_it_and_one_slid_along_it_has_not() {
+    // Set 20 cm to the right, through the sheet: every boundary node of the cube (98) went
+    // through it, in one face and out of the opposite one.
+    let (mut world, sheet, cube) = cube_beside_a_soft_sheet();
+    let mut audit = Audit::default();
+    audit.restart_world(&world);
+    shift_body(&mut world, cube, DVec3::new(0.2, 0.0, 0.0));
+    let found = audit.check_world(&world, &Vec::new());
+    let body = found.body(cube).unwrap();
+    assert_eq!(body.penetrations.crossed, 98, "{body:#?}");
+    assert_eq!(
+        body.penetrations.first_crossed,
+        Some(PenetrationTarget::SoftBody(sheet))
+    );
+    assert!(body.crossed() && !body.penetrates());
+    // Slid 5 cm along the sheet's face instead: its face nodes stay on the sheet's surface, the
+    // others beside it; none went through.
+    let (mut world, _, cube) = cube_beside_a_soft_sheet();
+    let mut audit = Audit::default();
+    audit.restart_world(&world);
+    shift_body(&mut world, cube, DVec3::new(0.0, 0.05, 0.0));
+    let found = audit.check_world(&world, &Vec::new());
+    let body = found.body(cube).unwrap();
+    assert!(!body.crossed() && !body.penetrates(), "{body:#?}");
+    // The sheet carried along with the cube, both 20 cm to the right: nothing crossed.
+    let (mut world, sheet, cube) = cube_beside_a_soft_sheet();
+    let mut audit = Audit::default();
+    audit.restart_world(&world);
+    shift_body(&mut world, cube, DVec3::new(0.2, 0.0, 0.0));
+    shift_body(&mut world, sheet, DVec3::new(0.2, 0.0, 0.0));
+    let found = audit.check_world(&world, &Vec::new());
+    assert!(found.bodies.iter().all(|(_, b)| !b.crossed()), "{found:#?}");
 }
 
 #[test]

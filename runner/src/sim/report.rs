@@ -165,7 +165,8 @@ pub struct BodyFlags {
     /// Contact points deeper than the tolerance inside a collider or another soft body (worst:
     /// the deepest, m).
     pub penetration: Option<Flag>,
-    /// Contact points that went through a collider over a frame (worst: most in a frame).
+    /// Contact points that went through a collider or another soft body over a frame (worst:
+    /// most in a frame).
     pub crossing: Option<Flag>,
     /// Elements of zero or negative volume left after a frame (worst: most in a frame).
     pub inverted_elements: Option<Flag>,

@@ -15,7 +15,8 @@
 //!    box tumbling off a soft block onto the ground gained 0.64 J in one 1/30 s frame, the same
 //!    with the block moved 10 m away before the frame).
 //! 2. **Contacts**: no contact point of a body lies deeper than the penetration tolerance inside
-//!    a collider or another deformable body, and none crossed a collider over the frame.
+//!    a collider or another deformable body, and none crossed a collider or another deformable
+//!    body over the frame.
 //! 3. **Elements**: no element is inverted (`V ≤ 0`) or collapsed (`V < J_min V₀`).
 //! 4. **Step**: the body's step was not refused ([`BodyAudit::step_error`]): the integrators
 //!    refuse a frame rather than keep one they could not resolve (an implicit Newton solve that
@@ -43,6 +44,7 @@
 //! frame's: call [`Audit::restart`] after changing it.
 
 mod cluster;
+mod crossing;
 mod elements;
 mod energy;
 mod penetration;
@@ -233,6 +235,10 @@ impl Audit {
         for (other_handle, other) in input.soft_bodies.iter() {
             if other_handle != handle {
                 penetration::against_soft(&checked, other, other_handle, &mut penetrations);
+                if let Some(before) = previous.and_then(|p| p.positions.get(&other_handle)) {
+                    let other = (other, other_handle);
+                    crossing::through_soft(&checked, other, before, &mut penetrations);
+                }
             }
         }
         let elements = elements::element_state(body, self.settings.collapse_ratio);

@@ -14,7 +14,8 @@
 //!   its surface to end deeper than the tolerance on the far side (a triangle mesh or height
 //!   field, which has no interior): the point went through it.
 //!
-//! Crossings of deformable bodies' surfaces and self-penetration are not checked.
+//! Crossings of other deformable bodies are the `crossing` module's; self-penetration is not
+//! checked.
 
 use super::{PenetrationTarget, Penetrations};
 use crate::body::{DeformableBody, DeformableBodyHandle};
@@ -71,7 +72,9 @@ pub(super) fn against_colliders(
                 && crossed(collider, pose, before[i].0, *x, checked.tolerance)
             {
                 found.crossed += 1;
-                found.crossed_collider.get_or_insert(handle);
+                found
+                    .first_crossed
+                    .get_or_insert(PenetrationTarget::Collider(handle));
             }
         }
     }
@@ -181,7 +184,11 @@ pub(super) fn colliders_inside(
 
 /// How deep (m) `point` lies inside `body`, whose nodes lie within `(lo, hi)` (m): its distance
 /// to the boundary if it is within one of the body's tetrahedra, `None` otherwise.
-fn depth_inside(body: &DeformableBody, (lo, hi): (DVec3, DVec3), point: DVec3) -> Option<f64> {
+pub(super) fn depth_inside(
+    body: &DeformableBody,
+    (lo, hi): (DVec3, DVec3),
+    point: DVec3,
+) -> Option<f64> {
     if point.cmplt(lo).any() || point.cmpgt(hi).any() {
         return None;
     }

@@ -46,10 +46,10 @@ pub struct Penetrations {
     pub deepest: f64,
     /// What the deepest lies in.
     pub deepest_in: Option<PenetrationTarget>,
-    /// Points that went through a collider over the frame.
+    /// Points that went through a collider or another deformable body over the frame.
     pub crossed: usize,
-    /// The first collider crossed.
-    pub crossed_collider: Option<ColliderHandle>,
+    /// The first collider or deformable body crossed.
+    pub first_crossed: Option<PenetrationTarget>,
 }
 
 impl Penetrations {
@@ -100,7 +100,7 @@ impl BodyAudit {
         self.penetrations.points > 0
     }
 
-    /// Whether a contact point went through a collider.
+    /// Whether a contact point went through a collider or another deformable body.
     pub fn crossed(&self) -> bool {
         self.penetrations.crossed > 0
     }
