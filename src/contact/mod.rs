@@ -122,7 +122,10 @@ pub struct ContactSettings {
     /// The deepest (m) an implicit step leaves a point behind its contact plane with a collider
     /// before the contact's penalty stiffens: a contact whose load presses it deeper has its
     /// stiffness raised so that the load holds it at half this depth, and the step is solved
-    /// again; the contact keeps that stiffness while it is detected in later frames.
+    /// again; the contact keeps that stiffness while it is detected in later frames. A point
+    /// that already lay behind its plane at the step's start holds more energy in the stiffer
+    /// penalty than it did: at most its load times this depth (0.04 J for a node carrying 40 N
+    /// at the default), given back as the step pushes it out.
     pub resting_depth: f64,
     /// The most speed (m/s) at which explicit contacts push a node found inside a collider back
     /// out (it entered between detections, e.g. pushed by a rigid body that moved): an impulse,
