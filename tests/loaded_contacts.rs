@@ -1,8 +1,9 @@
 //! Implicit contact stiffness follows the load (`ContactSettings::resting_depth`): a light node
-//! carrying a heavy body rests no deeper than the resting depth behind the collider it presses
-//! on, while the reaction still balances the weight.
+//! carrying a heavy body, or a node whose penalty an absurdly long step has made feeble, rests
+//! no deeper than the resting depth behind the collider it presses on, while the reaction still
+//! balances the weight.
 //!
-//! The scene: a 10 cm block (4 cells a side, E = 1e7 Pa, ν = 0.3, 1000 kg/m³: 1 kg, its 25 bottom
+//! The first scene: a 10 cm block (4 cells a side, E = 1e7 Pa, ν = 0.3, 1000 kg/m³: 1 kg, its 25 bottom
 //! nodes of 1.3 to 13 g) on the ground, under a 100 kg rigid box as wide as its top, at 1/30 s
 //! frames of forced implicit steps, one coupling substep per frame. The penalty
 //! `penalty_factor m/h²` of a bottom node is then 1.2e3 to 1.2e4 N/m; the bottom nodes carry
@@ -90,4 +91,35 @@ fn a_light_node_under_a_heavy_box_rests_within_the_resting_depth() {
         soft_deepest > 5.0 * settings.resting_depth,
         "deepest {soft_deepest} m"
     );
+}
+
+#[test]
+fn a_cube_on_the_ground_stays_on_it_through_frames_of_a_thousand_seconds() {
+    // A 10 cm cube (4 cells a side, E = 1e6 Pa, 1 kg) resting on the ground, three implicit
+    // frames of 1000 s: the penalty `penalty_factor m/h²` of a 2 g node at h = 250 s is 3e-5 N/m,
+    // and the frame's gravity drop `g h²` is 6e5 m; without the stiffening the cube sank 1042 m
+    // through the ground in the first frame. It must stay on the ground, no node deeper than the
+    // resting depth (2 % for the f32 ground's rounding) and none lifted above its rest height.
+    let mut world = common::world_with_ground(Some(IntegratorKind::Implicit));
+    world.physics.integration_parameters.dt = 1000.0;
+    let material = Material::new(MaterialModel::StableNeoHookean, 1e6, 0.3, 1000.0).unwrap();
+    let cube =
+        DeformableBodyBuilder::new(mesh::cuboid(DVec3::splat(0.05), [4; 3]).unwrap(), material)
+            .translation(DVec3::new(0.0, 0.05, 0.0))
+            .build()
+            .unwrap();
+    let cube = world.soft_bodies.insert(cube);
+    let resting_depth = world.coupling.contact.resting_depth;
+    for frame in 0..3 {
+        for (_, outcome) in world.step() {
+            outcome.unwrap_or_else(|error| panic!("frame {frame}: {error}"));
+        }
+        let heights = world.soft_bodies[cube].positions().iter().map(|x| x.y);
+        let (lowest, highest) = heights.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), y| {
+            (lo.min(y), hi.max(y))
+        });
+        println!("frame {frame}: lowest {lowest:.4e} m, highest {highest:.6} m");
+        assert!(lowest >= -1.02 * resting_depth, "frame {frame}: {lowest} m");
+        assert!(highest <= 0.1, "frame {frame}: {highest} m");
+    }
 }
