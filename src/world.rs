@@ -224,6 +224,7 @@ impl<'a> AuditInput<'a> {
             colliders: &world.physics.colliders,
             gravity: world.physics.gravity.as_dvec3(),
             dt: f64::from(world.physics.integration_parameters.dt),
+            solver_iterations: world.physics.integration_parameters.num_solver_iterations,
         }
     }
 }

@@ -9,8 +9,12 @@
 //!   stiffness the contact's load called for if more, and `ĥ` the substep's effective step.
 //!   Embedded contact points' penalties are not counted.
 //! - Dynamic rigid bodies: `m v²/2 + ωᵀ I ω / 2`, and the gravitational energy `-m g·x` at the
-//!   centre of mass half a coupling substep `h` back along the velocity, `x − v h/2`, which
-//!   rapier's symplectic Euler step keeps exactly in free flight. A body an implicit soft step
+//!   centre of mass half of rapier's integration step `h` back along the velocity, `x − v h/2`,
+//!   which rapier's symplectic Euler step keeps exactly in free flight. `h` is the coupling
+//!   substep divided by the solver iterations rapier runs in it (its TGS solver integrates
+//!   positions once per iteration): with one coupling substep and rapier's default four
+//!   iterations, a quarter of the frame (taking the whole frame, a 0.43 kg box falling freely
+//!   within reach of a soft block measured a gain of 4.3 mJ every 1/60 s frame). A body an implicit soft step
 //!   moved in the frame (it touches or is glued to a deformable body whose last substep was
 //!   implicit) is measured at its centre of mass `x` itself, in both frames compared: the
 //!   implicit step solves its motion with the soft body's as one backward Euler step, whose
@@ -54,7 +58,7 @@ pub(super) enum Member {
 pub(super) struct MemberEnergy {
     /// The total, a rigid body's gravitational energy taken at its centre of mass.
     pub(super) total: f64,
-    /// What a rigid body's gravitational energy taken half a coupling substep `h` back along its
+    /// What a rigid body's gravitational energy taken half an integration step `h` back along its
     /// velocity `v` adds to the total, `½ h m g·v`; zero for a deformable body.
     pub(super) half_step_back: f64,
     pub(super) moving: f64,
@@ -99,11 +103,20 @@ pub(super) fn energies(
             },
         );
     }
-    let h = input.dt / f64::from(input.coupling.substeps.max(1));
+    let h = rigid_integration_step(input);
     for (handle, body) in input.bodies.iter().filter(|(_, b)| b.is_dynamic()) {
         all.insert(Member::Rigid(handle), rigid_energy(body, g, h));
     }
     all
+}
+
+/// The step (s) of rapier's position integration in a frame of `input`: each coupling substep
+/// of `dt / substeps` runs `⌈num_solver_iterations / substeps⌉` solver iterations (at least
+/// one), each of which integrates positions over its share of the substep (rapier's TGS solver).
+fn rigid_integration_step(input: &AuditInput<'_>) -> f64 {
+    let substeps = input.coupling.substeps.max(1) as usize;
+    let iterations = input.solver_iterations.div_ceil(substeps).max(1);
+    input.dt / (substeps * iterations) as f64
 }
 
 /// The energy (J) the implicit contact penalties of the deformable body `handle` hold now.

@@ -94,7 +94,7 @@ impl Default for AuditSettings {
 
 /// What the audit reads of a world after a frame: the deformable bodies, the coupling that
 /// stepped them (its contacts, attachments and loads), the rigid bodies and colliders, gravity
-/// (m/s²) and the frame step (s).
+/// (m/s²), the frame step (s) and rapier's solver iterations.
 #[derive(Clone, Copy)]
 pub struct AuditInput<'a> {
     /// The deformable bodies.
@@ -109,6 +109,9 @@ pub struct AuditInput<'a> {
     pub gravity: DVec3,
     /// The frame step (s).
     pub dt: f64,
+    /// rapier's `num_solver_iterations` for the frame, which the coupling divides among its
+    /// substeps: each is a substep of rapier's position integration (its TGS solver).
+    pub solver_iterations: usize,
 }
 
 /// The state a frame is compared with: the previous frame's.
