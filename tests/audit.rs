@@ -175,15 +175,25 @@ fn shift_body(world: &mut FvmWorld, body: DeformableBodyHandle, shift: DVec3) {
     world.soft_bodies[body].set_positions(&moved).unwrap();
 }
 
+/// The audit of the cube beside the sheet after the cube and the sheet are moved by hand by
+/// `cube_shift` and `sheet_shift` (m), as one frame; with the handles of the sheet and cube.
+fn audit_after_moving(
+    cube_shift: DVec3,
+    sheet_shift: DVec3,
+) -> (FrameAudit, DeformableBodyHandle, DeformableBodyHandle) {
+    let (mut world, sheet, cube) = cube_beside_a_soft_sheet();
+    let mut audit = Audit::default();
+    audit.restart_world(&world);
+    shift_body(&mut world, cube, cube_shift);
+    shift_body(&mut world, sheet, sheet_shift);
+    (audit.check_world(&world, &Vec::new()), sheet, cube)
+}
+
 #[test]
 fn a_cube_moved_through_a_thin_soft_sheet_has_crossed_it_and_one_slid_along_it_has_not() {
     // Set 20 cm to the right, through the sheet: every boundary node of the cube (98) went
     // through it, in one face and out of the opposite one.
-    let (mut world, sheet, cube) = cube_beside_a_soft_sheet();
-    let mut audit = Audit::default();
-    audit.restart_world(&world);
-    shift_body(&mut world, cube, DVec3::new(0.2, 0.0, 0.0));
-    let found = audit.check_world(&world, &Vec::new());
+    let (found, sheet, cube) = audit_after_moving(DVec3::new(0.2, 0.0, 0.0), DVec3::ZERO);
     let body = found.body(cube).unwrap();
     assert_eq!(body.penetrations.crossed, 98, "{body:#?}");
     assert_eq!(
@@ -193,20 +203,12 @@ fn a_cube_moved_through_a_thin_soft_sheet_has_crossed_it_and_one_slid_along_it_h
     assert!(body.crossed() && !body.penetrates());
     // Slid 5 cm along the sheet's face instead: its face nodes stay on the sheet's surface, the
     // others beside it; none went through.
-    let (mut world, _, cube) = cube_beside_a_soft_sheet();
-    let mut audit = Audit::default();
-    audit.restart_world(&world);
-    shift_body(&mut world, cube, DVec3::new(0.0, 0.05, 0.0));
-    let found = audit.check_world(&world, &Vec::new());
+    let (found, _, cube) = audit_after_moving(DVec3::new(0.0, 0.05, 0.0), DVec3::ZERO);
     let body = found.body(cube).unwrap();
     assert!(!body.crossed() && !body.penetrates(), "{body:#?}");
     // The sheet carried along with the cube, both 20 cm to the right: nothing crossed.
-    let (mut world, sheet, cube) = cube_beside_a_soft_sheet();
-    let mut audit = Audit::default();
-    audit.restart_world(&world);
-    shift_body(&mut world, cube, DVec3::new(0.2, 0.0, 0.0));
-    shift_body(&mut world, sheet, DVec3::new(0.2, 0.0, 0.0));
-    let found = audit.check_world(&world, &Vec::new());
+    let both = DVec3::new(0.2, 0.0, 0.0);
+    let (found, _, _) = audit_after_moving(both, both);
     assert!(found.bodies.iter().all(|(_, b)| !b.crossed()), "{found:#?}");
 }
 
