@@ -108,6 +108,12 @@ impl RigidProxy {
         self.linvel += gravity * (self.fall * h);
     }
 
+    /// The gravity scale the body falls by in the soft step: its own if dynamic and not held,
+    /// zero otherwise.
+    pub(crate) fn gravity_scale(&self) -> f64 {
+        self.fall
+    }
+
     /// Keeps the body from falling during the soft step: for a body that rapier's own contacts
     /// hold up (standing on rigid ground), whose weight rapier's step will carry.
     pub(crate) fn hold(&mut self) {

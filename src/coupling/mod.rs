@@ -31,7 +31,9 @@
 //!    during rapier's step.
 //! 6. **Rigid step.** rapier steps the rigid bodies over `h`, with the frame's
 //!    `num_solver_iterations` divided among the substeps (rounded up), so that its solver cost
-//!    per frame is about unchanged.
+//!    per frame is about unchanged. A dynamic body an implicit soft step moved is carried by it
+//!    as that step assumed (`carry`: rapier's iterations, each integrating gravity over its
+//!    share of `h`, would carry it `(n − 1)/(2n) |g| h²` less far down in `n` iterations).
 //!
 //! Sub-cycling keeps the rigid bodies' view of the deformable bodies one short substep old, which
 //! removes the friction ratchet and the rocking that a single rapier step per frame shows.
@@ -41,6 +43,7 @@
 
 mod audit;
 mod bodies;
+mod carry;
 mod groups;
 mod kinematic;
 mod loads;
@@ -56,8 +59,9 @@ use crate::Error;
 use crate::body::{DeformableBody, DeformableBodyHandle, DeformableBodySet};
 use crate::constraint::{self, BodyConstraints};
 use crate::contact::{self, ContactSettings, NodeContact};
-use crate::integrate::{AutomaticIntegrator, AutomaticReport, BodyInStep};
+use crate::integrate::{AutomaticIntegrator, AutomaticReport, BodyInStep, IntegratorKind};
 use bodies::LinkSet;
+use carry::{Carried, RapierCarry};
 use groups::{GroupStep, step_groups, touching_groups};
 use kinematic::KinematicPath;
 use loads::FrameLoads;
@@ -227,8 +231,11 @@ impl SoftCoupling {
                 colliders: rapier.colliders,
                 narrow_phase: rapier.narrow_phase,
             };
-            self.step_soft_bodies(soft_bodies, rigid, &mut outcomes, h, gravity);
+            let carried = self.step_soft_bodies(soft_bodies, rigid, &mut outcomes, h, gravity);
+            let iterations = substep_parameters.num_solver_iterations;
+            let carry = RapierCarry::lead(&carried, rapier.bodies, gravity, (h, iterations));
             rapier.step_rapier(pipeline, &substep_parameters, hooks, events);
+            carry.settle(rapier.bodies);
         }
         self.loads.finish(f64::from(frame.dt));
         results(outcomes)
@@ -253,7 +260,10 @@ impl SoftCoupling {
     /// Steps every deformable body by `h` (s) under `gravity` (m/s²) against the rigid world as
     /// it is (stages 2 to 5 of the module's documentation), for a program that runs its own
     /// rapier step of `h` right after. [`SoftCoupling::rigid_loads`] then holds this substep's
-    /// loads.
+    /// loads. That rapier step should run one solver iteration
+    /// (`IntegrationParameters::num_solver_iterations = 1`) when an implicit step moves dynamic
+    /// rigid bodies: with `n`, rapier carries each of them `(n − 1)/(2n) |g| h²` less far down
+    /// than the soft step assumed, which [`SoftCoupling::step`] corrects and this call cannot.
     pub fn substep(
         &mut self,
         soft_bodies: &mut DeformableBodySet,
@@ -369,7 +379,7 @@ impl SoftCoupling {
         outcomes: &mut [(DeformableBodyHandle, Outcome)],
         h: f64,
         gravity: DVec3,
-    ) {
+    ) -> Vec<Carried> {
         self.links.prune(soft_bodies);
         let (live, held) = self.detect(soft_bodies, &rigid, outcomes, h, gravity);
         let between = {
@@ -394,11 +404,18 @@ impl SoftCoupling {
         }
         let stepped = step_groups(&mut ready, &self.integrator, &self.contact, (h, gravity));
         let steps = ready.into_iter().flat_map(|group| group.bodies);
+        let mut carried = Vec::new();
         for ((handle, mut step), result) in
             handles.iter().zip(steps).zip(stepped.into_iter().flatten())
         {
             if result.is_err() {
                 constraint::hold_partners(step.body, step.constraints, h, gravity);
+            }
+            if result
+                .as_ref()
+                .is_ok_and(|r| r.choice == IntegratorKind::Implicit)
+            {
+                Carried::add(&mut carried, &step.constraints.rigid_proxies);
             }
             hand_over(&mut self.loads, *handle, &mut step, rigid.bodies);
             if let Some((_, outcome)) = outcomes.iter_mut().find(|(h, _)| h == handle) {
@@ -416,6 +433,7 @@ impl SoftCoupling {
             constraint::hold_partners(step.body, step.constraints, h, gravity);
             hand_over(&mut self.loads, *handle, &mut step, rigid.bodies);
         }
+        carried
     }
 
     /// Finds the contacts of every body of `outcomes` whose state a step can take, and returns
