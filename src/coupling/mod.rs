@@ -372,6 +372,8 @@ impl SoftCoupling {
     /// step is refused, in this substep or an earlier one of the frame, stays where it was and
     /// holds the rigid bodies it touches or is glued to as a fixed obstacle would
     /// ([`constraint::hold_partners`]): rapier's step must not let them sink into it meanwhile.
+    /// Returns the dynamic rigid bodies implicit steps moved, for rapier's step to carry them
+    /// as those steps did ([`RapierCarry`]).
     fn step_soft_bodies(
         &mut self,
         soft_bodies: &mut DeformableBodySet,
