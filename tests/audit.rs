@@ -356,12 +356,12 @@ fn velocities_set_between_frames_are_energy_gained_until_the_audit_restarts() {
 fn a_box_falling_beside_a_soft_pillar_gains_nothing_at_any_coupling_substeps() {
     // A 0.43 kg box (6 cm, 2000 kg/m³) released at rest 0.5 mm beside the side of a 1 m pillar
     // (E = 1e8 Pa, settled within its first frame) standing on the ground, falling freely along
-    // it for 12 frames of 1/60 s (0.2 m) without touching it: it is within the pillar's contact reach, so the coupled system counts it. Its
-    // energy measured half of rapier's integration step back is exactly constant in free flight
-    // (symplectic Euler), and rapier integrates positions once per solver iteration: taking the
-    // coupling substep instead (1/60 s with one substep and rapier's four iterations) measured a
-    // gain of 2.8 mJ in the first frame (tolerance 0.77 mJ), and of 4.3 mJ every frame for the
-    // same box on its own.
+    // it for 12 frames of 1/60 s (0.2 m) without touching it: it is within the pillar's contact
+    // reach, so the coupled system counts it. Its energy measured half of rapier's integration
+    // step back is exactly constant in free flight (symplectic Euler), and rapier integrates
+    // positions once per solver iteration: taking the coupling substep instead (1/60 s with one
+    // substep and rapier's four iterations) measured a gain of 2.8 mJ in the first frame
+    // (tolerance 0.77 mJ), and of 4.3 mJ every frame for the same box on its own.
     for substeps in [1, 2, 4] {
         let mut world = common::world_with_ground(Some(IntegratorKind::Explicit));
         world.coupling.substeps = substeps;

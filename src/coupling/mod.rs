@@ -216,10 +216,8 @@ impl SoftCoupling {
         let gravity = rapier.gravity.as_dvec3();
         let mut substep_parameters = frame;
         substep_parameters.dt = frame.dt / substeps as f32;
-        substep_parameters.num_solver_iterations = frame
-            .num_solver_iterations
-            .div_ceil(substeps as usize)
-            .max(1);
+        substep_parameters.num_solver_iterations =
+            iterations_per_substep(frame.num_solver_iterations, substeps);
         let mut outcomes = unstepped(soft_bodies);
         let paths = KinematicPath::all(rapier.bodies);
         for substep in 1..=substeps {
@@ -487,6 +485,14 @@ fn hand_over(
 ) {
     loads.add_body(handle, step.body, step.constraints);
     step.constraints.transfer_contact_impulses(bodies);
+}
+
+/// The solver iterations (at least one) rapier runs in each of `substeps` coupling substeps of a
+/// frame given `frame_iterations`: the frame's share, rounded up, so that its solver cost per
+/// frame is about unchanged. Each iteration of rapier's TGS solver integrates positions over its
+/// share of the substep.
+pub(crate) fn iterations_per_substep(frame_iterations: usize, substeps: u32) -> usize {
+    frame_iterations.div_ceil(substeps.max(1) as usize).max(1)
 }
 
 /// Every body of `soft_bodies` with `error`: a frame refused before anything moved.

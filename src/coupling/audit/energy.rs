@@ -10,18 +10,18 @@
 //!   Embedded contact points' penalties are not counted.
 //! - Dynamic rigid bodies: `m v²/2 + ωᵀ I ω / 2`, and the gravitational energy `-m g·x` at the
 //!   centre of mass half of rapier's integration step `h` back along the velocity, `x − v h/2`,
-//!   which rapier's symplectic Euler step keeps exactly in free flight. `h` is the coupling
-//!   substep divided by the solver iterations rapier runs in it (its TGS solver integrates
-//!   positions once per iteration): with one coupling substep and rapier's default four
-//!   iterations, a quarter of the frame (taking the whole frame, a 0.43 kg box falling freely
-//!   within reach of a soft block measured a gain of 4.3 mJ every 1/60 s frame). A body an implicit soft step
-//!   moved in the frame (it touches or is glued to a deformable body whose last substep was
-//!   implicit) is measured at its centre of mass `x` itself, in both frames compared: the
-//!   implicit step solves its motion with the soft body's as one backward Euler step, whose
-//!   energy `Σ m v²/2 − m g·x + Ψ` cannot rise, while the half-substep-back measure then moves by
-//!   `½ h m g·Δv` with each velocity change `Δv` the soft body gives it (the 20 kg ball on the
-//!   20 g rope at 1/60 s frames: +2.3e-3 J in a frame measured half a substep back, −1.0e-3 J at
-//!   the centre of mass). Fixed and kinematic bodies carry none.
+//!   which rapier's symplectic Euler step keeps exactly in free flight. `h` is the coupling substep
+//!   divided by the solver iterations rapier runs in it (its TGS solver integrates positions once
+//!   per iteration): with one coupling substep and rapier's default four iterations, a quarter of
+//!   the frame (taking the whole frame, a 0.43 kg box falling freely within reach of a soft block
+//!   measured a gain of 4.3 mJ every 1/60 s frame). A body an implicit soft step moved in the frame
+//!   (it touches or is glued to a deformable body whose last substep was implicit) is measured at
+//!   its centre of mass `x` itself, in both frames compared: the implicit step solves its motion
+//!   with the soft body's as one backward Euler step, whose energy `Σ m v²/2 − m g·x + Ψ` cannot
+//!   rise, while the half-substep-back measure then moves by `½ h m g·Δv` with each velocity change
+//!   `Δv` the soft body gives it (the 20 kg ball on the 20 g rope at 1/60 s frames: +2.3e-3 J in a
+//!   frame measured half a substep back, −1.0e-3 J at the centre of mass). Fixed and kinematic
+//!   bodies carry none.
 //! - Work: a kinematic (or fixed) rigid body a deformable body pushed with the mean force `F` and
 //!   torque `τ` over the frame ([`RigidLoad`](crate::coupling::RigidLoad)) while moving its centre
 //!   of mass by `Δx` and turning by `Δθ` did `W = -(F·Δx + τ·Δθ)` on it. Gravity's work is in the
@@ -37,7 +37,7 @@
 use super::{AuditInput, EnergyCheck};
 use crate::body::{DeformableBody, DeformableBodyHandle};
 use crate::contact::BodyPoint;
-use crate::coupling::SoftStepResults;
+use crate::coupling::{SoftStepResults, iterations_per_substep};
 use crate::integrate::{ImplicitScheme, IntegratorKind, SymplecticEuler};
 use rapier3d::dynamics::{RigidBody, RigidBodyHandle};
 use rapier3d::glamx::{DMat3, DQuat, DVec3};
@@ -114,9 +114,9 @@ pub(super) fn energies(
 /// of `dt / substeps` runs `⌈num_solver_iterations / substeps⌉` solver iterations (at least
 /// one), each of which integrates positions over its share of the substep (rapier's TGS solver).
 fn rigid_integration_step(input: &AuditInput<'_>) -> f64 {
-    let substeps = input.coupling.substeps.max(1) as usize;
-    let iterations = input.solver_iterations.div_ceil(substeps).max(1);
-    input.dt / (substeps * iterations) as f64
+    let substeps = input.coupling.substeps.max(1);
+    let iterations = iterations_per_substep(input.solver_iterations, substeps);
+    input.dt / (substeps as usize * iterations) as f64
 }
 
 /// The energy (J) the implicit contact penalties of the deformable body `handle` hold now.
