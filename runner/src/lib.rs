@@ -20,6 +20,7 @@
 //!
 //! All lengths are in m, times in s, velocities in m/s and stresses in Pa.
 
+pub mod calibrate;
 pub mod output;
 pub mod scene;
 pub mod sim;

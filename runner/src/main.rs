@@ -13,7 +13,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 /// Runs scenes of finite-volume soft bodies and rapier rigid bodies (described in TOML)
-/// headless, and checks meshes.
+/// headless, checks meshes, and measures the automatic integrator's costs on this machine.
 ///
 /// Errors (a missing file, a malformed scene or mesh) print one line on stderr and exit with
 /// status 1; wrong command-line arguments exit with status 2.
@@ -80,6 +80,12 @@ enum Command {
         #[arg(long, default_value_t = 16)]
         cells_across: usize,
     },
+    /// Measures the automatic integrator's cost model on this machine.
+    ///
+    /// Steps a soft cube free and dropped on the ground with each integrator forced (about half
+    /// a minute), prints each case's time per frame, then the model as a scene's
+    /// `[integrator.cost]` table, to paste into scenes run on this machine.
+    Calibrate,
 }
 
 fn main() -> ExitCode {
@@ -110,6 +116,7 @@ fn main() -> ExitCode {
             density,
             cells_across,
         } => check(mesh, scale, [young, poisson, density], cells_across),
+        Command::Calibrate => calibrate(),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -118,6 +125,14 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// `calibrate`: measures the cost model and prints it.
+fn calibrate() -> Result<(), String> {
+    let cost = rapier_fvm_runner::calibrate::calibrate(|line| eprintln!("{line}"))
+        .map_err(|e| e.to_string())?;
+    print!("{}", rapier_fvm_runner::calibrate::as_toml(&cost));
+    Ok(())
 }
 
 /// `run`: runs the scene, its soft bodies within `memory_limit` GB if given, and prints a
@@ -169,6 +184,16 @@ fn run(
             body.implicit_frames,
             body.failed_frames,
             body.max_inverted_tets
+        );
+        let c = &body.cost;
+        println!(
+            "       {:<16} per step: predicted explicit {:.3} ms, implicit {:.3} ms; used {:.3} ms predicted, {:.3} ms measured ({:.2}x)",
+            "",
+            c.predicted_explicit_ms,
+            c.predicted_implicit_ms,
+            c.predicted_ms,
+            c.measured_ms,
+            c.measured_over_predicted
         );
     }
     for probe in &report.probes {

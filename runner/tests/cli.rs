@@ -119,3 +119,55 @@ fn a_short_run_succeeds_and_prints_a_summary() {
     assert!(text.contains("tip deflection"), "{text}");
     assert!(out.join("report.json").is_file());
 }
+
+#[test]
+fn calibrate_prints_a_cost_table_a_scene_reads() {
+    // The measured values differ from machine to machine and run to run; what is checked is
+    // that the printed table is a scene's `[integrator.cost]`, read back to the printed digits,
+    // every value finite and positive (a contact point's cost may measure zero within the
+    // timer's noise), and the cases' progress on stderr.
+    let output = rapier_fvm(&["calibrate"]);
+    assert!(output.status.success());
+    let table = String::from_utf8_lossy(&output.stdout);
+    let progress = String::from_utf8_lossy(&output.stderr);
+    assert!(progress.contains("implicit, dropped"), "{progress}");
+    let scene = format!(
+        "name = \"c\"\n[world]\nduration = 0.1\n[[soft_body]]\nname = \"cube\"\n\
+         mesh = {{ cuboid = {{ half_extents = [0.05, 0.05, 0.05], cells = [2, 2, 2] }} }}\n\
+         material = {{ model = \"linear\", young = 1e5, poisson = 0.3, density = 1000.0 }}\n{table}"
+    );
+    let scene = rapier_fvm_runner::scene::Scene::parse("calibrated.toml", scene).unwrap();
+    let cost = scene.integrator.integrator().cost;
+    let printed = |key: &str| -> f64 {
+        let line = table
+            .lines()
+            .find(|l| l.starts_with(&format!("{key} ")))
+            .unwrap();
+        line.split('=')
+            .nth(1)
+            .unwrap()
+            .split('#')
+            .next()
+            .unwrap()
+            .trim()
+            .parse()
+            .unwrap()
+    };
+    for (key, value) in [
+        ("explicit_tet", cost.explicit_tet),
+        ("explicit_tet_corotated", cost.explicit_tet_corotated),
+        ("explicit_damped_factor", cost.explicit_damped_factor),
+        ("explicit_contact_point", cost.explicit_contact_point),
+        ("newton_tet", cost.newton_tet),
+        ("newton_tet_corotated", cost.newton_tet_corotated),
+        ("newton_iterations", cost.newton_iterations),
+    ] {
+        let least = if key == "explicit_contact_point" {
+            0.0
+        } else {
+            f64::MIN_POSITIVE
+        };
+        assert!(value.is_finite() && value >= least, "{key} = {value}");
+        assert_eq!(value, printed(key), "{key}");
+    }
+}

@@ -282,3 +282,39 @@ fn a_missing_scene_file_names_the_file() {
         "{e}"
     );
 }
+
+#[test]
+fn a_cost_model_table_sets_the_automatic_choices_costs() {
+    let text =
+        format!("{VALID}\n[integrator.cost]\nnewton_tet = 2.5e-6\nexplicit_damped_factor = 1.5\n");
+    let scene = Scene::parse("scenes/ok.toml", text).unwrap();
+    let cost = scene.integrator.integrator().cost;
+    assert_eq!(cost.newton_tet, 2.5e-6);
+    assert_eq!(cost.explicit_damped_factor, 1.5);
+    let default = rapier_fvm::integrate::CostModel::default();
+    assert_eq!(
+        cost.explicit_tet, default.explicit_tet,
+        "unset keys keep the default"
+    );
+}
+
+#[test]
+fn a_negative_cost_is_refused() {
+    let line = VALID.lines().count() + 3;
+    let e = error(format!("{VALID}\n[integrator.cost]\nnewton_tet = -1e-6\n"));
+    assert_names(&e, line, "integrator.cost.newton_tet", "positive");
+}
+
+#[test]
+fn a_damping_cost_factor_below_one_is_refused() {
+    let line = VALID.lines().count() + 3;
+    let e = error(format!(
+        "{VALID}\n[integrator.cost]\nexplicit_damped_factor = 0.5\n"
+    ));
+    assert_names(
+        &e,
+        line,
+        "integrator.cost.explicit_damped_factor",
+        "at least 1",
+    );
+}

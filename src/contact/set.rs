@@ -29,14 +29,32 @@ impl ContactSet {
         }
     }
 
-    /// Whether the set holds self-contacts or rigid corners, for which the automatic integrator
-    /// keeps the explicit one (its cost model does not price their implicit terms).
-    pub(crate) fn needs_explicit(&self) -> bool {
-        !self.corners.is_empty()
-            || self
-                .nodes
-                .iter()
-                .any(|c| matches!(c.obstacle, Obstacle::OwnTriangle(_)))
+    /// The contact points in the set: surface points against colliders and the body itself,
+    /// and rigid corners against its triangles.
+    pub(crate) fn point_count(&self) -> usize {
+        self.nodes.len() + self.corners.len()
+    }
+
+    /// Whether the set holds self-contacts or rigid corners: contacts that couple several of
+    /// the body's nodes (a triangle's), so that one explicit sweep does not solve them.
+    pub(crate) fn couples_nodes(&self) -> bool {
+        !self.corners.is_empty() || self.has_self_contacts()
+    }
+
+    /// How deep (m) the deepest surface point lay behind its collider's plane when the
+    /// contacts were found (zero when none did).
+    pub(crate) fn deepest_found(&self) -> f64 {
+        (self.nodes.iter())
+            .filter(|c| matches!(c.obstacle, Obstacle::Collider { .. }))
+            .map(|c| -c.gap(c.detected_at))
+            .fold(0.0, f64::max)
+    }
+
+    /// Whether the set holds self-contacts (points against the body's own triangles).
+    pub(crate) fn has_self_contacts(&self) -> bool {
+        self.nodes
+            .iter()
+            .any(|c| matches!(c.obstacle, Obstacle::OwnTriangle(_)))
     }
 
     /// Whether a surface point of `body` is behind its collider contact's plane by more than

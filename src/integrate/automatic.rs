@@ -1,14 +1,10 @@
 //! Automatic choice between explicit and implicit integration: for each frame, the cost of the
-//! explicit substeps the stability limit requires is compared with the cost of an implicit step,
-//! and the cheaper is taken. Explicit integration is preferred at equal cost: it has no numerical
-//! damping.
-//!
-//! The costs per tetrahedron were measured on this crate's development machine (one core of a
-//! 2-core AMD EPYC, undamped beams of 50 to 25 600 tetrahedra): an explicit substep costs about
-//! 20 ns per tetrahedron (90 ns for the corotated model, whose polar decomposition dominates;
-//! damping adds about half), an implicit Newton iteration about 6 µs (7 µs), and an implicit frame
-//! takes about 3.5 Newton iterations. Only their ratio matters for the choice.
+//! explicit substeps the stability limit requires (with the body's contacts) is compared with
+//! the cost of an implicit step (with the body's own Newton iterations), both predicted by the
+//! [`CostModel`] measured on the machine, and the cheaper is taken. Explicit integration is
+//! preferred at equal cost: it has no numerical damping.
 
+use super::cost::{CostModel, Workload};
 use super::{
     BodyInStep, ImplicitIntegrator, ImplicitReport, SolverWorkspace, StepReport, SymplecticEuler,
 };
@@ -16,27 +12,13 @@ use crate::Error;
 use crate::body::DeformableBody;
 use crate::constraint::BodyConstraints;
 use crate::contact::{BetweenContact, ContactSettings};
-use crate::material::MaterialModel;
 use rapier3d::glamx::DVec3;
+use std::time::Instant;
 
-/// Seconds per tetrahedron per explicit substep, for the model.
-fn explicit_cost_per_tet(model: MaterialModel) -> f64 {
-    match model {
-        MaterialModel::Corotated => 90e-9,
-        _ => 20e-9,
-    }
-}
-
-/// Seconds per tetrahedron per Newton iteration, for the model.
-fn newton_cost_per_tet(model: MaterialModel) -> f64 {
-    match model {
-        MaterialModel::Corotated => 7e-6,
-        _ => 6e-6,
-    }
-}
-
-/// Newton iterations an implicit frame typically takes.
-const NEWTON_ITERATIONS_PER_FRAME: f64 = 3.5;
+/// Newton iterations per substep an implicit frame the automatic choice took is given at least
+/// before it is handed to the explicit integrator (see [`AutomaticIntegrator::implicit_for`]):
+/// smooth motion takes one to three, an impact or a change of contacts up to about ten.
+const NEWTON_BUDGET_FLOOR: usize = 10;
 
 /// Which integrator advanced a frame.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -56,6 +38,10 @@ pub enum IntegratorKind {
 pub struct CostPrediction {
     /// Substeps the explicit stability limit requires.
     pub explicit_substeps: f64,
+    /// Contact points the explicit substeps sweep (those found at the frame's start).
+    pub contact_points: usize,
+    /// Newton iterations per implicit substep expected (the body's recent mean).
+    pub newton_iterations: f64,
     /// Predicted time of the explicit frame (s).
     pub explicit_seconds: f64,
     /// Predicted time of the implicit frame (s).
@@ -84,10 +70,17 @@ pub struct AutomaticReport {
     pub explicit: Option<StepReport>,
     /// The implicit frame's report, if implicit.
     pub implicit: Option<ImplicitReport>,
-    /// Whether the frame was chosen explicit but redone implicitly, because crushed elements
-    /// lowered the stability limit partway below what `max_substeps` allows, or the explicit
-    /// frame produced a non-finite state.
+    /// Whether the frame was redone with the other integrator than the one chosen: chosen
+    /// explicit, because crushed elements lowered the stability limit partway below what
+    /// `max_substeps` allows, or the explicit frame produced a non-finite state; chosen
+    /// implicit, because its Newton solve failed or it crushed an element even in the most
+    /// substeps it may take.
     pub fell_back: bool,
+    /// Wall-clock time the frame's integration took (s), prediction and contact detection
+    /// excluded; for bodies stepped together, the group's time shared in proportion to each
+    /// body's predicted cost with the integrator used. Measured, so it differs from run to run;
+    /// nothing in the step depends on it.
+    pub seconds: f64,
 }
 
 /// Picks, frame by frame, the cheaper of an explicit and an implicit integrator.
@@ -103,37 +96,67 @@ pub struct AutomaticIntegrator {
     pub implicit: ImplicitIntegrator,
     /// Forces one integrator instead of choosing.
     pub force: Option<IntegratorKind>,
+    /// The measured costs the choice compares.
+    pub cost: CostModel,
 }
 
 impl AutomaticIntegrator {
-    /// The predicted cost of a frame of `frame_dt` (s) for `body` with each integrator; an
-    /// invalid explicit setting predicts an infinite explicit cost.
+    /// The predicted cost of a frame of `frame_dt` (s) for `body` with each integrator, free of
+    /// contacts and before any implicit step; an invalid explicit setting predicts an infinite
+    /// explicit cost.
     pub fn predict(&self, body: &DeformableBody, frame_dt: f64) -> CostPrediction {
         let needed = self
             .explicit
             .needed_substeps(body, frame_dt)
             .unwrap_or(f64::INFINITY);
-        self.prediction(body, needed)
+        let work = self.workload(body, None, None);
+        self.prediction(&work, needed)
     }
 
-    /// The prediction for a frame whose explicit version takes `explicit_substeps`.
-    fn prediction(&self, body: &DeformableBody, explicit_substeps: f64) -> CostPrediction {
-        let tets = body.mesh().tet_count() as f64;
-        let model = body.material().model();
-        let implicit_frames = f64::from(self.implicit.substeps.max(1));
+    /// What the cost of a frame of `body` depends on, with its `constraints` (contacts) and
+    /// `workspace` (Newton history) where known.
+    fn workload(
+        &self,
+        body: &DeformableBody,
+        constraints: Option<&BodyConstraints>,
+        workspace: Option<&SolverWorkspace>,
+    ) -> Workload {
+        let (contact_points, sweeps) = constraints.map_or((0, 1), |c| {
+            let sweeps = if c.coupled() {
+                c.contacts.settings.velocity_iterations.max(1)
+            } else {
+                1
+            };
+            (c.contacts.point_count(), sweeps)
+        });
+        Workload {
+            tets: body.mesh().tet_count() as f64,
+            model: body.material().model(),
+            damped: body.damping.is_some(),
+            contact_points: contact_points as f64,
+            sweeps: f64::from(sweeps),
+            newton_iterations: workspace.map_or(self.cost.newton_iterations, |w| {
+                w.newton.or(self.cost.newton_iterations)
+            }),
+        }
+    }
+
+    /// The prediction for `work` whose explicit frame takes `explicit_substeps`.
+    fn prediction(&self, work: &Workload, explicit_substeps: f64) -> CostPrediction {
+        let implicit_substeps = f64::from(self.implicit.substeps.max(1));
         CostPrediction {
             explicit_substeps,
-            explicit_seconds: explicit_substeps * tets * explicit_cost_per_tet(model),
-            implicit_seconds: implicit_frames
-                * NEWTON_ITERATIONS_PER_FRAME
-                * tets
-                * newton_cost_per_tet(model),
+            contact_points: work.contact_points as usize,
+            newton_iterations: work.newton_iterations,
+            explicit_seconds: self.cost.explicit_seconds(work, explicit_substeps),
+            implicit_seconds: self.cost.implicit_seconds(work, implicit_substeps),
         }
     }
 
     /// Advances `body` by `frame_dt` (s) under gravity (m/s²) against its `constraints`, with
     /// `workspace` its solver caches, by the cheaper integrator (or the forced one); explicit
-    /// while the body has self-contacts or rigid corners against its surface.
+    /// while the body has self-contacts or corners of dynamic rigid bodies against its surface
+    /// (the implicit step exchanges angular momentum through them only approximately).
     ///
     /// # Errors
     /// [`Error::InvalidTimeStep`] for a non-positive or non-finite `frame_dt`, [`Error::NonFiniteInput`]
@@ -151,9 +174,11 @@ impl AutomaticIntegrator {
         Error::check_step(frame_dt, gravity)?;
         // The stability limit is evaluated once and serves both the prediction and the step.
         let needed = self.explicit.needed_substeps(body, frame_dt)?;
-        let prediction = self.prediction(body, needed);
-        // Self-contacts and rigid corners keep the explicit integrator: the cost model does not
-        // price their implicit terms (a forced implicit step solves them).
+        let prediction = self.prediction(
+            &self.workload(body, Some(constraints), Some(workspace)),
+            needed,
+        );
+        let started = Instant::now();
         let choice = self.force.unwrap_or_else(|| {
             if constraints.needs_explicit_contacts() {
                 IntegratorKind::Explicit
@@ -161,66 +186,170 @@ impl AutomaticIntegrator {
                 prediction.cheaper()
             }
         });
-        let explicit = match choice {
-            IntegratorKind::Explicit => {
-                let mut step = BodyInStep {
-                    body,
-                    constraints,
-                    workspace,
-                };
-                Some(self.explicit.advance(&mut step, frame_dt, gravity, needed))
-            }
-            IntegratorKind::Implicit => None,
+        let mut step = BodyInStep {
+            body,
+            constraints,
+            workspace,
         };
-        let (explicit, fell_back) = self.explicit_outcome(explicit)?;
-        let implicit = match explicit {
-            Some(_) => None,
-            None => Some(
-                self.implicit
-                    .step(body, constraints, workspace, frame_dt, gravity)?,
-            ),
+        let explicit_frame =
+            |step: &mut BodyInStep<'_>| self.explicit.advance(step, frame_dt, gravity, needed);
+        let implicit_frame = |step: &mut BodyInStep<'_>, implicit: &ImplicitIntegrator| {
+            let outcome = implicit.step(
+                step.body,
+                step.constraints,
+                step.workspace,
+                frame_dt,
+                gravity,
+            );
+            step.workspace.newton.record_outcome(&outcome, implicit);
+            outcome
         };
+        let (explicit, implicit, fell_back) = self.with_fallback(
+            (choice, &prediction),
+            &mut step,
+            explicit_frame,
+            implicit_frame,
+        )?;
+        if explicit.is_some() {
+            step.workspace.newton.forget(self.cost.newton_iterations);
+        }
         Ok(AutomaticReport {
-            choice: if fell_back {
-                IntegratorKind::Implicit
+            choice: if explicit.is_some() {
+                IntegratorKind::Explicit
             } else {
-                choice
+                IntegratorKind::Implicit
             },
             prediction,
             explicit,
             implicit,
             fell_back,
+            seconds: started.elapsed().as_secs_f64(),
         })
     }
 
-    /// What an explicit frame (if one ran) leaves: its report, and whether the frame must be
-    /// redone implicitly because it would take too many substeps or gave a non-finite state
-    /// (the explicit integrator then left the bodies as they were), unless a choice is forced.
-    ///
-    /// # Errors
-    /// The explicit frame's other errors, and those two when explicit is forced.
-    fn explicit_outcome<T>(
-        &self,
-        explicit: Option<Result<T, Error>>,
-    ) -> Result<(Option<T>, bool), Error> {
-        match explicit {
-            Some(Ok(report)) => Ok((Some(report), false)),
-            Some(Err(Error::TooManySubsteps { .. } | Error::NonFiniteState { .. }))
-                if self.force.is_none() =>
-            {
-                Ok((None, true))
-            }
-            Some(Err(error)) => Err(error),
-            None => Ok((None, false)),
+    /// The implicit integrator a frame predicted as `prediction` runs with. Chosen, not forced,
+    /// while the explicit frame can be taken (within `max_substeps`), it gives the frame up to
+    /// the explicit integrator (see [`AutomaticIntegrator::with_fallback`]) as soon as it would
+    /// cost more than the explicit frame was predicted to: a failing frame is not refined, and
+    /// its substeps' Newton iterations stop at what the explicit frame's predicted time buys
+    /// (at least [`NEWTON_BUDGET_FLOOR`]). Forced, or where the explicit frame cannot be taken,
+    /// it is [`AutomaticIntegrator::implicit`] as set.
+    fn implicit_for(&self, prediction: &CostPrediction) -> ImplicitIntegrator {
+        let explicit_possible =
+            prediction.explicit_substeps <= f64::from(self.explicit.max_substeps);
+        if self.force.is_some() || !explicit_possible || prediction.implicit_seconds <= 0.0 {
+            return self.implicit;
+        }
+        let substeps = f64::from(self.implicit.substeps.max(1));
+        let per_iteration =
+            prediction.implicit_seconds / (prediction.newton_iterations.max(1.0) * substeps);
+        let affordable = (prediction.explicit_seconds / per_iteration / substeps).ceil();
+        ImplicitIntegrator {
+            max_refinement: 1,
+            max_newton_iterations: (affordable.min(usize::MAX as f64) as usize)
+                .max(NEWTON_BUDGET_FLOOR)
+                .min(self.implicit.max_newton_iterations),
+            ..self.implicit
         }
     }
 
+    /// Runs a frame of `target` (one body or a group) predicted as `prediction` with the
+    /// integrator `choice`, by `explicit` or `implicit` (which steps with the implicit
+    /// integrator it is given); unless a choice is forced, a frame the one cannot take is
+    /// redone by the other (each leaves the bodies as they were when it fails): an explicit
+    /// frame that would need more than `max_substeps` or gave a non-finite state, by
+    /// [`AutomaticIntegrator::implicit`] as set; an implicit frame, chosen, whose Newton solve,
+    /// factorization or contacts failed, or that crushed an element (a step too long to follow
+    /// an impact), within what [`AutomaticIntegrator::implicit_for`] allows. The explicit
+    /// report, the implicit report (one of them), and whether the frame was redone.
+    ///
+    /// # Errors
+    /// The error of the integrator that ran last; for a redone frame that failed again, the
+    /// first integrator's error.
+    fn with_fallback<T, E, I>(
+        &self,
+        (choice, prediction): (IntegratorKind, &CostPrediction),
+        target: &mut T,
+        mut explicit: impl FnMut(&mut T) -> Result<E, Error>,
+        mut implicit: impl FnMut(&mut T, &ImplicitIntegrator) -> Result<I, Error>,
+    ) -> Result<(Option<E>, Option<I>, bool), Error> {
+        let free = self.force.is_none();
+        match choice {
+            IntegratorKind::Explicit => match explicit(target) {
+                Ok(report) => Ok((Some(report), None, false)),
+                Err(Error::TooManySubsteps { .. } | Error::NonFiniteState { .. }) if free => {
+                    Ok((None, Some(implicit(target, &self.implicit)?), true))
+                }
+                Err(error) => Err(error),
+            },
+            IntegratorKind::Implicit => match implicit(target, &self.implicit_for(prediction)) {
+                Ok(report) => Ok((None, Some(report), false)),
+                Err(
+                    error @ (Error::NewtonDidNotConverge { .. }
+                    | Error::IndefiniteStiffness { .. }
+                    | Error::ContactNotResolved { .. }
+                    | Error::ElementCrushed { .. }),
+                ) if free => match explicit(target) {
+                    Ok(report) => Ok((Some(report), None, true)),
+                    Err(_) => Err(error),
+                },
+                Err(error) => Err(error),
+            },
+        }
+    }
+
+    /// The predictions for soft `bodies` stepping together with `between` contact points among
+    /// them, in order (the explicit substeps those of the stiffest body: the group takes the
+    /// shortest stable step), the group's (their sum), and the integrator for the group: the
+    /// forced one, else explicit. Measured on the showcase's stack (two soft blocks and a rigid
+    /// box, 1/240 s coupling substeps), the implicit group's Newton solve missed its tolerance
+    /// within ten iterations in 136 of 210 frames, at 1.8 ms per iteration for 270
+    /// tetrahedra, six times a lone body's: the cost model does not price it yet.
+    ///
+    /// # Errors
+    /// [`Error::InvalidSetting`] for an invalid explicit setting.
+    fn group_choice(
+        &self,
+        bodies: &[BodyInStep<'_>],
+        between: usize,
+        frame_dt: f64,
+    ) -> Result<(Vec<CostPrediction>, CostPrediction, IntegratorKind), Error> {
+        let mut needed = 1.0f64;
+        for step in bodies {
+            needed = needed.max(self.explicit.needed_substeps(step.body, frame_dt)?);
+        }
+        let works: Vec<Workload> = (bodies.iter())
+            .map(|s| self.workload(s.body, Some(s.constraints), Some(s.workspace)))
+            .collect();
+        let predictions: Vec<CostPrediction> =
+            works.iter().map(|w| self.prediction(w, needed)).collect();
+        let sweeps = works.iter().map(|w| w.sweeps).fold(1.0, f64::max);
+        let between_seconds = needed * between as f64 * sweeps * self.cost.explicit_contact_point;
+        let explicit =
+            between_seconds + predictions.iter().map(|p| p.explicit_seconds).sum::<f64>();
+        let total = CostPrediction {
+            explicit_substeps: needed,
+            contact_points: between + predictions.iter().map(|p| p.contact_points).sum::<usize>(),
+            newton_iterations: works
+                .iter()
+                .map(|w| w.newton_iterations)
+                .fold(0.0, f64::max),
+            explicit_seconds: explicit,
+            implicit_seconds: predictions.iter().map(|p| p.implicit_seconds).sum(),
+        };
+        Ok((
+            predictions,
+            total,
+            self.force.unwrap_or(IntegratorKind::Explicit),
+        ))
+    }
+
     /// Advances soft `bodies` touching each other through `between` (indices into `bodies`)
-    /// by `frame_dt` (s) together, with `settings` for the contacts between them: forced
-    /// implicit, as one implicit system; otherwise explicitly, their contacts solved in the
-    /// explicit sweeps with both bodies' nodes, and, unless explicit is forced, redone as one
-    /// implicit system when the explicit frame would take more than `max_substeps` or gave a
-    /// non-finite state. A report per body, in order.
+    /// by `frame_dt` (s) together, with `settings` for the contacts between them, by the
+    /// integrator [`AutomaticIntegrator::group_choice`] picks: implicit as one system; explicit
+    /// with their contacts solved in the explicit sweeps with both bodies' nodes, and, unless
+    /// explicit is forced, redone as one implicit system when the explicit frame would take
+    /// more than `max_substeps` or gave a non-finite state. A report per body, in order.
     ///
     /// # Errors
     /// Those of [`SymplecticEuler::step`] or [`ImplicitIntegrator::step`], whichever ran last;
@@ -232,41 +361,80 @@ impl AutomaticIntegrator {
         frame_dt: f64,
         gravity: DVec3,
     ) -> Result<Vec<AutomaticReport>, Error> {
-        let predictions: Vec<CostPrediction> = bodies
-            .iter()
-            .map(|step| self.predict(step.body, frame_dt))
-            .collect();
-        let explicit = match self.force {
-            Some(IntegratorKind::Implicit) => None,
-            _ => Some(
-                self.explicit
-                    .step_together(bodies, between, frame_dt, gravity),
-            ),
+        let (predictions, total, choice) = self.group_choice(bodies, between.len(), frame_dt)?;
+        let started = Instant::now();
+        type Group<'g, 'b> = (&'g mut [BodyInStep<'b>], &'g mut [BetweenContact]);
+        let explicit_frame = |(bodies, between): &mut Group<'_, '_>| {
+            self.explicit
+                .step_together(bodies, between, frame_dt, gravity)
         };
-        let (explicit, fell_back) = self.explicit_outcome(explicit)?;
-        let reports: Vec<(Option<StepReport>, Option<ImplicitReport>)> = match explicit {
-            Some(reports) => reports.into_iter().map(|r| (Some(r), None)).collect(),
-            None => self
-                .implicit
-                .step_together(bodies, between, settings, (frame_dt, gravity))?
-                .into_iter()
+        let implicit_frame = |(bodies, between): &mut Group<'_, '_>,
+                              implicit: &ImplicitIntegrator| {
+            let outcome = implicit.step_together(bodies, between, settings, (frame_dt, gravity));
+            for (n, step) in bodies.iter_mut().enumerate() {
+                let own = outcome
+                    .as_ref()
+                    .map(|reports| reports[n])
+                    .map_err(Clone::clone);
+                step.workspace.newton.record_outcome(&own, implicit);
+            }
+            outcome
+        };
+        let mut group: Group<'_, '_> = (&mut *bodies, &mut *between);
+        let (explicit, implicit, fell_back) =
+            self.with_fallback((choice, &total), &mut group, explicit_frame, implicit_frame)?;
+        let reports: Vec<(Option<StepReport>, Option<ImplicitReport>)> = match (explicit, implicit)
+        {
+            (Some(reports), _) => {
+                for step in bodies.iter_mut() {
+                    step.workspace.newton.forget(self.cost.newton_iterations);
+                }
+                reports.into_iter().map(|r| (Some(r), None)).collect()
+            }
+            (None, reports) => (reports.unwrap_or_default().into_iter())
                 .map(|r| (None, Some(r)))
                 .collect(),
         };
-        Ok(reports
-            .into_iter()
-            .zip(predictions)
-            .map(|((explicit, implicit), prediction)| AutomaticReport {
-                choice: if explicit.is_some() {
-                    IntegratorKind::Explicit
-                } else {
-                    IntegratorKind::Implicit
+        let explicit_used = reports.first().is_some_and(|(e, _)| e.is_some());
+        let seconds = shares(started.elapsed().as_secs_f64(), &predictions, explicit_used);
+        Ok((reports.into_iter().zip(predictions).zip(seconds))
+            .map(
+                |(((explicit, implicit), prediction), seconds)| AutomaticReport {
+                    choice: if explicit.is_some() {
+                        IntegratorKind::Explicit
+                    } else {
+                        IntegratorKind::Implicit
+                    },
+                    prediction,
+                    explicit,
+                    implicit,
+                    fell_back,
+                    seconds,
                 },
-                prediction,
-                explicit,
-                implicit,
-                fell_back,
-            })
+            )
             .collect())
     }
+}
+
+/// `seconds` a group's frame took, shared among its bodies in proportion to their `predictions`
+/// for the integrator used (explicit or not), equally where those are all zero.
+fn shares(seconds: f64, predictions: &[CostPrediction], explicit: bool) -> Vec<f64> {
+    let used = |p: &CostPrediction| {
+        if explicit {
+            p.explicit_seconds
+        } else {
+            p.implicit_seconds
+        }
+    };
+    let sum: f64 = predictions.iter().map(used).sum();
+    let count = predictions.len() as f64;
+    (predictions.iter())
+        .map(|p| {
+            if sum > 0.0 {
+                seconds * used(p) / sum
+            } else {
+                seconds / count
+            }
+        })
+        .collect()
 }

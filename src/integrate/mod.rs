@@ -5,6 +5,7 @@
 //! the workspace the solver's caches.
 
 mod automatic;
+mod cost;
 mod crush;
 mod explicit;
 mod implicit;
@@ -12,6 +13,7 @@ mod mesh_time_step;
 mod workspace;
 
 pub use automatic::{AutomaticIntegrator, AutomaticReport, CostPrediction, IntegratorKind};
+pub use cost::CostModel;
 pub use crush::COLLAPSE_RATIO;
 pub(crate) use crush::CrushWatch;
 pub use explicit::{COURANT_NUMBER, StepReport, Substeps, SymplecticEuler};

@@ -1,10 +1,12 @@
 //! What the integrators keep of a body between steps, beside the body itself: scratch forces,
 //! the nodal state saved before a step (restored if it fails), the state at the start of the
 //! last implicit step (for two-step schemes), the sparse tangent's pattern and symbolic
-//! factorization, and the chord method's last numeric factorization. None of it is the body's
+//! factorization, the chord method's last numeric factorization, and the body's mean Newton
+//! iterations (for the automatic choice). None of it is the body's
 //! state: an empty workspace steps a body to the same result, except that BDF2 restarts with a
 //! backward Euler step and the first Newton iteration refactors.
 
+use super::cost::NewtonHistory;
 use crate::assembly::Stiffness;
 use crate::body::DeformableBody;
 use crate::chord::Chord;
@@ -43,6 +45,8 @@ pub struct SolverWorkspace {
     pub(crate) tangent: Option<Stiffness>,
     /// The implicit integrator's last factorization, kept for reuse by the chord method.
     pub(crate) chord: Chord,
+    /// The body's Newton iterations per implicit substep, for the automatic choice's cost.
+    pub(crate) newton: NewtonHistory,
     /// Read back: the node pairs the tangent coupled beyond the mesh's, for its next build.
     #[cfg(feature = "serde-serialize")]
     pending_pairs: Vec<[u32; 2]>,
@@ -56,6 +60,8 @@ struct WorkspaceRecord {
     previous_step: Option<PreviousStep>,
     tangent_pairs: Vec<[u32; 2]>,
     chord: Chord,
+    #[serde(default)]
+    newton: NewtonHistory,
 }
 
 #[cfg(feature = "serde-serialize")]
@@ -70,6 +76,7 @@ impl From<SolverWorkspace> for WorkspaceRecord {
             previous_step: workspace.previous_step,
             tangent_pairs,
             chord: workspace.chord,
+            newton: workspace.newton,
         }
     }
 }
@@ -82,6 +89,7 @@ impl From<WorkspaceRecord> for SolverWorkspace {
             forces: vec![DVec3::ZERO; record.fitted.0],
             previous_step: record.previous_step,
             chord: record.chord,
+            newton: record.newton,
             pending_pairs: record.tangent_pairs,
             ..Self::default()
         }

@@ -20,6 +20,10 @@
 //! max_newton_iterations = 100 # implicit: per substep; a failed solve redoes the frame in more substeps
 //! reuse_factorization = true # implicit: reuse earlier factorizations while they converge fast
 //!
+//! [integrator.cost]          # the automatic choice's cost model: `rapier-fvm calibrate` prints
+//! explicit_tet = 32e-9       # the measured table for this machine (seconds per unit of work;
+//! newton_tet = 1e-6          # keys left out keep the library's CostModel::default)
+//!
 //! [output]
 //! save_every = 3             # frames between saved ParaView/OBJ frames (frame 0 always saved)
 //! pictures = [0.0, 1.0, 2.0] # times (s) of the rendered views; default: start, 1/3, 2/3, end
@@ -30,7 +34,8 @@
 use super::check::Checker;
 use rapier_fvm::contact::ContactSettings;
 use rapier_fvm::integrate::{
-    AutomaticIntegrator, ImplicitIntegrator, ImplicitScheme, IntegratorKind, SymplecticEuler,
+    AutomaticIntegrator, CostModel, ImplicitIntegrator, ImplicitScheme, IntegratorKind,
+    SymplecticEuler,
 };
 use serde::Deserialize;
 
@@ -133,6 +138,78 @@ pub struct IntegratorSpec {
     pub max_newton_iterations: Option<usize>,
     /// Implicit: whether Newton may reuse earlier factorizations (the chord method).
     pub reuse_factorization: Option<bool>,
+    /// The automatic choice's cost model.
+    #[serde(default)]
+    pub cost: CostSpec,
+}
+
+/// The automatic choice's cost model (see [`CostModel`]); unset keys keep its default.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CostSpec {
+    /// Seconds per tetrahedron per explicit substep.
+    pub explicit_tet: Option<f64>,
+    /// The same, corotated model.
+    pub explicit_tet_corotated: Option<f64>,
+    /// A damped tetrahedron's explicit cost over an undamped one's (at least 1).
+    pub explicit_damped_factor: Option<f64>,
+    /// Seconds per contact point per velocity sweep per explicit substep.
+    pub explicit_contact_point: Option<f64>,
+    /// Seconds per tetrahedron per Newton iteration.
+    pub newton_tet: Option<f64>,
+    /// The same, corotated model.
+    pub newton_tet_corotated: Option<f64>,
+    /// Newton iterations per implicit substep before a body has its own.
+    pub newton_iterations: Option<f64>,
+}
+
+impl CostSpec {
+    /// The library's cost model.
+    pub fn model(&self) -> CostModel {
+        let d = CostModel::default();
+        CostModel {
+            explicit_tet: self.explicit_tet.unwrap_or(d.explicit_tet),
+            explicit_tet_corotated: self
+                .explicit_tet_corotated
+                .unwrap_or(d.explicit_tet_corotated),
+            explicit_damped_factor: self
+                .explicit_damped_factor
+                .unwrap_or(d.explicit_damped_factor),
+            explicit_contact_point: self
+                .explicit_contact_point
+                .unwrap_or(d.explicit_contact_point),
+            newton_tet: self.newton_tet.unwrap_or(d.newton_tet),
+            newton_tet_corotated: self.newton_tet_corotated.unwrap_or(d.newton_tet_corotated),
+            newton_iterations: self.newton_iterations.unwrap_or(d.newton_iterations),
+        }
+    }
+
+    /// Checks every key given: finite, positive (the contact cost may be zero), the damping
+    /// factor at least 1.
+    fn check(&self, c: &mut Checker<'_>) {
+        if let Some(value) = self.explicit_contact_point {
+            c.non_negative("integrator.cost.explicit_contact_point", value, "s");
+        }
+        for (key, value) in [
+            ("explicit_tet", self.explicit_tet),
+            ("explicit_tet_corotated", self.explicit_tet_corotated),
+            ("newton_tet", self.newton_tet),
+            ("newton_tet_corotated", self.newton_tet_corotated),
+            ("newton_iterations", self.newton_iterations),
+        ] {
+            if let Some(value) = value {
+                c.positive(&format!("integrator.cost.{key}"), value, "s or iterations");
+            }
+        }
+        if let Some(f) = self.explicit_damped_factor
+            && !(f.is_finite() && f >= 1.0)
+        {
+            c.fail(
+                "integrator.cost.explicit_damped_factor",
+                format!("must be a finite number of at least 1, got {f}"),
+            );
+        }
+    }
 }
 
 impl IntegratorSpec {
@@ -166,10 +243,12 @@ impl IntegratorSpec {
                 IntegratorChoice::Explicit => Some(IntegratorKind::Explicit),
                 IntegratorChoice::Implicit => Some(IntegratorKind::Implicit),
             },
+            cost: self.cost.model(),
         }
     }
 
     pub(crate) fn check(&self, c: &mut Checker<'_>) {
+        self.cost.check(c);
         if let Some(f) = self.safety_factor
             && !(f > 0.0 && f <= 1.0)
         {

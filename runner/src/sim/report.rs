@@ -106,8 +106,58 @@ pub struct SoftBodyReport {
     pub stability_flags: BodyFlags,
     /// Whether no flag was raised and no step failed.
     pub stable: bool,
+    /// What its steps cost: the automatic choice's predictions beside the measured time.
+    pub cost: StepCost,
     #[serde(skip)]
     explicit_substeps_sum: u64,
+}
+
+/// What a soft body's coupling substeps cost (the last of each frame, whose report the frame
+/// returns), means over the frames in ms: the automatic integrator's predictions
+/// ([`rapier_fvm::integrate::CostModel`]) of an explicit and an implicit step, its prediction
+/// for the integrator it used, and the time the integration measured.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct StepCost {
+    /// Predicted explicit step (ms).
+    pub predicted_explicit_ms: f64,
+    /// Predicted implicit step (ms).
+    pub predicted_implicit_ms: f64,
+    /// Predicted step of the integrator used (ms).
+    pub predicted_ms: f64,
+    /// Measured step (ms).
+    pub measured_ms: f64,
+    /// Measured over predicted.
+    pub measured_over_predicted: f64,
+    #[serde(skip)]
+    steps: f64,
+}
+
+impl StepCost {
+    /// Takes in a step's `report`.
+    fn record(&mut self, report: &AutomaticReport) {
+        let p = &report.prediction;
+        let used = match report.choice {
+            IntegratorKind::Explicit => p.explicit_seconds,
+            IntegratorKind::Implicit => p.implicit_seconds,
+        };
+        let mean = |mean: &mut f64, seconds: f64, steps: f64| {
+            *mean += (seconds * 1e3 - *mean) / steps;
+        };
+        self.steps += 1.0;
+        mean(
+            &mut self.predicted_explicit_ms,
+            p.explicit_seconds,
+            self.steps,
+        );
+        mean(
+            &mut self.predicted_implicit_ms,
+            p.implicit_seconds,
+            self.steps,
+        );
+        mean(&mut self.predicted_ms, used, self.steps);
+        mean(&mut self.measured_ms, report.seconds, self.steps);
+        self.measured_over_predicted = self.measured_ms / self.predicted_ms;
+    }
 }
 
 /// A rigid body's name and kind.
@@ -318,6 +368,7 @@ impl SoftBodyReport {
     ) {
         match outcome {
             Ok(report) => {
+                self.cost.record(report);
                 match report.choice {
                     IntegratorKind::Explicit => self.explicit_frames += 1,
                     IntegratorKind::Implicit => self.implicit_frames += 1,

@@ -12,8 +12,8 @@
 use super::potential::Potential;
 use super::rigid_response::{Placement, RigidResponse};
 use super::{
-    CrushWatch, ImplicitIntegrator, ImplicitReport, MAX_REFINEMENT, Outcome, STIFFENING_ROUNDS,
-    Stop, end_substep, on_round_off_floor, refinable,
+    CrushWatch, ImplicitIntegrator, ImplicitReport, Outcome, STIFFENING_ROUNDS, Stop, end_substep,
+    on_round_off_floor, refinable,
 };
 use crate::Error;
 use crate::assembly::Stiffness;
@@ -275,7 +275,7 @@ impl ImplicitIntegrator {
         Error::check_step(frame_dt, gravity)?;
         self.check()?;
         let watches: Vec<CrushWatch> = bodies.iter().map(|s| CrushWatch::new(s.body)).collect();
-        let limit = self.substeps.saturating_mul(MAX_REFINEMENT);
+        let limit = self.substeps.saturating_mul(self.max_refinement);
         let mut refined = *self;
         loop {
             let attempt = refined.attempt_together(

@@ -108,7 +108,8 @@ pub enum ImplicitScheme {
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(
     feature = "serde-serialize",
-    derive(serde::Serialize, serde::Deserialize)
+    derive(serde::Serialize, serde::Deserialize),
+    serde(default)
 )]
 pub struct ImplicitIntegrator {
     /// The time discretization.
@@ -128,9 +129,12 @@ pub struct ImplicitIntegrator {
     /// solve fails, that leaves a surface point behind its contact plane by more than half the
     /// thickness of the collider it touches (a fast body pressed past the middle of a thin wall,
     /// where the penalty of a long step is too soft to hold it), or that crushes an element, is
-    /// redone in twice as many, and so on up to [`MAX_REFINEMENT`] times as many, then refused:
-    /// the report's `substeps` says how many were taken.
+    /// redone in twice as many, and so on up to [`ImplicitIntegrator::max_refinement`] times as
+    /// many, then refused: the report's `substeps` says how many were taken.
     pub substeps: u32,
+    /// How many times [`ImplicitIntegrator::substeps`] a failing frame may be redone in, at
+    /// most (at least 1: 1 refuses it at once); default [`MAX_REFINEMENT`].
+    pub max_refinement: u32,
     /// How each Newton iteration's linear system is solved.
     pub linear_solver: LinearSolver,
     /// Whether Newton iterations solved by the direct method may reuse the Cholesky
@@ -155,6 +159,7 @@ impl Default for ImplicitIntegrator {
             tolerance: 1e-6,
             max_newton_iterations: 100,
             substeps: 1,
+            max_refinement: MAX_REFINEMENT,
             linear_solver: LinearSolver::Automatic,
             reuse_factorization: true,
         }
@@ -167,12 +172,13 @@ impl ImplicitIntegrator {
     /// A frame whose Newton solve fails (out of iterations, or no descent left, above the
     /// tolerance and off its round-off floor), or that leaves a surface point past the middle of
     /// the collider it touches, is redone in twice the substeps, and so on up to
-    /// [`MAX_REFINEMENT`] times [`ImplicitIntegrator::substeps`]; past that it is refused.
+    /// [`ImplicitIntegrator::max_refinement`] times [`ImplicitIntegrator::substeps`]; past that
+    /// it is refused.
     ///
     /// # Errors
     /// [`Error::InvalidTimeStep`] for a non-positive or non-finite `frame_dt`;
     /// [`Error::NonFiniteInput`] for a non-finite gravity; [`Error::InvalidSetting`] for zero
-    /// substeps, a non-positive tolerance, zero Newton iterations or an invalid
+    /// substeps, a non-positive tolerance, zero `max_refinement`, zero Newton iterations or an invalid
     /// [`LinearSolver::ConjugateGradient`] setting;
     /// [`Error::IndefiniteStiffness`] if a linear system cannot be factored;
     /// [`Error::NonFiniteState`] if the step produced a NaN; [`Error::NewtonDidNotConverge`] and
@@ -190,7 +196,7 @@ impl ImplicitIntegrator {
     ) -> Result<ImplicitReport, Error> {
         let before = workspace.previous_step.clone();
         let watch = CrushWatch::new(body);
-        let limit = self.substeps.saturating_mul(MAX_REFINEMENT);
+        let limit = self.substeps.saturating_mul(self.max_refinement);
         let mut refined = *self;
         loop {
             let attempt =
@@ -307,6 +313,13 @@ impl ImplicitIntegrator {
             });
         }
         check_tolerance(self.tolerance)?;
+        if self.max_refinement == 0 {
+            return Err(Error::InvalidSetting {
+                parameter: "max_refinement",
+                value: 0.0,
+                reason: "at least 1 is needed (1 refuses a failing frame at once)",
+            });
+        }
         if self.max_newton_iterations == 0 {
             return Err(Error::InvalidSetting {
                 parameter: "max_newton_iterations",

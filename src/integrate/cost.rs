@@ -1,0 +1,198 @@
+//! The predicted cost of a frame with each integrator, from constants measured on the machine
+//! that runs it (`rapier-fvm calibrate` measures them and prints them as a scene's
+//! `[integrator.cost]` table; [`CostModel::default`] holds those measured on the development
+//! machine):
+//!
+//! - explicit: `n (T c_tet d + P s c_point)`: the `n` substeps the stability limit needs, `T`
+//!   tetrahedra at `c_tet` each (the material model's), `d` the factor damping costs (1 when
+//!   undamped), and `P` contact points swept `s` times per substep at `c_point` each;
+//! - implicit: `k N T c_newton`: `k` substeps of `N` Newton iterations over `T` tetrahedra at
+//!   `c_newton` each (the material model's). `N` is the body's own mean over its recent implicit
+//!   frames ([`NewtonHistory`]), [`CostModel::newton_iterations`] until it has one.
+//!
+//! Only the ratio of the two predictions decides, so the constants need be right relative to
+//! each other on the machine at hand; a run's report gives each body's predictions beside its
+//! measured time per frame.
+
+use super::{ImplicitIntegrator, ImplicitReport};
+use crate::Error;
+use crate::material::MaterialModel;
+
+/// Seconds per unit of work of each integrator, measured on one machine (one core).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "serde-serialize",
+    derive(serde::Serialize, serde::Deserialize)
+)]
+pub struct CostModel {
+    /// Explicit: seconds per tetrahedron per substep (internal forces and the update), for the
+    /// linear, St. Venant–Kirchhoff and stable Neo-Hookean models.
+    pub explicit_tet: f64,
+    /// Explicit: seconds per tetrahedron per substep for the corotated model (its polar
+    /// decomposition per element).
+    pub explicit_tet_corotated: f64,
+    /// Explicit: how many times the cost of an undamped tetrahedron a damped one costs
+    /// (dimensionless, at least 1).
+    pub explicit_damped_factor: f64,
+    /// Explicit: seconds per contact point per velocity sweep per substep.
+    pub explicit_contact_point: f64,
+    /// Implicit: seconds per tetrahedron per Newton iteration (assembly, factorization or
+    /// reuse, solve, line search), for the linear, St. Venant–Kirchhoff and stable Neo-Hookean
+    /// models.
+    pub newton_tet: f64,
+    /// Implicit: seconds per tetrahedron per Newton iteration for the corotated model.
+    pub newton_tet_corotated: f64,
+    /// Implicit: Newton iterations per substep assumed for a body that has not yet taken an
+    /// implicit step.
+    pub newton_iterations: f64,
+}
+
+impl Default for CostModel {
+    /// Measured by `rapier-fvm calibrate` on the development machine (one core of a 2-core
+    /// Intel Xeon): see the README's "Choosing the integrator".
+    fn default() -> Self {
+        Self {
+            explicit_tet: 17e-9,
+            explicit_tet_corotated: 148e-9,
+            explicit_damped_factor: 1.36,
+            explicit_contact_point: 118e-9,
+            newton_tet: 1.0e-6,
+            newton_tet_corotated: 1.87e-6,
+            newton_iterations: 1.27,
+        }
+    }
+}
+
+/// What a frame's prediction needs to know of a body.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Workload {
+    /// Tetrahedra.
+    pub(crate) tets: f64,
+    /// The material model.
+    pub(crate) model: MaterialModel,
+    /// Whether the body is damped.
+    pub(crate) damped: bool,
+    /// Contact points (against colliders, the body itself, rigid corners and other bodies).
+    pub(crate) contact_points: f64,
+    /// Velocity sweeps per explicit substep.
+    pub(crate) sweeps: f64,
+    /// Newton iterations per implicit substep expected.
+    pub(crate) newton_iterations: f64,
+}
+
+impl CostModel {
+    /// Predicted seconds of an explicit frame of `substeps` for `work`.
+    pub(crate) fn explicit_seconds(&self, work: &Workload, substeps: f64) -> f64 {
+        let per_tet = match work.model {
+            MaterialModel::Corotated => self.explicit_tet_corotated,
+            _ => self.explicit_tet,
+        };
+        let damping = if work.damped {
+            self.explicit_damped_factor
+        } else {
+            1.0
+        };
+        let per_substep = work.tets * per_tet * damping
+            + work.contact_points * work.sweeps * self.explicit_contact_point;
+        substeps * per_substep
+    }
+
+    /// Predicted seconds of an implicit frame of `substeps` for `work`.
+    pub(crate) fn implicit_seconds(&self, work: &Workload, substeps: f64) -> f64 {
+        let per_tet = match work.model {
+            MaterialModel::Corotated => self.newton_tet_corotated,
+            _ => self.newton_tet,
+        };
+        substeps * work.newton_iterations * work.tets * per_tet
+    }
+}
+
+/// A body's Newton iterations per implicit substep, averaged over its recent implicit frames
+/// (each new frame weighs [`NewtonHistory::WEIGHT`]), and drawn back towards the cost model's
+/// assumption by each explicit frame (by [`NewtonHistory::FORGETTING`]), so that a body that
+/// left the implicit integrator after a few hard frames (an impact) tries it again once they are
+/// forgotten. The same run gives the same history, so the choices it drives repeat bit for bit.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(
+    feature = "serde-serialize",
+    derive(serde::Serialize, serde::Deserialize)
+)]
+pub(crate) struct NewtonHistory {
+    mean: Option<f64>,
+}
+
+impl NewtonHistory {
+    /// The weight of the newest frame in the mean.
+    const WEIGHT: f64 = 0.25;
+
+    /// The fraction of its distance to the assumption an explicit frame draws the mean back.
+    const FORGETTING: f64 = 1.0 / 16.0;
+
+    /// Takes in an implicit frame of `iterations` Newton iterations over `substeps`.
+    fn record(&mut self, iterations: usize, substeps: u32) {
+        let per_substep = iterations as f64 / f64::from(substeps.max(1));
+        self.mean = Some(match self.mean {
+            Some(mean) => mean + Self::WEIGHT * (per_substep - mean),
+            None => per_substep,
+        });
+    }
+
+    /// Takes in an implicit frame's `outcome` by `integrator`: its iterations, or for a frame
+    /// it could not take, every iteration it was allowed (what the attempt cost).
+    pub(crate) fn record_outcome(
+        &mut self,
+        outcome: &Result<ImplicitReport, Error>,
+        integrator: &ImplicitIntegrator,
+    ) {
+        match outcome {
+            Ok(report) => self.record(report.newton_iterations, report.substeps),
+            Err(_) => self.record(integrator.max_newton_iterations, 1),
+        }
+    }
+
+    /// Takes in an explicit frame: the mean moves towards `assumed`.
+    pub(crate) fn forget(&mut self, assumed: f64) {
+        if let Some(mean) = &mut self.mean {
+            *mean += Self::FORGETTING * (assumed - *mean);
+        }
+    }
+
+    /// The mean, or `default` before any implicit frame.
+    pub(crate) fn or(&self, default: f64) -> f64 {
+        self.mean.unwrap_or(default)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_history_is_an_exponential_mean_drawn_back_by_explicit_frames() {
+        // Closed form: 4 per substep, then 8 → 4 + (8 − 4)/4 = 5; an explicit frame → 5 + (1 −
+        // 5)/16 = 4.75; a refused frame of budget 20 → 4.75 + (20 − 4.75)/4 = 8.5625.
+        let mut history = NewtonHistory::default();
+        assert_eq!(history.or(1.0), 1.0);
+        history.forget(1.0);
+        assert_eq!(
+            history.or(1.0),
+            1.0,
+            "nothing to forget before an implicit frame"
+        );
+        history.record(8, 2);
+        history.record(8, 1);
+        assert_eq!(history.or(1.0), 5.0);
+        history.forget(1.0);
+        assert_eq!(history.or(1.0), 4.75);
+        let integrator = ImplicitIntegrator {
+            max_newton_iterations: 20,
+            ..ImplicitIntegrator::default()
+        };
+        let refused = Err(Error::NewtonDidNotConverge {
+            residual: 1.0,
+            substeps: 1,
+        });
+        history.record_outcome(&refused, &integrator);
+        assert_eq!(history.or(1.0), 8.5625);
+    }
+}

@@ -1,0 +1,123 @@
+//! The automatic choice between the explicit and the implicit integrator: the cost it predicts
+//! is the cost model's formula with the body's contacts and its own Newton iterations, the
+//! cheaper integrator is taken, and a frame the implicit integrator cannot take within what the
+//! explicit frame would have cost is handed to the explicit one.
+
+use rapier_fvm::integrate::{AutomaticReport, CostModel, IntegratorKind};
+use rapier_fvm::prelude::*;
+use rapier_fvm::world::FvmWorld;
+use rapier3d::prelude::{ColliderBuilder, SharedShape, Vector};
+
+/// A 10 cm cube of 4 cells a side (320 tetrahedra), E = 1e5 Pa, ν = 0.3, 1000 kg/m³, its
+/// bottom `gap` (m) above the ground, damped (2 ms) or not.
+fn cube(gap: f64, damped: bool) -> DeformableBody {
+    let material = Material::new(MaterialModel::StableNeoHookean, 1e5, 0.3, 1000.0).unwrap();
+    let mut builder =
+        DeformableBodyBuilder::new(mesh::cuboid(DVec3::splat(0.05), [4; 3]).unwrap(), material)
+            .translation(DVec3::new(0.0, 0.05 + gap, 0.0));
+    if damped {
+        builder = builder
+            .damping(RayleighDamping::stiffness_proportional(2e-3, material.lame()).unwrap());
+    }
+    builder.build().unwrap()
+}
+
+/// A world with a ground (friction 0.5) holding `body`, one coupling substep per frame.
+fn world_with(body: DeformableBody) -> (FvmWorld, DeformableBodyHandle) {
+    let mut world = FvmWorld::default();
+    world.coupling.substeps = 1;
+    world.physics.insert_collider(
+        ColliderBuilder::new(SharedShape::halfspace(Vector::Y)).friction(0.5),
+        None,
+    );
+    let handle = world.soft_bodies.insert(body);
+    (world, handle)
+}
+
+/// Steps `world` one frame and returns `handle`'s report.
+fn step(world: &mut FvmWorld, handle: DeformableBodyHandle) -> AutomaticReport {
+    let results = world.step();
+    let (_, outcome) = results.into_iter().find(|(h, _)| *h == handle).unwrap();
+    outcome.unwrap()
+}
+
+#[test]
+fn the_prediction_is_the_cost_models_formula_and_the_cheaper_integrator_is_taken() {
+    // A damped cube resting on the ground, 60 frames: each frame's prediction must be the cost
+    // model's formula (explicit: n (T c d + P s c_p); implicit: k N T c_N) to round-off (1e-12
+    // relative), with the contacts counted, and the integrator taken the cheaper one.
+    let (mut world, handle) = world_with(cube(0.0, true));
+    let cost = CostModel::default();
+    let tets = world.soft_bodies[handle].mesh().tet_count() as f64;
+    let (mut implicit_frames, mut touched) = (0, 0);
+    for _ in 0..60 {
+        let report = step(&mut world, handle);
+        let p = report.prediction;
+        // Against a fixed ground, one velocity sweep per substep.
+        let explicit = p.explicit_substeps
+            * (tets * cost.explicit_tet * cost.explicit_damped_factor
+                + p.contact_points as f64 * cost.explicit_contact_point);
+        let implicit = p.newton_iterations * tets * cost.newton_tet;
+        assert!((p.explicit_seconds - explicit).abs() <= 1e-12 * explicit);
+        assert!((p.implicit_seconds - implicit).abs() <= 1e-12 * implicit);
+        assert_eq!(report.choice, p.cheaper());
+        touched += usize::from(p.contact_points > 0);
+        implicit_frames += usize::from(report.choice == IntegratorKind::Implicit);
+    }
+    println!("{implicit_frames} of 60 frames implicit, {touched} with contacts");
+    assert_eq!(
+        touched, 60,
+        "the resting cube's bottom is in contact every frame"
+    );
+    assert!(implicit_frames > 0);
+}
+
+#[test]
+fn an_undamped_cube_falling_free_is_stepped_explicitly() {
+    // Undamped, E = 1e5 Pa, 2.5 cm cells: a few tens of explicit substeps per 1/60 s frame cost
+    // less than one Newton iteration over the 320 tetrahedra (by the cost model's constants).
+    let (mut world, handle) = world_with(cube(1.0, false));
+    for _ in 0..10 {
+        let report = step(&mut world, handle);
+        let p = report.prediction;
+        println!(
+            "explicit {:.0} substeps {:.3} ms, implicit {:.3} ms",
+            p.explicit_substeps,
+            p.explicit_seconds * 1e3,
+            p.implicit_seconds * 1e3
+        );
+        assert!(p.explicit_seconds < p.implicit_seconds);
+        assert_eq!(report.choice, IntegratorKind::Explicit);
+    }
+}
+
+#[test]
+fn a_frame_the_implicit_integrator_cannot_take_is_handed_to_the_explicit_one() {
+    // A cube dropped 2 cm onto the ground, the cost model making the implicit frame look cheaper
+    // (explicit tetrahedra priced at 1 ms) and the implicit integrator allowed one Newton
+    // iteration: the landing frames cannot converge in one, so they are redone explicitly
+    // (reported explicit and fallen back); the body ends every frame in a finite state and
+    // lands on the ground (its lowest node within 1 mm of it after 0.5 s, the contact margin's
+    // order).
+    let (mut world, handle) = world_with(cube(0.02, true));
+    world.coupling.integrator.cost.explicit_tet = 1e-3;
+    world.coupling.integrator.implicit.max_newton_iterations = 1;
+    let mut handed = 0;
+    for _ in 0..30 {
+        let report = step(&mut world, handle);
+        assert!(report.prediction.implicit_seconds < report.prediction.explicit_seconds);
+        if report.fell_back {
+            assert_eq!(report.choice, IntegratorKind::Explicit);
+            assert!(report.explicit.is_some() && report.implicit.is_none());
+            handed += 1;
+        }
+        let body = &world.soft_bodies[handle];
+        assert!(body.positions().iter().all(|x| x.is_finite()));
+    }
+    let lowest = (world.soft_bodies[handle].positions().iter())
+        .map(|x| x.y)
+        .fold(f64::INFINITY, f64::min);
+    println!("{handed} of 30 frames handed to the explicit integrator; lowest node {lowest:.2e} m");
+    assert!(handed > 0);
+    assert!(lowest.abs() < 1e-3);
+}
