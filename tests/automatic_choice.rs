@@ -44,8 +44,9 @@ fn step(world: &mut FvmWorld, handle: DeformableBodyHandle) -> AutomaticReport {
 #[test]
 fn the_prediction_is_the_cost_models_formula_and_the_cheaper_integrator_is_taken() {
     // A damped cube resting on the ground, 60 frames: each frame's prediction must be the cost
-    // model's formula (explicit: n (T c d + P s c_p); implicit: k N T c_N) to round-off (1e-12
-    // relative), with the contacts counted, and the integrator taken the cheaper one.
+    // model's formula (explicit: n (T c d + P s c_p); implicit: k N T c_N (T/1000)^α) to
+    // round-off (1e-12 relative), with the contacts counted, and the integrator taken the
+    // cheaper one.
     let (mut world, handle) = world_with(cube(0.0, true));
     let cost = CostModel::default();
     let tets = world.soft_bodies[handle].mesh().tet_count() as f64;
@@ -57,7 +58,8 @@ fn the_prediction_is_the_cost_models_formula_and_the_cheaper_integrator_is_taken
         let explicit = p.explicit_substeps
             * (tets * cost.explicit_tet * cost.explicit_damped_factor
                 + p.contact_points as f64 * cost.explicit_contact_point);
-        let implicit = p.newton_iterations * tets * cost.newton_tet;
+        let size = (tets / 1000.0).powf(cost.newton_size_exponent);
+        let implicit = p.newton_iterations * tets * cost.newton_tet * size;
         assert!((p.explicit_seconds - explicit).abs() <= 1e-12 * explicit);
         assert!((p.implicit_seconds - implicit).abs() <= 1e-12 * implicit);
         assert_eq!(report.choice, p.cheaper());

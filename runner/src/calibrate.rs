@@ -8,7 +8,8 @@
 //! - dropped 2 cm onto the ground and left to settle, explicit: what the substeps cost beyond
 //!   their tetrahedra, per contact point (found at each frame's start) per substep;
 //! - the same drop, implicit: seconds per tetrahedron per Newton iteration for both models, and
-//!   the Newton iterations per step.
+//!   the Newton iterations per step; then with 16 cells a side (20 480 tetrahedra): how the
+//!   cost per tetrahedron grows with the body's size.
 //!
 //! Each time is the whole frame (rapier's step and contact detection included), the fastest of
 //! three runs, on the threads rayon is given. The result prints as a scene's `[integrator.cost]`
@@ -44,13 +45,14 @@ pub struct Sample {
 }
 
 /// A calibration case: the material model, damping, whether the cube drops onto the ground
-/// (else it spins free in zero gravity), and the integrator forced.
+/// (else it spins free in zero gravity), the integrator forced, and the cells a side.
 #[derive(Debug, Clone, Copy)]
 struct Case {
     model: MaterialModel,
     damped: bool,
     dropped: bool,
     force: IntegratorKind,
+    cells: usize,
 }
 
 /// Measures the cost model, printing each case's figures through `log`.
@@ -65,6 +67,7 @@ pub fn calibrate(mut log: impl FnMut(&str)) -> Result<CostModel, Error> {
         damped,
         dropped,
         force,
+        cells: 6,
     };
     let mut fastest = |c: Case, name: &str| -> Result<Sample, Error> {
         let mut best = measure(c)?;
@@ -107,17 +110,30 @@ pub fn calibrate(mut log: impl FnMut(&str)) -> Result<CostModel, Error> {
         case(Corotated, false, true, Implicit),
         "implicit, dropped, corotated",
     )?;
+    let larger = Case {
+        cells: 16,
+        ..case(StableNeoHookean, false, true, Implicit)
+    };
+    let newton_larger = fastest(larger, "implicit, dropped, 16 cells a side")?;
     let per_tet_substep = |s: &Sample| s.seconds / (s.tets * s.substeps);
     let explicit_tet = per_tet_substep(&free);
     let per_tet_iteration = |s: &Sample| s.seconds / (s.tets * s.newton_iterations);
     let contact_seconds = dropped.seconds - explicit_tet * dropped.tets * dropped.substeps;
+    // Per tetrahedron per iteration c (T/1000)^α at both sizes: α from their ratio, c at 1000.
+    let (small, large) = (
+        per_tet_iteration(&newton),
+        per_tet_iteration(&newton_larger),
+    );
+    let exponent = ((large / small).ln() / (newton_larger.tets / newton.tets).ln()).clamp(0.0, 1.0);
+    let at_thousand = |s: &Sample| per_tet_iteration(s) / (s.tets / 1000.0).powf(exponent);
     Ok(CostModel {
         explicit_tet,
         explicit_tet_corotated: per_tet_substep(&corotated),
         explicit_damped_factor: (per_tet_substep(&damped) / explicit_tet).max(1.0),
         explicit_contact_point: (contact_seconds / dropped.contact_substeps.max(1.0)).max(0.0),
-        newton_tet: per_tet_iteration(&newton),
-        newton_tet_corotated: per_tet_iteration(&newton_corotated),
+        newton_tet: at_thousand(&newton),
+        newton_size_exponent: exponent,
+        newton_tet_corotated: at_thousand(&newton_corotated),
         newton_iterations: newton.newton_iterations / newton.implicit_substeps.max(1.0),
     })
 }
@@ -148,7 +164,12 @@ pub fn as_toml(cost: &CostModel) -> String {
         (
             "newton_tet",
             cost.newton_tet,
-            "s per tetrahedron per Newton iteration",
+            "s per tetrahedron per Newton iteration at 1000 tetrahedra",
+        ),
+        (
+            "newton_size_exponent",
+            cost.newton_size_exponent,
+            "per-tetrahedron Newton cost grows as (T/1000)^this",
         ),
         (
             "newton_tet_corotated",
@@ -186,7 +207,7 @@ fn measure(case: Case) -> Result<Sample, Error> {
     }
     let material = Material::new(case.model, 1e5, 0.3, 1000.0)?;
     let mut builder =
-        DeformableBodyBuilder::new(mesh::cuboid(DVec3::splat(half), [6; 3])?, material)
+        DeformableBodyBuilder::new(mesh::cuboid(DVec3::splat(half), [case.cells; 3])?, material)
             .translation(translation);
     if case.damped {
         builder = builder.damping(RayleighDamping::stiffness_proportional(

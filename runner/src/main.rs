@@ -30,9 +30,10 @@ enum Command {
     ///
     /// Steps the scene frame by frame (progress bar on stderr when it is a terminal), then
     /// writes into the output folder: report.json (settings used, tets and nodes per body,
-    /// integrator choices, wall time and ms per frame, stability flags, every probe as a time
-    /// series with its final value); paraview/<scene>.pvd with a .vtu per soft body per saved
-    /// frame (displacement, velocity, Cauchy and von Mises stress); obj/surface_<frame>.obj
+    /// integrator choices, each body's predicted and measured step cost, wall time and ms per
+    /// frame, stability flags, every probe as a time series with its final value);
+    /// paraview/<scene>.pvd with a .vtu per soft body per saved frame (displacement,
+    /// velocity, Cauchy and von Mises stress); obj/surface_<frame>.obj
     /// (every body's surface, for Blender); pictures/view_<frame>.png and
     /// pictures/stress_<frame>.png (rendered views coloured by material and by von Mises
     /// stress); plots/<probe>.png (each probe against time). Prints a summary on stdout.

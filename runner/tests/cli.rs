@@ -124,8 +124,8 @@ fn a_short_run_succeeds_and_prints_a_summary() {
 fn calibrate_prints_a_cost_table_a_scene_reads() {
     // The measured values differ from machine to machine and run to run; what is checked is
     // that the printed table is a scene's `[integrator.cost]`, read back to the printed digits,
-    // every value finite and positive (a contact point's cost may measure zero within the
-    // timer's noise), and the cases' progress on stderr.
+    // every value finite and positive (a contact point's cost and the size exponent may
+    // measure zero within the timer's noise), and the cases' progress on stderr.
     let output = rapier_fvm(&["calibrate"]);
     assert!(output.status.success());
     let table = String::from_utf8_lossy(&output.stdout);
@@ -159,6 +159,7 @@ fn calibrate_prints_a_cost_table_a_scene_reads() {
         ("explicit_damped_factor", cost.explicit_damped_factor),
         ("explicit_contact_point", cost.explicit_contact_point),
         ("newton_tet", cost.newton_tet),
+        ("newton_size_exponent", cost.newton_size_exponent),
         ("newton_tet_corotated", cost.newton_tet_corotated),
         ("newton_iterations", cost.newton_iterations),
     ] {

@@ -6,9 +6,11 @@
 //! - explicit: `n (T c_tet d + P s c_point)`: the `n` substeps the stability limit needs, `T`
 //!   tetrahedra at `c_tet` each (the material model's), `d` the factor damping costs (1 when
 //!   undamped), and `P` contact points swept `s` times per substep at `c_point` each;
-//! - implicit: `k N T c_newton`: `k` substeps of `N` Newton iterations over `T` tetrahedra at
-//!   `c_newton` each (the material model's). `N` is the body's own mean over its recent implicit
-//!   frames ([`NewtonHistory`]), [`CostModel::newton_iterations`] until it has one.
+//! - implicit: `k N T c_newton (T/1000)^α`: `k` substeps of `N` Newton iterations over `T`
+//!   tetrahedra at `c_newton` each at a thousand tetrahedra (the material model's), dearer per
+//!   tetrahedron in larger bodies by the exponent `α` (the sparse factorization's fill grows
+//!   faster than the mesh). `N` is the body's own mean over its recent implicit frames
+//!   ([`NewtonHistory`]), [`CostModel::newton_iterations`] until it has one.
 //!
 //! Only the ratio of the two predictions decides, so the constants need be right relative to
 //! each other on the machine at hand; a run's report gives each body's predictions beside its
@@ -37,9 +39,12 @@ pub struct CostModel {
     /// Explicit: seconds per contact point per velocity sweep per substep.
     pub explicit_contact_point: f64,
     /// Implicit: seconds per tetrahedron per Newton iteration (assembly, factorization or
-    /// reuse, solve, line search), for the linear, St. Venant–Kirchhoff and stable Neo-Hookean
-    /// models.
+    /// reuse, solve, line search) in a body of a thousand tetrahedra, for the linear, St.
+    /// Venant–Kirchhoff and stable Neo-Hookean models.
     pub newton_tet: f64,
+    /// Implicit: how the cost per tetrahedron of a Newton iteration grows with the body's
+    /// tetrahedra `T`, as `(T/1000)^α` (dimensionless, from 0 to 1).
+    pub newton_size_exponent: f64,
     /// Implicit: seconds per tetrahedron per Newton iteration for the corotated model.
     pub newton_tet_corotated: f64,
     /// Implicit: Newton iterations per substep assumed for a body that has not yet taken an
@@ -52,12 +57,13 @@ impl Default for CostModel {
     /// Intel Xeon): see the README's "Choosing the integrator".
     fn default() -> Self {
         Self {
-            explicit_tet: 17e-9,
-            explicit_tet_corotated: 148e-9,
-            explicit_damped_factor: 1.36,
-            explicit_contact_point: 118e-9,
-            newton_tet: 1.0e-6,
-            newton_tet_corotated: 1.87e-6,
+            explicit_tet: 19.0e-9,
+            explicit_tet_corotated: 164e-9,
+            explicit_damped_factor: 1.64,
+            explicit_contact_point: 138e-9,
+            newton_tet: 1.10e-6,
+            newton_size_exponent: 0.16,
+            newton_tet_corotated: 2.13e-6,
             newton_iterations: 1.27,
         }
     }
@@ -103,7 +109,8 @@ impl CostModel {
             MaterialModel::Corotated => self.newton_tet_corotated,
             _ => self.newton_tet,
         };
-        substeps * work.newton_iterations * work.tets * per_tet
+        let size = (work.tets / 1000.0).powf(self.newton_size_exponent);
+        substeps * work.newton_iterations * work.tets * per_tet * size
     }
 }
 

@@ -155,8 +155,10 @@ pub struct CostSpec {
     pub explicit_damped_factor: Option<f64>,
     /// Seconds per contact point per velocity sweep per explicit substep.
     pub explicit_contact_point: Option<f64>,
-    /// Seconds per tetrahedron per Newton iteration.
+    /// Seconds per tetrahedron per Newton iteration, at a thousand tetrahedra.
     pub newton_tet: Option<f64>,
+    /// The exponent of the per-tetrahedron Newton cost's growth with size, in [0, 1].
+    pub newton_size_exponent: Option<f64>,
     /// The same, corotated model.
     pub newton_tet_corotated: Option<f64>,
     /// Newton iterations per implicit substep before a body has its own.
@@ -179,13 +181,14 @@ impl CostSpec {
                 .explicit_contact_point
                 .unwrap_or(d.explicit_contact_point),
             newton_tet: self.newton_tet.unwrap_or(d.newton_tet),
+            newton_size_exponent: self.newton_size_exponent.unwrap_or(d.newton_size_exponent),
             newton_tet_corotated: self.newton_tet_corotated.unwrap_or(d.newton_tet_corotated),
             newton_iterations: self.newton_iterations.unwrap_or(d.newton_iterations),
         }
     }
 
     /// Checks every key given: finite, positive (the contact cost may be zero), the damping
-    /// factor at least 1.
+    /// factor at least 1, the size exponent in [0, 1].
     fn check(&self, c: &mut Checker<'_>) {
         if let Some(value) = self.explicit_contact_point {
             c.non_negative("integrator.cost.explicit_contact_point", value, "s");
@@ -200,6 +203,14 @@ impl CostSpec {
             if let Some(value) = value {
                 c.positive(&format!("integrator.cost.{key}"), value, "s or iterations");
             }
+        }
+        if let Some(a) = self.newton_size_exponent
+            && !(0.0..=1.0).contains(&a)
+        {
+            c.fail(
+                "integrator.cost.newton_size_exponent",
+                format!("must lie in [0, 1], got {a}"),
+            );
         }
         if let Some(f) = self.explicit_damped_factor
             && !(f.is_finite() && f >= 1.0)
