@@ -20,7 +20,8 @@ use super::{ImplicitIntegrator, ImplicitReport};
 use crate::Error;
 use crate::material::MaterialModel;
 
-/// Seconds per unit of work of each integrator, measured on one machine (one core).
+/// Seconds per unit of work of each integrator, measured on one machine (with the threads
+/// rayon is given there).
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(
     feature = "serde-serialize",
@@ -53,8 +54,8 @@ pub struct CostModel {
 }
 
 impl Default for CostModel {
-    /// Measured by `rapier-fvm calibrate` on the development machine (one core of a 2-core
-    /// Intel Xeon): see the README's "Choosing the integrator".
+    /// Measured by `rapier-fvm calibrate` on the development machine (two cores): see the
+    /// README's "Choosing the integrator".
     fn default() -> Self {
         Self {
             explicit_tet: 19.0e-9,
@@ -78,7 +79,8 @@ pub(crate) struct Workload {
     pub(crate) model: MaterialModel,
     /// Whether the body is damped.
     pub(crate) damped: bool,
-    /// Contact points (against colliders, the body itself, rigid corners and other bodies).
+    /// Contact points against colliders, the body's own triangles and rigid corners (those
+    /// with other soft bodies are counted for their group).
     pub(crate) contact_points: f64,
     /// Velocity sweeps per explicit substep.
     pub(crate) sweeps: f64,
