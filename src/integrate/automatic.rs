@@ -57,6 +57,14 @@ impl CostPrediction {
             IntegratorKind::Implicit
         }
     }
+
+    /// The predicted time (s) of the frame with `kind`.
+    pub fn seconds(&self, kind: IntegratorKind) -> f64 {
+        match kind {
+            IntegratorKind::Explicit => self.explicit_seconds,
+            IntegratorKind::Implicit => self.implicit_seconds,
+        }
+    }
 }
 
 /// What an automatic frame did and why.
@@ -213,18 +221,12 @@ impl AutomaticIntegrator {
         if explicit.is_some() {
             step.workspace.newton.forget(self.cost.newton_iterations);
         }
-        Ok(AutomaticReport {
-            choice: if explicit.is_some() {
-                IntegratorKind::Explicit
-            } else {
-                IntegratorKind::Implicit
-            },
+        Ok(AutomaticReport::of(
             prediction,
-            explicit,
-            implicit,
+            (explicit, implicit),
             fell_back,
-            seconds: started.elapsed().as_secs_f64(),
-        })
+            started.elapsed().as_secs_f64(),
+        ))
     }
 
     /// The implicit integrator a frame predicted as `prediction` runs with. Chosen, not forced,
@@ -324,7 +326,7 @@ impl AutomaticIntegrator {
         let predictions: Vec<CostPrediction> =
             works.iter().map(|w| self.prediction(w, needed)).collect();
         let sweeps = works.iter().map(|w| w.sweeps).fold(1.0, f64::max);
-        let between_seconds = needed * between as f64 * sweeps * self.cost.explicit_contact_point;
+        let between_seconds = self.cost.contact_seconds(between as f64, sweeps, needed);
         let explicit =
             between_seconds + predictions.iter().map(|p| p.explicit_seconds).sum::<f64>();
         let total = CostPrediction {
@@ -395,43 +397,52 @@ impl AutomaticIntegrator {
                 .map(|r| (None, Some(r)))
                 .collect(),
         };
-        let explicit_used = reports.first().is_some_and(|(e, _)| e.is_some());
-        let seconds = shares(started.elapsed().as_secs_f64(), &predictions, explicit_used);
+        let used = match reports.first() {
+            Some((Some(_), _)) => IntegratorKind::Explicit,
+            _ => IntegratorKind::Implicit,
+        };
+        let seconds = shares(started.elapsed().as_secs_f64(), &predictions, used);
         Ok((reports.into_iter().zip(predictions).zip(seconds))
-            .map(
-                |(((explicit, implicit), prediction), seconds)| AutomaticReport {
-                    choice: if explicit.is_some() {
-                        IntegratorKind::Explicit
-                    } else {
-                        IntegratorKind::Implicit
-                    },
-                    prediction,
-                    explicit,
-                    implicit,
-                    fell_back,
-                    seconds,
-                },
-            )
+            .map(|((frame, prediction), seconds)| {
+                AutomaticReport::of(prediction, frame, fell_back, seconds)
+            })
             .collect())
     }
 }
 
-/// `seconds` a group's frame took, shared among its bodies in proportion to their `predictions`
-/// for the integrator used (explicit or not), equally where those are all zero.
-fn shares(seconds: f64, predictions: &[CostPrediction], explicit: bool) -> Vec<f64> {
-    let used = |p: &CostPrediction| {
-        if explicit {
-            p.explicit_seconds
-        } else {
-            p.implicit_seconds
+impl AutomaticReport {
+    /// The report of a frame predicted as `prediction`, taken by the integrator whose report
+    /// `frame` holds (explicit, implicit), redone or not (`fell_back`), in `seconds`.
+    fn of(
+        prediction: CostPrediction,
+        (explicit, implicit): (Option<StepReport>, Option<ImplicitReport>),
+        fell_back: bool,
+        seconds: f64,
+    ) -> Self {
+        Self {
+            choice: if explicit.is_some() {
+                IntegratorKind::Explicit
+            } else {
+                IntegratorKind::Implicit
+            },
+            prediction,
+            explicit,
+            implicit,
+            fell_back,
+            seconds,
         }
-    };
-    let sum: f64 = predictions.iter().map(used).sum();
+    }
+}
+
+/// `seconds` a group's frame took, shared among its bodies in proportion to their `predictions`
+/// for the integrator `used`, equally where those are all zero.
+fn shares(seconds: f64, predictions: &[CostPrediction], used: IntegratorKind) -> Vec<f64> {
+    let sum: f64 = predictions.iter().map(|p| p.seconds(used)).sum();
     let count = predictions.len() as f64;
     (predictions.iter())
         .map(|p| {
             if sum > 0.0 {
-                seconds * used(p) / sum
+                seconds * p.seconds(used) / sum
             } else {
                 seconds / count
             }

@@ -100,9 +100,14 @@ impl CostModel {
         } else {
             1.0
         };
-        let per_substep = work.tets * per_tet * damping
-            + work.contact_points * work.sweeps * self.explicit_contact_point;
-        substeps * per_substep
+        substeps * work.tets * per_tet * damping
+            + self.contact_seconds(work.contact_points, work.sweeps, substeps)
+    }
+
+    /// Predicted seconds of sweeping `points` contact points `sweeps` times per explicit
+    /// substep over `substeps`.
+    pub(crate) fn contact_seconds(&self, points: f64, sweeps: f64, substeps: f64) -> f64 {
+        substeps * points * sweeps * self.explicit_contact_point
     }
 
     /// Predicted seconds of an implicit frame of `substeps` for `work`.

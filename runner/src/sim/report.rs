@@ -136,10 +136,7 @@ impl StepCost {
     /// Takes in a step's `report`.
     fn record(&mut self, report: &AutomaticReport) {
         let p = &report.prediction;
-        let used = match report.choice {
-            IntegratorKind::Explicit => p.explicit_seconds,
-            IntegratorKind::Implicit => p.implicit_seconds,
-        };
+        let used = p.seconds(report.choice);
         let mean = |mean: &mut f64, seconds: f64, steps: f64| {
             *mean += (seconds * 1e3 - *mean) / steps;
         };
