@@ -6,6 +6,10 @@
 
 use super::Stiffness;
 
+/// How many times the pairs its contacts couple now a group's tangent may keep from earlier
+/// frames (see [`Stiffness::joint_after`]).
+const KEPT_PAIRS: usize = 2;
+
 impl Stiffness {
     /// The pattern of `parts` side by side (part `k`'s nodes numbered from the sum of the node
     /// counts before it), widened by the node `pairs` (`[a, b]`, `a > b`, in that numbering),
@@ -32,7 +36,41 @@ impl Stiffness {
             list.sort_unstable();
             list.dedup();
         }
-        Some(Self::with_neighbours(lower_neighbours))
+        let mut extra_pairs = pairs.to_vec();
+        extra_pairs.sort_unstable();
+        extra_pairs.dedup();
+        Some(Self {
+            extra_pairs,
+            ..Self::with_neighbours(lower_neighbours)
+        })
+    }
+
+    /// [`Stiffness::joint`] for a group whose tangent was `earlier` the frame before: while the
+    /// group has as many nodes, its pattern keeps `earlier`'s pairs as well (up to
+    /// [`KEPT_PAIRS`] times the pairs of now), and takes over its symbolic factorization when
+    /// that leaves the pattern as it was. Contacts that move among neighbouring nodes then
+    /// keep one pattern, analysed once, at the cost of a few zero blocks.
+    pub(crate) fn joint_after(
+        parts: &[&Stiffness],
+        pairs: &[[u32; 2]],
+        earlier: Option<Stiffness>,
+    ) -> Option<Self> {
+        let joint = Self::joint(parts, pairs)?;
+        let Some(earlier) = earlier.filter(|earlier| {
+            earlier.dofs == joint.dofs
+                && earlier.extra_pairs.len() <= KEPT_PAIRS * joint.extra_pairs.len().max(1)
+        }) else {
+            return Some(joint);
+        };
+        let mut union = joint.extra_pairs.clone();
+        union.extend_from_slice(&earlier.extra_pairs);
+        union.sort_unstable();
+        union.dedup();
+        let mut joint = Self::joint(parts, &union)?;
+        if earlier.col_ptr == joint.col_ptr && earlier.row_idx == joint.row_idx {
+            joint.symbolic = earlier.symbolic;
+        }
+        Some(joint)
     }
 
     /// Adds the values of `part`, one of the parts this joint pattern was made of, whose first

@@ -43,6 +43,10 @@ pub struct SolverWorkspace {
     /// The sparse tangent's pattern and symbolic factorization, built by the first implicit or
     /// static solve and kept for the next.
     pub(crate) tangent: Option<Stiffness>,
+    /// The tangent of the last group of touching bodies this body was the first of (see
+    /// [`ImplicitIntegrator::step_together`](super::ImplicitIntegrator)), whose symbolic
+    /// factorization the next group's tangent takes over when their patterns are the same.
+    pub(crate) group_tangent: Option<Stiffness>,
     /// The implicit integrator's last factorization, kept for reuse by the chord method.
     pub(crate) chord: Chord,
     /// The body's Newton iterations per implicit substep, for the automatic choice's cost.

@@ -4,8 +4,11 @@
 //! [`crate::contact::JointContacts`]), and Newton minimizes it over every body's nodes at once.
 //! The tangent is the bodies' tangents side by side with the blocks coupling each contact's node
 //! and triangle ([`Stiffness::joint`]), factored whole; the rigid partners' response of each
-//! body is taken into the direction with that factorization. Each step assembles and factors
-//! anew (no reuse of factorizations across iterations) and solves directly, whatever
+//! body is taken into the direction with that factorization. The tangent's pattern and
+//! symbolic factorization are kept for the next frame in the first body's workspace, the pattern
+//! keeping the node pairs earlier contacts coupled ([`Stiffness::joint_after`]); each iteration
+//! assembles and factors anew (no reuse of factorizations across iterations) and solves
+//! directly, whatever
 //! [`ImplicitIntegrator::linear_solver`] says; the scheme is BDF2 only when every body of the
 //! group has the history for it, backward Euler otherwise, so that all take the same `ĥ`.
 
@@ -238,7 +241,8 @@ impl GroupSolver {
             })
             .collect();
         let refs: Vec<&Stiffness> = parts.iter().collect();
-        let joint = Stiffness::joint(&refs, &cross)
+        let earlier = (bodies.first_mut()).and_then(|step| step.workspace.group_tangent.take());
+        let joint = Stiffness::joint_after(&refs, &cross, earlier)
             .expect("the contacts couple nodes of the group's bodies, ordered");
         Self {
             between,
@@ -248,10 +252,13 @@ impl GroupSolver {
         }
     }
 
-    /// Gives each body's tangent back to its workspace.
+    /// Gives each body's tangent back to its workspace, and the group's to the first body's.
     fn give_back(self, bodies: &mut [BodyInStep<'_>]) {
         for (step, part) in bodies.iter_mut().zip(self.parts) {
             step.workspace.tangent = Some(part);
+        }
+        if let Some(first) = bodies.first_mut() {
+            first.workspace.group_tangent = Some(self.joint);
         }
     }
 }
