@@ -95,3 +95,54 @@ impl Stiffness {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use faer::Side;
+    use faer::sparse::linalg::solvers::SymbolicLlt;
+
+    /// A part of four nodes, all coupled (one tetrahedron's pattern).
+    fn tetrahedron() -> Stiffness {
+        Stiffness::with_neighbours((0..4u32).map(|b| (b..4).collect()).collect())
+    }
+
+    /// `joint` with its symbolic factorization made, as the first factorization makes it.
+    fn analysed(mut joint: Stiffness) -> Stiffness {
+        let pattern = joint.as_faer().symbolic();
+        joint.symbolic = Some(SymbolicLlt::try_new(pattern, Side::Lower).unwrap());
+        joint
+    }
+
+    #[test]
+    fn a_group_whose_contact_moves_between_triangles_keeps_one_pattern_and_its_analysis() {
+        let part = tetrahedron();
+        let parts = [&part, &part];
+        // Node 4 (the second part's first) touches the first part's triangle 0-1-2, then 1-2-3,
+        // then 0-1-2 again.
+        let first = analysed(Stiffness::joint(&parts, &[[4, 0], [4, 1], [4, 2]]).unwrap());
+        let second = Stiffness::joint_after(&parts, &[[4, 1], [4, 2], [4, 3]], Some(first));
+        let second = second.unwrap();
+        assert!(second.couples(4, 0) && second.couples(4, 3));
+        assert!(
+            second.symbolic.is_none(),
+            "a wider pattern is analysed anew"
+        );
+        let second = analysed(second);
+        let (col_ptr, row_idx) = (second.col_ptr.clone(), second.row_idx.clone());
+        let third = Stiffness::joint_after(&parts, &[[4, 0], [4, 1], [4, 2]], Some(second));
+        let third = third.unwrap();
+        assert_eq!((&third.col_ptr, &third.row_idx), (&col_ptr, &row_idx));
+        assert!(
+            third.symbolic.is_some(),
+            "the same pattern keeps its analysis"
+        );
+        // Far more pairs kept than coupled now: the pattern starts afresh.
+        let fourth = Stiffness::joint_after(&parts, &[[5, 0]], Some(third)).unwrap();
+        assert!(!fourth.couples(4, 0) && fourth.couples(5, 0) && fourth.symbolic.is_none());
+        // Another group size: the earlier tangent is not used.
+        let three = [&part, &part, &part];
+        let other = Stiffness::joint_after(&three, &[[8, 0]], Some(analysed(fourth))).unwrap();
+        assert!(!other.couples(5, 0) && other.symbolic.is_none());
+    }
+}
