@@ -55,14 +55,16 @@ impl Stiffness {
         pairs: &[[u32; 2]],
         earlier: Option<Stiffness>,
     ) -> Option<Self> {
-        let joint = Self::joint(parts, pairs)?;
-        let Some(earlier) = earlier.filter(|earlier| {
-            earlier.dofs == joint.dofs
-                && earlier.extra_pairs.len() <= KEPT_PAIRS * joint.extra_pairs.len().max(1)
-        }) else {
-            return Some(joint);
+        let dofs: usize = parts.iter().map(|part| part.dofs).sum();
+        let mut union = pairs.to_vec();
+        union.sort_unstable();
+        union.dedup();
+        let earlier = earlier.filter(|earlier| {
+            earlier.dofs == dofs && earlier.extra_pairs.len() <= KEPT_PAIRS * union.len().max(1)
+        });
+        let Some(earlier) = earlier else {
+            return Self::joint(parts, &union);
         };
-        let mut union = joint.extra_pairs.clone();
         union.extend_from_slice(&earlier.extra_pairs);
         union.sort_unstable();
         union.dedup();
