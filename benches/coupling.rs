@@ -20,8 +20,12 @@
 //!   stepped together. Beside it, `e_two_cubes_alone`: the same two cubes falling freely, each
 //!   stepped as in (a).
 //!
+//! - (f) `f_soft_cube_asleep`: (b)'s cube once asleep (the default [`SleepSettings`]): what a
+//!   body at rest costs when it is not stepped.
+//!
 //! Every other scene first runs 1 s of frames outside the timing, so that (b) and (c) measure
-//! steady contact. Times are per frame.
+//! steady contact; bodies other than (f)'s never sleep, so that every frame steps them. Times
+//! are per frame.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use rapier_fvm::glamx::Vec3;
@@ -53,9 +57,11 @@ fn drop_cube(y: f64) -> DeformableBody {
     soft_cube(0.1, 6, 1e5, DVec3::new(0.0, y, 0.0))
 }
 
-/// A world with a fixed half-space ground of friction coefficient `friction`.
+/// A world with a fixed half-space ground of friction coefficient `friction`, whose bodies
+/// never sleep.
 fn world_on_ground(friction: f32) -> FvmWorld {
     let mut world = FvmWorld::default();
+    world.coupling.sleep = SleepSettings::never();
     world.physics.insert_collider(
         ColliderBuilder::new(SharedShape::halfspace(Vec3::Y)).friction(friction),
         None,
@@ -150,6 +156,13 @@ fn coupling_frame(c: &mut Criterion) {
             SolverWorkspace::new(),
         ),
     ];
+    // (f) The resting cube, asleep.
+    let mut asleep = world_on_ground(0.5);
+    asleep.coupling.sleep = SleepSettings::default();
+    let cube = asleep.soft_bodies.insert(drop_cube(0.05));
+    while !asleep.coupling.is_sleeping(cube) {
+        step(&mut asleep);
+    }
     // (a) The cube alone, stepped as the world steps its soft bodies; and the grasp's cube.
     let mut alone = (drop_cube(0.55), SolverWorkspace::new());
     let mut grasp_alone = (grasp_cube(0.5), SolverWorkspace::new());
@@ -190,6 +203,7 @@ fn coupling_frame(c: &mut Criterion) {
     group.bench_function("e_two_cubes_alone", |b| {
         b.iter(|| pair_alone.iter_mut().for_each(frame_alone))
     });
+    group.bench_function("f_soft_cube_asleep", |b| b.iter(|| step(&mut asleep)));
     group.finish();
 }
 

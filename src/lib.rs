@@ -122,7 +122,9 @@ pub mod prelude {
     };
     pub use crate::constraint::BodyConstraints;
     pub use crate::contact::{BodyPoint, ContactSettings, ContactTarget, NodeContact};
-    pub use crate::coupling::{ColliderLoad, RapierSets, RigidLoad, RigidSets, SoftCoupling};
+    pub use crate::coupling::{
+        ColliderLoad, RapierSets, RigidLoad, RigidSets, SleepSettings, SoftCoupling,
+    };
     pub use crate::damping::RayleighDamping;
     pub use crate::fvm::VolumetricTreatment;
     pub use crate::integrate::{

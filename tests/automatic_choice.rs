@@ -46,8 +46,10 @@ fn the_prediction_is_the_cost_models_formula_and_the_cheaper_integrator_is_taken
     // A damped cube resting on the ground, 60 frames: each frame's prediction must be the cost
     // model's formula (explicit: n (T c d + P s c_p); implicit: k N T c_N (T/1000)^α) to
     // round-off (1e-12 relative), with the contacts counted, and the integrator taken the
-    // cheaper one.
+    // cheaper one. Kept awake: every frame is stepped and predicted (asleep, the resting cube
+    // would not be).
     let (mut world, handle) = world_with(cube(0.0, true));
+    world.coupling.sleep = SleepSettings::never();
     let cost = CostModel::default();
     let tets = world.soft_bodies[handle].mesh().tet_count() as f64;
     let (mut implicit_frames, mut touched) = (0, 0);

@@ -176,13 +176,14 @@ fn run(
             .embedded_tets
             .map_or(String::new(), |tets| format!(", carrying {tets} tets"));
         println!(
-            "  soft {:<16} {:>6} {} {:>5} nodes{embedded}; {} explicit / {} implicit frames; {} failed; max inverted {}",
+            "  soft {:<16} {:>6} {} {:>5} nodes{embedded}; {} explicit / {} implicit / {} asleep frames; {} failed; max inverted {}",
             body.name,
             body.elements,
             body.element_kind,
             body.nodes,
             body.explicit_frames,
             body.implicit_frames,
+            body.asleep_frames,
             body.failed_frames,
             body.max_inverted_tets
         );

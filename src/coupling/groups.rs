@@ -58,26 +58,15 @@ pub(crate) fn touching_groups(
     count: usize,
     between: Vec<BetweenContact>,
 ) -> Vec<(Vec<usize>, Vec<BetweenContact>)> {
-    let mut root: Vec<usize> = (0..count).collect();
-    fn find(root: &mut [usize], mut i: usize) -> usize {
-        while root[i] != i {
-            root[i] = root[root[i]];
-            i = root[i];
-        }
-        i
-    }
+    let mut components = Components::new(count);
     for contact in &between {
-        let (a, b) = (
-            find(&mut root, contact.node_body),
-            find(&mut root, contact.triangle_body),
-        );
-        root[a.max(b)] = a.min(b);
+        components.join(contact.node_body, contact.triangle_body);
     }
     let mut groups: Vec<(Vec<usize>, Vec<BetweenContact>)> = Vec::new();
     let mut group_of = vec![usize::MAX; count];
     let mut slot_of = vec![0; count];
     for (i, slot) in slot_of.iter_mut().enumerate() {
-        let r = find(&mut root, i);
+        let r = components.find(i);
         if group_of[r] == usize::MAX {
             group_of[r] = groups.len();
             groups.push((Vec::new(), Vec::new()));
@@ -87,10 +76,55 @@ pub(crate) fn touching_groups(
         group.push(i);
     }
     for mut contact in between {
-        let g = group_of[find(&mut root, contact.node_body)];
+        let g = group_of[components.find(contact.node_body)];
         contact.node_body = slot_of[contact.node_body];
         contact.triangle_body = slot_of[contact.triangle_body];
         groups[g].1.push(contact);
     }
     groups
+}
+
+/// The connected components of a graph on `0..n` built edge by edge (union–find with path
+/// halving; each component's root is its smallest member).
+pub(super) struct Components {
+    root: Vec<usize>,
+}
+
+impl Components {
+    /// `n` members, each its own component.
+    pub(super) fn new(n: usize) -> Self {
+        Self {
+            root: (0..n).collect(),
+        }
+    }
+
+    /// The root of `i`'s component.
+    pub(super) fn find(&mut self, mut i: usize) -> usize {
+        while self.root[i] != i {
+            self.root[i] = self.root[self.root[i]];
+            i = self.root[i];
+        }
+        i
+    }
+
+    /// Joins the components of `a` and `b`.
+    pub(super) fn join(&mut self, a: usize, b: usize) {
+        let (a, b) = (self.find(a), self.find(b));
+        self.root[a.max(b)] = a.min(b);
+    }
+
+    /// The components, each in increasing order, ordered by their smallest member.
+    pub(super) fn groups(&mut self) -> Vec<Vec<usize>> {
+        let mut groups: Vec<Vec<usize>> = Vec::new();
+        let mut group_of = vec![usize::MAX; self.root.len()];
+        for i in 0..self.root.len() {
+            let r = self.find(i);
+            if group_of[r] == usize::MAX {
+                group_of[r] = groups.len();
+                groups.push(Vec::new());
+            }
+            groups[group_of[r]].push(i);
+        }
+        groups
+    }
 }

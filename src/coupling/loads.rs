@@ -4,6 +4,7 @@
 //! their centre of mass; colliders (with or without a rigid body, the fixed ground among them)
 //! with the torque about the world origin.
 
+use super::sleep::RestingLoads;
 use crate::body::{DeformableBody, DeformableBodyHandle};
 use crate::constraint::BodyConstraints;
 use rapier3d::dynamics::RigidBodyHandle;
@@ -131,6 +132,22 @@ impl FrameLoads {
         }
         for (collider, impulse, angular_impulse) in constraints.collider_impulses(body) {
             self.add_collider(handle, collider, impulse, angular_impulse);
+        }
+    }
+
+    /// Adds what the sleeping deformable body `handle` keeps exerting, `loads` (N, N m), over a
+    /// substep of `h` (s) to the frame's totals.
+    pub(crate) fn add_resting(
+        &mut self,
+        handle: DeformableBodyHandle,
+        loads: &RestingLoads,
+        h: f64,
+    ) {
+        for &(rigid_body, force, torque) in &loads.rigid {
+            self.add_rigid(handle, rigid_body, force * h, torque * h);
+        }
+        for &(collider, force, torque) in &loads.colliders {
+            self.add_collider(handle, collider, force * h, torque * h);
         }
     }
 

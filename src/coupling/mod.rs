@@ -7,6 +7,8 @@
 //!
 //! 1. **Kinematic paths.** Each position-based kinematic body told where to be at the end of the
 //!    frame is told the part of its straight path it reaches by the end of this substep.
+//!    Sleeping bodies that something disturbed wake (see [`SleepSettings`]); those left asleep
+//!    skip stages 2 to 5 and count the loads they rest with.
 //! 2. **Contacts.** Each deformable body finds the colliders its surface can reach within `h`
 //!    ([`BodyConstraints::detect_contacts`]), and
 //!    the bodies find each other's surfaces.
@@ -24,7 +26,8 @@
 //!    something is fast (no extra coupling substeps); detection reaches twice a collider's travel
 //!    over the substep, up to 1 m.
 //! 5. **Exchange.** The impulses the soft step gave dynamic rigid bodies are handed to rapier at
-//!    the nodes, and summed into the frame's [`RigidLoad`]s. A body whose step was refused (in
+//!    the nodes, and summed into the frame's [`RigidLoad`]s. Bodies still long enough fall
+//!    asleep, with the dynamic rigid bodies they touch. A body whose step was refused (in
 //!    this substep or an earlier one of the frame) stays where it was, and the dynamic rigid
 //!    bodies it touches or is glued to get the impulses a fixed obstacle would give them
 //!    (`constraint::hold_partners`): they rest on it or hang from it instead of sinking into it
@@ -48,19 +51,21 @@ mod groups;
 mod kinematic;
 mod loads;
 mod rapier_view;
+mod sleep;
 
 pub use audit::{
     Audit, AuditInput, AuditSettings, BodyAudit, EnergyCheck, FrameAudit, PenetrationTarget,
     Penetrations,
 };
 pub use loads::{ColliderLoad, RigidLoad};
+pub use sleep::SleepSettings;
 
 use crate::Error;
 use crate::body::{DeformableBody, DeformableBodyHandle, DeformableBodySet};
 use crate::constraint::{self, BodyConstraints};
 use crate::contact::{self, ContactSettings, NodeContact};
 use crate::integrate::{AutomaticIntegrator, AutomaticReport, BodyInStep, IntegratorKind};
-use bodies::LinkSet;
+use bodies::{BodyLinks, LinkSet};
 use carry::{Carried, RapierCarry};
 use groups::{GroupStep, step_groups, touching_groups};
 use kinematic::KinematicPath;
@@ -73,6 +78,7 @@ use rapier3d::geometry::{BroadPhaseBvh, ColliderHandle, ColliderSet, NarrowPhase
 use rapier3d::glamx::DVec3;
 use rapier3d::math::Vector;
 use rapier3d::pipeline::{EventHandler, PhysicsHooks, PhysicsPipeline};
+use sleep::SleepSet;
 
 /// Each deformable body's result over a frame: the report of its last substep, or the first
 /// error it met (a body whose step was refused keeps the state it had before that substep for the
@@ -165,10 +171,14 @@ pub struct SoftCoupling {
     /// rapier steps per frame, with the deformable bodies stepped between them (at least 1: zero
     /// is refused by [`SoftCoupling::step`]).
     pub substeps: u32,
+    /// When bodies at rest fall asleep (see [`SleepSettings`]).
+    pub sleep: SleepSettings,
     /// What each deformable body exerted on each rigid body over the last frame or substep.
     loads: FrameLoads,
     /// Each deformable body's constraints and solver caches, by handle.
     links: LinkSet,
+    /// Each deformable body's sleep, by handle.
+    sleeping: SleepSet,
 }
 
 impl Default for SoftCoupling {
@@ -177,8 +187,10 @@ impl Default for SoftCoupling {
             integrator: AutomaticIntegrator::default(),
             contact: ContactSettings::default(),
             substeps: 4,
+            sleep: SleepSettings::default(),
             loads: FrameLoads::default(),
             links: LinkSet::default(),
+            sleeping: SleepSet::default(),
         }
     }
 }
@@ -316,6 +328,7 @@ impl SoftCoupling {
         rigid_bodies: &RigidBodySet,
     ) -> Result<(), Error> {
         let body = soft_bodies.get(soft).ok_or(Error::UnknownDeformableBody)?;
+        self.sleeping.wake_up(soft);
         self.links
             .entry(soft)
             .constraints
@@ -324,9 +337,23 @@ impl SoftCoupling {
 
     /// Removes every attachment of the deformable body `soft` to the rigid body `rigid`.
     pub fn detach(&mut self, soft: DeformableBodyHandle, rigid: RigidBodyHandle) {
+        self.sleeping.wake_up(soft);
         if let Some(links) = self.links.get_mut(soft) {
             links.constraints.detach(rigid);
         }
+    }
+
+    /// Whether the deformable body `soft` is asleep (see [`SleepSettings`]): not stepped, at
+    /// rest, until something disturbs it.
+    pub fn is_sleeping(&self, soft: DeformableBodyHandle) -> bool {
+        self.sleeping.is_asleep(soft)
+    }
+
+    /// Wakes the deformable body `soft` if it is asleep, and restarts the time it must stay still
+    /// before it sleeps again: call it after changing what a step reads that the coupling does
+    /// not watch (its friction, say). Editing its positions or velocities wakes it by itself.
+    pub fn wake_up(&mut self, soft: DeformableBodyHandle) {
+        self.sleeping.wake_up(soft);
     }
 
     /// The contacts, rigid corners and attachments of the deformable body `soft` as the last
@@ -375,12 +402,22 @@ impl SoftCoupling {
     fn step_soft_bodies(
         &mut self,
         soft_bodies: &mut DeformableBodySet,
-        rigid: RigidSets<'_>,
+        mut rigid: RigidSets<'_>,
         outcomes: &mut [(DeformableBodyHandle, Outcome)],
         h: f64,
         gravity: DVec3,
     ) -> Vec<Carried> {
         self.links.prune(soft_bodies);
+        self.sleeping.prune(soft_bodies);
+        let margin = self.contact.margin;
+        let sleep = (h, gravity, margin);
+        (self.sleeping).wake_disturbed(
+            soft_bodies,
+            &mut rigid,
+            &mut self.loads,
+            &self.sleep,
+            sleep,
+        );
         let (live, held) = self.detect(soft_bodies, &rigid, outcomes, h, gravity);
         let between = {
             let bodies: Vec<&DeformableBody> = live.iter().map(|&h| &soft_bodies[h]).collect();
@@ -417,6 +454,12 @@ impl SoftCoupling {
             {
                 Carried::add(&mut carried, &step.constraints.rigid_proxies);
             }
+            self.sleeping.observe(
+                (*handle, step.body, step.constraints),
+                (rigid.bodies, rigid.colliders),
+                &self.sleep,
+                (h, result.is_ok(), margin),
+            );
             hand_over(&mut self.loads, *handle, &mut step, rigid.bodies);
             if let Some((_, outcome)) = outcomes.iter_mut().find(|(h, _)| h == handle) {
                 // A step refused in an earlier substep of the frame stays reported.
@@ -425,15 +468,38 @@ impl SoftCoupling {
                 }
             }
         }
-        let holds = (self.links.many_mut(&held).into_iter())
-            .zip(soft_bodies.get_many_mut(&held))
+        self.hold_refused(soft_bodies, &held, &mut rigid, h, gravity);
+        let links = &self.links;
+        let constraints = |handle| links.get(handle).map(|l: &BodyLinks| &l.constraints);
+        (self.sleeping).settle(soft_bodies, constraints, &mut rigid, &self.sleep, sleep);
+        carried
+    }
+
+    /// Holds, for a substep of `h` (s) under `gravity` (m/s²), the rigid bodies that the bodies
+    /// `held` (whose step was refused earlier in the frame) touch or are glued to, as a fixed
+    /// obstacle would ([`constraint::hold_partners`]), and hands those impulses over.
+    fn hold_refused(
+        &mut self,
+        soft_bodies: &mut DeformableBodySet,
+        held: &[DeformableBodyHandle],
+        rigid: &mut RigidSets<'_>,
+        h: f64,
+        gravity: DVec3,
+    ) {
+        let holds = (self.links.many_mut(held).into_iter())
+            .zip(soft_bodies.get_many_mut(held))
             .map(|(links, body)| links.with(body));
         for (handle, mut step) in held.iter().zip(holds) {
             hold_supported_bodies(step.constraints, rigid.bodies, rigid.narrow_phase);
             constraint::hold_partners(step.body, step.constraints, h, gravity);
+            self.sleeping.observe(
+                (*handle, step.body, step.constraints),
+                (rigid.bodies, rigid.colliders),
+                &self.sleep,
+                (h, false, self.contact.margin),
+            );
             hand_over(&mut self.loads, *handle, &mut step, rigid.bodies);
         }
-        carried
     }
 
     /// Finds the contacts of every body of `outcomes` whose state a step can take, and returns
@@ -452,6 +518,9 @@ impl SoftCoupling {
         let lookup = rapier_view::rigid_lookup(rigid.bodies, h);
         let (mut live, mut held) = (Vec::new(), Vec::new());
         for (handle, outcome) in outcomes.iter_mut() {
+            if self.sleeping.is_asleep(*handle) {
+                continue;
+            }
             let body = &soft_bodies[*handle];
             let detected = body.check_state().and_then(|()| {
                 self.links.entry(*handle).constraints.detect_among(

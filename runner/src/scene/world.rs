@@ -6,6 +6,8 @@
 //! dt = 0.016666666666666666   # frame step (s), default 1/60
 //! duration = 2.0              # simulated time (s), required
 //! coupling_substeps = 4       # rapier steps per frame, soft bodies stepped between, default 4
+//! sleep_speed = 1e-3          # nodes slower than this (m/s) count as still, default 1e-3
+//! time_until_sleep = 0.5      # bodies still this long (s) fall asleep, default 0.5; inf: never
 //! ```
 
 use super::check::Checker;
@@ -29,6 +31,21 @@ pub struct WorldSpec {
     /// Rapier steps per frame with the soft bodies stepped between them; default 4.
     #[serde(default = "default_coupling_substeps")]
     pub coupling_substeps: u32,
+    /// Speed (m/s) below which a body's nodes count as still; default 1e-3
+    /// ([`SleepSettings`](rapier_fvm::coupling::SleepSettings)).
+    #[serde(default = "default_sleep_speed")]
+    pub sleep_speed: f64,
+    /// How long (s) a body stays still before it falls asleep; default 0.5, `inf` never.
+    #[serde(default = "default_time_until_sleep")]
+    pub time_until_sleep: f64,
+}
+
+fn default_sleep_speed() -> f64 {
+    rapier_fvm::coupling::SleepSettings::default().speed_threshold
+}
+
+fn default_time_until_sleep() -> f64 {
+    rapier_fvm::coupling::SleepSettings::default().time_until_sleep
 }
 
 fn default_gravity() -> [f64; 3] {
@@ -76,6 +93,18 @@ impl WorldSpec {
         }
         if self.coupling_substeps == 0 {
             c.fail("world.coupling_substeps", "must be at least 1");
+        }
+        if !(self.sleep_speed >= 0.0 && self.sleep_speed.is_finite()) {
+            c.fail(
+                "world.sleep_speed",
+                "must be a finite speed of at least 0 m/s",
+            );
+        }
+        if self.time_until_sleep.is_nan() || self.time_until_sleep < 0.0 {
+            c.fail(
+                "world.time_until_sleep",
+                "must be at least 0 s (inf: never)",
+            );
         }
     }
 }

@@ -9,6 +9,7 @@ use crate::scene::rigid_body::{RigidBodySpec, RigidKind, ShapeSpec};
 use crate::scene::soft_body::{SoftBodySpec, VolumetricSpec};
 use crate::scene::{Scene, SceneError, SceneSource};
 use rapier_fvm::body::{DeformableBodyBuilder, DeformableBodyHandle};
+use rapier_fvm::coupling::SleepSettings;
 use rapier_fvm::fvm::VolumetricTreatment;
 use rapier_fvm::glamx::{DVec3, Vec3};
 use rapier_fvm::mesh::import::surface;
@@ -65,6 +66,10 @@ impl Simulation {
         world.physics.gravity = DVec3::from_array(scene.world.gravity).as_vec3();
         world.physics.integration_parameters.dt = scene.world.dt as f32;
         world.coupling.substeps = scene.world.coupling_substeps;
+        world.coupling.sleep = SleepSettings {
+            speed_threshold: scene.world.sleep_speed,
+            time_until_sleep: scene.world.time_until_sleep,
+        };
         world.coupling.contact = scene.contact.settings();
         world.coupling.integrator = scene.integrator.integrator();
         let mut rigid = Vec::new();

@@ -52,6 +52,10 @@ pub struct Settings {
     pub gravity: [f64; 3],
     /// Rapier steps per frame.
     pub coupling_substeps: u32,
+    /// Speed (m/s) below which nodes count as still.
+    pub sleep_speed: f64,
+    /// Time (s) a body stays still before it sleeps (`null`: never).
+    pub time_until_sleep: f64,
     /// `automatic`, `explicit` or `implicit`.
     pub integrator: String,
     /// Explicit safety factor.
@@ -88,6 +92,8 @@ pub struct SoftBodyReport {
     pub explicit_frames: usize,
     /// Frames its last substep stepped implicitly.
     pub implicit_frames: usize,
+    /// Frames it ended asleep, not stepped.
+    pub asleep_frames: usize,
     /// Frames chosen explicit but redone implicitly.
     pub fell_back_frames: usize,
     /// Mean explicit substeps per explicit coupling substep.

@@ -82,6 +82,9 @@ pub fn run(scene: &Scene, options: &RunOptions) -> Result<Report, RunError> {
                 bodies[i].record(outcome, &mut stability);
             }
         }
+        for (entry, body) in sim.soft.iter().zip(&mut bodies) {
+            body.asleep_frames += usize::from(sim.world.coupling.is_sleeping(entry.handle));
+        }
         let found = audit.check_world(&sim.world, &outcomes);
         stability.record_system(frame, found.system);
         for (handle, body_audit) in &found.bodies {
@@ -155,6 +158,8 @@ fn settings(scene: &Scene, world: &WorldSpec, sim: &Simulation) -> Settings {
         duration: world.duration,
         gravity: world.gravity,
         coupling_substeps: sim.world.coupling.substeps,
+        sleep_speed: sim.world.coupling.sleep.speed_threshold,
+        time_until_sleep: sim.world.coupling.sleep.time_until_sleep,
         integrator: format!("{:?}", scene.integrator.kind).to_lowercase(),
         explicit_safety_factor: integrator.explicit.safety_factor,
         implicit_substeps: integrator.implicit.substeps,

@@ -80,9 +80,11 @@ impl Contact {
         )
     }
 
-    /// A world at frame step `DT` with this case's integrator and coupling.
+    /// A world at frame step `DT` with this case's integrator and coupling. Bodies never sleep:
+    /// every engine compared steps every frame, so the time per step is the solver's.
     pub fn world(&self) -> FvmWorld {
         let mut world = FvmWorld::default();
+        world.coupling.sleep = SleepSettings::never();
         world.physics.integration_parameters.dt = DT as f32;
         world.physics.gravity = GRAVITY.as_vec3();
         world.coupling.substeps = self.coupling_substeps;

@@ -1,0 +1,123 @@
+//! What counts as still for sleeping, and what disturbs a sleeping body: bounds and their
+//! overlaps, the fastest point of a rigid body, the colliders within a body's bounds.
+
+use super::Asleep;
+use crate::constraint::BodyConstraints;
+use crate::coupling::RigidSets;
+use crate::rigid::coming_velocity;
+use rapier3d::dynamics::{RigidBody, RigidBodyHandle, RigidBodySet, RigidBodyType};
+use rapier3d::geometry::{ColliderHandle, ColliderSet};
+use rapier3d::glamx::DVec3;
+
+/// An axis-aligned box, minimum and maximum corners (m).
+pub(super) type Bounds = (DVec3, DVec3);
+
+/// The bounds of `points`, widened by `by` (m) on every side.
+pub(super) fn bounds_of(points: &[DVec3], by: f64) -> Bounds {
+    let (low, high) = points.iter().fold(
+        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+        |(low, high), &p| (low.min(p), high.max(p)),
+    );
+    (low - DVec3::splat(by), high + DVec3::splat(by))
+}
+
+/// Whether two boxes overlap.
+pub(super) fn overlap(a: Bounds, b: Bounds) -> bool {
+    a.0.cmple(b.1).all() && b.0.cmple(a.1).all()
+}
+
+/// The fastest a point of `body` moves (m/s) over a step of `dt` (s), bounded by its centre of
+/// mass's speed plus its turn rate times the farthest corner of its colliders' bounds.
+pub(super) fn fastest_point(body: &RigidBody, colliders: &ColliderSet, dt: f64) -> f64 {
+    let (linvel, angvel) = coming_velocity(body, dt);
+    let com = body.mass_properties().world_com.as_dvec3();
+    let reach = (body.colliders().iter())
+        .filter_map(|&handle| colliders.get(handle))
+        .map(|collider| {
+            let aabb = collider.compute_aabb();
+            let centre = (aabb.mins.as_dvec3() + aabb.maxs.as_dvec3()) / 2.0;
+            (centre - com).length() + f64::from(aabb.half_extents().length())
+        })
+        .fold(0.0, f64::max);
+    linvel.length() + angvel.length() * reach
+}
+
+/// Whether `body` is still for a deformable body resting with it: fixed, sleeping, or moving
+/// slower than `speed` (m/s) everywhere (a kinematic one not at all) over a step of `dt` (s).
+pub(super) fn rigid_still(body: &RigidBody, colliders: &ColliderSet, speed: f64, dt: f64) -> bool {
+    match body.body_type() {
+        RigidBodyType::Fixed => true,
+        RigidBodyType::Dynamic => body.is_sleeping() || fastest_point(body, colliders, dt) < speed,
+        _ => fastest_point(body, colliders, dt) == 0.0,
+    }
+}
+
+/// The non-sensor colliders whose bounds, widened by their travel over `dt` (s), overlap
+/// `bounds`, sorted, and whether all their rigid bodies are still (see [`rigid_still`]).
+pub(super) fn colliders_within(
+    bounds: Bounds,
+    colliders: &ColliderSet,
+    bodies: &RigidBodySet,
+    speed: f64,
+    dt: f64,
+) -> (Vec<ColliderHandle>, bool) {
+    let mut within = Vec::new();
+    let mut still = true;
+    for (handle, collider) in colliders.iter().filter(|(_, c)| !c.is_sensor()) {
+        let aabb = collider.compute_aabb();
+        let parent = collider.parent().and_then(|parent| bodies.get(parent));
+        let travel = parent.map_or(0.0, |body| 2.0 * fastest_point(body, colliders, dt) * dt);
+        let widened = travel * DVec3::ONE;
+        let reach = (
+            aabb.mins.as_dvec3() - widened,
+            aabb.maxs.as_dvec3() + widened,
+        );
+        if overlap(bounds, reach) {
+            within.push(handle);
+            still &= parent.is_none_or(|body| rigid_still(body, colliders, speed, dt));
+        }
+    }
+    within.sort_unstable_by_key(|handle| handle.into_raw_parts());
+    (within, still)
+}
+
+/// The rigid bodies `constraints` touch or are glued to, sorted and without repeats.
+pub(super) fn partners_of(constraints: &BodyConstraints) -> Vec<RigidBodyHandle> {
+    let mut partners: Vec<RigidBodyHandle> = (constraints.rigid_impulses())
+        .map(|(handle, ..)| handle)
+        .chain(constraints.attachments().iter().map(|a| a.body))
+        .collect();
+    partners.sort_unstable_by_key(|handle| handle.into_raw_parts());
+    partners.dedup();
+    partners
+}
+
+/// Whether the rigid world disturbs a body asleep with `asleep` within `widened` bounds over a
+/// step of `dt` (s): a rigid body it rested with woke in rapier, moves or left, a collider came
+/// within its bounds or left them, or one there moves faster than `speed` (m/s).
+pub(super) fn rigid_disturbs(
+    asleep: &Asleep,
+    widened: Bounds,
+    rigid: &RigidSets<'_>,
+    speed: f64,
+    dt: f64,
+) -> bool {
+    let (within, still) = colliders_within(widened, rigid.colliders, rigid.bodies, speed, dt);
+    !still
+        || within != asleep.colliders
+        || asleep.partners.iter().any(|&partner| {
+            rigid.bodies.get(partner).is_none_or(|body| {
+                (body.is_dynamic() && !body.is_sleeping())
+                    || !rigid_still(body, rigid.colliders, 0.0, dt)
+            })
+        })
+}
+
+/// Whether two sleeping bodies rested together: their bounds, widened by `margin` (m), overlap,
+/// or they touched the same dynamic rigid body of `bodies`.
+pub(super) fn rested_together(a: &Asleep, b: &Asleep, bodies: &RigidBodySet, margin: f64) -> bool {
+    let widen = |bounds: Bounds| (bounds.0 - margin, bounds.1 + margin);
+    overlap(widen(a.bounds), widen(b.bounds))
+        || (a.partners.iter())
+            .any(|p| b.partners.contains(p) && bodies.get(*p).is_some_and(RigidBody::is_dynamic))
+}
