@@ -20,9 +20,9 @@
 //! [`MAX_PAUSE`] implicit substeps (doubling with each consecutive failing substep), so a
 //! strongly nonlinear motion wastes at most one solve every few substeps.
 
+use crate::assembly::Factor;
 #[cfg(feature = "serde-serialize")]
 use crate::assembly::Stiffness;
-use faer::sparse::linalg::solvers::Llt;
 
 /// A reused factorization must bring the out-of-balance force to at most this fraction of its
 /// previous value per iteration (dimensionless). At 0.1, a tolerance of 1e-6 is reached within
@@ -56,7 +56,7 @@ pub(crate) fn within_budget(reduction: f64, remaining: usize) -> bool {
 pub(crate) struct Chord {
     /// The last factorization of the implicit Newton system and the effective step `ĥ` (s) whose
     /// inertia it holds.
-    factor: Option<(Llt<usize, f64>, f64)>,
+    factor: Option<(Factor, f64)>,
     /// The matrix the kept factorization was made of, kept for serialization and factored
     /// again after reading back.
     #[cfg(feature = "serde-serialize")]
@@ -81,7 +81,7 @@ impl Chord {
 
     /// The factorization an iteration of a step of effective length `h` (s) may reuse, if the
     /// rule allows one (`within_budget`: see [`within_budget`]).
-    pub(crate) fn factor_for(&self, h: f64, within_budget: bool) -> Option<&Llt<usize, f64>> {
+    pub(crate) fn factor_for(&self, h: f64, within_budget: bool) -> Option<&Factor> {
         if self.paused || self.failed_this_step || !within_budget {
             return None;
         }
@@ -93,7 +93,7 @@ impl Chord {
 
     /// Keeps a fresh factorization made for effective step `h` (s).
     /// Keeps a fresh factorization made for effective step `h` (s).
-    pub(crate) fn keep(&mut self, factor: Llt<usize, f64>, h: f64) {
+    pub(crate) fn keep(&mut self, factor: Factor, h: f64) {
         self.factor = Some((factor, h));
     }
 
@@ -200,20 +200,19 @@ impl From<ChordRecord> for Chord {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use faer::Side;
+    use crate::assembly::SymbolicFactor;
     use faer::sparse::SparseColMat;
-    use faer::sparse::linalg::solvers::SymbolicLlt;
 
     /// The factorization of the 1 x 1 matrix `[2]`.
-    fn factor() -> Llt<usize, f64> {
+    fn factor() -> Factor {
         let matrix = SparseColMat::<usize, f64>::try_new_from_triplets(
             1,
             1,
             &[faer::sparse::Triplet::new(0, 0, 2.0)],
         )
         .unwrap();
-        let symbolic = SymbolicLlt::try_new(matrix.symbolic(), Side::Lower).unwrap();
-        Llt::try_new_with_symbolic(symbolic, matrix.as_ref(), Side::Lower).unwrap()
+        let symbolic = SymbolicFactor::try_new(matrix.symbolic()).unwrap();
+        Factor::try_new(symbolic, matrix.as_ref()).unwrap()
     }
 
     /// Within the iteration budget.

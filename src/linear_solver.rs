@@ -28,10 +28,10 @@
 //! compares the two predictions; see its documentation for the rule and its calibration.
 
 use crate::Error;
+use crate::assembly::Factor;
 use crate::assembly::{Stiffness, factorize, solve};
 use crate::body::DeformableBody;
 use crate::material::is_positive_definite;
-use faer::sparse::linalg::solvers::Llt;
 use rapier3d::glamx::{DMat3, DVec3};
 
 /// How the Newton system of each implicit iteration is solved.
@@ -241,7 +241,7 @@ pub(crate) struct Solution {
     /// the rest of the frame).
     pub(crate) fell_back: bool,
     /// The Cholesky factorization solved with, when the direct method was used.
-    pub(crate) factor: Option<Llt<usize, f64>>,
+    pub(crate) factor: Option<Factor>,
     /// Numeric Cholesky factorizations attempted (two when the exact tangent failed and the
     /// projected one was factored).
     pub(crate) factorizations: usize,
@@ -337,7 +337,7 @@ pub(crate) fn solve_newton_system(
 
 /// A successful Cholesky factorization of the Newton system.
 struct DirectFactorization {
-    factor: Llt<usize, f64>,
+    factor: Factor,
     /// Whether the tangent factored is the projected one.
     projected: bool,
     /// Factorizations attempted: 1, or 2 when the exact tangent failed first.

@@ -101,8 +101,7 @@ impl Stiffness {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use faer::Side;
-    use faer::sparse::linalg::solvers::SymbolicLlt;
+    use crate::assembly::SymbolicFactor;
 
     /// A part of four nodes, all coupled (one tetrahedron's pattern).
     fn tetrahedron() -> Stiffness {
@@ -112,7 +111,7 @@ mod tests {
     /// `joint` with its symbolic factorization made, as the first factorization makes it.
     fn analysed(mut joint: Stiffness) -> Stiffness {
         let pattern = joint.as_faer().symbolic();
-        joint.symbolic = Some(SymbolicLlt::try_new(pattern, Side::Lower).unwrap());
+        joint.symbolic = Some(SymbolicFactor::try_new(pattern).unwrap());
         joint
     }
 

@@ -9,7 +9,10 @@
 //! Venant–Kirchhoff and Neo-Hookean are indefinite under compression); the projection stiffens
 //! the rotational directions of a stressed element, so exact tangents are used where they exist.
 
+mod cholesky;
 mod joint;
+
+pub(crate) use cholesky::{Factor, SymbolicFactor};
 
 use crate::Error;
 use crate::body::DeformableBody;
@@ -17,10 +20,8 @@ use crate::element::deformation_gradient;
 use crate::fvm::NodalAveraging;
 use crate::material::{HyperelasticModel, with_hyperelastic_model};
 use crate::stencil::Stencil;
-use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
+use faer::Col;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
-use faer::{Col, Side};
 use rapier3d::glamx::{DMat3, DVec3};
 use rapier3d::na;
 
@@ -42,7 +43,7 @@ pub(crate) struct Stiffness {
     extra_pairs: Vec<[u32; 2]>,
     /// The symbolic Cholesky factorization (fill-reducing ordering and elimination tree) of the
     /// pattern, computed at the first factorization and reused by every later one.
-    symbolic: Option<SymbolicLlt<usize>>,
+    symbolic: Option<SymbolicFactor>,
     /// Scratch of [`Stiffness::add_point`]: per node of an element, `A ∇N_b`.
     stress_maps: Vec<na::SMatrix<f64, 9, 3>>,
     /// The element whose points are being added, and its dense tangent so far (`3n x 3n`,
@@ -426,27 +427,23 @@ fn couple_all_pairs<'a>(
 }
 
 /// The Cholesky factor of an assembled matrix.
-pub(crate) fn factorize(
-    stiffness: &mut Stiffness,
-    iteration: usize,
-) -> Result<Llt<usize, f64>, Error> {
+pub(crate) fn factorize(stiffness: &mut Stiffness, iteration: usize) -> Result<Factor, Error> {
     let indefinite = Error::IndefiniteStiffness { iteration };
     let symbolic = match &stiffness.symbolic {
         Some(symbolic) => symbolic.clone(),
         None => {
             let pattern = stiffness.as_faer().symbolic();
-            let symbolic =
-                SymbolicLlt::try_new(pattern, Side::Lower).map_err(|_| indefinite.clone())?;
+            let symbolic = SymbolicFactor::try_new(pattern).ok_or_else(|| indefinite.clone())?;
             stiffness.symbolic = Some(symbolic.clone());
             symbolic
         }
     };
-    Llt::try_new_with_symbolic(symbolic, stiffness.as_faer(), Side::Lower).map_err(|_| indefinite)
+    Factor::try_new(symbolic, stiffness.as_faer()).ok_or(indefinite)
 }
 
 /// Solves `K u_k = rhs_k` for every column `rhs_k` (per-node vectors) in one pass over the
 /// factor.
-pub(crate) fn solve_columns(factor: &Llt<usize, f64>, columns: &[Vec<DVec3>]) -> Vec<Vec<DVec3>> {
+pub(crate) fn solve_columns(factor: &Factor, columns: &[Vec<DVec3>]) -> Vec<Vec<DVec3>> {
     let Some(n) = columns.first().map(Vec::len) else {
         return Vec::new();
     };
@@ -462,7 +459,7 @@ pub(crate) fn solve_columns(factor: &Llt<usize, f64>, columns: &[Vec<DVec3>]) ->
 }
 
 /// Solves `K u = rhs` for per-node vectors.
-pub(crate) fn solve(factor: &Llt<usize, f64>, rhs: &[DVec3]) -> Vec<DVec3> {
+pub(crate) fn solve(factor: &Factor, rhs: &[DVec3]) -> Vec<DVec3> {
     let mut x = Col::<f64>::from_fn(3 * rhs.len(), |i| rhs[i / 3][i % 3]);
     factor.solve_in_place(x.as_mat_mut());
     (0..rhs.len())

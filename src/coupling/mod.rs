@@ -51,6 +51,7 @@ mod groups;
 mod kinematic;
 mod loads;
 mod rapier_view;
+mod reach;
 mod sleep;
 
 pub use audit::{

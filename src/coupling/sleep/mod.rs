@@ -30,16 +30,14 @@ pub(crate) use resting::RestingLoads;
 use super::RigidSets;
 use super::groups::Components;
 use super::loads::FrameLoads;
+use super::reach::{Bounds, body_reach, bounds_of, overlap};
 use crate::body::{DeformableBody, DeformableBodyHandle, DeformableBodySet};
 use crate::constraint::BodyConstraints;
 use rapier3d::dynamics::{RigidBody, RigidBodyHandle, RigidBodySet};
 use rapier3d::geometry::{ColliderHandle, ColliderSet};
 use rapier3d::glamx::DVec3;
 use std::collections::BTreeMap;
-use still::{
-    Bounds, bounds_of, colliders_within, overlap, partners_of, rested_together, rigid_disturbs,
-    rigid_still,
-};
+use still::{colliders_within, partners_of, rested_together, rigid_disturbs, rigid_still};
 
 /// When deformable bodies fall asleep (see the module's documentation).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -177,17 +175,7 @@ impl SleepSet {
         }
         let awake: Vec<Bounds> = (soft_bodies.iter())
             .filter(|(handle, _)| !self.is_asleep(*handle))
-            .map(|(_, body)| {
-                let fastest = body
-                    .velocities
-                    .iter()
-                    .map(|v| v.length())
-                    .fold(0.0, f64::max);
-                bounds_of(
-                    &body.positions,
-                    margin + 2.0 * (fastest + gravity.length() * h) * h,
-                )
-            })
+            .map(|(_, body)| body_reach(body, margin, h, gravity))
             .collect();
         let mut woken: Vec<bool> = (sleeping.iter())
             .map(|&(handle, asleep)| {

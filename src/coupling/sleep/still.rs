@@ -1,46 +1,13 @@
-//! What counts as still for sleeping, and what disturbs a sleeping body: bounds and their
-//! overlaps, the fastest point of a rigid body, the colliders within a body's bounds.
+//! What counts as still for sleeping, and what disturbs a sleeping body: the rigid bodies it
+//! rests with, the colliders within its bounds.
 
 use super::Asleep;
 use crate::constraint::BodyConstraints;
 use crate::coupling::RigidSets;
-use crate::rigid::coming_velocity;
+use crate::coupling::reach::{Bounds, fastest_point, overlap};
 use rapier3d::dynamics::{RigidBody, RigidBodyHandle, RigidBodySet, RigidBodyType};
 use rapier3d::geometry::{ColliderHandle, ColliderSet};
 use rapier3d::glamx::DVec3;
-
-/// An axis-aligned box, minimum and maximum corners (m).
-pub(super) type Bounds = (DVec3, DVec3);
-
-/// The bounds of `points`, widened by `by` (m) on every side.
-pub(super) fn bounds_of(points: &[DVec3], by: f64) -> Bounds {
-    let (low, high) = points.iter().fold(
-        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-        |(low, high), &p| (low.min(p), high.max(p)),
-    );
-    (low - DVec3::splat(by), high + DVec3::splat(by))
-}
-
-/// Whether two boxes overlap.
-pub(super) fn overlap(a: Bounds, b: Bounds) -> bool {
-    a.0.cmple(b.1).all() && b.0.cmple(a.1).all()
-}
-
-/// The fastest a point of `body` moves (m/s) over a step of `dt` (s), bounded by its centre of
-/// mass's speed plus its turn rate times the farthest corner of its colliders' bounds.
-pub(super) fn fastest_point(body: &RigidBody, colliders: &ColliderSet, dt: f64) -> f64 {
-    let (linvel, angvel) = coming_velocity(body, dt);
-    let com = body.mass_properties().world_com.as_dvec3();
-    let reach = (body.colliders().iter())
-        .filter_map(|&handle| colliders.get(handle))
-        .map(|collider| {
-            let aabb = collider.compute_aabb();
-            let centre = (aabb.mins.as_dvec3() + aabb.maxs.as_dvec3()) / 2.0;
-            (centre - com).length() + f64::from(aabb.half_extents().length())
-        })
-        .fold(0.0, f64::max);
-    linvel.length() + angvel.length() * reach
-}
 
 /// Whether `body` is still for a deformable body resting with it: fixed, sleeping, or moving
 /// slower than `speed` (m/s) everywhere (a kinematic one not at all) over a step of `dt` (s).

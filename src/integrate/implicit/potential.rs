@@ -8,6 +8,7 @@
 
 use super::ImplicitScheme;
 use super::rigid_response::{Placement, RigidResponse};
+use crate::assembly::Factor;
 use crate::assembly::{Stiffness, solve};
 use crate::body::DeformableBody;
 use crate::constraint::{self, BodyConstraints};
@@ -16,7 +17,6 @@ use crate::element::{add_point_forces, deformation_gradient};
 use crate::integrate::PreviousStep;
 use crate::material::green_strain;
 use crate::newton::norm;
-use faer::sparse::linalg::solvers::Llt;
 use rapier3d::glamx::{DMat3, DVec3};
 use std::cell::RefCell;
 
@@ -243,7 +243,7 @@ impl Potential<'_> {
     pub(super) fn reused_direction(
         &self,
         body: &DeformableBody,
-        factor: &Llt<usize, f64>,
+        factor: &Factor,
         residual: &[DVec3],
     ) -> Vec<DVec3> {
         let direction = solve(factor, residual);
@@ -256,7 +256,7 @@ impl Potential<'_> {
     pub(super) fn take_in_rigid_response(
         &self,
         body: &DeformableBody,
-        factor: (&Llt<usize, f64>, bool),
+        factor: (&Factor, bool),
         residual: &[DVec3],
         direction: Vec<DVec3>,
     ) -> Vec<DVec3> {
@@ -272,7 +272,7 @@ impl Potential<'_> {
     pub(super) fn take_in_placed(
         &self,
         body: &DeformableBody,
-        factor: (&Llt<usize, f64>, bool),
+        factor: (&Factor, bool),
         placement: Placement,
         residual: &[DVec3],
         direction: Vec<DVec3>,

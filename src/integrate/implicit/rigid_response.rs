@@ -22,12 +22,12 @@
 //! `ι = −h Σ J_cᵀ f_c`: exactly the opposite of the impulses the terms give the soft body, which
 //! is what the bodies receive when the step's impulses are recorded.
 
+use crate::assembly::Factor;
 use crate::assembly::solve_columns;
 use crate::body::DeformableBody;
 use crate::constraint::{self, BodyConstraints, ImplicitTerm};
 use crate::contact::ImplicitStep;
 use crate::rigid::RigidProxy;
-use faer::sparse::linalg::solvers::Llt;
 use rapier3d::glamx::{DMat3, DVec3};
 use rapier3d::na::{DMatrix, DVector, Matrix3, Matrix6, Vector6};
 use std::borrow::Cow;
@@ -411,7 +411,7 @@ impl RigidResponse {
     pub(super) fn take_in(
         &mut self,
         (body, constraints): (&DeformableBody, &BodyConstraints),
-        (factor, same_factor): (&Llt<usize, f64>, bool),
+        (factor, same_factor): (&Factor, bool),
         placement: Placement,
         residual: &[DVec3],
         direction: Vec<DVec3>,
