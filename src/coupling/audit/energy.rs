@@ -8,6 +8,9 @@
 //!   own mass: a dynamic rigid partner's share is left out, so this is a lower bound) or the
 //!   stiffness the contact's load called for if more, and `ĥ` the substep's effective step.
 //!   Embedded contact points' penalties are not counted.
+//!   A sleeping body not stepped in the frame keeps the energy it had when it was last measured:
+//!   its state does not change, and the penalty energy its last implicit step held is still
+//!   there (measured afresh it would drop out, then count as a gain when the body wakes).
 //! - Dynamic rigid bodies: `m v²/2 + ωᵀ I ω / 2`, and the gravitational energy `-m g·x` at the
 //!   centre of mass half of rapier's integration step `h` back along the velocity, `x − v h/2`,
 //!   which rapier's symplectic Euler step keeps exactly in free flight. `h` is the coupling substep
@@ -108,6 +111,25 @@ pub(super) fn energies(
         all.insert(Member::Rigid(handle), rigid_energy(body, g, h));
     }
     all
+}
+
+/// Gives every deformable body of `input` that slept through the frame (no result in
+/// `results`) its energy of `before` in `now`.
+pub(super) fn keep_sleeping(
+    input: &AuditInput<'_>,
+    results: &SoftStepResults,
+    before: &HashMap<Member, MemberEnergy>,
+    now: &mut HashMap<Member, MemberEnergy>,
+) {
+    for (handle, _) in input.soft_bodies.iter() {
+        let stepped = results.iter().any(|(h, _)| *h == handle);
+        if !stepped
+            && input.coupling.is_sleeping(handle)
+            && let Some(energy) = before.get(&Member::Soft(handle))
+        {
+            now.insert(Member::Soft(handle), *energy);
+        }
+    }
 }
 
 /// The step (s) of rapier's position integration in a frame of `input`: each coupling substep

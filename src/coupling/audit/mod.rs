@@ -156,9 +156,12 @@ impl Audit {
     /// check nor crossing check. The world as it is now becomes the state the next frame is
     /// compared with.
     pub fn check(&mut self, input: AuditInput<'_>, results: &SoftStepResults) -> FrameAudit {
-        let now = snapshot(&input, results);
+        let mut now = snapshot(&input, results);
         let settings = self.settings;
         let previous = self.previous.as_ref();
+        if let Some(before) = previous {
+            energy::keep_sleeping(&input, results, &before.energies, &mut now.energies);
+        }
         let energy_of = |members: &[Member]| {
             previous.map(|before| {
                 let work = (members.iter())
