@@ -9,12 +9,12 @@
 //! to within that. Bodies whose bounds (widened by the contact margin) overlap, or which touch
 //! the same dynamic rigid body, fall asleep together, once all of them are still that long and
 //! one of them rests on something (its contacts or attachments pushed on a collider or rigid
-//! body in its last substep, or it has a pinned node: a free body keeps its motion, however
+//! body while it was still, or it has a pinned node: a free body keeps its motion, however
 //! slow); the dynamic rigid bodies they touch are put to sleep in rapier.
 //!
 //! A sleeping body is neither detected nor stepped: its nodes keep their positions at zero
-//! velocity, and the loads it exerted in its last substep count again in every substep (the
-//! ground still carries its weight). It wakes, with the rigid bodies it rests with and the
+//! velocity, and the mean loads it exerted while it was still count again in every substep (the
+//! ground still carries its weight, see [`RestingLoads`]). It wakes, with the rigid bodies it rests with and the
 //! sleeping bodies it overlaps, when its state is edited
 //! ([`DeformableBody::positions_mut`], [`DeformableBody::velocities_mut`]), gravity changes, a
 //! rigid body it rests with wakes in rapier, moves or leaves, a collider comes within (or leaves)
@@ -102,8 +102,11 @@ struct Asleep {
     derive(serde::Serialize, serde::Deserialize)
 )]
 struct SleepState {
+    /// How long (s) it has been still.
     still_for: f64,
+    /// The impulses it exerted meanwhile (N s, N m s).
     resting: RestingLoads,
+    /// What it fell asleep with, while it sleeps.
     asleep: Option<Asleep>,
 }
 
