@@ -305,3 +305,31 @@ fn the_audit_counts_a_sleeping_body_s_energy_so_waking_it_gains_nothing() {
         frame(&mut world);
     }
 }
+
+#[test]
+fn moving_a_fixed_platform_by_hand_wakes_the_block_sleeping_on_it() {
+    // The block rests on a fixed 2 cm slab (a rigid body of its own, top at y = 0) and sleeps.
+    // The slab is then set 0.8 mm lower by hand: still within the block's bounds widened by the
+    // 1 mm contact margin, so no collider came or left, but one moved. The block wakes, falls
+    // and rests on the slab again: its lowest node 0.8 mm lower than before, to 0.1 mm.
+    let (mut world, soft) = block_on_ground();
+    let ground: Vec<_> = world.physics.colliders.iter().map(|(h, _)| h).collect();
+    for handle in ground {
+        world.physics.remove_collider(handle);
+    }
+    let (slab, _) = world.physics.insert(
+        RigidBodyBuilder::fixed().translation(Vec3::new(0.0, -0.01, 0.0)),
+        ColliderBuilder::cuboid(0.2, 0.01, 0.2).friction(0.8),
+    );
+    until_asleep(&mut world, soft, 300);
+    let bottom = |world: &FvmWorld| {
+        (world.soft_bodies[soft].positions().iter()).fold(f64::INFINITY, |low, x| low.min(x.y))
+    };
+    let before = bottom(&world);
+    world.physics.bodies[slab].set_translation(Vec3::new(0.0, -0.0108, 0.0), true);
+    assert!(step(&mut world, soft), "the moved slab wakes the block");
+    until_asleep(&mut world, soft, 600);
+    let lowered = before - bottom(&world);
+    println!("the block's bottom went down {lowered:.6} m with the slab");
+    assert!((lowered - 8e-4).abs() < 1e-4, "{lowered} m");
+}

@@ -18,7 +18,8 @@
 //! sleeping bodies it overlaps, when its state is edited
 //! ([`DeformableBody::positions_mut`], [`DeformableBody::velocities_mut`]), gravity changes, a
 //! rigid body it rests with wakes in rapier, moves or leaves, a collider comes within (or leaves)
-//! its bounds, one there moves, an awake deformable body comes within them, it is attached to
+//! its bounds, one there moves or is moved (a fixed one set elsewhere by hand), an awake
+//! deformable body comes within them, it is attached to
 //! or detached from a rigid body, or [`SoftCoupling::wake_up`](super::SoftCoupling::wake_up) is
 //! called (after changing its friction, say).
 
@@ -36,6 +37,7 @@ use crate::constraint::BodyConstraints;
 use rapier3d::dynamics::{RigidBody, RigidBodyHandle, RigidBodySet};
 use rapier3d::geometry::{ColliderHandle, ColliderSet};
 use rapier3d::glamx::DVec3;
+use rapier3d::math::Pose;
 use std::collections::BTreeMap;
 use still::{colliders_within, partners_of, rested_together, rigid_disturbs, rigid_still};
 
@@ -86,8 +88,8 @@ struct Asleep {
     gravity: DVec3,
     /// The nodes' bounds (m).
     bounds: Bounds,
-    /// The colliders within the bounds, sorted.
-    colliders: Vec<ColliderHandle>,
+    /// The colliders within the bounds, with their poses, sorted by handle.
+    colliders: Vec<(ColliderHandle, Pose)>,
     /// The rigid bodies its contacts and attachments touched.
     partners: Vec<RigidBodyHandle>,
     /// The loads it keeps exerting.

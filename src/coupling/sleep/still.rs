@@ -8,6 +8,7 @@ use crate::coupling::reach::{Bounds, fastest_point, overlap};
 use rapier3d::dynamics::{RigidBody, RigidBodyHandle, RigidBodySet, RigidBodyType};
 use rapier3d::geometry::{ColliderHandle, ColliderSet};
 use rapier3d::glamx::DVec3;
+use rapier3d::math::Pose;
 
 /// Whether `body` is still for a deformable body resting with it: fixed, sleeping, or moving
 /// slower than `speed` (m/s) everywhere (a kinematic one not at all) over a step of `dt` (s).
@@ -20,14 +21,15 @@ pub(super) fn rigid_still(body: &RigidBody, colliders: &ColliderSet, speed: f64,
 }
 
 /// The non-sensor colliders whose bounds, widened by their travel over `dt` (s), overlap
-/// `bounds`, sorted, and whether all their rigid bodies are still (see [`rigid_still`]).
+/// `bounds`, with their poses, sorted by handle, and whether all their rigid bodies are still
+/// (see [`rigid_still`]).
 pub(super) fn colliders_within(
     bounds: Bounds,
     colliders: &ColliderSet,
     bodies: &RigidBodySet,
     speed: f64,
     dt: f64,
-) -> (Vec<ColliderHandle>, bool) {
+) -> (Vec<(ColliderHandle, Pose)>, bool) {
     let mut within = Vec::new();
     let mut still = true;
     for (handle, collider) in colliders.iter().filter(|(_, c)| !c.is_sensor()) {
@@ -40,11 +42,11 @@ pub(super) fn colliders_within(
             aabb.maxs.as_dvec3() + widened,
         );
         if overlap(bounds, reach) {
-            within.push(handle);
+            within.push((handle, *collider.position()));
             still &= parent.is_none_or(|body| rigid_still(body, colliders, speed, dt));
         }
     }
-    within.sort_unstable_by_key(|handle| handle.into_raw_parts());
+    within.sort_unstable_by_key(|(handle, _)| handle.into_raw_parts());
     (within, still)
 }
 
@@ -61,7 +63,8 @@ pub(super) fn partners_of(constraints: &BodyConstraints) -> Vec<RigidBodyHandle>
 
 /// Whether the rigid world disturbs a body asleep with `asleep` within `widened` bounds over a
 /// step of `dt` (s): a rigid body it rested with woke in rapier, moves or left, a collider came
-/// within its bounds or left them, or one there moves faster than `speed` (m/s).
+/// within its bounds, left them or was moved there (a fixed one set elsewhere by hand), or one
+/// there moves faster than `speed` (m/s).
 pub(super) fn rigid_disturbs(
     asleep: &Asleep,
     widened: Bounds,
