@@ -1,7 +1,7 @@
-//! What the coupling keeps of each deformable body beside the body, by handle: the constraints
-//! acting on it (contacts, rigid corners, attachments, rigid proxies) and its solver workspace.
-//! An entry is made the first time a body is attached or stepped, and dropped once its body has
-//! left the set.
+//! What the coupling keeps of each deformable body beside the body, by handle ([`BodyMap`]): the
+//! constraints acting on it (contacts, rigid corners, attachments, rigid proxies) and its solver
+//! workspace. An entry is made the first time a body is attached or stepped, and dropped once its
+//! body has left the set.
 
 use crate::body::{DeformableBody, DeformableBodyHandle, DeformableBodySet};
 use crate::constraint::BodyConstraints;
@@ -30,65 +30,86 @@ impl BodyLinks {
     }
 }
 
-/// The links of every deformable body, by handle.
-#[derive(Debug, Clone, Default)]
+/// A value per deformable body, by handle; written (feature `serde-serialize`) as a list of
+/// pairs, as formats such as JSON take only strings as map keys.
+#[derive(Debug, Clone)]
 #[cfg_attr(
     feature = "serde-serialize",
     derive(serde::Serialize, serde::Deserialize),
     serde(
-        into = "Vec<(DeformableBodyHandle, BodyLinks)>",
-        from = "Vec<(DeformableBodyHandle, BodyLinks)>"
+        into = "Vec<(DeformableBodyHandle, T)>",
+        from = "Vec<(DeformableBodyHandle, T)>"
     )
 )]
-pub(super) struct LinkSet {
-    links: BTreeMap<DeformableBodyHandle, BodyLinks>,
+pub(super) struct BodyMap<T: Clone> {
+    map: BTreeMap<DeformableBodyHandle, T>,
 }
 
-/// Written as a list of pairs (formats such as JSON take only strings as map keys).
-impl From<LinkSet> for Vec<(DeformableBodyHandle, BodyLinks)> {
-    fn from(set: LinkSet) -> Self {
-        set.links.into_iter().collect()
-    }
-}
-
-impl From<Vec<(DeformableBodyHandle, BodyLinks)>> for LinkSet {
-    fn from(pairs: Vec<(DeformableBodyHandle, BodyLinks)>) -> Self {
+impl<T: Clone> Default for BodyMap<T> {
+    fn default() -> Self {
         Self {
-            links: pairs.into_iter().collect(),
+            map: BTreeMap::new(),
         }
     }
 }
 
-impl LinkSet {
-    /// The links of `handle`, if it has some.
-    pub(super) fn get(&self, handle: DeformableBodyHandle) -> Option<&BodyLinks> {
-        self.links.get(&handle)
+impl<T: Clone> From<BodyMap<T>> for Vec<(DeformableBodyHandle, T)> {
+    fn from(set: BodyMap<T>) -> Self {
+        set.map.into_iter().collect()
+    }
+}
+
+impl<T: Clone> From<Vec<(DeformableBodyHandle, T)>> for BodyMap<T> {
+    fn from(pairs: Vec<(DeformableBodyHandle, T)>) -> Self {
+        Self {
+            map: pairs.into_iter().collect(),
+        }
+    }
+}
+
+/// The links of every deformable body.
+pub(super) type LinkSet = BodyMap<BodyLinks>;
+
+impl<T: Clone + Default> BodyMap<T> {
+    /// The value of `handle`, if it has one.
+    pub(super) fn get(&self, handle: DeformableBodyHandle) -> Option<&T> {
+        self.map.get(&handle)
     }
 
-    /// The links of `handle`, mutably, if it has some.
-    pub(super) fn get_mut(&mut self, handle: DeformableBodyHandle) -> Option<&mut BodyLinks> {
-        self.links.get_mut(&handle)
+    /// The value of `handle`, mutably, if it has one.
+    pub(super) fn get_mut(&mut self, handle: DeformableBodyHandle) -> Option<&mut T> {
+        self.map.get_mut(&handle)
     }
 
-    /// The links of `handle`, made empty if it has none yet.
-    pub(super) fn entry(&mut self, handle: DeformableBodyHandle) -> &mut BodyLinks {
-        self.links.entry(handle).or_default()
+    /// The value of `handle`, made the default if it has none yet.
+    pub(super) fn entry(&mut self, handle: DeformableBodyHandle) -> &mut T {
+        self.map.entry(handle).or_default()
     }
 
-    /// Drops the links of bodies no longer in `bodies`.
+    /// Forgets the value of `handle`.
+    pub(super) fn remove(&mut self, handle: DeformableBodyHandle) {
+        self.map.remove(&handle);
+    }
+
+    /// Every body's value, by handle.
+    pub(super) fn iter(&self) -> impl Iterator<Item = (DeformableBodyHandle, &T)> {
+        self.map.iter().map(|(&handle, value)| (handle, value))
+    }
+
+    /// Drops the values of bodies no longer in `bodies`.
     pub(super) fn prune(&mut self, bodies: &DeformableBodySet) {
-        self.links.retain(|handle, _| bodies.contains(*handle));
+        self.map.retain(|handle, _| bodies.contains(*handle));
     }
 
-    /// The links of distinct `handles`, made if missing, in the order given.
-    pub(super) fn many_mut(&mut self, handles: &[DeformableBodyHandle]) -> Vec<&mut BodyLinks> {
+    /// The values of distinct `handles`, made if missing, in the order given.
+    pub(super) fn many_mut(&mut self, handles: &[DeformableBodyHandle]) -> Vec<&mut T> {
         for &handle in handles {
             self.entry(handle);
         }
-        let mut found: Vec<Option<&mut BodyLinks>> = handles.iter().map(|_| None).collect();
-        for (handle, links) in &mut self.links {
+        let mut found: Vec<Option<&mut T>> = handles.iter().map(|_| None).collect();
+        for (handle, value) in &mut self.map {
             if let Some(i) = handles.iter().position(|h| h == handle) {
-                found[i] = Some(links);
+                found[i] = Some(value);
             }
         }
         found.into_iter().flatten().collect()

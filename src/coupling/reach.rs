@@ -10,12 +10,8 @@ use rapier3d::glamx::DVec3;
 /// An axis-aligned box, minimum and maximum corners (m).
 pub(crate) type Bounds = (DVec3, DVec3);
 
-/// The bounds of `points`, widened by `by` (m) on every side.
-pub(crate) fn bounds_of(points: &[DVec3], by: f64) -> Bounds {
-    let (low, high) = points.iter().fold(
-        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-        |(low, high), &p| (low.min(p), high.max(p)),
-    );
+/// `bounds` widened by `by` (m) on every side.
+pub(crate) fn widen((low, high): Bounds, by: f64) -> Bounds {
     (low - DVec3::splat(by), high + DVec3::splat(by))
 }
 
@@ -44,11 +40,6 @@ pub(crate) fn fastest_point(body: &RigidBody, colliders: &ColliderSet, dt: f64) 
 /// travel over a step of `dt` (s) under `gravity` (m/s²), `2 (|v|max + |g| dt) dt`: the reach of
 /// its contact detection.
 pub(crate) fn body_reach(body: &DeformableBody, margin: f64, dt: f64, gravity: DVec3) -> Bounds {
-    let fastest = (body.velocities.iter())
-        .map(|v| v.length())
-        .fold(0.0, f64::max);
-    bounds_of(
-        &body.positions,
-        margin + 2.0 * (fastest + gravity.length() * dt) * dt,
-    )
+    let travel = 2.0 * (body.fastest_node_speed() + gravity.length() * dt) * dt;
+    widen(body.position_bounds(), margin + travel)
 }

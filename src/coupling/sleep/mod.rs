@@ -29,16 +29,16 @@ mod still;
 pub(crate) use resting::RestingLoads;
 
 use super::RigidSets;
+use super::bodies::BodyMap;
 use super::groups::Components;
 use super::loads::FrameLoads;
-use super::reach::{Bounds, body_reach, bounds_of, overlap};
+use super::reach::{Bounds, body_reach, overlap, widen};
 use crate::body::{DeformableBody, DeformableBodyHandle, DeformableBodySet};
 use crate::constraint::BodyConstraints;
 use rapier3d::dynamics::{RigidBody, RigidBodyHandle, RigidBodySet};
 use rapier3d::geometry::{ColliderHandle, ColliderSet};
 use rapier3d::glamx::DVec3;
 use rapier3d::math::Pose;
-use std::collections::BTreeMap;
 use still::{colliders_within, partners_of, rested_together, rigid_disturbs, rigid_still};
 
 /// When deformable bodies fall asleep (see the module's documentation).
@@ -116,46 +116,27 @@ struct SleepState {
 #[derive(Debug, Clone, Default)]
 #[cfg_attr(
     feature = "serde-serialize",
-    derive(serde::Serialize, serde::Deserialize),
-    serde(
-        into = "Vec<(DeformableBodyHandle, SleepState)>",
-        from = "Vec<(DeformableBodyHandle, SleepState)>"
-    )
+    derive(serde::Serialize, serde::Deserialize)
 )]
 pub(super) struct SleepSet {
-    states: BTreeMap<DeformableBodyHandle, SleepState>,
-}
-
-/// Written as a list of pairs (formats such as JSON take only strings as map keys).
-impl From<SleepSet> for Vec<(DeformableBodyHandle, SleepState)> {
-    fn from(set: SleepSet) -> Self {
-        set.states.into_iter().collect()
-    }
-}
-
-impl From<Vec<(DeformableBodyHandle, SleepState)>> for SleepSet {
-    fn from(pairs: Vec<(DeformableBodyHandle, SleepState)>) -> Self {
-        Self {
-            states: pairs.into_iter().collect(),
-        }
-    }
+    states: BodyMap<SleepState>,
 }
 
 impl SleepSet {
     /// Drops the states of bodies no longer in `bodies`.
     pub(super) fn prune(&mut self, bodies: &DeformableBodySet) {
-        self.states.retain(|handle, _| bodies.contains(*handle));
+        self.states.prune(bodies);
     }
 
     /// Whether body `handle` is asleep.
     pub(super) fn is_asleep(&self, handle: DeformableBodyHandle) -> bool {
-        self.states.get(&handle).is_some_and(|s| s.asleep.is_some())
+        self.states.get(handle).is_some_and(|s| s.asleep.is_some())
     }
 
     /// Wakes body `handle` (if asleep) and restarts its still time; the rigid bodies it rested
     /// with wake as its next step hands them impulses.
     pub(super) fn wake_up(&mut self, handle: DeformableBodyHandle) {
-        self.states.remove(&handle);
+        self.states.remove(handle);
     }
 }
 
@@ -173,7 +154,7 @@ impl SleepSet {
         (h, gravity, margin): (f64, DVec3, f64),
     ) {
         let sleeping: Vec<(DeformableBodyHandle, &Asleep)> = (self.states.iter())
-            .filter_map(|(&handle, state)| state.asleep.as_ref().map(|a| (handle, a)))
+            .filter_map(|(handle, state)| state.asleep.as_ref().map(|a| (handle, a)))
             .collect();
         if sleeping.is_empty() {
             return;
@@ -185,7 +166,7 @@ impl SleepSet {
         let mut woken: Vec<bool> = (sleeping.iter())
             .map(|&(handle, asleep)| {
                 let body = &soft_bodies[handle];
-                let widened = (asleep.bounds.0 - margin, asleep.bounds.1 + margin);
+                let widened = widen(asleep.bounds, margin);
                 body.state_edits() != asleep.state_edits
                     || gravity != asleep.gravity
                     || awake.iter().any(|&other| overlap(widened, other))
@@ -217,7 +198,7 @@ impl SleepSet {
             .map(|((handle, asleep), _)| (*handle, asleep.partners.clone()))
             .collect();
         for (handle, partners) in wake {
-            self.states.remove(&handle);
+            self.states.remove(handle);
             for partner in partners {
                 if let Some(body) = rigid.bodies.get_mut(partner) {
                     body.wake_up(true);
@@ -244,14 +225,14 @@ impl SleepSet {
                 (bodies.get(partner)).is_some_and(|b| rigid_still(b, colliders, speed, h))
             })
             && colliders_within(
-                bounds_of(&body.positions, margin),
+                widen(body.position_bounds(), margin),
                 colliders,
                 bodies,
                 speed,
                 h,
             )
             .1;
-        let state = self.states.entry(handle).or_default();
+        let state = self.states.entry(handle);
         if still {
             state.still_for += h;
             state.resting.add_substep(body, constraints);
@@ -276,14 +257,14 @@ impl SleepSet {
         let ready = |state: &SleepState| {
             state.still_for >= settings.time_until_sleep && state.asleep.is_none()
         };
-        if !self.states.values().any(ready) {
+        if !self.states.iter().any(|(_, state)| ready(state)) {
             return;
         }
         let awake: Vec<(DeformableBodyHandle, Bounds, Vec<RigidBodyHandle>)> = (soft_bodies.iter())
             .filter(|(handle, _)| !self.is_asleep(*handle))
             .map(|(handle, body)| {
                 let partners = constraints(handle).map(partners_of).unwrap_or_default();
-                (handle, bounds_of(&body.positions, margin), partners)
+                (handle, widen(body.position_bounds(), margin), partners)
             })
             .collect();
         let mut components = Components::new(awake.len());
@@ -300,10 +281,10 @@ impl SleepSet {
         for group in components.groups() {
             let all_ready = group
                 .iter()
-                .all(|&i| self.states.get(&awake[i].0).is_some_and(ready));
+                .all(|&i| self.states.get(awake[i].0).is_some_and(ready));
             let resting = group.iter().any(|&i| {
                 soft_bodies[awake[i].0].pinned.iter().any(|&p| p)
-                    || (self.states.get(&awake[i].0)).is_some_and(|s| s.resting.bears_load())
+                    || (self.states.get(awake[i].0)).is_some_and(|s| s.resting.bears_load())
             });
             if !(all_ready && resting) {
                 continue;
@@ -312,8 +293,8 @@ impl SleepSet {
                 let (handle, _, ref partners) = awake[i];
                 let body = &mut soft_bodies[handle];
                 body.velocities.fill(DVec3::ZERO);
-                let bounds = bounds_of(&body.positions, 0.0);
-                let widened = (bounds.0 - margin, bounds.1 + margin);
+                let bounds = body.position_bounds();
+                let widened = widen(bounds, margin);
                 let speed = settings.speed_threshold;
                 let (colliders, _) =
                     colliders_within(widened, rigid.colliders, rigid.bodies, speed, h);
@@ -324,7 +305,7 @@ impl SleepSet {
                         rigid_body.sleep();
                     }
                 }
-                let state = self.states.entry(handle).or_default();
+                let state = self.states.entry(handle);
                 state.asleep = Some(Asleep {
                     state_edits: body.state_edits(),
                     gravity,

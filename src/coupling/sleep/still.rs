@@ -4,10 +4,9 @@
 use super::Asleep;
 use crate::constraint::BodyConstraints;
 use crate::coupling::RigidSets;
-use crate::coupling::reach::{Bounds, fastest_point, overlap};
+use crate::coupling::reach::{Bounds, fastest_point, overlap, widen};
 use rapier3d::dynamics::{RigidBody, RigidBodyHandle, RigidBodySet, RigidBodyType};
 use rapier3d::geometry::{ColliderHandle, ColliderSet};
-use rapier3d::glamx::DVec3;
 use rapier3d::math::Pose;
 
 /// Whether `body` is still for a deformable body resting with it: fixed, sleeping, or moving
@@ -36,11 +35,7 @@ pub(super) fn colliders_within(
         let aabb = collider.compute_aabb();
         let parent = collider.parent().and_then(|parent| bodies.get(parent));
         let travel = parent.map_or(0.0, |body| 2.0 * fastest_point(body, colliders, dt) * dt);
-        let widened = travel * DVec3::ONE;
-        let reach = (
-            aabb.mins.as_dvec3() - widened,
-            aabb.maxs.as_dvec3() + widened,
-        );
+        let reach = widen((aabb.mins.as_dvec3(), aabb.maxs.as_dvec3()), travel);
         if overlap(bounds, reach) {
             within.push((handle, *collider.position()));
             still &= parent.is_none_or(|body| rigid_still(body, colliders, speed, dt));
@@ -86,8 +81,7 @@ pub(super) fn rigid_disturbs(
 /// Whether two sleeping bodies rested together: their bounds, widened by `margin` (m), overlap,
 /// or they touched the same dynamic rigid body of `bodies`.
 pub(super) fn rested_together(a: &Asleep, b: &Asleep, bodies: &RigidBodySet, margin: f64) -> bool {
-    let widen = |bounds: Bounds| (bounds.0 - margin, bounds.1 + margin);
-    overlap(widen(a.bounds), widen(b.bounds))
+    overlap(widen(a.bounds, margin), widen(b.bounds, margin))
         || (a.partners.iter())
             .any(|p| b.partners.contains(p) && bodies.get(*p).is_some_and(RigidBody::is_dynamic))
 }
