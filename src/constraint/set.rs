@@ -8,7 +8,9 @@
 use crate::Error;
 use crate::attachment::{self, Attachment};
 use crate::body::DeformableBody;
-use crate::contact::{self, ColliderView, ContactSet, ContactSettings, NodeContact};
+use crate::contact::{
+    self, ColliderView, ContactSet, ContactSettings, CornerContact, CornerPlace, NodeContact,
+};
 use crate::rigid::RigidProxy;
 use rapier3d::dynamics::RigidBodyHandle;
 use rapier3d::geometry::ColliderHandle;
@@ -55,13 +57,15 @@ pub struct BodyConstraints {
     saved: SavedConstraints,
 }
 
-/// The proxies, attachment anchors (m) and contact planes (point and normal) saved with the
-/// state before a step: explicit substeps move them.
+/// The proxies, attachment anchors (m), contact planes (point and normal) and rigid corners
+/// saved with the state before a step: substeps move them, and a refused frame is redone from
+/// where it started.
 #[derive(Debug, Clone, Default)]
 struct SavedConstraints {
     proxies: Vec<RigidProxy>,
     anchors: Vec<DVec3>,
     planes: Vec<(DVec3, DVec3)>,
+    corners: Vec<CornerPlace>,
 }
 
 impl BodyConstraints {
@@ -219,6 +223,10 @@ impl BodyConstraints {
         self.saved
             .planes
             .extend(self.contacts.nodes.iter().map(|c| (c.point, c.normal)));
+        self.saved.corners.clear();
+        self.saved
+            .corners
+            .extend(self.contacts.corners.iter().map(CornerContact::place));
     }
 
     /// Puts back what [`BodyConstraints::save`] set aside.
@@ -231,6 +239,9 @@ impl BodyConstraints {
         for (contact, (point, normal)) in self.contacts.nodes.iter_mut().zip(&self.saved.planes) {
             contact.point = *point;
             contact.normal = *normal;
+        }
+        for (corner, place) in self.contacts.corners.iter_mut().zip(&self.saved.corners) {
+            corner.set_place(*place);
         }
     }
 }

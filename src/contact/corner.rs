@@ -61,7 +61,31 @@ pub(crate) struct CornerContact {
     slip_origin: DVec3,
 }
 
+/// Where a step leaves a corner: its vertex and its contact plane's point (m) and unit normal.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct CornerPlace {
+    vertex: DVec3,
+    point: DVec3,
+    normal: DVec3,
+}
+
 impl CornerContact {
+    /// Where the corner is now, for [`CornerContact::set_place`] to put it back.
+    pub(crate) fn place(&self) -> CornerPlace {
+        CornerPlace {
+            vertex: self.vertex,
+            point: self.point,
+            normal: self.normal,
+        }
+    }
+
+    /// Puts the corner back where [`CornerContact::place`] found it.
+    pub(crate) fn set_place(&mut self, place: CornerPlace) {
+        self.vertex = place.vertex;
+        self.point = place.point;
+        self.normal = place.normal;
+    }
+
     /// Where (m) and with what mean force (N) the soft body pushed the collider over the last
     /// step, of length `dt` (s).
     pub(crate) fn force_on_collider(&self, dt: f64) -> (DVec3, DVec3) {

@@ -66,7 +66,7 @@ mod velocity_constraint;
 
 pub(crate) use between::{BetweenContact, detect_between, prepare_between, solve_between};
 pub(crate) use corner::{
-    CornerContact, advance_corners, for_each_corner_stencil, for_each_corner_term,
+    CornerContact, CornerPlace, advance_corners, for_each_corner_stencil, for_each_corner_term,
     lag_corner_friction, prepare_corners, record_corner_impulses, solve_corners,
 };
 use detect::nearest_surface_point;
