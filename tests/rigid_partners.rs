@@ -665,12 +665,7 @@ fn a_box_crushing_a_soft_block_in_long_implicit_frames_stays_on_it_or_is_refused
     // is refused at frame 5.
     let (mut world, rigid) = box_on_block(Some(IntegratorKind::Implicit), 100.0, 1e6);
     world.physics.integration_parameters.dt = 1.0 / 30.0;
-    let block = world
-        .soft_bodies
-        .iter()
-        .next()
-        .map(|(handle, _)| handle)
-        .unwrap();
+    let block = world.soft_bodies.iter().next().unwrap().0;
     for frame in 0..30 {
         let refused = world
             .step()

@@ -70,7 +70,7 @@ impl<T: Clone> From<Vec<(DeformableBodyHandle, T)>> for BodyMap<T> {
 /// The links of every deformable body.
 pub(super) type LinkSet = BodyMap<BodyLinks>;
 
-impl<T: Clone + Default> BodyMap<T> {
+impl<T: Clone> BodyMap<T> {
     /// The value of `handle`, if it has one.
     pub(super) fn get(&self, handle: DeformableBodyHandle) -> Option<&T> {
         self.map.get(&handle)
@@ -79,11 +79,6 @@ impl<T: Clone + Default> BodyMap<T> {
     /// The value of `handle`, mutably, if it has one.
     pub(super) fn get_mut(&mut self, handle: DeformableBodyHandle) -> Option<&mut T> {
         self.map.get_mut(&handle)
-    }
-
-    /// The value of `handle`, made the default if it has none yet.
-    pub(super) fn entry(&mut self, handle: DeformableBodyHandle) -> &mut T {
-        self.map.entry(handle).or_default()
     }
 
     /// Forgets the value of `handle`.
@@ -99,6 +94,13 @@ impl<T: Clone + Default> BodyMap<T> {
     /// Drops the values of bodies no longer in `bodies`.
     pub(super) fn prune(&mut self, bodies: &DeformableBodySet) {
         self.map.retain(|handle, _| bodies.contains(*handle));
+    }
+}
+
+impl<T: Clone + Default> BodyMap<T> {
+    /// The value of `handle`, made the default if it has none yet.
+    pub(super) fn entry(&mut self, handle: DeformableBodyHandle) -> &mut T {
+        self.map.entry(handle).or_default()
     }
 
     /// The values of distinct `handles`, made if missing, in the order given.
