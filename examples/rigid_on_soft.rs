@@ -108,9 +108,7 @@ fn creep_from(start: DVec3, x: DVec3) -> f64 {
 
 /// Settles, prints the header and first row, then measures, printing every [`ROW_FRAMES`].
 fn run(scene: &mut Scene) -> Result<Measured, Error> {
-    // The contacts' impulses are those of the frame's last soft step, one coupling substep long.
     let world = &mut scene.world;
-    let h = f64::from(world.physics.integration_parameters.dt) / f64::from(world.coupling.substeps);
     for _ in 0..SETTLE_S * FPS {
         step(world)?;
     }
@@ -132,7 +130,7 @@ fn run(scene: &mut Scene) -> Result<Measured, Error> {
     let (mut reaction_sum, mut row_sum, mut fastest) = (0.0, 0.0, 0.0f64);
     for frame in 1..=MEASURE_S * FPS {
         step(world)?;
-        let reaction = -world.contact_force_on(scene.block, scene.ground, h)?.0.y;
+        let reaction = -world.contact_force_on(scene.block, scene.ground)?.0.y;
         reaction_sum += reaction;
         row_sum += reaction;
         let rigid = &world.physics.bodies[scene.rigid_box];

@@ -117,15 +117,13 @@ fn build_scene() -> Result<Scene, Error> {
 fn run(scene: &mut Scene) -> Result<(f64, f64), Error> {
     let frames = 120;
     let world = &mut scene.world;
-    let substep =
-        f64::from(world.physics.integration_parameters.dt) / f64::from(world.coupling.substeps);
     let (mut deepest, mut reaction) = (0.0f64, 0.0);
     for frame in 0..frames {
         for (_, outcome) in world.step() {
             outcome?;
         }
         if frame >= frames - 60 {
-            let (force, _) = world.contact_force_on(scene.handles[0], scene.ground, substep)?;
+            let (force, _) = world.contact_force_on(scene.handles[0], scene.ground)?;
             reaction -= force.y / 60.0;
         }
         for pair in scene.handles.windows(2) {

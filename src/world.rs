@@ -157,7 +157,8 @@ impl FvmWorld {
     }
 
     /// The mean force (N) and torque about the world origin (N m) the contacts of the deformable
-    /// body `soft` exerted on `collider` over the last coupling substep, of length `dt` (s); see
+    /// body `soft` exerted on `collider` over its last step (the frame's last coupling substep,
+    /// or the whole frame for a body that needed no coupling); see
     /// [`SoftCoupling::contact_force_on`].
     ///
     /// # Errors
@@ -166,10 +167,9 @@ impl FvmWorld {
         &self,
         soft: DeformableBodyHandle,
         collider: ColliderHandle,
-        dt: f64,
     ) -> Result<(DVec3, DVec3), Error> {
         self.coupling
-            .contact_force_on(&self.soft_bodies, soft, collider, dt)
+            .contact_force_on(&self.soft_bodies, soft, collider)
     }
 
     /// Advances the world by one frame (`physics.integration_parameters.dt`), without hooks or

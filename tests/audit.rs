@@ -82,10 +82,14 @@ fn a_free_fall_loses_exactly_the_energy_symplectic_euler_loses_and_raises_nothin
         for _ in 0..30 {
             let results = world.step();
             let report = *results[0].1.as_ref().unwrap();
-            // Every coupling substep of a free body takes the same explicit substeps.
-            let per_coupling_substep = report.explicit.map_or(1, |e| e.substeps);
-            let steps = f64::from(world.coupling.substeps * per_coupling_substep);
-            let h = f64::from(world.physics.integration_parameters.dt) / steps;
+            // A free body needs no coupling: it steps once per frame, in the substeps its
+            // report tells.
+            let (steps, h) = (report.explicit.map(|e| (e.substeps, e.substep_dt)))
+                .or(report.implicit.map(|i| (i.substeps, i.substep_dt)))
+                .expect("a stepped body reports its substeps");
+            let frame = f64::from(world.physics.integration_parameters.dt);
+            assert!((f64::from(steps) * h - frame).abs() < 1e-12 * frame);
+            let steps = f64::from(steps);
             let expected = -steps * 0.5 * mass * 9.81f64.powi(2) * h * h;
             let found = audit.check_world(&world, &results);
             assert!(found.is_clean(), "{integrator:?}: {found:#?}");

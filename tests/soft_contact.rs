@@ -91,8 +91,7 @@ fn stack_of_two(force: Option<IntegratorKind>) {
         if index >= frames - 60 {
             let expected = force.unwrap_or(IntegratorKind::Explicit);
             assert!(reports.iter().all(|(_, r)| r.choice == expected));
-            let substep = frame / f64::from(world.coupling.substeps);
-            let (force, _) = world.contact_force_on(bottom, ground, substep).unwrap();
+            let (force, _) = world.contact_force_on(bottom, ground).unwrap();
             reaction -= force.y;
             averaged += 1;
             fastest = world.soft_bodies[top]
@@ -277,8 +276,7 @@ fn a_body_of_two_separate_cubes_lands_on_itself_only_with_self_contact() {
         for index in 0..frames {
             step(&mut world);
             if index >= frames - 60 {
-                let substep = frame / f64::from(world.coupling.substeps);
-                let (force, _) = world.contact_force_on(handle, ground, substep).unwrap();
+                let (force, _) = world.contact_force_on(handle, ground).unwrap();
                 reaction -= force.y;
                 averaged += 1;
             }

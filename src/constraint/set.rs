@@ -159,7 +159,9 @@ impl BodyConstraints {
     /// `collider` over the last step, of length `dt` (s): their impulses over `dt` (the torque
     /// taken at the surface points' end-of-step positions, and at the collider's vertices for
     /// its corners pressing on the surface). In an [`FvmWorld`](crate::world::FvmWorld) the last
-    /// step is the frame's last coupling substep.
+    /// step is the frame's last coupling substep, or the whole frame for a body that needed no
+    /// coupling ([`FvmWorld::contact_force_on`](crate::world::FvmWorld::contact_force_on) knows
+    /// which).
     ///
     /// # Errors
     /// [`Error::InvalidTimeStep`] for a non-positive or non-finite `dt`.

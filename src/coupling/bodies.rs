@@ -17,6 +17,10 @@ use std::collections::BTreeMap;
 pub(super) struct BodyLinks {
     pub(super) constraints: BodyConstraints,
     pub(super) workspace: SolverWorkspace,
+    /// The length (s) of the body's last step: a coupling substep, or the whole frame for a body
+    /// that needed no coupling; zero before any.
+    #[cfg_attr(feature = "serde-serialize", serde(default))]
+    pub(super) last_step: f64,
 }
 
 impl BodyLinks {
@@ -115,5 +119,16 @@ impl<T: Clone + Default> BodyMap<T> {
             }
         }
         found.into_iter().flatten().collect()
+    }
+}
+
+impl LinkSet {
+    /// Records that the bodies `stepped` (which have links) last stepped over `h` (s).
+    pub(super) fn set_last_step(&mut self, stepped: &[DeformableBodyHandle], h: f64) {
+        for &handle in stepped {
+            if let Some(links) = self.get_mut(handle) {
+                links.last_step = h;
+            }
+        }
     }
 }

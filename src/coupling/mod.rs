@@ -3,7 +3,9 @@
 //!
 //! rapier offers no callback inside its step, so a frame of `dt` is cut into
 //! [`SoftCoupling::substeps`] rapier steps of `h = dt / substeps`, and the deformable bodies step
-//! between them. One coupling substep, in order:
+//! between them. A body that needs no coupling (within its reach over the frame only fixed and
+//! kinematic colliders: no dynamic rigid body, no other deformable body) steps once over the
+//! whole frame before the substeps, which skip it (`uncoupled`). One coupling substep, in order:
 //!
 //! 1. **Kinematic paths.** Each position-based kinematic body told where to be at the end of the
 //!    frame is told the part of its straight path it reaches by the end of this substep.
@@ -53,6 +55,7 @@ mod loads;
 mod rapier_view;
 mod reach;
 mod sleep;
+mod uncoupled;
 
 pub use audit::{
     Audit, AuditInput, AuditSettings, BodyAudit, EnergyCheck, FrameAudit, PenetrationTarget,
@@ -64,7 +67,7 @@ pub use sleep::SleepSettings;
 use crate::Error;
 use crate::body::{DeformableBody, DeformableBodyHandle, DeformableBodySet};
 use crate::constraint::{self, BodyConstraints};
-use crate::contact::{self, ContactSettings, NodeContact};
+use crate::contact::{self, BetweenContact, ContactSettings, NodeContact};
 use crate::integrate::{AutomaticIntegrator, AutomaticReport, BodyInStep, IntegratorKind};
 use bodies::{BodyLinks, LinkSet};
 use carry::{Carried, RapierCarry};
@@ -170,7 +173,8 @@ pub struct SoftCoupling {
     /// How their contacts are detected and enforced.
     pub contact: ContactSettings,
     /// rapier steps per frame, with the deformable bodies stepped between them (at least 1: zero
-    /// is refused by [`SoftCoupling::step`]).
+    /// is refused by [`SoftCoupling::step`]); a body that needs no coupling steps once per frame
+    /// (see the module's documentation).
     pub substeps: u32,
     /// When bodies at rest fall asleep (see [`SleepSettings`]).
     pub sleep: SleepSettings,
@@ -198,8 +202,9 @@ impl Default for SoftCoupling {
 
 impl SoftCoupling {
     /// Advances rigid and deformable bodies by one frame (`integration_parameters.dt`, s): the
-    /// [`SoftCoupling::substeps`] coupling substeps of the module's documentation, each a soft
-    /// step then one `pipeline` step on the caller's `rapier` sets with `hooks` and `events`.
+    /// bodies that need no coupling over the whole frame, then the [`SoftCoupling::substeps`]
+    /// coupling substeps of the module's documentation, each a soft step of the others then one
+    /// `pipeline` step on the caller's `rapier` sets with `hooks` and `events`.
     /// A frame of `dt = 0` (a pause) only lets rapier apply changes, and steps no deformable
     /// body. A negative or non-finite `dt`, or zero [`SoftCoupling::substeps`], steps nothing,
     /// rapier included, and every deformable body's result is the error
@@ -233,6 +238,17 @@ impl SoftCoupling {
             iterations_per_substep(frame.num_solver_iterations, substeps);
         let mut outcomes = unstepped(soft_bodies);
         let paths = KinematicPath::all(rapier.bodies);
+        let uncoupled = if substeps > 1 {
+            let rigid = RigidSets {
+                bodies: rapier.bodies,
+                colliders: rapier.colliders,
+                narrow_phase: rapier.narrow_phase,
+            };
+            let frame_dt = f64::from(frame.dt);
+            self.step_uncoupled(soft_bodies, rigid, &mut outcomes, (frame_dt, gravity))
+        } else {
+            Vec::new()
+        };
         for substep in 1..=substeps {
             for path in &paths {
                 path.advance(rapier.bodies, substep as f32 / substeps as f32);
@@ -242,7 +258,8 @@ impl SoftCoupling {
                 colliders: rapier.colliders,
                 narrow_phase: rapier.narrow_phase,
             };
-            let carried = self.step_soft_bodies(soft_bodies, rigid, &mut outcomes, h, gravity);
+            let carried =
+                self.step_soft_bodies(soft_bodies, rigid, &mut outcomes, &uncoupled, (h, gravity));
             let iterations = substep_parameters.num_solver_iterations;
             let carry = RapierCarry::lead(&carried, rapier.bodies, gravity, (h, iterations));
             rapier.step_rapier(pipeline, &substep_parameters, hooks, events);
@@ -284,7 +301,7 @@ impl SoftCoupling {
     ) -> SoftStepResults {
         self.loads.clear();
         let mut outcomes = unstepped(soft_bodies);
-        self.step_soft_bodies(soft_bodies, rigid, &mut outcomes, h, gravity);
+        self.step_soft_bodies(soft_bodies, rigid, &mut outcomes, &[], (h, gravity));
         if h > 0.0 {
             self.loads.finish(h);
         }
@@ -370,28 +387,28 @@ impl SoftCoupling {
     }
 
     /// The mean force (N) and torque about the world origin (N m) the contacts of the deformable
-    /// body `soft` of `soft_bodies` exerted on `collider` over the last substep, of length `dt`
-    /// (s); see [`BodyConstraints::contact_force_on`]. Zero for a body without contacts.
+    /// body `soft` of `soft_bodies` exerted on `collider` over the body's last step (the frame's
+    /// last coupling substep, or the whole frame for a body that needed no coupling); see
+    /// [`BodyConstraints::contact_force_on`]. Zero for a body never stepped or without contacts.
+    /// [`SoftCoupling::collider_loads`] holds the mean over the whole frame.
     ///
     /// # Errors
-    /// [`Error::UnknownDeformableBody`] if `soft` is not in `soft_bodies`;
-    /// [`Error::InvalidTimeStep`] for a non-positive or non-finite `dt`.
+    /// [`Error::UnknownDeformableBody`] if `soft` is not in `soft_bodies`.
     pub fn contact_force_on(
         &self,
         soft_bodies: &DeformableBodySet,
         soft: DeformableBodyHandle,
         collider: ColliderHandle,
-        dt: f64,
     ) -> Result<(DVec3, DVec3), Error> {
         let body = soft_bodies.get(soft).ok_or(Error::UnknownDeformableBody)?;
-        match self.constraints(soft) {
-            Some(constraints) => constraints.contact_force_on(body, collider, dt),
-            None => BodyConstraints::new().contact_force_on(body, collider, dt),
+        match self.links.get(soft).filter(|links| links.last_step > 0.0) {
+            Some(links) => (links.constraints).contact_force_on(body, collider, links.last_step),
+            None => Ok((DVec3::ZERO, DVec3::ZERO)),
         }
     }
 
-    /// One coupling substep of `h` (s): each body whose state passes
-    /// [`DeformableBody::check_state`] finds its contacts with the colliders (the others keep
+    /// One coupling substep of `h` (s): each body but those in `skip` (stepped over the whole
+    /// frame already) whose state passes [`DeformableBody::check_state`] finds its contacts with the colliders (the others keep
     /// their state and take its error), bodies touching each other are grouped and stepped
     /// together, the others alone, and the impulses they gave rigid bodies go to rapier and to
     /// the loads. Each body's outcome becomes its last report or its first error. A body whose
@@ -405,8 +422,8 @@ impl SoftCoupling {
         soft_bodies: &mut DeformableBodySet,
         mut rigid: RigidSets<'_>,
         outcomes: &mut [(DeformableBodyHandle, Outcome)],
-        h: f64,
-        gravity: DVec3,
+        skip: &[DeformableBodyHandle],
+        (h, gravity): (f64, DVec3),
     ) -> Vec<Carried> {
         self.links.prune(soft_bodies);
         self.sleeping.prune(soft_bodies);
@@ -419,11 +436,40 @@ impl SoftCoupling {
             &self.sleep,
             sleep,
         );
-        let (live, held) = self.detect(soft_bodies, &rigid, outcomes, h, gravity);
+        let (live, held) = self.detect(soft_bodies, &rigid, outcomes, skip, (h, gravity));
         let between = {
             let bodies: Vec<&DeformableBody> = live.iter().map(|&h| &soft_bodies[h]).collect();
             contact::detect_between(&bodies, &self.contact, h, gravity)
         };
+        let carried = self.step_live(
+            soft_bodies,
+            &mut rigid,
+            outcomes,
+            (&live, between),
+            (h, gravity),
+        );
+        self.hold_refused(soft_bodies, &held, &mut rigid, h, gravity);
+        let links = &self.links;
+        let constraints = |handle| links.get(handle).map(|l: &BodyLinks| &l.constraints);
+        (self.sleeping).settle(soft_bodies, constraints, &mut rigid, &self.sleep, sleep);
+        carried
+    }
+
+    /// Steps the bodies `live` over `h` (s) under `gravity` (m/s²), in the groups the contacts
+    /// `between` them (indices into `live`) link: each group at once, the rigid bodies they
+    /// touch that rest on something held within the step; then each body's outcome is recorded,
+    /// its stillness observed and its impulses handed to rapier and the loads (a refused body
+    /// holding the rigid bodies it touches as a fixed obstacle would). Returns the dynamic rigid
+    /// bodies implicit steps moved.
+    fn step_live(
+        &mut self,
+        soft_bodies: &mut DeformableBodySet,
+        rigid: &mut RigidSets<'_>,
+        outcomes: &mut [(DeformableBodyHandle, Outcome)],
+        (live, between): (&[DeformableBodyHandle], Vec<BetweenContact>),
+        (h, gravity): (f64, DVec3),
+    ) -> Vec<Carried> {
+        let margin = self.contact.margin;
         let groups = touching_groups(live.len(), between);
         let handles: Vec<DeformableBodyHandle> = (groups.iter())
             .flat_map(|(group, _)| group.iter().map(|&i| live[i]))
@@ -469,10 +515,7 @@ impl SoftCoupling {
                 }
             }
         }
-        self.hold_refused(soft_bodies, &held, &mut rigid, h, gravity);
-        let links = &self.links;
-        let constraints = |handle| links.get(handle).map(|l: &BodyLinks| &l.constraints);
-        (self.sleeping).settle(soft_bodies, constraints, &mut rigid, &self.sleep, sleep);
+        self.links.set_last_step(&handles, h);
         carried
     }
 
@@ -501,9 +544,11 @@ impl SoftCoupling {
             );
             hand_over(&mut self.loads, *handle, &mut step, rigid.bodies);
         }
+        self.links.set_last_step(held, h);
     }
 
-    /// Finds the contacts of every body of `outcomes` whose state a step can take, and returns
+    /// Finds the contacts of every awake body of `outcomes` not in `skip` whose state a step can
+    /// take, for a substep of `h` (s) under `gravity` (m/s²), and returns
     /// those to step (no error yet in the frame) and those to hold only (a step refused earlier
     /// in the frame); a body whose state fails [`DeformableBody::check_state`] or whose
     /// detection fails takes that error and neither.
@@ -512,14 +557,14 @@ impl SoftCoupling {
         soft_bodies: &DeformableBodySet,
         rigid: &RigidSets<'_>,
         outcomes: &mut [(DeformableBodyHandle, Outcome)],
-        h: f64,
-        gravity: DVec3,
+        skip: &[DeformableBodyHandle],
+        (h, gravity): (f64, DVec3),
     ) -> (Vec<DeformableBodyHandle>, Vec<DeformableBodyHandle>) {
         let views = rapier_view::collider_views(rigid.colliders, rigid.bodies, h);
         let lookup = rapier_view::rigid_lookup(rigid.bodies, h);
         let (mut live, mut held) = (Vec::new(), Vec::new());
         for (handle, outcome) in outcomes.iter_mut() {
-            if self.sleeping.is_asleep(*handle) {
+            if self.sleeping.is_asleep(*handle) || skip.contains(handle) {
                 continue;
             }
             let body = &soft_bodies[*handle];

@@ -333,7 +333,6 @@ pub fn settled_reaction(
     body: DeformableBodyHandle,
     ground: rapier3d::prelude::ColliderHandle,
 ) -> f64 {
-    let h = f64::from(world.physics.integration_parameters.dt) / f64::from(world.coupling.substeps);
     let step = |world: &mut rapier_fvm::world::FvmWorld| {
         for (_, outcome) in world.step() {
             outcome.unwrap();
@@ -346,7 +345,7 @@ pub fn settled_reaction(
     let mut reaction = 0.0;
     for _ in 0..frames {
         step(world);
-        reaction -= world.contact_force_on(body, ground, h).unwrap().0.y;
+        reaction -= world.contact_force_on(body, ground).unwrap().0.y;
     }
     reaction / f64::from(frames)
 }

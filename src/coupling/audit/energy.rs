@@ -85,12 +85,9 @@ pub(super) fn energies(
             .iter()
             .find(|(h, _)| *h == handle)
             .and_then(|(_, r)| r.as_ref().ok());
-        let implicit = report.is_some_and(|r| r.choice == IntegratorKind::Implicit);
-        let penalty = if implicit {
-            penalty_energy(input, handle, body)
-        } else {
-            0.0
-        };
+        let penalty = report
+            .and_then(|r| r.implicit)
+            .map_or(0.0, |r| penalty_energy(input, handle, body, r.substep_dt));
         let moving = body.kinetic_energy() + body.elastic_energy() + penalty;
         let total = moving + body.gravity_potential_energy(g);
         let ratio = report.and_then(|r| r.explicit).map_or(0.0, |e| {
@@ -141,22 +138,23 @@ fn rigid_integration_step(input: &AuditInput<'_>) -> f64 {
     input.dt / (substeps as usize * iterations) as f64
 }
 
-/// The energy (J) the implicit contact penalties of the deformable body `handle` hold now.
+/// The energy (J) the implicit contact penalties of the deformable body `handle` hold now, after
+/// an implicit step in substeps of `h` (s).
 fn penalty_energy(
     input: &AuditInput<'_>,
     handle: DeformableBodyHandle,
     body: &DeformableBody,
+    h: f64,
 ) -> f64 {
     let Some(constraints) = input.coupling.constraints(handle) else {
         return 0.0;
     };
     let implicit = &input.coupling.integrator.implicit;
-    let h = input.dt / f64::from(input.coupling.substeps.max(1) * implicit.substeps.max(1));
     let effective = match implicit.scheme {
         ImplicitScheme::BackwardEuler => h,
         ImplicitScheme::Bdf2 => 2.0 * h / 3.0,
     };
-    let settings = &input.coupling.contact;
+    let settings = &constraints.contacts.settings;
     constraints
         .contacts()
         .iter()

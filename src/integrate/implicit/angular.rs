@@ -34,6 +34,38 @@ pub(super) fn give_back(body: &mut DeformableBody, before: &[DVec3], h: f64) {
         .filter(|&n| !body.pinned[n])
         .map(|n| before[n].cross(body.velocities[n]) * (body.masses[n] * h))
         .sum();
+    turn_by(body, lost);
+}
+
+/// Gives back to `body`, free (nothing pinned, nothing but uniform gravity and its own forces
+/// acting on it over the step), the angular momentum about its centre of mass it started the
+/// step with at `positions` (m) and `velocities` (m/s): all it has lost, the drain `δL` and
+/// what the Newton solve's tolerance left (its residual's torque), so that a free body's spin is
+/// kept to round-off however loosely each step is solved.
+pub(super) fn keep_free_spin(body: &mut DeformableBody, positions: &[DVec3], velocities: &[DVec3]) {
+    let start = momentum_about_centre(positions, velocities, &body.masses);
+    let now = momentum_about_centre(&body.positions, &body.velocities, &body.masses);
+    turn_by(body, start - now);
+}
+
+/// The angular momentum (N m s) of nodes at `positions` (m) moving at `velocities` (m/s) with
+/// `masses` (kg) about their centre of mass.
+fn momentum_about_centre(positions: &[DVec3], velocities: &[DVec3], masses: &[f64]) -> DVec3 {
+    let total: f64 = masses.iter().sum();
+    let centre = positions
+        .iter()
+        .zip(masses)
+        .map(|(x, m)| *x * *m)
+        .sum::<DVec3>()
+        / total;
+    (positions.iter().zip(velocities).zip(masses))
+        .map(|((x, v), m)| (*x - centre).cross(*v) * *m)
+        .sum()
+}
+
+/// Adds to the free nodes of `body` the rotation the pins allow whose angular momentum is `lost`
+/// (N m s).
+fn turn_by(body: &mut DeformableBody, lost: DVec3) {
     if lost == DVec3::ZERO || !lost.is_finite() {
         return;
     }
@@ -45,6 +77,14 @@ pub(super) fn give_back(body: &mut DeformableBody, before: &[DVec3], h: f64) {
             body.velocities[n] += turn.cross(body.positions[n] - centre);
         }
     }
+}
+
+/// How fast `body` turns (rad/s): its angular momentum about its centre of mass over its inertia
+/// there, `|I_c⁻¹ L_c|`; zero for a body whose nodes lie on one line.
+pub(super) fn spin(body: &DeformableBody) -> f64 {
+    let momentum = momentum_about_centre(&body.positions, &body.velocities, &body.masses);
+    let inertia = inertia_about(body, body.center_of_mass());
+    solve(inertia, momentum).map_or(0.0, |turn| turn.length())
 }
 
 /// The rotation (its centre, m, and angular velocity, rad/s) the pins of `body` allow whose

@@ -317,7 +317,7 @@ impl ImplicitIntegrator {
         }
         let mut solver = GroupSolver::new(bodies, between, settings);
         let h = frame_dt / f64::from(self.substeps);
-        let mut report = ImplicitReport::empty(self.substeps);
+        let mut report = ImplicitReport::empty(self.substeps, h);
         let mut last: Vec<Option<PreviousStep>> = histories.clone();
         let mut failure = None;
         for _ in 0..self.substeps {
@@ -448,7 +448,7 @@ impl ImplicitIntegrator {
             .zip(starts.into_iter().zip(responses))
             .zip(last.iter_mut())
         {
-            *last = Some(end_substep(body, constraints, start, response, h));
+            *last = Some(end_substep(body, constraints, (start, response), h, false));
         }
         Ok(outcome)
     }

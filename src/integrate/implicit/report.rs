@@ -8,6 +8,8 @@ use crate::Error;
 pub struct ImplicitReport {
     /// Substeps taken.
     pub substeps: u32,
+    /// Length of each substep (s): the frame step over the substeps.
+    pub substep_dt: f64,
     /// Newton iterations over all substeps, those that reused a factorization included.
     pub newton_iterations: usize,
     /// Conjugate gradient iterations over all substeps (zero when every system was solved by
@@ -69,10 +71,12 @@ pub(super) struct Outcome {
 }
 
 impl ImplicitReport {
-    /// The report of a frame of `substeps` before any: nothing done, converged.
-    pub(super) fn empty(substeps: u32) -> Self {
+    /// The report of a frame of `substeps` of `substep_dt` (s) each before any: nothing done,
+    /// converged.
+    pub(super) fn empty(substeps: u32, substep_dt: f64) -> Self {
         Self {
             substeps,
+            substep_dt,
             newton_iterations: 0,
             linear_iterations: 0,
             reused_factorizations: 0,
