@@ -432,7 +432,7 @@ impl SoftCoupling {
         (self.sleeping).wake_disturbed(
             soft_bodies,
             &mut rigid,
-            &mut self.loads,
+            (&mut self.loads, skip),
             &self.sleep,
             sleep,
         );

@@ -144,12 +144,14 @@ impl SleepSet {
     /// Wakes every sleeping body of `soft_bodies` that something disturbed (see the module's
     /// documentation), with the sleeping bodies it overlaps or shares a rigid body with and the
     /// rigid bodies they rested with, before a substep of `h` (s) under `gravity` (m/s²); the
-    /// bodies left asleep count their loads into `loads` again. `margin` (m) widens bounds.
+    /// bodies left asleep count their loads into `loads` again, but for those in `counted`
+    /// (stepped over the whole frame, asleep since: their step's loads are the frame's). `margin`
+    /// (m) widens bounds.
     pub(super) fn wake_disturbed(
         &mut self,
         soft_bodies: &DeformableBodySet,
         rigid: &mut RigidSets<'_>,
-        loads: &mut FrameLoads,
+        (loads, counted): (&mut FrameLoads, &[DeformableBodyHandle]),
         settings: &SleepSettings,
         (h, gravity, margin): (f64, DVec3, f64),
     ) {
@@ -192,7 +194,9 @@ impl SleepSet {
         let (wake, keep): (Vec<_>, Vec<_>) =
             (sleeping.iter().zip(&woken)).partition(|(_, woken)| **woken);
         for ((handle, asleep), _) in keep {
-            loads.add_resting(*handle, &asleep.loads, h);
+            if !counted.contains(handle) {
+                loads.add_resting(*handle, &asleep.loads, h);
+            }
         }
         let wake: Vec<(DeformableBodyHandle, Vec<RigidBodyHandle>)> = (wake.into_iter())
             .map(|((handle, asleep), _)| (*handle, asleep.partners.clone()))
