@@ -55,6 +55,7 @@ mod loads;
 mod rapier_view;
 mod reach;
 mod sleep;
+mod substep;
 mod uncoupled;
 
 pub use audit::{
@@ -65,13 +66,12 @@ pub use loads::{ColliderLoad, RigidLoad};
 pub use sleep::SleepSettings;
 
 use crate::Error;
-use crate::body::{DeformableBody, DeformableBodyHandle, DeformableBodySet};
-use crate::constraint::{self, BodyConstraints};
-use crate::contact::{self, BetweenContact, ContactSettings, NodeContact};
-use crate::integrate::{AutomaticIntegrator, AutomaticReport, BodyInStep, IntegratorKind};
-use bodies::{BodyLinks, LinkSet};
-use carry::{Carried, RapierCarry};
-use groups::{GroupStep, step_groups, touching_groups};
+use crate::body::{DeformableBodyHandle, DeformableBodySet};
+use crate::constraint::BodyConstraints;
+use crate::contact::{ContactSettings, NodeContact};
+use crate::integrate::{AutomaticIntegrator, AutomaticReport};
+use bodies::LinkSet;
+use carry::RapierCarry;
 use kinematic::KinematicPath;
 use loads::FrameLoads;
 use rapier3d::dynamics::{
@@ -210,7 +210,7 @@ impl SoftCoupling {
     /// rapier included, and every deformable body's result is the error
     /// ([`Error::InvalidTimeStep`], [`Error::InvalidSetting`]). A body whose state a step cannot
     /// take (a position or velocity made NaN, infinite or absurd through the raw slices, see
-    /// [`DeformableBody::check_state`]) is not stepped and its result is that error, every frame
+    /// [`DeformableBody::check_state`](crate::body::DeformableBody::check_state)) is not stepped and its result is that error, every frame
     /// until its state is fixed.
     pub fn step(
         &mut self,
@@ -406,200 +406,6 @@ impl SoftCoupling {
             None => Ok((DVec3::ZERO, DVec3::ZERO)),
         }
     }
-
-    /// One coupling substep of `h` (s): each body but those in `skip` (stepped over the whole
-    /// frame already) whose state passes [`DeformableBody::check_state`] finds its contacts with the colliders (the others keep
-    /// their state and take its error), bodies touching each other are grouped and stepped
-    /// together, the others alone, and the impulses they gave rigid bodies go to rapier and to
-    /// the loads. Each body's outcome becomes its last report or its first error. A body whose
-    /// step is refused, in this substep or an earlier one of the frame, stays where it was and
-    /// holds the rigid bodies it touches or is glued to as a fixed obstacle would
-    /// ([`constraint::hold_partners`]): rapier's step must not let them sink into it meanwhile.
-    /// Returns the dynamic rigid bodies implicit steps moved, for rapier's step to carry them
-    /// as those steps did ([`RapierCarry`]).
-    fn step_soft_bodies(
-        &mut self,
-        soft_bodies: &mut DeformableBodySet,
-        mut rigid: RigidSets<'_>,
-        outcomes: &mut [(DeformableBodyHandle, Outcome)],
-        skip: &[DeformableBodyHandle],
-        (h, gravity): (f64, DVec3),
-    ) -> Vec<Carried> {
-        self.links.prune(soft_bodies);
-        self.sleeping.prune(soft_bodies);
-        let margin = self.contact.margin;
-        let sleep = (h, gravity, margin);
-        (self.sleeping).wake_disturbed(
-            soft_bodies,
-            &mut rigid,
-            (&mut self.loads, skip),
-            &self.sleep,
-            sleep,
-        );
-        let (live, held) = self.detect(soft_bodies, &rigid, outcomes, skip, (h, gravity));
-        let between = {
-            let bodies: Vec<&DeformableBody> = live.iter().map(|&h| &soft_bodies[h]).collect();
-            contact::detect_between(&bodies, &self.contact, h, gravity)
-        };
-        let carried = self.step_live(
-            soft_bodies,
-            &mut rigid,
-            outcomes,
-            (&live, between),
-            (h, gravity),
-        );
-        self.hold_refused(soft_bodies, &held, &mut rigid, h, gravity);
-        let links = &self.links;
-        let constraints = |handle| links.get(handle).map(|l: &BodyLinks| &l.constraints);
-        (self.sleeping).settle(soft_bodies, constraints, &mut rigid, &self.sleep, sleep);
-        carried
-    }
-
-    /// Steps the bodies `live` over `h` (s) under `gravity` (m/s²), in the groups the contacts
-    /// `between` them (indices into `live`) link: each group at once, the rigid bodies they
-    /// touch that rest on something held within the step; then each body's outcome is recorded,
-    /// its stillness observed and its impulses handed to rapier and the loads (a refused body
-    /// holding the rigid bodies it touches as a fixed obstacle would). Returns the dynamic rigid
-    /// bodies implicit steps moved.
-    fn step_live(
-        &mut self,
-        soft_bodies: &mut DeformableBodySet,
-        rigid: &mut RigidSets<'_>,
-        outcomes: &mut [(DeformableBodyHandle, Outcome)],
-        (live, between): (&[DeformableBodyHandle], Vec<BetweenContact>),
-        (h, gravity): (f64, DVec3),
-    ) -> Vec<Carried> {
-        let margin = self.contact.margin;
-        let groups = touching_groups(live.len(), between);
-        let handles: Vec<DeformableBodyHandle> = (groups.iter())
-            .flat_map(|(group, _)| group.iter().map(|&i| live[i]))
-            .collect();
-        let mut steps = (self.links.many_mut(&handles).into_iter())
-            .zip(soft_bodies.get_many_mut(&handles))
-            .map(|(links, body)| links.with(body));
-        let mut ready: Vec<GroupStep> = (groups.into_iter())
-            .map(|(group, between)| GroupStep {
-                bodies: steps.by_ref().take(group.len()).collect(),
-                between,
-            })
-            .collect();
-        for step in ready.iter_mut().flat_map(|group| group.bodies.iter_mut()) {
-            hold_supported_bodies(step.constraints, rigid.bodies, rigid.narrow_phase);
-        }
-        let stepped = step_groups(&mut ready, &self.integrator, &self.contact, (h, gravity));
-        let steps = ready.into_iter().flat_map(|group| group.bodies);
-        let mut carried = Vec::new();
-        for ((handle, mut step), result) in
-            handles.iter().zip(steps).zip(stepped.into_iter().flatten())
-        {
-            if result.is_err() {
-                constraint::hold_partners(step.body, step.constraints, h, gravity);
-            }
-            if result
-                .as_ref()
-                .is_ok_and(|r| r.choice == IntegratorKind::Implicit)
-            {
-                Carried::add(&mut carried, &step.constraints.rigid_proxies);
-            }
-            self.sleeping.observe(
-                (*handle, step.body, step.constraints),
-                (rigid.bodies, rigid.colliders),
-                &self.sleep,
-                (h, result.is_ok(), margin),
-            );
-            hand_over(&mut self.loads, *handle, &mut step, rigid.bodies);
-            if let Some((_, outcome)) = outcomes.iter_mut().find(|(h, _)| h == handle) {
-                // A step refused in an earlier substep of the frame stays reported.
-                if !matches!(outcome, Some(Err(_))) {
-                    *outcome = Some(result);
-                }
-            }
-        }
-        self.links.set_last_step(&handles, h);
-        carried
-    }
-
-    /// Holds, for a substep of `h` (s) under `gravity` (m/s²), the rigid bodies that the bodies
-    /// `held` (whose step was refused earlier in the frame) touch or are glued to, as a fixed
-    /// obstacle would ([`constraint::hold_partners`]), and hands those impulses over.
-    fn hold_refused(
-        &mut self,
-        soft_bodies: &mut DeformableBodySet,
-        held: &[DeformableBodyHandle],
-        rigid: &mut RigidSets<'_>,
-        h: f64,
-        gravity: DVec3,
-    ) {
-        let holds = (self.links.many_mut(held).into_iter())
-            .zip(soft_bodies.get_many_mut(held))
-            .map(|(links, body)| links.with(body));
-        for (handle, mut step) in held.iter().zip(holds) {
-            hold_supported_bodies(step.constraints, rigid.bodies, rigid.narrow_phase);
-            constraint::hold_partners(step.body, step.constraints, h, gravity);
-            self.sleeping.observe(
-                (*handle, step.body, step.constraints),
-                (rigid.bodies, rigid.colliders),
-                &self.sleep,
-                (h, false, self.contact.margin),
-            );
-            hand_over(&mut self.loads, *handle, &mut step, rigid.bodies);
-        }
-        self.links.set_last_step(held, h);
-    }
-
-    /// Finds the contacts of every awake body of `outcomes` not in `skip` whose state a step can
-    /// take, for a substep of `h` (s) under `gravity` (m/s²), and returns
-    /// those to step (no error yet in the frame) and those to hold only (a step refused earlier
-    /// in the frame); a body whose state fails [`DeformableBody::check_state`] or whose
-    /// detection fails takes that error and neither.
-    fn detect(
-        &mut self,
-        soft_bodies: &DeformableBodySet,
-        rigid: &RigidSets<'_>,
-        outcomes: &mut [(DeformableBodyHandle, Outcome)],
-        skip: &[DeformableBodyHandle],
-        (h, gravity): (f64, DVec3),
-    ) -> (Vec<DeformableBodyHandle>, Vec<DeformableBodyHandle>) {
-        let views = rapier_view::collider_views(rigid.colliders, rigid.bodies, h);
-        let lookup = rapier_view::rigid_lookup(rigid.bodies, h);
-        let (mut live, mut held) = (Vec::new(), Vec::new());
-        for (handle, outcome) in outcomes.iter_mut() {
-            if self.sleeping.is_asleep(*handle) || skip.contains(handle) {
-                continue;
-            }
-            let body = &soft_bodies[*handle];
-            let detected = body.check_state().and_then(|()| {
-                self.links.entry(*handle).constraints.detect_among(
-                    body,
-                    &views,
-                    &lookup,
-                    h,
-                    gravity,
-                    &self.contact,
-                )
-            });
-            let refused_before = matches!(outcome, Some(Err(_)));
-            match detected {
-                Err(error) if !refused_before => *outcome = Some(Err(error)),
-                Err(_) => {}
-                Ok(_) if refused_before => held.push(*handle),
-                Ok(_) => live.push(*handle),
-            }
-        }
-        (live, held)
-    }
-}
-
-/// Hands the impulses `step`'s body (`handle`) gave rigid bodies over its substep to rapier's
-/// `bodies` and adds them, and those on colliders, to the frame's `loads`.
-fn hand_over(
-    loads: &mut FrameLoads,
-    handle: DeformableBodyHandle,
-    step: &mut BodyInStep<'_>,
-    bodies: &mut RigidBodySet,
-) {
-    loads.add_body(handle, step.body, step.constraints);
-    step.constraints.transfer_contact_impulses(bodies);
 }
 
 /// The solver iterations (at least one) rapier runs in each of `substeps` coupling substeps of a
@@ -632,25 +438,4 @@ fn results(outcomes: Vec<(DeformableBodyHandle, Outcome)>) -> SoftStepResults {
         .into_iter()
         .filter_map(|(handle, outcome)| outcome.map(|outcome| (handle, outcome)))
         .collect()
-}
-
-/// Holds the rigid bodies a body's `constraints` touch that rigid contacts support: within the soft step they
-/// would otherwise fall freely, the ground that holds them acting only in rapier's step.
-fn hold_supported_bodies(
-    constraints: &mut BodyConstraints,
-    bodies: &RigidBodySet,
-    narrow_phase: &NarrowPhase,
-) {
-    for proxy in &mut constraints.rigid_proxies {
-        let supported = bodies.get(proxy.handle).is_some_and(|rigid| {
-            rigid.colliders().iter().any(|&collider| {
-                narrow_phase
-                    .contact_pairs_with(collider)
-                    .any(|pair| pair.has_any_active_contact())
-            })
-        });
-        if supported {
-            proxy.hold();
-        }
-    }
 }
