@@ -209,7 +209,13 @@ impl BodyConstraints {
     /// velocity or the nodes of a self-contact triangle or a rigid corner), so that one explicit
     /// sweep does not solve them.
     pub(crate) fn coupled(&self) -> bool {
-        self.rigid_proxies.iter().any(RigidProxy::is_dynamic) || self.contacts.couples_nodes()
+        self.touches_dynamic_body() || self.contacts.couples_nodes()
+    }
+
+    /// Whether the contacts or attachments touch a dynamic rigid body (as the last detection
+    /// found them).
+    pub(crate) fn touches_dynamic_body(&self) -> bool {
+        self.rigid_proxies.iter().any(RigidProxy::is_dynamic)
     }
 
     /// Sets aside what a step moves (no allocation after the first call), and starts counting

@@ -25,9 +25,7 @@
 use super::reach::{body_reach, overlap};
 use super::{Outcome, RigidSets, SoftCoupling, rapier_view};
 use crate::body::{DeformableBodyHandle, DeformableBodySet};
-use crate::constraint::BodyConstraints;
 use crate::contact::ContactSettings;
-use crate::rigid::RigidProxy;
 use rapier3d::glamx::DVec3;
 
 impl SoftCoupling {
@@ -55,43 +53,41 @@ impl SoftCoupling {
             };
             (reaches.iter()).any(|&(other, reach)| other != handle && overlap(own, reach))
         };
-        let mut alone = Vec::new();
         let substeps = f64::from(self.substeps.max(1));
         let settings = ContactSettings {
             penalty_factor: self.contact.penalty_factor * substeps * substeps,
             ..self.contact
         };
-        let views = rapier_view::collider_views(rigid.colliders, rigid.bodies, dt);
-        let lookup = rapier_view::rigid_lookup(rigid.bodies, dt);
-        for (handle, outcome) in outcomes.iter() {
-            let body = &soft_bodies[*handle];
-            let coupled_before = (self.links.get(*handle))
-                .is_some_and(|links| has_dynamic_partner(&links.constraints));
-            if outcome.is_some()
-                || body.self_contact
-                || self.sleeping.is_asleep(*handle)
-                || coupled_before
-                || near_another(*handle)
-                || body.check_state().is_err()
-            {
-                continue;
+        let alone: Vec<DeformableBodyHandle> = {
+            let views = rapier_view::collider_views(rigid.colliders, rigid.bodies, dt);
+            let lookup = rapier_view::rigid_lookup(rigid.bodies, dt);
+            let mut alone = Vec::new();
+            for (handle, outcome) in outcomes.iter() {
+                let body = &soft_bodies[*handle];
+                let coupled_before = (self.links.get(*handle))
+                    .is_some_and(|links| links.constraints.touches_dynamic_body());
+                if outcome.is_some()
+                    || body.self_contact
+                    || self.sleeping.is_asleep(*handle)
+                    || coupled_before
+                    || near_another(*handle)
+                    || body.check_state().is_err()
+                {
+                    continue;
+                }
+                let constraints = &mut self.links.entry(*handle).constraints;
+                let detected =
+                    constraints.detect_among(body, &views, &lookup, dt, gravity, &settings);
+                if detected.is_ok() && !constraints.touches_dynamic_body() {
+                    alone.push(*handle);
+                }
             }
-            let constraints = &mut self.links.entry(*handle).constraints;
-            let detected = constraints.detect_among(body, &views, &lookup, dt, gravity, &settings);
-            if detected.is_ok() && !has_dynamic_partner(constraints) {
-                alone.push(*handle);
-            }
-        }
-        drop(lookup);
+            alone
+        };
         if !alone.is_empty() {
             let live = (&alone[..], Vec::new());
             self.step_live(soft_bodies, &mut rigid, outcomes, live, (dt, gravity));
         }
         alone
     }
-}
-
-/// Whether `constraints` touch or are glued to a dynamic rigid body.
-fn has_dynamic_partner(constraints: &BodyConstraints) -> bool {
-    constraints.rigid_proxies.iter().any(RigidProxy::is_dynamic)
 }

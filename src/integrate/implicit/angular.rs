@@ -44,12 +44,13 @@ pub(super) fn give_back(body: &mut DeformableBody, before: &[DVec3], h: f64) {
 /// kept to round-off however loosely each step is solved.
 pub(super) fn keep_free_spin(body: &mut DeformableBody, positions: &[DVec3], velocities: &[DVec3]) {
     let start = momentum_about_centre(positions, velocities, &body.masses);
-    let now = momentum_about_centre(&body.positions, &body.velocities, &body.masses);
+    let now = body.angular_momentum();
     turn_by(body, start - now);
 }
 
 /// The angular momentum (N m s) of nodes at `positions` (m) moving at `velocities` (m/s) with
-/// `masses` (kg) about their centre of mass.
+/// `masses` (kg) about their centre of mass: [`DeformableBody::angular_momentum`] of a state the
+/// body had.
 fn momentum_about_centre(positions: &[DVec3], velocities: &[DVec3], masses: &[f64]) -> DVec3 {
     let total: f64 = masses.iter().sum();
     let centre = positions
@@ -82,9 +83,8 @@ fn turn_by(body: &mut DeformableBody, lost: DVec3) {
 /// How fast `body` turns (rad/s): its angular momentum about its centre of mass over its inertia
 /// there, `|I_c⁻¹ L_c|`; zero for a body whose nodes lie on one line.
 pub(super) fn spin(body: &DeformableBody) -> f64 {
-    let momentum = momentum_about_centre(&body.positions, &body.velocities, &body.masses);
     let inertia = inertia_about(body, body.center_of_mass());
-    solve(inertia, momentum).map_or(0.0, |turn| turn.length())
+    solve(inertia, body.angular_momentum()).map_or(0.0, |turn| turn.length())
 }
 
 /// The rotation (its centre, m, and angular velocity, rad/s) the pins of `body` allow whose
