@@ -96,6 +96,7 @@ pub mod linear_solver;
 pub mod material;
 pub mod mesh;
 mod newton;
+mod parallel;
 pub mod query;
 mod rigid;
 pub mod shape;

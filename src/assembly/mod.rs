@@ -9,9 +9,12 @@
 //! Venant–Kirchhoff and Neo-Hookean are indefinite under compression); the projection stiffens
 //! the rotational directions of a stressed element, so exact tangents are used where they exist.
 
+mod block_rows;
 mod cholesky;
+mod element_tangents;
 mod joint;
 
+pub(crate) use block_rows::{BlockRows, ROWS_PER_CHUNK};
 pub(crate) use cholesky::{Factor, SymbolicFactor};
 
 use crate::Error;
@@ -20,6 +23,7 @@ use crate::element::deformation_gradient;
 use crate::fvm::NodalAveraging;
 use crate::material::{HyperelasticModel, with_hyperelastic_model};
 use crate::stencil::Stencil;
+use element_tangents::ElementTangents;
 use faer::Col;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use rapier3d::glamx::{DMat3, DVec3};
@@ -44,13 +48,12 @@ pub(crate) struct Stiffness {
     /// The symbolic Cholesky factorization (fill-reducing ordering and elimination tree) of the
     /// pattern, computed at the first factorization and reused by every later one.
     symbolic: Option<SymbolicFactor>,
-    /// Scratch of [`Stiffness::add_point`]: per node of an element, `A ∇N_b`.
-    stress_maps: Vec<na::SMatrix<f64, 9, 3>>,
-    /// The element whose points are being added, and its dense tangent so far (`3n x 3n`,
-    /// column-major, local node order): scattered into `values` once per element, so that an
-    /// element of many points searches the pattern once per node pair.
-    element_nodes: Vec<u32>,
-    element_block: Vec<f64>,
+    /// The matrix in full block rows for the conjugate gradient's products, its pattern made at
+    /// the first [`Stiffness::block_rows`] and its values gathered at each.
+    block_rows: Option<BlockRows>,
+    /// Scratch of [`Stiffness::add_element_tangents`]: per chunk of elements, their dense
+    /// tangents.
+    element_tangents: Vec<ElementTangents>,
 }
 
 impl Stiffness {
@@ -97,9 +100,8 @@ impl Stiffness {
             lower_neighbours,
             extra_pairs: Vec::new(),
             symbolic: None,
-            stress_maps: Vec::new(),
-            element_nodes: Vec::new(),
-            element_block: Vec::new(),
+            block_rows: None,
+            element_tangents: Vec::new(),
         }
     }
 
@@ -169,7 +171,7 @@ impl Stiffness {
         body: &DeformableBody,
         diagonal: Option<&[f64]>,
         project: bool,
-        extra: impl Fn(usize, &DMat3, &DMat3) -> DMat3,
+        extra: impl Fn(usize, &DMat3, &DMat3) -> DMat3 + Sync,
     ) {
         self.values.fill(0.0);
         let x = body.positions();
@@ -178,27 +180,24 @@ impl Stiffness {
             let measures = averaging.map(|(a, fvm)| a.measures(&model, fvm, x));
             let excesses = body.elements.volumetric_excesses(&model, x);
             let changes = unit_changes();
-            body.elements
-                .for_each_point(|point, nodes, gradients, weight| {
-                    let f = deformation_gradient(nodes, gradients, x);
-                    let excess = match (&measures, &excesses) {
-                        (Some(m), _) => Some(m.excess(nodes, point)),
-                        (_, Some(excesses)) => Some(excesses[point]),
-                        _ => None,
-                    };
-                    let elastic = match excess {
-                        Some(excess) => changes.map(|df| {
-                            NodalAveraging::element_differential(&model, &f, excess, &df)
-                        }),
-                        None => model.first_piola_differentials(&f, &changes),
-                    };
-                    let a = tangent_from_columns(std::array::from_fn(|c| {
-                        elastic[c] + extra(point, &f, &changes[c])
-                    }));
-                    let a = if project { project_positive(a) } else { a };
-                    self.add_point(nodes, gradients, weight, &a, &body.pinned);
-                });
-            self.flush_element(&body.pinned);
+            let point_tangent = |point: usize, nodes: &[u32], gradients: &[DVec3]| {
+                let f = deformation_gradient(nodes, gradients, x);
+                let excess = match (&measures, &excesses) {
+                    (Some(m), _) => Some(m.excess(nodes, point)),
+                    (_, Some(excesses)) => Some(excesses[point]),
+                    _ => None,
+                };
+                let elastic = match excess {
+                    Some(excess) => changes
+                        .map(|df| NodalAveraging::element_differential(&model, &f, excess, &df)),
+                    None => model.first_piola_differentials(&f, &changes),
+                };
+                let a = tangent_from_columns(std::array::from_fn(|c| {
+                    elastic[c] + extra(point, &f, &changes[c])
+                }));
+                if project { project_positive(a) } else { a }
+            };
+            self.add_element_tangents(&body.elements, &body.pinned, point_tangent);
             // The coupling is positive semi-definite (K > 0), so it needs no projection.
             if let Some((averaging, fvm)) = averaging {
                 averaging.for_each_coupling(&model, fvm, x, |gradient, weight| {
@@ -247,70 +246,6 @@ impl Stiffness {
         }
     }
 
-    /// Adds one integration point's `w ∇N_aᵀ A ∇N_b` (N/m) for every pair of its nodes:
-    /// `K_ab[i][j] = w Σ_cd A[(i,c),(j,d)] g_a,c g_b,d`, with `g` the shape-function gradients
-    /// (1/m), `w` the point's rest volume (m³) and `A` the stress tangent (Pa). Points of one
-    /// element are summed densely; [`Stiffness::flush_element`] scatters the sum.
-    fn add_point(
-        &mut self,
-        nodes: &[u32],
-        gradients: &[DVec3],
-        weight: f64,
-        tangent: &StressTangent,
-        pinned: &[bool],
-    ) {
-        if self.element_nodes != nodes {
-            self.flush_element(pinned);
-            self.element_nodes.extend_from_slice(nodes);
-            self.element_block
-                .resize(9 * nodes.len() * nodes.len(), 0.0);
-        }
-        // A g_b: per node, the 9 x 3 map from its displacement to dP.
-        let mut stress_maps = std::mem::take(&mut self.stress_maps);
-        stress_maps.clear();
-        stress_maps.extend(gradients.iter().map(|g| {
-            na::SMatrix::<f64, 9, 3>::from_fn(|row, j| {
-                (0..3).map(|d| tangent[(row, 3 * d + j)] * g[d]).sum()
-            })
-        }));
-        let rows = 3 * nodes.len();
-        for (cb, &b) in nodes.iter().enumerate() {
-            let map = &stress_maps[cb];
-            for (ca, &a) in nodes.iter().enumerate() {
-                // The lower triangle of the global matrix only.
-                if a < b {
-                    continue;
-                }
-                let ga = gradients[ca] * weight;
-                for j in 0..3 {
-                    let column = &mut self.element_block[rows * (3 * cb + j) + 3 * ca..][..3];
-                    for (i, entry) in column.iter_mut().enumerate() {
-                        *entry += (0..3).map(|c| ga[c] * map[(3 * c + i, j)]).sum::<f64>();
-                    }
-                }
-            }
-        }
-        self.stress_maps = stress_maps;
-    }
-
-    /// Scatters the dense tangent of the element being added into `values`, and forgets it.
-    fn flush_element(&mut self, pinned: &[bool]) {
-        let nodes = std::mem::take(&mut self.element_nodes);
-        let mut block = std::mem::take(&mut self.element_block);
-        let rows = 3 * nodes.len();
-        for (cb, &b) in nodes.iter().enumerate() {
-            for (ca, &a) in nodes.iter().enumerate() {
-                self.add_pair_block(a as usize, b as usize, pinned, |i, j| {
-                    block[rows * (3 * cb + j) + 3 * ca + i]
-                });
-            }
-        }
-        block.fill(0.0);
-        self.element_nodes = nodes;
-        self.element_nodes.clear();
-        self.element_block = block;
-    }
-
     /// Adds `value(i, j)` to the entries (row `3a + i`, column `3b + j`) of the lower triangle,
     /// unless either node is pinned or the block lies above the diagonal.
     fn add_pair_block(
@@ -344,12 +279,8 @@ impl Stiffness {
         }
     }
 
-    /// Number of rows (and columns): three per node.
-    pub(crate) fn dofs(&self) -> usize {
-        self.dofs
-    }
-
     /// The 3 x 3 diagonal block of node `node` (N/m).
+    #[cfg(test)]
     pub(crate) fn diagonal_block(&self, node: usize) -> DMat3 {
         let mut block = [0.0; 9];
         for j in 0..3 {
@@ -364,6 +295,7 @@ impl Stiffness {
 
     /// `out = K x` for the assembled symmetric matrix `K` (from its lower triangle), `x` and
     /// `out` flat with three entries per node.
+    #[cfg(test)]
     pub(crate) fn multiply_into(&self, x: &[f64], out: &mut [f64]) {
         out.fill(0.0);
         for column in 0..self.dofs {
@@ -390,6 +322,16 @@ impl Stiffness {
         out.chunks(3)
             .map(|c| DVec3::new(c[0], c[1], c[2]))
             .collect()
+    }
+
+    /// The assembled matrix in full block rows (see [`BlockRows`]).
+    pub(crate) fn block_rows(&mut self) -> &BlockRows {
+        let mut rows = self
+            .block_rows
+            .take()
+            .unwrap_or_else(|| BlockRows::new(self));
+        rows.gather_from(&self.values);
+        self.block_rows.insert(rows)
     }
 
     /// A view of the assembled matrix for faer.

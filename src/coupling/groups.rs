@@ -28,8 +28,9 @@ pub(super) fn step_groups(
     (h, gravity): (f64, DVec3),
 ) -> Vec<Vec<Result<AutomaticReport, Error>>> {
     let step = |group: &mut GroupStep<'_>| step_group(group, integrator, settings, (h, gravity));
+    // On the pool: a lone group would otherwise step on the calling thread.
     #[cfg(feature = "parallel")]
-    return groups.par_iter_mut().map(step).collect();
+    return crate::parallel::on_pool(|| groups.par_iter_mut().map(step).collect());
     #[cfg(not(feature = "parallel"))]
     groups.iter_mut().map(step).collect()
 }

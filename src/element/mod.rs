@@ -24,6 +24,9 @@ pub(crate) use quadratic::deformation_gradient;
 pub use quadratic::{ElementShape, QuadraticElements};
 use rapier3d::glamx::{DMat3, DVec3};
 
+/// Elements per chunk of [`Elements::sum_over_points`].
+const ELEMENTS_PER_SUM: usize = 2048;
+
 /// The most nodes an element has (quadratic hexahedra).
 pub(crate) const MAX_ELEMENT_NODES: usize = hex27::NODES;
 
@@ -125,22 +128,48 @@ impl Elements {
         }
     }
 
+    /// Number of elements.
+    pub(crate) fn element_count(&self) -> usize {
+        match self {
+            Self::Linear { fvm, .. } => fvm.tets().len(),
+            Self::Quadratic { elements, .. } => elements.element_count(),
+        }
+    }
+
+    /// Nodes per element.
+    pub(crate) fn nodes_per_element(&self) -> usize {
+        match self {
+            Self::Linear { .. } => 4,
+            Self::Quadratic { elements, .. } => elements.shape().node_count(),
+        }
+    }
+
     /// Calls `visit(point, nodes, gradients, weight)` for every integration point in order: its
     /// index, its element's nodes, their rest shape-function gradients there (1/m) and the rest
     /// volume it stands for (m³).
-    pub(crate) fn for_each_point(&self, mut visit: impl FnMut(usize, &[u32], &[DVec3], f64)) {
+    pub(crate) fn for_each_point(&self, visit: impl FnMut(usize, &[u32], &[DVec3], f64)) {
+        self.for_each_point_in(0..self.element_count(), visit);
+    }
+
+    /// [`Elements::for_each_point`] over the points of the elements `elements` only.
+    pub(crate) fn for_each_point_in(
+        &self,
+        elements: std::ops::Range<usize>,
+        mut visit: impl FnMut(usize, &[u32], &[DVec3], f64),
+    ) {
         match self {
             Self::Linear { fvm, .. } => {
-                for (t, tet) in fvm.tets().iter().enumerate() {
+                for t in elements {
                     let rest = fvm.tet_rest(t);
-                    visit(t, tet, &rest.shape_gradients(), rest.volume);
+                    visit(t, &fvm.tets()[t], &rest.shape_gradients(), rest.volume);
                 }
             }
             Self::Quadratic {
                 elements: quadratic,
                 ..
             } => {
-                for (element, nodes) in quadratic.elements().enumerate() {
+                for element in elements {
+                    let nodes = quadratic.element(element);
                     for point in quadratic.element_points(element) {
                         visit(
                             point,
@@ -203,7 +232,7 @@ impl Elements {
         out.fill(DVec3::ZERO);
         let excesses = self.volumetric_excesses(model, x);
         let bulk = model.volumetric_modulus();
-        self.for_each_point(|point, nodes, gradients, weight| {
+        self.add_stress_forces(out, |point, nodes, gradients| {
             let f = deformation_gradient(nodes, gradients, x);
             let mut stress = model.first_piola(&f);
             if let Some(excesses) = &excesses {
@@ -212,8 +241,61 @@ impl Elements {
             if let Some(damping) = damping {
                 stress += damping.first_piola(&f, &deformation_gradient(nodes, gradients, v));
             }
-            add_point_forces(nodes, gradients, &(stress * weight), out);
+            stress
         });
+    }
+
+    /// Adds `−w P ∇N_a` (N) to `out[a]` for every node `a` of every integration point, `P =
+    /// stress(point, nodes, gradients)` (Pa) and `w` the point's weight (m³). Above
+    /// [`ELEMENTS_PER_SUM`] elements, each chunk of that many elements sums its forces on one
+    /// thread (rayon's with the `parallel` feature) over the span of nodes it touches, and the
+    /// chunks' forces are added in order: the same whatever the number of threads.
+    pub(crate) fn add_stress_forces(
+        &self,
+        out: &mut [DVec3],
+        stress: impl Fn(usize, &[u32], &[DVec3]) -> DMat3 + Sync + Send,
+    ) {
+        let count = self.element_count();
+        if count <= ELEMENTS_PER_SUM {
+            self.for_each_point(|point, nodes, gradients, weight| {
+                add_point_forces(
+                    nodes,
+                    gradients,
+                    &(stress(point, nodes, gradients) * weight),
+                    out,
+                );
+            });
+            return;
+        }
+        let windows = crate::parallel::map_ranges(count, ELEMENTS_PER_SUM, |elements| {
+            let (first, last) = elements
+                .clone()
+                .flat_map(|e| self.element(e))
+                .fold((u32::MAX, 0), |(first, last), &n| {
+                    (first.min(n), last.max(n))
+                });
+            let mut window = vec![DVec3::ZERO; (last + 1 - first) as usize];
+            self.for_each_point_in(elements, |point, nodes, gradients, weight| {
+                let weighted = stress(point, nodes, gradients) * weight;
+                for (&n, g) in nodes.iter().zip(gradients) {
+                    window[(n - first) as usize] -= weighted * *g;
+                }
+            });
+            (first as usize, window)
+        });
+        for (first, window) in windows {
+            for (total, force) in out[first..].iter_mut().zip(window) {
+                *total += force;
+            }
+        }
+    }
+
+    /// The nodes of element `element`.
+    fn element(&self, element: usize) -> &[u32] {
+        match self {
+            Self::Linear { fvm, .. } => &fvm.tets()[element],
+            Self::Quadratic { elements, .. } => elements.element(element),
+        }
     }
 
     /// Elastic strain energy (J) at positions `x` (m).
@@ -230,10 +312,27 @@ impl Elements {
             } => mean_dilatation::energy_change(model, elements, basis, x),
             Self::Quadratic { .. } => 0.0,
         };
-        self.for_each_point(|_, nodes, gradients, weight| {
-            energy += weight * model.energy_density(&deformation_gradient(nodes, gradients, x));
+        energy += self.sum_over_points(|_, nodes, gradients, weight| {
+            weight * model.energy_density(&deformation_gradient(nodes, gradients, x))
         });
         energy
+    }
+
+    /// `Σ term(point, nodes, gradients, weight)` over the integration points (see
+    /// [`Elements::for_each_point`]), summed in chunks of [`ELEMENTS_PER_SUM`] elements (on
+    /// rayon's threads with the `parallel` feature), the chunks' sums in order: the same
+    /// whatever the number of threads.
+    pub(crate) fn sum_over_points(
+        &self,
+        term: impl Fn(usize, &[u32], &[DVec3], f64) -> f64 + Sync + Send,
+    ) -> f64 {
+        crate::parallel::sum_ranges(self.element_count(), ELEMENTS_PER_SUM, |elements| {
+            let mut sum = 0.0;
+            self.for_each_point_in(elements, |point, nodes, gradients, weight| {
+                sum += term(point, nodes, gradients, weight);
+            });
+            sum
+        })
     }
 
     /// Calls `add(gradient, weight)` for every rank-one term `weight g gᵀ` (N/m) the averaged

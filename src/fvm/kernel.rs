@@ -227,13 +227,16 @@ impl FvmMesh {
     }
 
     /// Total elastic energy `Σ V Ψ(F)` (J) at positions `x` (m).
+    /// Summed in the force loop's chunks of tetrahedra (on rayon's threads with the `parallel`
+    /// feature), the chunks' sums in order: the same whatever the number of threads.
     pub fn elastic_energy<M: HyperelasticModel>(&self, model: &M, x: &[DVec3]) -> f64 {
-        (0..self.tet_count)
-            .map(|t| {
+        crate::parallel::sum_ranges(self.tet_count, CHUNK_TETS, |tets| {
+            tets.map(|t| {
                 let rest = self.tet_rest(t);
                 rest.volume * model.energy_density(&rest.gradient(&gather(&self.tets[t], x)))
             })
             .sum()
+        })
     }
 }
 

@@ -199,8 +199,9 @@ impl AutomaticIntegrator {
             constraints,
             workspace,
         };
-        let explicit_frame =
-            |step: &mut BodyInStep<'_>| self.explicit.advance(step, frame_dt, gravity, needed);
+        let explicit_frame = |step: &mut BodyInStep<'_>| {
+            crate::parallel::on_pool(|| self.explicit.advance(step, frame_dt, gravity, needed))
+        };
         let implicit_frame = |step: &mut BodyInStep<'_>, implicit: &ImplicitIntegrator| {
             let outcome = implicit.step(
                 step.body,

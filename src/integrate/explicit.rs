@@ -131,7 +131,7 @@ impl SymplecticEuler {
             constraints,
             workspace,
         };
-        self.advance(&mut step, frame_dt, gravity, needed)
+        crate::parallel::on_pool(|| self.advance(&mut step, frame_dt, gravity, needed))
     }
 
     /// Runs a frame in `needed` substeps (as given by [`SymplecticEuler::needed_substeps`]),

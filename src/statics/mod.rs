@@ -71,7 +71,7 @@ pub fn solve_equilibrium(
     let mut workspace = SolverWorkspace::new();
     workspace.save_state(body);
     let mut stiffness = workspace.take_tangent(body);
-    let result = newton(body, &mut stiffness, gravity, settings);
+    let result = crate::parallel::on_pool(|| newton(body, &mut stiffness, gravity, settings));
     match result {
         Ok(_) => body.count_state_edit(),
         Err(_) => workspace.restore_state(body),

@@ -206,6 +206,20 @@ impl ImplicitIntegrator {
         frame_dt: f64,
         gravity: DVec3,
     ) -> Result<ImplicitReport, Error> {
+        crate::parallel::on_pool(|| {
+            self.step_on_pool(body, constraints, workspace, frame_dt, gravity)
+        })
+    }
+
+    /// [`ImplicitIntegrator::step`], on rayon's pool.
+    fn step_on_pool(
+        &self,
+        body: &mut DeformableBody,
+        constraints: &mut BodyConstraints,
+        workspace: &mut SolverWorkspace,
+        frame_dt: f64,
+        gravity: DVec3,
+    ) -> Result<ImplicitReport, Error> {
         let before = workspace.previous_step.clone();
         let watch = CrushWatch::new(body);
         let turning = self.turning_substeps(body, frame_dt);

@@ -13,7 +13,7 @@ use crate::assembly::{Stiffness, solve};
 use crate::body::DeformableBody;
 use crate::constraint::{self, BodyConstraints};
 use crate::damping::RayleighDamping;
-use crate::element::{add_point_forces, deformation_gradient};
+use crate::element::deformation_gradient;
 use crate::integrate::PreviousStep;
 use crate::material::green_strain;
 use crate::newton::norm;
@@ -162,10 +162,9 @@ impl Potential<'_> {
         out: &mut [DVec3],
     ) {
         body.elements
-            .for_each_point(|point, nodes, gradients, weight| {
+            .add_stress_forces(out, |point, nodes, gradients| {
                 let f = deformation_gradient(nodes, gradients, &body.positions);
-                let stress = damping.step_first_piola(&f, &self.start.green[point], self.start.h);
-                add_point_forces(nodes, gradients, &(stress * weight), out);
+                damping.step_first_piola(&f, &self.start.green[point], self.start.h)
             });
     }
 
@@ -201,16 +200,12 @@ impl Potential<'_> {
             .map(|(f, (x, x0))| f.dot(*x - *x0))
             .sum();
         let dissipation = match body.damping {
-            Some(damping) => {
-                let mut dissipation = 0.0;
-                body.elements
-                    .for_each_point(|point, nodes, gradients, weight| {
-                        let f = deformation_gradient(nodes, gradients, &body.positions);
-                        dissipation += weight
-                            * damping.step_potential(&f, &self.start.green[point], self.start.h);
-                    });
-                dissipation
-            }
+            Some(damping) => body
+                .elements
+                .sum_over_points(|point, nodes, gradients, weight| {
+                    let f = deformation_gradient(nodes, gradients, &body.positions);
+                    weight * damping.step_potential(&f, &self.start.green[point], self.start.h)
+                }),
             None => 0.0,
         };
         let mut rigid = self.rigid.borrow_mut();

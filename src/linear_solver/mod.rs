@@ -27,12 +27,14 @@
 //! mesh (its fill), but does not depend on the conditioning. [`LinearSolver::Automatic`]
 //! compares the two predictions; see its documentation for the rule and its calibration.
 
+mod conjugate_gradient;
+
 use crate::Error;
 use crate::assembly::Factor;
 use crate::assembly::{Stiffness, factorize, solve};
 use crate::body::DeformableBody;
-use crate::material::is_positive_definite;
-use rapier3d::glamx::{DMat3, DVec3};
+use conjugate_gradient::{CgOutcome, conjugate_gradient};
+use rapier3d::glamx::DVec3;
 
 /// How the Newton system of each implicit iteration is solved.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -290,7 +292,7 @@ pub(crate) fn solve_newton_system(
     let mut cg_iterations = 0;
     let mut projected = false;
     loop {
-        match conjugate_gradient(stiffness, &b, tolerance, max_iterations) {
+        match conjugate_gradient(stiffness.block_rows(), &b, tolerance, max_iterations) {
             CgOutcome::Solved {
                 x,
                 iterations,
@@ -371,107 +373,4 @@ fn factorize_direct(
             })
         }
     }
-}
-
-/// The end of a conjugate gradient solve.
-enum CgOutcome {
-    /// An iterate (flat, 3 entries per node), the iterations taken and whether the tolerance was
-    /// met.
-    Solved {
-        x: Vec<f64>,
-        iterations: usize,
-        converged: bool,
-    },
-    /// A search direction (or a diagonal block) of zero or negative curvature after this many
-    /// iterations: the matrix is not positive definite.
-    NegativeCurvature { iterations: usize },
-}
-
-/// The block-Jacobi preconditioned conjugate gradient on `K u = b` from `u = 0`, until
-/// `‖b - K u‖ <= tolerance ‖b‖` or `max_iterations`.
-fn conjugate_gradient(
-    stiffness: &Stiffness,
-    b: &[f64],
-    tolerance: f64,
-    max_iterations: usize,
-) -> CgOutcome {
-    let dofs = b.len();
-    let mut x = vec![0.0; dofs];
-    let Some(preconditioner) = block_jacobi(stiffness) else {
-        return CgOutcome::NegativeCurvature { iterations: 0 };
-    };
-    let target = tolerance * dot(b, b).sqrt();
-    if target == 0.0 {
-        return CgOutcome::Solved {
-            x,
-            iterations: 0,
-            converged: true,
-        };
-    }
-    let mut r = b.to_vec();
-    let mut z = vec![0.0; dofs];
-    apply(&preconditioner, &r, &mut z);
-    let mut p = z.clone();
-    let mut q = vec![0.0; dofs];
-    let mut rz = dot(&r, &z);
-    for iteration in 1..=max_iterations {
-        stiffness.multiply_into(&p, &mut q);
-        let curvature = dot(&p, &q);
-        if curvature.is_nan() || curvature <= 0.0 {
-            return CgOutcome::NegativeCurvature {
-                iterations: iteration,
-            };
-        }
-        let alpha = rz / curvature;
-        for i in 0..dofs {
-            x[i] += alpha * p[i];
-            r[i] -= alpha * q[i];
-        }
-        if dot(&r, &r).sqrt() <= target {
-            return CgOutcome::Solved {
-                x,
-                iterations: iteration,
-                converged: true,
-            };
-        }
-        apply(&preconditioner, &r, &mut z);
-        let next = dot(&r, &z);
-        let beta = next / rz;
-        rz = next;
-        for i in 0..dofs {
-            p[i] = z[i] + beta * p[i];
-        }
-    }
-    CgOutcome::Solved {
-        x,
-        iterations: max_iterations,
-        converged: false,
-    }
-}
-
-/// The inverses of the nodes' 3 x 3 diagonal blocks (m/N), or `None` if one is not positive
-/// definite (then neither is the matrix).
-fn block_jacobi(stiffness: &Stiffness) -> Option<Vec<DMat3>> {
-    (0..stiffness.dofs() / 3)
-        .map(|node| {
-            let a = stiffness.diagonal_block(node);
-            is_positive_definite(&a).then(|| a.inverse())
-        })
-        .collect()
-}
-
-/// `z = P r` for the block-Jacobi preconditioner `P`.
-fn apply(preconditioner: &[DMat3], r: &[f64], z: &mut [f64]) {
-    for ((block, r), z) in preconditioner
-        .iter()
-        .zip(r.chunks_exact(3))
-        .zip(z.chunks_exact_mut(3))
-    {
-        let v = *block * DVec3::new(r[0], r[1], r[2]);
-        z.copy_from_slice(&v.to_array());
-    }
-}
-
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(a, b)| a * b).sum()
 }

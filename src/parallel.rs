@@ -1,0 +1,175 @@
+//! Deterministic data parallelism over slices: a slice is cut into chunks of a fixed length, each
+//! chunk's work is done whole on one thread (rayon's pool with the `parallel` feature), and the
+//! chunks' results come back in chunk order. A reduction summed from them in that order is the
+//! same whatever the number of threads, and with or without the feature: only the chunk length
+//! decides how the arithmetic is grouped. A slice of one chunk is worked on the calling thread
+//! (handing a small product to the pool costs more than doing it).
+
+#[cfg(feature = "parallel")]
+use rayon::prelude::*;
+
+/// Runs `work` on rayon's pool with the `parallel` feature: inline on a thread of the pool,
+/// else handed to the pool once and waited for. The parallel loops inside it then split among
+/// the pool's threads without each handing its work over from outside (a hand-over costs about
+/// as much as a thousand-node matrix product). Without the feature, on the calling thread.
+pub(crate) fn on_pool<R: Send>(work: impl FnOnce() -> R + Send) -> R {
+    #[cfg(feature = "parallel")]
+    return rayon::scope(|_| work());
+    #[cfg(not(feature = "parallel"))]
+    work()
+}
+
+/// `work(index, chunk)` on each `chunk`-long piece of `data` (the last may be shorter), the
+/// results in chunk order.
+pub(crate) fn map_chunks<T: Send, R: Send>(
+    data: &mut [T],
+    chunk: usize,
+    work: impl Fn(usize, &mut [T]) -> R + Sync + Send,
+) -> Vec<R> {
+    #[cfg(feature = "parallel")]
+    if data.len() > chunk {
+        return data
+            .par_chunks_mut(chunk)
+            .enumerate()
+            .map(|(index, piece)| work(index, piece))
+            .collect();
+    }
+    data.chunks_mut(chunk)
+        .enumerate()
+        .map(|(index, piece)| work(index, piece))
+        .collect()
+}
+
+/// `work(index, a_chunk, b_chunk)` on the matching `chunk`-long pieces of two slices of one
+/// length, the results in chunk order.
+pub(crate) fn map_chunk_pairs<T: Send, U: Send, R: Send>(
+    (a, b): (&mut [T], &mut [U]),
+    chunk: usize,
+    work: impl Fn(usize, &mut [T], &mut [U]) -> R + Sync + Send,
+) -> Vec<R> {
+    debug_assert_eq!(a.len(), b.len());
+    #[cfg(feature = "parallel")]
+    if a.len() > chunk {
+        return a
+            .par_chunks_mut(chunk)
+            .zip(b.par_chunks_mut(chunk))
+            .enumerate()
+            .map(|(index, (a, b))| work(index, a, b))
+            .collect();
+    }
+    a.chunks_mut(chunk)
+        .zip(b.chunks_mut(chunk))
+        .enumerate()
+        .map(|(index, (a, b))| work(index, a, b))
+        .collect()
+}
+
+/// `work(item)` on each of `items`, each on one thread.
+pub(crate) fn for_each<T: Send>(items: &mut [T], work: impl Fn(&mut T) + Sync + Send) {
+    #[cfg(feature = "parallel")]
+    if items.len() > 1 {
+        items.par_iter_mut().for_each(work);
+        return;
+    }
+    items.iter_mut().for_each(work);
+}
+
+/// The threads work may be spread over: rayon's current pool's with the `parallel` feature, else
+/// one.
+pub(crate) fn threads() -> usize {
+    #[cfg(feature = "parallel")]
+    return rayon::current_num_threads();
+    #[cfg(not(feature = "parallel"))]
+    1
+}
+
+/// `work(range)` for each range of `chunk` (the last may be shorter) cutting `0..count`, the
+/// results in order.
+pub(crate) fn map_ranges<R: Send>(
+    count: usize,
+    chunk: usize,
+    work: impl Fn(std::ops::Range<usize>) -> R + Sync + Send,
+) -> Vec<R> {
+    let range = |index: usize| work(index * chunk..((index + 1) * chunk).min(count));
+    let chunks = count.div_ceil(chunk);
+    #[cfg(feature = "parallel")]
+    if chunks > 1 {
+        return (0..chunks).into_par_iter().map(range).collect();
+    }
+    (0..chunks).map(range).collect()
+}
+
+/// `Σ term(range)` over the ranges of [`map_ranges`], their sums added in order.
+pub(crate) fn sum_ranges(
+    count: usize,
+    chunk: usize,
+    term: impl Fn(std::ops::Range<usize>) -> f64 + Sync + Send,
+) -> f64 {
+    map_ranges(count, chunk, term).iter().sum()
+}
+
+/// `Σ a_i b_i`, summed chunk by chunk (`chunk` entries each) and the chunks' sums in order.
+pub(crate) fn dot(a: &[f64], b: &[f64], chunk: usize) -> f64 {
+    debug_assert_eq!(a.len(), b.len());
+    let partial = |index: usize| {
+        let start = index * chunk;
+        let end = (start + chunk).min(a.len());
+        a[start..end]
+            .iter()
+            .zip(&b[start..end])
+            .map(|(a, b)| a * b)
+            .sum::<f64>()
+    };
+    let chunks = a.len().div_ceil(chunk);
+    #[cfg(feature = "parallel")]
+    if chunks > 1 {
+        let sums: Vec<f64> = (0..chunks).into_par_iter().map(partial).collect();
+        return sums.iter().sum();
+    }
+    (0..chunks).map(partial).sum()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The same sums on a pool of one thread and of four: the grouping depends on the chunk
+    /// length only (bit-identical, not within a tolerance).
+    #[cfg(feature = "parallel")]
+    #[test]
+    fn sums_do_not_depend_on_the_threads() {
+        let a: Vec<f64> = (0..10_007).map(|i| (i as f64 * 0.37).sin()).collect();
+        let b: Vec<f64> = (0..10_007).map(|i| (i as f64 * 1.91).cos()).collect();
+        let on = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .expect("a pool");
+            pool.install(|| {
+                let mut c = a.clone();
+                let partial = map_chunks(&mut c, 1000, |_, piece| {
+                    piece.iter_mut().for_each(|v| *v *= 3.0);
+                    piece.iter().sum::<f64>()
+                });
+                (dot(&a, &b, 1000), partial)
+            })
+        };
+        let (one, four) = (on(1), on(4));
+        assert_eq!(one.0.to_bits(), four.0.to_bits());
+        assert_eq!(one.1, four.1);
+        assert_eq!(one.1.len(), 11);
+    }
+
+    /// Pairs of slices are cut at the same places, the last chunk shorter.
+    #[test]
+    fn pairs_are_cut_alike() {
+        let (mut a, mut b) = (vec![1.0; 25], vec![2.0; 25]);
+        let lengths = map_chunk_pairs((&mut a, &mut b), 10, |index, a, b| {
+            a.iter_mut().zip(b.iter()).for_each(|(a, b)| *a += b);
+            (index, a.len(), b.len())
+        });
+        assert_eq!(lengths, vec![(0, 10, 10), (1, 10, 10), (2, 5, 5)]);
+        assert!(a.iter().all(|&v| v == 3.0));
+        assert_eq!(dot(&a, &b, 7), 25.0 * 6.0);
+    }
+}
