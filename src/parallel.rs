@@ -112,22 +112,13 @@ pub(crate) fn sum_ranges(
 /// `Σ a_i b_i`, summed chunk by chunk (`chunk` entries each) and the chunks' sums in order.
 pub(crate) fn dot(a: &[f64], b: &[f64], chunk: usize) -> f64 {
     debug_assert_eq!(a.len(), b.len());
-    let partial = |index: usize| {
-        let start = index * chunk;
-        let end = (start + chunk).min(a.len());
-        a[start..end]
+    sum_ranges(a.len(), chunk, |range| {
+        a[range.clone()]
             .iter()
-            .zip(&b[start..end])
+            .zip(&b[range])
             .map(|(a, b)| a * b)
-            .sum::<f64>()
-    };
-    let chunks = a.len().div_ceil(chunk);
-    #[cfg(feature = "parallel")]
-    if chunks > 1 {
-        let sums: Vec<f64> = (0..chunks).into_par_iter().map(partial).collect();
-        return sums.iter().sum();
-    }
-    (0..chunks).map(partial).sum()
+            .sum()
+    })
 }
 
 #[cfg(test)]

@@ -15,6 +15,9 @@ use rapier3d::glamx::DMat3;
 /// Nodes per chunk of a product: a chunk's rows are summed on one thread.
 pub(crate) const ROWS_PER_CHUNK: usize = 512;
 
+/// Block entries per chunk of [`BlockRows::gather_from`].
+const GATHERED_PER_CHUNK: usize = 9 * 4096;
+
 /// Both triangles of a symmetric matrix in rows of 3 x 3 blocks.
 #[derive(Debug, Clone)]
 pub(crate) struct BlockRows {
@@ -78,8 +81,8 @@ impl BlockRows {
     /// Takes the values of `lower` (the lower triangle's, in the pattern this was made from).
     pub(crate) fn gather_from(&mut self, lower: &[f64]) {
         let gather = &self.gather;
-        parallel::map_chunks(&mut self.values, 9 * 4096, |index, values| {
-            let start = index * 9 * 4096;
+        parallel::map_chunks(&mut self.values, GATHERED_PER_CHUNK, |index, values| {
+            let start = index * GATHERED_PER_CHUNK;
             for (value, &at) in values.iter_mut().zip(&gather[start..]) {
                 *value = lower[at];
             }

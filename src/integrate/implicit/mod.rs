@@ -206,20 +206,6 @@ impl ImplicitIntegrator {
         frame_dt: f64,
         gravity: DVec3,
     ) -> Result<ImplicitReport, Error> {
-        crate::parallel::on_pool(|| {
-            self.step_on_pool(body, constraints, workspace, frame_dt, gravity)
-        })
-    }
-
-    /// [`ImplicitIntegrator::step`], on rayon's pool.
-    fn step_on_pool(
-        &self,
-        body: &mut DeformableBody,
-        constraints: &mut BodyConstraints,
-        workspace: &mut SolverWorkspace,
-        frame_dt: f64,
-        gravity: DVec3,
-    ) -> Result<ImplicitReport, Error> {
         let before = workspace.previous_step.clone();
         let watch = CrushWatch::new(body);
         let turning = self.turning_substeps(body, frame_dt);
@@ -233,17 +219,24 @@ impl ImplicitIntegrator {
             ..*self
         };
         let limit = refined.substeps.saturating_mul(self.max_refinement);
-        loop {
-            let attempt =
-                refined.step_in_substeps(body, constraints, workspace, (frame_dt, gravity), &watch);
-            match attempt {
-                Err(error) if refinable(&error) && refined.substeps < limit => {
-                    workspace.previous_step.clone_from(&before);
-                    refined.substeps = refined.substeps.saturating_mul(2).min(limit);
+        crate::parallel::on_pool(|| {
+            loop {
+                let attempt = refined.step_in_substeps(
+                    body,
+                    constraints,
+                    workspace,
+                    (frame_dt, gravity),
+                    &watch,
+                );
+                match attempt {
+                    Err(error) if refinable(&error) && refined.substeps < limit => {
+                        workspace.previous_step.clone_from(&before);
+                        refined.substeps = refined.substeps.saturating_mul(2).min(limit);
+                    }
+                    outcome => break outcome,
                 }
-                outcome => return outcome,
             }
-        }
+        })
     }
 
     /// The substeps a backward Euler frame of `frame_dt` (s) needs for `body` to turn at most
