@@ -1,8 +1,12 @@
 """Writes the mesh files under assets/meshes/ used by tests/mesh_import.rs.
 
-Needs gmsh and meshio from PyPI:
-    python3 -m venv /tmp/venv-gmsh && /tmp/venv-gmsh/bin/pip install gmsh meshio
+Needs gmsh and meshio from PyPI (and vtk and numpy for cube_vtk_library):
+    python3 -m venv /tmp/venv-gmsh && /tmp/venv-gmsh/bin/pip install gmsh meshio vtk numpy
     /tmp/venv-gmsh/bin/python tools/make_test_meshes.py
+
+With no arguments every function below is run; with arguments only the named ones, e.g.
+    /tmp/venv-gmsh/bin/python tools/make_test_meshes.py cube_meshio_compressed cube_vtk_library
+writes those files alone and leaves the others as they are.
 """
 import math
 import os
@@ -123,8 +127,181 @@ def surfaces():
         f.write("endsolid sphere\n")
 
 
+def cube_points_tets():
+    """The cube of cube_v41_ascii.msh as cube_others reads it: the points its tetrahedra use,
+    renumbered in sorted order (341 points), and those tetrahedra (1140), as numpy arrays."""
+    import numpy as np
+
+    mesh = meshio.read(os.path.join(OUT, "cube_v41_ascii.msh"))
+    tets = mesh.cells_dict["tetra"]
+    used = sorted(set(tets.flatten().tolist()))
+    renumber = {old: new for new, old in enumerate(used)}
+    points = np.asarray(mesh.points[used], dtype=np.float64)
+    tets = np.array([[renumber[n] for n in t] for t in tets], dtype=np.int64)
+    return points, tets
+
+
+def cube_meshio_compressed():
+    """The same cube through meshio as compressed VTU (base64 inline, zlib and lzma), and the
+    cube meshed by gmsh at second order as an ASCII VTU of tetra10 cells."""
+    points, tets = cube_points_tets()
+    out = meshio.Mesh(points, [("tetra", tets)])
+    meshio.write(os.path.join(OUT, "cube_zlib.vtu"), out, binary=True)  # zlib is the default
+    meshio.write(os.path.join(OUT, "cube_lzma.vtu"), out, binary=True, compression="lzma")
+
+    # Quadratic: cube_msh's geometry and size, raised to order 2 by gmsh, read back by meshio.
+    import tempfile
+
+    gmsh.initialize()
+    gmsh.option.setNumber("General.Terminal", 0)
+    gmsh.model.add("cube_tet10")
+    gmsh.model.occ.addBox(0, 0, 0, 1, 1, 1)
+    gmsh.model.occ.synchronize()
+    gmsh.option.setNumber("Mesh.MeshSizeMax", 0.35)
+    gmsh.model.mesh.generate(3)
+    gmsh.model.mesh.setOrder(2)
+    gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
+    gmsh.option.setNumber("Mesh.Binary", 0)
+    with tempfile.TemporaryDirectory() as tmp:
+        msh = os.path.join(tmp, "cube_tet10.msh")
+        gmsh.write(msh)
+        gmsh.finalize()
+        mesh = meshio.read(msh)
+    tets10 = mesh.cells_dict["tetra10"]
+    used = sorted(set(tets10.flatten().tolist()))
+    renumber = {old: new for new, old in enumerate(used)}
+    quad = meshio.Mesh(mesh.points[used], [("tetra10", [[renumber[n] for n in t] for t in tets10])])
+    meshio.write(os.path.join(OUT, "cube_tet10_ascii.vtu"), quad, binary=False)
+    print("cube_tet10_ascii.vtu: %d points, %d tetra10" % (len(used), len(tets10)))
+
+
+def cube_vtk_library():
+    """The same cube written by the VTK library itself (vtkXMLUnstructuredGridWriter in each of
+    its data modes, encodings, compressors, header and id types, and the legacy
+    vtkUnstructuredGridWriter in ASCII and binary)."""
+    from vtkmodules.vtkCommonCore import VTK_DOUBLE, vtkIdList, vtkPoints, vtkVersion
+    from vtkmodules.vtkCommonDataModel import VTK_TETRA, vtkUnstructuredGrid
+    from vtkmodules.vtkIOLegacy import vtkUnstructuredGridWriter
+    from vtkmodules.vtkIOXML import vtkXMLUnstructuredGridWriter
+
+    points, tets = cube_points_tets()
+
+    def make_grid(norm_range, cells_32bit=False):
+        """A fresh grid for each file, so that no file depends on which were written before.
+        Computing the points' L2 norm range, as ParaView does, caches it in the array's
+        information, which the XML writer then writes as an <InformationKey> child inside the
+        Points <DataArray> (after the data in ascii and inline binary modes). The cells are kept
+        in 64-bit arrays, written as Int64 whatever the writer's IdType, unless cells_32bit."""
+        vtk_points = vtkPoints()
+        vtk_points.SetDataType(VTK_DOUBLE)
+        vtk_points.SetNumberOfPoints(len(points))
+        for i, p in enumerate(points):
+            vtk_points.SetPoint(i, *(float(x) for x in p))
+        grid = vtkUnstructuredGrid()
+        grid.SetPoints(vtk_points)
+        grid.Allocate(len(tets))
+        for t in tets:
+            ids = vtkIdList()
+            for n in t:
+                ids.InsertNextId(int(n))
+            grid.InsertNextCell(VTK_TETRA, ids)
+        if cells_32bit:
+            if not grid.GetCells().ConvertTo32BitStorage():
+                raise RuntimeError("could not convert the cells to 32-bit storage")
+        if norm_range:
+            vtk_points.GetData().GetRange(-1)
+        return grid
+
+    defaults = vtkXMLUnstructuredGridWriter()
+    print("VTK %s vtkXMLUnstructuredGridWriter defaults: DataMode=%d (Ascii=0 Binary=1 Appended=2) "
+          "EncodeAppendedData=%d Compressor=%s HeaderType=%d IdType=%d BlockSize=%d "
+          "CompressionLevel=%d ByteOrder=%d (BigEndian=0 LittleEndian=1)"
+          % (vtkVersion.GetVTKVersion(), defaults.GetDataMode(), defaults.GetEncodeAppendedData(),
+             defaults.GetCompressor().GetClassName() if defaults.GetCompressor() else None,
+             defaults.GetHeaderType(), defaults.GetIdType(), defaults.GetBlockSize(),
+             defaults.GetCompressionLevel(), defaults.GetByteOrder()))
+
+    def xml(name, configure, norm_range=True, cells_32bit=False):
+        writer = vtkXMLUnstructuredGridWriter()
+        writer.SetInputData(make_grid(norm_range, cells_32bit))
+        writer.SetFileName(os.path.join(OUT, name))
+        configure(writer)
+        if writer.Write() != 1:
+            raise RuntimeError("vtkXMLUnstructuredGridWriter failed on " + name)
+
+    # The library's defaults untouched (VTK 9.7: appended, base64-encoded since
+    # EncodeAppendedData is on by default, zlib, UInt32 headers, Int64 ids), from a grid on which
+    # nothing was computed: no <InformationKey>.
+    xml("cube_vtk_defaults.vtu", lambda w: None, norm_range=False)
+    # Appended raw binary with the default compressor (zlib) and block size.
+    xml("cube_vtk_appended_raw_zlib.vtu", lambda w: w.EncodeAppendedDataOff())
+    xml("cube_vtk_appended_base64.vtu",
+        lambda w: (w.EncodeAppendedDataOn(), w.SetCompressorTypeToNone()))
+    xml("cube_vtk_appended_raw.vtu",
+        lambda w: (w.EncodeAppendedDataOff(), w.SetCompressorTypeToNone()))
+    xml("cube_vtk_binary_zlib.vtu",
+        lambda w: (w.SetDataModeToBinary(), w.SetCompressorTypeToZLib()))
+    # SetIdTypeToInt32 alone leaves VTK 9's connectivity and offsets Int64 (they are not
+    # vtkIdTypeArrays): 32-bit cell storage makes them Int32.
+    xml("cube_vtk_binary_uint32.vtu",
+        lambda w: (w.SetDataModeToBinary(), w.SetCompressorTypeToNone(),
+                   w.SetHeaderTypeToUInt32(), w.SetIdTypeToInt32()), cells_32bit=True)
+    xml("cube_vtk_ascii.vtu", lambda w: w.SetDataModeToAscii())
+    if hasattr(vtkXMLUnstructuredGridWriter, "SetCompressorTypeToLZ4"):
+        xml("cube_vtk_lz4.vtu",
+            lambda w: (w.EncodeAppendedDataOff(), w.SetCompressorTypeToLZ4()))
+    else:
+        print("this VTK has no LZ4 compressor: cube_vtk_lz4.vtu not written")
+    # UInt64 block headers (as ParaView writes them), appended raw zlib.
+    xml("cube_vtk_header_uint64.vtu",
+        lambda w: (w.EncodeAppendedDataOff(), w.SetHeaderTypeToUInt64()))
+    # Appended raw zlib in 1 KiB blocks, so that each array spans several compressed blocks.
+    xml("cube_vtk_zlib_small_blocks.vtu",
+        lambda w: (w.EncodeAppendedDataOff(), w.SetCompressorTypeToZLib(), w.SetBlockSize(1024)))
+
+    for name, binary in [("cube_vtk9_legacy.vtk", False), ("cube_vtk9_legacy_binary.vtk", True)]:
+        writer = vtkUnstructuredGridWriter()
+        writer.SetInputData(make_grid(True))
+        writer.SetFileName(os.path.join(OUT, name))
+        if binary:
+            writer.SetFileTypeToBinary()
+        if writer.Write() != 1:
+            raise RuntimeError("vtkUnstructuredGridWriter failed on " + name)
+
+
+def multi_solid_stl():
+    """The surface of a unit box meshed by gmsh, as ASCII STL with one solid per surface (six
+    solids) and as one solid."""
+    gmsh.initialize()
+    gmsh.option.setNumber("General.Terminal", 0)
+    gmsh.model.add("box_surface")
+    gmsh.model.occ.addBox(0, 0, 0, 1, 1, 1)
+    gmsh.model.occ.synchronize()
+    gmsh.option.setNumber("Mesh.MeshSizeMax", 0.5)
+    gmsh.model.mesh.generate(2)
+    gmsh.option.setNumber("Mesh.Binary", 0)
+    for per_surface, name in [(1, "cube_multi_solid.stl"), (0, "cube_one_solid.stl")]:
+        gmsh.option.setNumber("Mesh.StlOneSolidPerSurface", per_surface)
+        gmsh.write(os.path.join(OUT, name))
+    gmsh.finalize()
+    for name in ["cube_multi_solid.stl", "cube_one_solid.stl"]:
+        with open(os.path.join(OUT, name)) as f:
+            words = [line.split()[0] for line in f if line.strip()]
+        print("%s: %d solids, %d facets"
+              % (name, words.count("solid"), words.count("facet")))
+
+
+STEPS = [cube_msh, cube_others, surfaces, cube_meshio_compressed, cube_vtk_library,
+         multi_solid_stl]
+
 if __name__ == "__main__":
+    import sys
+
     os.makedirs(OUT, exist_ok=True)
-    cube_msh()
-    cube_others()
-    surfaces()
+    by_name = {step.__name__: step for step in STEPS}
+    unknown = [name for name in sys.argv[1:] if name not in by_name]
+    if unknown:
+        sys.exit("unknown function(s) %s; choose among %s"
+                 % (", ".join(unknown), ", ".join(by_name)))
+    for name in sys.argv[1:] or list(by_name):
+        by_name[name]()

@@ -13,8 +13,13 @@ use rapier_fvm::prelude::*;
 // (its tetrahedra, nodes and volume, see `file_numbers`). The number of executions
 // is `cases` of each property below; the total is printed by `fuzz_execution_count`.
 
-/// Cases per fuzz property.
-const CASES: u32 = 10_000;
+/// Cases per fuzz property: 10 000, or `PROPTEST_CASES` (for longer runs).
+fn cases() -> u32 {
+    std::env::var("PROPTEST_CASES")
+        .ok()
+        .and_then(|n| n.parse().ok())
+        .unwrap_or(10_000)
+}
 
 fn run_reader(reader: usize, data: &[u8]) {
     let result = match reader {
@@ -31,7 +36,12 @@ fn run_reader(reader: usize, data: &[u8]) {
     let outcome = result.and_then(|raw| Ok((raw.clone(), raw.into_mesh()?)));
     match outcome {
         Ok((raw, mesh)) => assert_mesh_is_the_files(&raw, &mesh),
-        Err(Error::MeshImport { .. } | Error::InvalidSetting { .. }) => {}
+        Err(e @ Error::MeshImport { .. }) => {
+            // One line of printable text, whatever bytes the file held.
+            let shown = e.to_string();
+            assert!(!shown.chars().any(char::is_control), "{shown:?}");
+        }
+        Err(Error::InvalidSetting { .. }) => {}
         Err(other) => panic!("untyped import error {other:?}"),
     }
 }
@@ -56,7 +66,7 @@ fn bytes_cached_ele() -> Vec<u8> {
 }
 
 /// (reader, valid file) pairs mutated by the fuzz properties.
-const SEEDS: [(usize, &str); 13] = [
+const SEEDS: [(usize, &str); 19] = [
     (0, "cube_v22_ascii.msh"),
     (0, "cube_v22_binary.msh"),
     (0, "cube_v41_ascii.msh"),
@@ -65,8 +75,14 @@ const SEEDS: [(usize, &str); 13] = [
     (2, "cube.ele"),
     (3, "cube_ascii.vtu"),
     (3, "cube_binary.vtu"),
+    (3, "cube_zlib.vtu"),
+    (3, "cube_vtk_appended_base64.vtu"),
+    (3, "cube_vtk_appended_raw_zlib.vtu"),
+    (3, "cube_vtk_zlib_small_blocks.vtu"),
+    (3, "cube_vtk_binary_uint32.vtu"),
     (4, "cube_ascii.vtk"),
     (4, "cube_binary.vtk"),
+    (4, "cube_vtk9_legacy.vtk"),
     (5, "sphere.obj"),
     (6, "cube.stl"),
     (6, "sphere_ascii.stl"),
@@ -146,7 +162,7 @@ fn mutate(data: &[u8], mutation: &Mutation) -> Vec<u8> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: CASES, failure_persistence: None, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: cases(), failure_persistence: None, ..ProptestConfig::default() })]
 
     #[test]
     fn fuzz_arbitrary_bytes(reader in 0usize..7, data in prop::collection::vec(any::<u8>(), 0..512)) {
@@ -192,6 +208,6 @@ fn fuzz_every_truncation_of_the_headers() {
 
 #[test]
 fn fuzz_execution_count() {
-    // 4 properties of CASES cases each, plus the truncations (printed by their test).
-    println!("proptest fuzz executions: {}", 4 * CASES);
+    // 4 properties of `cases()` cases each, plus the truncations (printed by their test).
+    println!("proptest fuzz executions: {}", 4 * cases());
 }

@@ -7,6 +7,7 @@ use rapier_fvm::prelude::*;
 use rapier_fvm::{FileLocation, ImportErrorKind};
 use std::path::PathBuf;
 
+mod binary_vtu;
 mod file_numbers;
 mod filling;
 mod fuzz;
@@ -35,10 +36,29 @@ const CUBE_FILES: [&str; 9] = [
     "cube_ascii.vtk",
 ];
 
+/// The same cube in the layouts meshio (zlib `.vtu`) and the VTK 9 library write (see
+/// `tools/make_test_meshes.py`): appended raw and base64, inline base64, ASCII, uncompressed and
+/// zlib (one and many blocks), 32- and 64-bit headers, 32-bit indices; legacy `.vtk` with METADATA.
+const CUBE_FROM_OTHER_WRITERS: [&str; 12] = [
+    "cube_zlib.vtu",
+    "cube_vtk_defaults.vtu",
+    "cube_vtk_appended_raw_zlib.vtu",
+    "cube_vtk_appended_base64.vtu",
+    "cube_vtk_appended_raw.vtu",
+    "cube_vtk_binary_zlib.vtu",
+    "cube_vtk_binary_uint32.vtu",
+    "cube_vtk_ascii.vtu",
+    "cube_vtk_zlib_small_blocks.vtu",
+    "cube_vtk_header_uint64.vtu",
+    "cube_vtk9_legacy.vtk",
+    "cube_vtk9_legacy_binary.vtk",
+];
+
 #[test]
 fn the_cube_reads_the_same_from_every_format() {
     let mut all = CUBE_FILES.to_vec();
     all.push("cube_binary.vtk");
+    all.extend(CUBE_FROM_OTHER_WRITERS);
     let reference = import::load(asset(all[0]), 1.0, &SurfaceOptions::default()).unwrap();
     for name in all {
         let mesh = import::load(asset(name), 1.0, &SurfaceOptions::default())
@@ -227,4 +247,50 @@ fn gmsh_quadratic_tetrahedra_load_as_quadratic_meshes() {
     let subdivided = raw.into_mesh().unwrap();
     assert_eq!(subdivided.tet_count(), 8 * written.element_count());
     assert!((subdivided.volume() - 0.4 * 0.2 * 0.2).abs() < 1e-15);
+}
+
+#[test]
+fn quadratic_tetrahedra_from_a_vtu_keep_their_mid_edge_nodes() {
+    // meshio's tetra10 `.vtu` of gmsh's second-order cube: 1140 quadratic tetrahedra on 2091
+    // nodes. Their corners are the linear cube's (to meshio's 12 ASCII digits, so 1e-11), and
+    // each mid-edge node is the middle of its edge in VTK's order (the cube's faces are flat:
+    // gmsh puts them there). The quadratic mesh encloses the unit volume to rounding.
+    const EDGES: [(usize, usize); 6] = [(0, 1), (1, 2), (0, 2), (0, 3), (1, 3), (2, 3)];
+    let raw = vtk::parse_vtu(&bytes("cube_tet10_ascii.vtu"), "cube.vtu", 1.0).unwrap();
+    let linear = vtk::parse_vtu(&bytes("cube_binary.vtu"), "cube.vtu", 1.0).unwrap();
+    assert_eq!(
+        (
+            raw.tets.len(),
+            raw.positions.len(),
+            raw.mid_edge_nodes.len()
+        ),
+        (1140, 2091, 1140)
+    );
+    let p = |i: u32| raw.positions[i as usize];
+    for ((tet, mid), reference) in raw.tets.iter().zip(&raw.mid_edge_nodes).zip(&linear.tets) {
+        for (&corner, &same) in tet.iter().zip(reference) {
+            assert!(p(corner).distance(linear.positions[same as usize]) < 1e-11);
+        }
+        for (&node, (a, b)) in mid.iter().zip(EDGES) {
+            assert!(p(node).distance((p(tet[a]) + p(tet[b])) / 2.0) < 1e-11);
+        }
+    }
+    let mesh = raw.into_quadratic_mesh().unwrap();
+    assert_eq!((mesh.element_count(), mesh.node_count()), (1140, 2091));
+    assert!((mesh.subdivided().volume() - 1.0).abs() < 1e-12);
+}
+
+#[test]
+fn vtu_compressed_other_than_by_zlib_is_refused_naming_the_compressor() {
+    // meshio's LZMA and the VTK library's LZ4 files: typed errors at the points' data (the
+    // first array read), naming the compressor.
+    for (name, compressor) in [
+        ("cube_lzma.vtu", "vtkLZMADataCompressor"),
+        ("cube_vtk_lz4.vtu", "vtkLZ4DataCompressor"),
+    ] {
+        let (kind, at, message) = kind_and_location(vtk::parse_vtu(&bytes(name), name, 1.0));
+        assert_eq!(kind, ImportErrorKind::UnknownVersion, "{name}");
+        assert_ne!(at, FileLocation::Whole, "{name}");
+        assert!(message.contains(compressor), "{name}: {message}");
+    }
 }

@@ -262,7 +262,7 @@ fn malformed_vtu_files_name_the_line() {
     let (kind, at, _) = parse(&cut);
     assert_eq!(
         (kind, at),
-        (ImportErrorKind::Syntax, FileLocation::Line(2000))
+        (ImportErrorKind::Truncated, FileLocation::Line(2000))
     );
     // A connectivity entry past the 341 points: the connectivity's `<DataArray>` line.
     let connectivity = line_of("<DataArray type=\"Int64\" Name=\"connectivity\"");
@@ -296,7 +296,7 @@ fn malformed_vtu_files_name_the_line() {
         (kind, at),
         (ImportErrorKind::NonFinite, FileLocation::Line(7))
     );
-    // One cell type too few: `vtkio` names the array, its line is given.
+    // One cell type too few: the types array's line.
     let mut lines: Vec<&str> = text.lines().collect();
     lines.remove(types);
     let (kind, at, _) = parse(&lines.join("\n"));

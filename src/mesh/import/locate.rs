@@ -1,11 +1,10 @@
-//! Placing the errors of the crates that read OBJ, STL and VTU files, which say what is wrong
+//! Placing the errors of the crates that read OBJ and STL files, which say what is wrong
 //! but not where: small scanners, run only once a reader has failed, that find the line (or the
 //! byte offset, in binary STL) of the first statement the crate rejects. They follow the
 //! crates' own rules (documented with each function) without building a mesh, allocate no more
 //! than a small multiple of their input and accept any bytes.
 
 use crate::error::FileLocation;
-use quick_xml::events::Event;
 
 /// The lines of `data` as [`std::io::BufRead::lines`] splits them (at `\n`, a trailing `\r`
 /// dropped), numbered from 1; `None` for a line that is not UTF-8.
@@ -21,14 +20,6 @@ fn lines(data: &[u8]) -> impl Iterator<Item = (usize, Option<&str>)> {
 /// Number of the last line of `data` (at least 1): where a file that ends too early stops.
 fn last_line(data: &[u8]) -> usize {
     lines(data).last().map_or(1, |(number, _)| number)
-}
-
-/// 1-based line of byte `offset` of `data`.
-fn line_at(data: &[u8], offset: usize) -> usize {
-    1 + data[..offset.min(data.len())]
-        .iter()
-        .filter(|&&b| b == b'\n')
-        .count()
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -317,155 +308,4 @@ pub(super) fn stl_bad_vertex_location(data: &[u8], scale: f64) -> Option<FileLoc
             bad(&[coordinate(0), coordinate(1), coordinate(2)])
         })
         .map(|(r, v, _)| FileLocation::Byte(STL_HEADER + STL_COUNT + r * STL_RECORD + 12 * v))
-}
-
-// ---------------------------------------------------------------------------------------------
-// VTK XML, re-scanned with the `quick-xml` that `vtkio` uses.
-
-/// The element holding appended data, where both scans stop.
-const APPENDED: &[u8] = b"AppendedData";
-
-/// Where the XML of `data` stops being well-formed, as `quick-xml` sees it: the line and its
-/// message; `None` if the document is well-formed. Besides `quick-xml`'s own errors
-/// (mismatched end tags, unclosed markup), malformed attributes and a file ending inside an
-/// element are reported.
-pub(super) fn xml_error(data: &[u8]) -> Option<(usize, String)> {
-    let mut reader = quick_xml::Reader::from_reader(data);
-    let mut depth = 0usize;
-    loop {
-        let start = offset(reader.buffer_position());
-        let (tag, opens) = match reader.read_event() {
-            Err(e) => {
-                return Some((
-                    line_at(data, offset(reader.error_position())),
-                    e.to_string(),
-                ));
-            }
-            Ok(Event::Start(tag)) => (tag, true),
-            Ok(Event::Empty(tag)) => (tag, false),
-            Ok(Event::End(_)) => {
-                depth = depth.saturating_sub(1);
-                continue;
-            }
-            Ok(Event::Eof) => {
-                return (depth > 0).then(|| {
-                    (
-                        last_line(data),
-                        format!("the file ends inside {depth} unclosed element(s)"),
-                    )
-                });
-            }
-            Ok(_) => continue,
-        };
-        if tag.local_name().as_ref() == APPENDED {
-            // Appended data may be raw bytes, not XML: `vtkio` reads it as such.
-            return None;
-        }
-        if let Some(Err(e)) = tag.attributes().find(Result::is_err) {
-            return Some((line_at(data, start), e.to_string()));
-        }
-        depth += usize::from(opens);
-    }
-}
-
-/// A byte position of `quick-xml` as an index into the input.
-fn offset(position: u64) -> usize {
-    usize::try_from(position).unwrap_or(usize::MAX)
-}
-
-/// The lines of a `.vtu` file's `<Piece>` elements and of the data arrays `parse_vtu` reads.
-#[derive(Debug, Default)]
-pub(super) struct PieceLines {
-    /// The `<Piece>` element.
-    pub(super) piece: usize,
-    /// The first `<DataArray>` of `<Points>`.
-    pub(super) points: Option<usize>,
-    /// `<Cells>`'s `<DataArray Name="connectivity">`.
-    pub(super) connectivity: Option<usize>,
-    /// `<Cells>`'s `<DataArray Name="offsets">`.
-    pub(super) offsets: Option<usize>,
-    /// `<Cells>`'s `<DataArray Name="types">`.
-    pub(super) types: Option<usize>,
-}
-
-/// Element lines of a `.vtu` file: its pieces in order, and every `<DataArray>` with its `Name`.
-#[derive(Debug, Default)]
-pub(super) struct VtuLines {
-    /// The pieces, in file order.
-    pub(super) pieces: Vec<PieceLines>,
-    /// Every `<DataArray>`: its `Name` attribute (empty if none) and line.
-    pub(super) arrays: Vec<(String, usize)>,
-}
-
-impl VtuLines {
-    /// The lines of the elements of `data`, read as far as its XML is well-formed.
-    pub(super) fn scan(data: &[u8]) -> Self {
-        let mut lines = Self::default();
-        let mut reader = quick_xml::Reader::from_reader(data);
-        // The enclosing element of the current one, and the line count up to `counted`.
-        let mut parents: Vec<Vec<u8>> = Vec::new();
-        let (mut line, mut counted) = (1, 0);
-        loop {
-            let start = offset(reader.buffer_position()).min(data.len());
-            let (tag, empty) = match reader.read_event() {
-                Ok(Event::Start(tag)) => (tag, false),
-                Ok(Event::Empty(tag)) => (tag, true),
-                Ok(Event::End(_)) => {
-                    parents.pop();
-                    continue;
-                }
-                Ok(Event::Eof) | Err(_) => return lines,
-                Ok(_) => continue,
-            };
-            if tag.local_name().as_ref() == APPENDED {
-                return lines;
-            }
-            line += data[counted.min(start)..start]
-                .iter()
-                .filter(|&&b| b == b'\n')
-                .count();
-            counted = counted.max(start);
-            let name = tag.local_name().as_ref().to_vec();
-            match name.as_slice() {
-                b"Piece" => lines.pieces.push(PieceLines {
-                    piece: line,
-                    ..PieceLines::default()
-                }),
-                b"DataArray" => {
-                    let array_name = tag
-                        .attributes()
-                        .flatten()
-                        .find(|a| a.key.local_name().as_ref() == b"Name")
-                        .map(|a| String::from_utf8_lossy(&a.value).into_owned())
-                        .unwrap_or_default();
-                    let parent = parents.last().map(Vec::as_slice);
-                    let slot = lines.pieces.last_mut().and_then(|piece| {
-                        match (parent, array_name.as_str()) {
-                            (Some(b"Points"), _) => Some(&mut piece.points),
-                            (Some(b"Cells"), "connectivity") => Some(&mut piece.connectivity),
-                            (Some(b"Cells"), "offsets") => Some(&mut piece.offsets),
-                            (Some(b"Cells"), "types") => Some(&mut piece.types),
-                            _ => None,
-                        }
-                    });
-                    if let Some(slot) = slot {
-                        slot.get_or_insert(line);
-                    }
-                    lines.arrays.push((array_name, line));
-                }
-                _ => {}
-            }
-            if !empty {
-                parents.push(name);
-            }
-        }
-    }
-
-    /// The line of the first `<DataArray>` named `name`.
-    pub(super) fn array(&self, name: &str) -> Option<usize> {
-        self.arrays
-            .iter()
-            .find(|(n, _)| n == name)
-            .map(|&(_, line)| line)
-    }
 }

@@ -5,7 +5,7 @@
 //! |---|---|---|
 //! | Gmsh MSH 2.2 and 4.1, ASCII and binary | `.msh` | [`gmsh`] |
 //! | `TetGen` | `.node` + `.ele` | [`tetgen`] |
-//! | VTK XML unstructured grid (ASCII, base64, appended; not compressed) | `.vtu` | [`vtk`] |
+//! | VTK XML unstructured grid (ASCII, base64, appended raw or base64; uncompressed or zlib) | `.vtu` | [`vtk`] |
 //! | VTK legacy unstructured grid (ASCII and binary, 2.0 to 5.1) | `.vtk` | [`vtk`] |
 //! | surface: Wavefront OBJ, STL (ASCII and binary) | `.obj`, `.stl` | [`surface`] |
 //!
@@ -18,14 +18,13 @@
 //!
 //! Malformed files give [`Error::MeshImport`] with the file, the line (text) or byte offset
 //! (binary) and the [`ImportErrorKind`]; files that cannot be opened give [`Error::Io`]. Every
-//! reader reports lines: the Gmsh, `TetGen` and legacy VTK readers as they read; the OBJ, STL
-//! and VTU readers, whose crates (`tobj`, `stl_io`, `vtkio`) say what is wrong but not where,
-//! by scanning the file again once it has failed (the first statement the crate rejects, the
-//! line where the XML stops being well-formed, the `<DataArray>` an error is about; binary STL
+//! reader reports lines: the Gmsh, `TetGen`, VTU and legacy VTK readers as they read (VTU
+//! errors at the `<DataArray>` or `<Piece>` at fault, appended binary data by byte offset); the
+//! OBJ and STL readers, whose crates (`tobj`, `stl_io`) say what is wrong but not where, by
+//! scanning the file again once it has failed (the first statement the crate rejects; binary STL
 //! by the offset of the incomplete record). Only what no single place causes (no tetrahedra at
-//! all, a few `vtkio` errors that name no element) carries [`FileLocation::Whole`]. No reader
-//! panics or allocates more than its input can fill, whatever the bytes (fuzzed in
-//! `tests/mesh_import.rs`).
+//! all) carries [`FileLocation::Whole`]. No reader panics or allocates more than its input can
+//! fill, whatever the bytes (fuzzed in `tests/mesh_import`).
 //!
 //! # Example
 //! ```

@@ -60,7 +60,7 @@ impl<'a> Source<'a> {
             path: self.path.to_owned(),
             location,
             kind,
-            message: message.into(),
+            message: printable(&message.into()),
         }
     }
 
@@ -269,6 +269,24 @@ pub(super) fn scaled(source: &Source<'_>, p: DVec3, scale: f64) -> Result<DVec3,
             format!("the node at {p} times the scale {scale} {problem}"),
         )),
     }
+}
+
+/// `message` on one line of printable text: control characters (line breaks, escapes, bytes
+/// of a binary file shown as text) written as Rust escapes (`\n`, `\u{1b}`).
+fn printable(message: &str) -> String {
+    if !message.chars().any(char::is_control) {
+        return message.to_owned();
+    }
+    message
+        .chars()
+        .map(|c| {
+            if c.is_control() {
+                c.escape_default().to_string()
+            } else {
+                c.to_string()
+            }
+        })
+        .collect()
 }
 
 /// At most 40 characters of `token`, for messages.

@@ -3,8 +3,9 @@
 //! Accepts versions 2.0 to 5.1 (`# vtk DataFile Version x.y`, the major version 1 to 5
 //! checked), a title line, `ASCII` or `BINARY` (big-endian) and `DATASET UNSTRUCTURED_GRID`,
 //! followed by `POINTS`, `CELLS` and `CELL_TYPES` in any order: `CELLS` as one list of `n i_1 ... i_n` before version 5, as
-//! `OFFSETS` and `CONNECTIVITY` arrays (the first offset 0) from version 5 on. Any other
-//! keyword before all three are read, another data set or encoding, and counts that disagree
+//! `OFFSETS` and `CONNECTIVITY` arrays (the first offset 0) from version 5 on. A `METADATA`
+//! block after an array (written by the VTK 9 library: component names, information keys, up to
+//! a blank line) is skipped. Any other keyword before all three are read, another data set or encoding, and counts that disagree
 //! with the data are errors at the line (or, in binary data, the byte offset) at fault.
 
 use super::legacy_data::{DataType, Legacy, data_type};
@@ -144,6 +145,9 @@ impl Sections {
                 let count: usize = parse_token(&file.source, words.next(), "cell type count")?;
                 self.types = Some(file.integers(count, DataType::Signed(4), "cell types")?);
             }
+            // The VTK 9 library's description of the array before (its names, its range): text
+            // lines up to a blank one.
+            "METADATA" => while file.source.line()?.is_some_and(|l| !l.is_empty()) {},
             _ => {
                 return Err(file.source.error(
                     ImportErrorKind::Syntax,

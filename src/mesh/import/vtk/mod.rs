@@ -1,22 +1,19 @@
 //! VTK unstructured grids: XML `.vtu` files and legacy `.vtk` files.
 //!
-//! Cells of type 10 (tetra) are read. Lower-dimensional cells (vertices, lines, triangles,
-//! quads and their higher-order forms: boundary elements written beside the volume) are
-//! skipped, as in Gmsh files. Any other volume cell (quadratic tetra 24, hexahedron 12, wedge
-//! 13, pyramid 14, ...) is an [`ImportErrorKind::UnsupportedElement`] error naming the cell:
-//! dropping it would silently lose material.
+//! Cells of type 10 (tetra) and 24 (quadratic tetra: its corners, then its mid-edge nodes in
+//! VTK's edge order, kept in [`RawMesh::mid_edge_nodes`]) are read, one kind per file.
+//! Lower-dimensional cells (vertices, lines, triangles, quads and their higher-order forms:
+//! boundary elements written beside the volume) are skipped, as in Gmsh files. Any other volume
+//! cell (hexahedron 12, wedge 13, pyramid 14, ...) is an [`ImportErrorKind::UnsupportedElement`]
+//! error naming the cell: dropping it would silently lose material.
 //!
-//! `.vtu` files are parsed by the `vtkio` crate (ASCII, base64 `binary` and appended data;
-//! compressed data is an error since this crate builds `vtkio` without its decompressors,
-//! which also rules out decompression bombs). `vtkio`'s errors do not say where in the file
-//! they arise: on an error the file is scanned again with `quick-xml` (the version `vtkio`
-//! uses) to report the line where the XML stops being well-formed, or the line of the
-//! `<DataArray>` a size mismatch or an unknown cell type is about; other `vtkio` errors carry
-//! [`FileLocation::Whole`]. The checks made here afterwards name the cell or the data array and
-//! report the line of that array's `<DataArray>` element (of the `<Piece>` for count
-//! mismatches); appended and binary data are placed at their element's line. Mutating valid
-//! files (tens of thousands of truncations, byte flips and huge counts) made `vtkio` neither
-//! panic nor allocate beyond its input.
+//! `.vtu` files are read by this crate (`xml`: the layout walked with `quick-xml` in
+//! `xml_document`, the values decoded in `xml_data`, binary blocks in `xml_block`): ASCII, base64 `binary` and appended raw or
+//! base64 data, uncompressed or zlib-compressed (inflated within the sizes the file declares),
+//! every count checked against the data. Errors name the line of the `<DataArray>` or
+//! `<Piece>` at fault, a token that is not a number at its own line, appended binary data at its
+//! byte offset. No input makes the reader panic or allocate beyond what its counts and data
+//! can fill (fuzzed in `tests/mesh_import`).
 //!
 //! Legacy `.vtk` files (versions 2.0 to 5.1, ASCII or big-endian BINARY, `DATASET
 //! UNSTRUCTURED_GRID`) are read by hand: `vtkio`'s legacy parser reports only the nom error
@@ -28,6 +25,9 @@
 mod legacy;
 mod legacy_data;
 mod xml;
+mod xml_block;
+mod xml_data;
+mod xml_document;
 
 pub use legacy::parse_legacy;
 pub use xml::parse_vtu;
@@ -93,26 +93,43 @@ fn build(
         ));
     }
     let mut tets = Vec::new();
+    let mut mid_edge_nodes = Vec::new();
     let mut tet_locations = Vec::new();
     for (cell, &cell_type) in cells.types.iter().enumerate() {
         let nodes = cells.nodes(source, cell, locate)?;
-        if let Some(tet) = tetrahedron(source, cell, cell_type, nodes, positions.len(), locate)? {
-            tets.push(tet);
-            tet_locations.push(locate(cell, CellData::Connectivity));
+        let Some(nodes) = tetrahedron(source, cell, cell_type, nodes, positions.len(), locate)?
+        else {
+            continue;
+        };
+        let quadratic = nodes.len() == 10;
+        if !tets.is_empty() && quadratic == mid_edge_nodes.is_empty() {
+            return Err(source.error_at(
+                locate(cell, CellData::Types),
+                ImportErrorKind::UnsupportedElement,
+                format!(
+                    "cell {cell} has type {cell_type}: linear (10) and quadratic (24) \
+                     tetrahedra cannot be mixed"
+                ),
+            ));
         }
+        tets.push([nodes[0], nodes[1], nodes[2], nodes[3]]);
+        if quadratic {
+            mid_edge_nodes.push([nodes[4], nodes[5], nodes[6], nodes[7], nodes[8], nodes[9]]);
+        }
+        tet_locations.push(locate(cell, CellData::Connectivity));
     }
     if tets.is_empty() {
         return Err(source.error_at(
             FileLocation::Whole,
             ImportErrorKind::NoTetrahedra,
-            "the file holds no tetrahedra (cell type 10)",
+            "the file holds no tetrahedra (cell type 10 or 24)",
         ));
     }
     Ok(RawMesh {
         path: source.path().to_owned(),
         positions,
         tets,
-        mid_edge_nodes: Vec::new(),
+        mid_edge_nodes,
         tet_locations,
     })
 }
@@ -136,9 +153,10 @@ impl Cells<'_> {
     }
 }
 
-/// The tetrahedron cell `cell` of `cell_type` with point indices `nodes` makes (of
-/// `point_count` points): `None` for a lower-dimensional cell, an error for a tetrahedron
-/// without four points in range and for any other volume cell.
+/// The nodes of the tetrahedron cell `cell` of `cell_type` with point indices `nodes` (of
+/// `point_count` points): four for a linear one, ten for a quadratic one; `None` for a
+/// lower-dimensional cell, an error for a tetrahedron with another number of points or one out
+/// of range, and for any other volume cell.
 fn tetrahedron(
     source: &Source<'_>,
     cell: usize,
@@ -146,48 +164,49 @@ fn tetrahedron(
     nodes: &[u64],
     point_count: usize,
     locate: Locate<'_>,
-) -> Result<Option<[u32; 4]>, Error> {
-    match cell_type {
-        VTK_TETRA => {
-            if nodes.len() != 4 {
-                return Err(source.error_at(
-                    locate(cell, CellData::Offsets),
-                    ImportErrorKind::BadCount,
-                    format!("cell {cell} is a tetrahedron with {} nodes", nodes.len()),
-                ));
-            }
-            let mut tet = [0u32; 4];
-            for (corner, &node) in tet.iter_mut().zip(nodes) {
-                if node >= point_count as u64 {
-                    return Err(source.error_at(
+) -> Result<Option<Vec<u32>>, Error> {
+    let expected = match cell_type {
+        VTK_TETRA => 4,
+        VTK_QUADRATIC_TETRA => 10,
+        _ if is_lower_dimensional(cell_type) => return Ok(None),
+        _ => {
+            return Err(source.error_at(
+                locate(cell, CellData::Types),
+                ImportErrorKind::UnsupportedElement,
+                format!(
+                    "cell {cell} has type {cell_type}, a volume cell other than a tetrahedron \
+                     (type 10 or 24): it cannot be used"
+                ),
+            ));
+        }
+    };
+    if nodes.len() != expected {
+        return Err(source.error_at(
+            locate(cell, CellData::Offsets),
+            ImportErrorKind::BadCount,
+            format!(
+                "cell {cell} has type {cell_type} but {} nodes, not {expected}",
+                nodes.len()
+            ),
+        ));
+    }
+    nodes
+        .iter()
+        .map(|&node| {
+            u32::try_from(node)
+                .ok()
+                .filter(|&n| (n as usize) < point_count)
+                .ok_or_else(|| {
+                    source.error_at(
                         locate(cell, CellData::Connectivity),
                         ImportErrorKind::IndexOutOfRange,
                         format!(
                             "cell {cell} refers to point {node}, but there are {point_count} \
                              points"
                         ),
-                    ));
-                }
-                *corner = node as u32;
-            }
-            Ok(Some(tet))
-        }
-        _ if is_lower_dimensional(cell_type) => Ok(None),
-        VTK_QUADRATIC_TETRA => Err(source.error_at(
-            locate(cell, CellData::Types),
-            ImportErrorKind::UnsupportedElement,
-            format!(
-                "cell {cell} is a quadratic tetrahedron (type 24): only linear tetrahedra \
-                 (type 10) are supported"
-            ),
-        )),
-        _ => Err(source.error_at(
-            locate(cell, CellData::Types),
-            ImportErrorKind::UnsupportedElement,
-            format!(
-                "cell {cell} has type {cell_type}, a volume cell other than a linear \
-                 tetrahedron (type 10): mixed element types cannot be used"
-            ),
-        )),
-    }
+                    )
+                })
+        })
+        .collect::<Result<_, _>>()
+        .map(Some)
 }

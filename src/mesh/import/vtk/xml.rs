@@ -1,82 +1,72 @@
-//! VTK XML unstructured grids (`.vtu`), parsed by `vtkio`.
+//! VTK XML unstructured grids (`.vtu`), read by this crate (the layout with `quick-xml` in
+//! `xml_document`, the values in `xml_data`).
 //!
-//! Reads every inline `<Piece>` of an `UnstructuredGrid` (ASCII, base64 or appended data; not
-//! compressed), its points as numbers (three coordinates each, finite once scaled) and its
-//! cells' offsets (a leading zero tolerated), connectivity and types; the pieces' points are
-//! numbered one after the other. A file holding another data set, or pieces stored in other
-//! files, is refused. Errors are placed at the line of the `<DataArray>` (or `<Piece>`) at
-//! fault, found by scanning the file with `quick-xml`; `vtkio`'s own errors at the line where
-//! the XML stops being well-formed or at the array they name, else [`FileLocation::Whole`].
+//! Reads every inline `<Piece>` of an `UnstructuredGrid`: ASCII, base64 `binary` and appended
+//! (raw or base64) data, uncompressed or zlib-compressed, either byte order, 32- or 64-bit
+//! headers; its points as numbers (three coordinates each, finite once scaled) and its cells'
+//! offsets (a leading zero tolerated), connectivity and types. Every array must hold exactly
+//! what its piece's `NumberOfPoints` and `NumberOfCells` declare, and each cell's points must
+//! be its own piece's; the pieces' points are numbered one after the other. Errors are placed
+//! at the line of the `<DataArray>` (a token that is not a number at its own line; binary
+//! appended data at its byte offset), count mismatches at the `<Piece>`.
 
+use super::xml_data::Decoder;
+use super::xml_document::{self, ArrayDecl, PieceDecl};
 use super::{CellData, Cells, build};
 use crate::Error;
 use crate::error::{FileLocation, ImportErrorKind};
-use crate::mesh::import::locate::{self, PieceLines, VtuLines};
 use crate::mesh::import::text::Source;
 use crate::mesh::import::{RawMesh, check_scale, scaled_defect};
 use rapier3d::glamx::DVec3;
-use vtkio::model::{DataSet, IOBuffer, Piece, UnstructuredGridPiece, VertexNumbers};
 
-/// Reads the `.vtu` file `data` (named `path` in errors) with `vtkio`, coordinates times
-/// `scale` (m per file unit). All pieces of the grid are read.
+/// Reads the `.vtu` file `data` (named `path` in errors), coordinates times `scale` (m per file
+/// unit). All pieces of the grid are read.
 ///
 /// # Errors
 /// [`Error::InvalidSetting`] for a bad `scale`; [`Error::MeshImport`] for malformed XML or
-/// data, pieces in other files, cells that are not linear tetrahedra or lower-dimensional,
-/// indices out of range, non-finite coordinates. Malformed XML is reported at the line where
-/// it stops being well-formed, errors about a data array at the line of its `<DataArray>`,
-/// count mismatches at the line of the `<Piece>`; `vtkio`'s errors that name no place carry
-/// [`FileLocation::Whole`].
+/// data, a count that disagrees with the data, pieces in other files, compressors other than
+/// zlib, cells that are not linear tetrahedra or lower-dimensional, indices out of range,
+/// non-finite coordinates. Malformed XML is reported at the line where it stops being
+/// well-formed, errors about a data array at the line of its `<DataArray>` (appended data at
+/// its byte offset), count mismatches at the line of the `<Piece>`.
 pub fn parse_vtu(data: &[u8], path: &str, scale: f64) -> Result<RawMesh, Error> {
     check_scale(scale)?;
     let source = Source::new(path, data);
-    let vtk = vtkio::Vtk::parse_xml(data).map_err(|e| vtkio_error(&source, data, &e))?;
-    let DataSet::UnstructuredGrid { pieces, .. } = vtk.data else {
-        return Err(source.error_at(
-            FileLocation::Whole,
-            ImportErrorKind::Syntax,
-            "the file holds no UnstructuredGrid",
-        ));
-    };
+    let document = xml_document::read(&source, data)?;
+    let arrays = document.pieces.iter().flat_map(|p| {
+        [&p.points, &p.connectivity, &p.offsets, &p.types]
+            .into_iter()
+            .flatten()
+    });
+    let decoder = Decoder::new(&source, &document.layout, document.appended, arrays);
     let mut grid = Grid {
         source: &source,
-        lines: VtuLines::scan(data),
         scale,
         positions: Vec::new(),
         offsets: vec![0u64],
         connectivity: Vec::new(),
         types: Vec::new(),
-        first_cells: Vec::new(),
+        pieces: Vec::new(),
     };
-    for (number, piece) in pieces.into_iter().enumerate() {
-        let piece = match piece {
-            Piece::Inline(piece) => piece,
-            Piece::Source(..) | Piece::Loaded(_) => {
-                return Err(source.error_at(
-                    grid.at(number, piece_line),
-                    ImportErrorKind::UnknownVersion,
-                    format!("piece {number} is stored in another file: not supported"),
-                ));
-            }
-        };
-        grid.add_piece(number, *piece)?;
+    for (number, piece) in document.pieces.iter().enumerate() {
+        grid.add_piece(&decoder, number, piece)?;
     }
     grid.build()
 }
 
-/// Chooses the line of one element of a piece.
-type PieceElement = fn(&PieceLines) -> Option<usize>;
-
-/// The line of the `<Piece>` element itself.
-fn piece_line(p: &PieceLines) -> Option<usize> {
-    Some(p.piece)
+/// Where a piece's data lies, for errors about its cells.
+struct PieceLines {
+    /// The piece's first cell in the joined grid.
+    first_cell: usize,
+    /// The lines of its offsets, connectivity and types arrays.
+    offsets: FileLocation,
+    connectivity: FileLocation,
+    types: FileLocation,
 }
 
 /// The pieces read so far, joined into one grid.
 struct Grid<'s> {
     source: &'s Source<'s>,
-    /// The lines of the file's elements, for error locations.
-    lines: VtuLines,
     /// Metres per file unit.
     scale: f64,
     /// The points of all pieces (m).
@@ -87,102 +77,158 @@ struct Grid<'s> {
     connectivity: Vec<u64>,
     /// The cells' VTK types.
     types: Vec<u64>,
-    /// The first cell of each piece, to find a cell's piece.
-    first_cells: Vec<usize>,
+    /// Where each piece's cells start and its arrays are.
+    pieces: Vec<PieceLines>,
+}
+
+/// The line of `array`, or of its piece if it is missing.
+fn line_of(array: Option<&ArrayDecl>, piece: &PieceDecl) -> FileLocation {
+    FileLocation::Line(array.map_or(piece.line, |a| a.line))
 }
 
 impl Grid<'_> {
-    /// The location of piece `number`'s element chosen by `element`.
-    fn at(&self, number: usize, element: PieceElement) -> FileLocation {
-        at(&self.lines, number, element)
+    /// A count error about piece `piece` at `at`.
+    fn bad_count(&self, at: FileLocation, message: String) -> Error {
+        self.source.error_at(at, ImportErrorKind::BadCount, message)
+    }
+
+    /// The array `array` of piece `number` (`what`), or an error if it is missing.
+    fn required<'p>(
+        &self,
+        array: Option<&'p ArrayDecl>,
+        piece: &PieceDecl,
+        what: &str,
+    ) -> Result<&'p ArrayDecl, Error> {
+        array.ok_or_else(|| {
+            self.bad_count(
+                FileLocation::Line(piece.line),
+                format!("the piece declares cells or points but has no {what} <DataArray>"),
+            )
+        })
     }
 
     /// Appends the points and cells of piece `number`, its point indices shifted past the
     /// points of the pieces before it.
-    fn add_piece(&mut self, number: usize, piece: UnstructuredGridPiece) -> Result<(), Error> {
-        let source = self.source;
+    fn add_piece(
+        &mut self,
+        decoder: &Decoder<'_, '_>,
+        number: usize,
+        piece: &PieceDecl,
+    ) -> Result<(), Error> {
         let first_point = self.positions.len() as u64;
-        self.add_points(number, &piece.points)?;
-        let (piece_offsets, piece_connectivity) =
-            self.cell_vertices(number, piece.cells.cell_verts)?;
-        // XML offsets are the cells' ends; some writers put a leading zero.
-        let ends = match piece_offsets.first() {
-            Some(0) if piece_offsets.len() == piece.cells.types.len() + 1 => &piece_offsets[1..],
-            _ => &piece_offsets[..],
-        };
-        if ends.len() != piece.cells.types.len() {
-            return Err(source.error_at(
-                self.at(number, piece_line),
-                ImportErrorKind::BadCount,
+        if piece.point_count > 0 {
+            let points = self.required(piece.points.as_ref(), piece, "Points")?;
+            self.add_points(decoder, number, piece, points)?;
+        }
+        self.pieces.push(PieceLines {
+            first_cell: self.types.len(),
+            offsets: line_of(piece.offsets.as_ref(), piece),
+            connectivity: line_of(piece.connectivity.as_ref(), piece),
+            types: line_of(piece.types.as_ref(), piece),
+        });
+        if piece.cell_count == 0 {
+            return Ok(());
+        }
+        let cells = piece.cell_count;
+        let what = |name: &str| format!("{name} of piece {number}");
+        let types_array = self.required(piece.types.as_ref(), piece, "types")?;
+        let types = decoder.indices(types_array, cells, &what("cell types"))?;
+        let offsets_array = self.required(piece.offsets.as_ref(), piece, "offsets")?;
+        let offsets = decoder.indices(offsets_array, cells + 1, &what("cell offsets"))?;
+        if types.len() as u64 != cells {
+            return Err(self.bad_count(
+                FileLocation::Line(types_array.line),
                 format!(
-                    "piece {number} has {} cell offsets but {} cell types",
-                    ends.len(),
-                    piece.cells.types.len()
+                    "piece {number} has {} cell types for {cells} cells",
+                    types.len()
                 ),
             ));
         }
-        self.first_cells.push(self.types.len());
+        // XML offsets are the cells' ends; some writers put a leading zero.
+        let ends = match offsets.first() {
+            Some(0) if offsets.len() as u64 == cells + 1 => &offsets[1..],
+            _ => &offsets[..],
+        };
+        if ends.len() as u64 != cells {
+            return Err(self.bad_count(
+                FileLocation::Line(offsets_array.line),
+                format!(
+                    "piece {number} has {} cell offsets for {cells} cells",
+                    ends.len()
+                ),
+            ));
+        }
+        let used = ends.last().copied().unwrap_or(0);
+        let connectivity_array =
+            self.required(piece.connectivity.as_ref(), piece, "connectivity")?;
+        let connectivity = decoder.indices(connectivity_array, used, &what("connectivity"))?;
+        let at = FileLocation::Line(connectivity_array.line);
+        if connectivity.len() as u64 != used {
+            return Err(self.bad_count(
+                at,
+                format!(
+                    "piece {number}'s connectivity has {} entries, its last cell ends at {used}",
+                    connectivity.len()
+                ),
+            ));
+        }
         let base = self.connectivity.len() as u64;
-        for &end in ends {
-            if end > piece_connectivity.len() as u64 {
-                return Err(source.error_at(
-                    self.at(number, |p| p.offsets),
-                    ImportErrorKind::BadCount,
+        self.offsets.extend(ends.iter().map(|&end| base + end));
+        for &node in &connectivity {
+            if node >= piece.point_count {
+                return Err(self.source.error_at(
+                    at,
+                    ImportErrorKind::IndexOutOfRange,
                     format!(
-                        "piece {number}: cell offset {end} is past the connectivity's {} entries",
-                        piece_connectivity.len()
+                        "piece {number} refers to point {node}, but has {} points",
+                        piece.point_count
                     ),
                 ));
             }
-            self.offsets.push(base + end);
+            self.connectivity.push(first_point + node);
         }
-        for &node in &piece_connectivity {
-            let global = node.checked_add(first_point).ok_or_else(|| {
-                source.error_at(
-                    self.at(number, |p| p.connectivity),
-                    ImportErrorKind::IndexOutOfRange,
-                    format!("piece {number} refers to point {node}"),
-                )
-            })?;
-            self.connectivity.push(global);
-        }
-        self.types
-            .extend(piece.cells.types.iter().map(|&t| t as u64));
+        self.types.extend(types);
         Ok(())
     }
 
-    /// Appends the points of piece `number`, scaled to m and checked finite.
-    fn add_points(&mut self, number: usize, points_data: &IOBuffer) -> Result<(), Error> {
+    /// Appends the points of piece `number` from `points`, scaled to m and checked finite.
+    fn add_points(
+        &mut self,
+        decoder: &Decoder<'_, '_>,
+        number: usize,
+        piece: &PieceDecl,
+        points: &ArrayDecl,
+    ) -> Result<(), Error> {
         let (source, scale) = (self.source, self.scale);
-        let points = self.at(number, |p| p.points);
-        let first_point = self.positions.len() as u64;
-        let coordinates = points_data.cast_into::<f64>().ok_or_else(|| {
-            source.error_at(
-                points,
-                ImportErrorKind::Syntax,
-                format!("the points of piece {number} are not numbers"),
-            )
-        })?;
-        if coordinates.len() % 3 != 0 {
-            return Err(source.error_at(
-                points,
-                ImportErrorKind::BadCount,
+        let at = FileLocation::Line(points.line);
+        if points.components != 3 {
+            return Err(self.bad_count(
+                at,
                 format!(
-                    "piece {number} has {} point coordinates, not a multiple of 3",
-                    coordinates.len()
+                    "the points of piece {number} have {} components, not 3",
+                    points.components
                 ),
             ));
         }
-        for p in coordinates.chunks_exact(3) {
+        let expected = piece.point_count.saturating_mul(3);
+        let coordinates = decoder.floats(points, expected, &format!("points of piece {number}"))?;
+        if coordinates.len() as u64 != expected {
+            return Err(self.bad_count(
+                at,
+                format!(
+                    "piece {number} has {} point coordinates for its {} points",
+                    coordinates.len(),
+                    piece.point_count
+                ),
+            ));
+        }
+        for (i, p) in coordinates.chunks_exact(3).enumerate() {
             let p = DVec3::new(p[0], p[1], p[2]);
             if let Some((kind, problem)) = scaled_defect(p, scale) {
                 return Err(source.error_at(
-                    points,
+                    at,
                     kind,
-                    format!(
-                        "point {} of piece {number} is {p}, which times the scale {scale} {problem}",
-                        self.positions.len() as u64 - first_point
-                    ),
+                    format!("point {i} of piece {number} is {p}, which times the scale {scale} {problem}"),
                 ));
             }
             self.positions.push(p * scale);
@@ -190,50 +236,15 @@ impl Grid<'_> {
         Ok(())
     }
 
-    /// The cell offsets (cells' ends, maybe after a leading zero) and connectivity of piece
-    /// `number`, converted from the legacy `n i_1 ... i_n` list when `vtkio` gives that.
-    fn cell_vertices(
-        &self,
-        number: usize,
-        cell_verts: VertexNumbers,
-    ) -> Result<(Vec<u64>, Vec<u64>), Error> {
-        match cell_verts {
-            VertexNumbers::XML {
-                connectivity,
-                offsets,
-            } => Ok((offsets, connectivity)),
-            VertexNumbers::Legacy { vertices, .. } => {
-                let mut offsets = Vec::new();
-                let mut connectivity = Vec::new();
-                let mut i = 0;
-                while i < vertices.len() {
-                    let n = vertices[i] as usize;
-                    let cell = vertices.get(i + 1..i + 1 + n).ok_or_else(|| {
-                        self.source.error_at(
-                            self.at(number, |p| p.connectivity),
-                            ImportErrorKind::Truncated,
-                            "a cell list is cut short",
-                        )
-                    })?;
-                    connectivity.extend(cell.iter().map(|&v| u64::from(v)));
-                    offsets.push(connectivity.len() as u64);
-                    i += 1 + n;
-                }
-                Ok((offsets, connectivity))
-            }
-        }
-    }
-
     /// The mesh of all pieces' tetrahedra, errors placed at the data arrays of the cell's piece.
     fn build(self) -> Result<RawMesh, Error> {
         let Grid {
             source,
-            lines,
             positions,
             offsets,
             connectivity,
             types,
-            first_cells,
+            pieces,
             ..
         } = self;
         let cells = Cells {
@@ -242,55 +253,15 @@ impl Grid<'_> {
             types: &types,
         };
         let locate = |cell: usize, data: CellData| {
-            let number = first_cells.partition_point(|&first| first <= cell).max(1) - 1;
-            at(
-                &lines,
-                number,
-                match data {
-                    CellData::Offsets => |p| p.offsets,
-                    CellData::Connectivity => |p| p.connectivity,
-                    CellData::Types => |p| p.types,
-                },
-            )
+            let number = pieces.partition_point(|p| p.first_cell <= cell).max(1) - 1;
+            pieces
+                .get(number)
+                .map_or(FileLocation::Whole, |p| match data {
+                    CellData::Offsets => p.offsets,
+                    CellData::Connectivity => p.connectivity,
+                    CellData::Types => p.types,
+                })
         };
         build(source, positions, &cells, &locate)
     }
-}
-
-/// The location of piece `number`'s element chosen by `element`, in the file of `lines`.
-fn at(lines: &VtuLines, number: usize, element: PieceElement) -> FileLocation {
-    lines
-        .pieces
-        .get(number)
-        .and_then(element)
-        .map_or(FileLocation::Whole, FileLocation::Line)
-}
-
-/// `vtkio`'s error `e` on `data`, placed: at the line where the XML stops being well-formed,
-/// else at the `<DataArray>` it names (a size mismatch, an unknown cell type), else nowhere.
-fn vtkio_error(source: &Source<'_>, data: &[u8], e: &vtkio::Error) -> Error {
-    use vtkio::xml::{Error as XmlError, ValidationError};
-    if let Some((line, syntax)) = locate::xml_error(data) {
-        return source.error_at(
-            FileLocation::Line(line),
-            ImportErrorKind::Syntax,
-            format!("invalid VTU file: malformed XML: {syntax}"),
-        );
-    }
-    let (kind, array) = match e {
-        vtkio::Error::XML(XmlError::Validation(ValidationError::DataArraySizeMismatch {
-            name,
-            ..
-        })) => (ImportErrorKind::BadCount, Some(name.as_str())),
-        vtkio::Error::XML(XmlError::Validation(ValidationError::InvalidCellType(_))) => {
-            (ImportErrorKind::UnsupportedElement, Some("types"))
-        }
-        _ => (ImportErrorKind::Syntax, None),
-    };
-    let line = array.and_then(|name| VtuLines::scan(data).array(name));
-    source.error_at(
-        line.map_or(FileLocation::Whole, FileLocation::Line),
-        kind,
-        format!("invalid VTU file: {e}"),
-    )
 }
