@@ -3,9 +3,9 @@
 
 use super::asset;
 use super::bytes;
-use rapier_fvm::ImportErrorKind;
 use rapier_fvm::mesh::import::{self, RawMesh, SurfaceOptions, surface};
 use rapier_fvm::prelude::*;
+use rapier_fvm::{FileLocation, ImportErrorKind};
 
 #[test]
 fn the_sphere_obj_fills_with_good_tetrahedra_close_to_its_volume() {
@@ -153,4 +153,50 @@ fn check_counts_inverted_and_degenerate_elements() {
         .unwrap()
         .critical;
     assert!(dt > 0.0 && dt < 1e-3, "{dt}");
+}
+
+#[test]
+fn a_multi_solid_stl_reads_every_solid() {
+    // gmsh's unit cube surface written with one solid per face (6 solids) and as one solid:
+    // the same 540 facets and welded vertices, enclosing the unit volume (1e-12: f32
+    // coordinates of a cube's faces, sums of exact products).
+    let many = surface::parse_stl(&bytes("cube_multi_solid.stl"), "many.stl", 1.0).unwrap();
+    let one = surface::parse_stl(&bytes("cube_one_solid.stl"), "one.stl", 1.0).unwrap();
+    assert_eq!(many.triangles.len(), 540);
+    assert_eq!(many.vertices.len(), one.vertices.len());
+    assert_eq!(many.triangles.len(), one.triangles.len());
+    assert!(
+        (many.enclosed_volume() - 1.0).abs() < 1e-12,
+        "{}",
+        many.enclosed_volume()
+    );
+    assert!((one.enclosed_volume() - 1.0).abs() < 1e-12);
+    // Text after the last solid is an error at its line, not ignored.
+    let mut text = bytes("cube_multi_solid.stl");
+    let lines = text.iter().filter(|&&b| b == b'\n').count();
+    text.extend_from_slice(b"facet normal 0 0 1\n");
+    let error = surface::parse_stl(&text, "tail.stl", 1.0).unwrap_err();
+    assert!(
+        matches!(error, Error::MeshImport { location: FileLocation::Line(l), .. } if l == lines + 1),
+        "{error}"
+    );
+}
+
+#[test]
+fn a_binary_stl_with_more_records_than_its_count_is_refused() {
+    // The 12-triangle cube whose header announces 11: the twelfth record would be dropped.
+    let mut data = bytes("cube.stl");
+    data[80..84].copy_from_slice(&11u32.to_le_bytes());
+    let error = surface::parse_stl(&data, "short.stl", 1.0).unwrap_err();
+    assert!(
+        matches!(
+            error,
+            Error::MeshImport {
+                kind: ImportErrorKind::BadCount,
+                location: FileLocation::Byte(634),
+                ..
+            }
+        ),
+        "{error}"
+    );
 }

@@ -178,6 +178,48 @@ fn tetgen_reads_one_based_indices_attributes_and_comments() {
 }
 
 #[test]
+fn tetgen_files_must_hold_what_their_headers_announce() {
+    // The gmsh cube through meshio's TetGen writer (1140 tetrahedra): a header announcing 1139
+    // would drop the last one; announcing 1141, the file ends where it is expected.
+    let node = bytes("cube.node");
+    let ele = String::from_utf8(bytes("cube.ele")).unwrap();
+    let lines = ele.lines().count();
+    let count = |n: usize| ele.replacen("\n1140 4 0\n", &format!("\n{n} 4 0\n"), 1);
+    let parse = |ele: &str| {
+        kind_and_location(tetgen::parse(
+            &node,
+            "cube.node",
+            ele.as_bytes(),
+            "cube.ele",
+            1.0,
+        ))
+    };
+    assert_eq!(parse(&count(1139)).0, ImportErrorKind::BadCount);
+    assert_eq!(parse(&count(1139)).1, FileLocation::Line(lines));
+    assert_eq!(parse(&count(1141)).0, ImportErrorKind::Truncated);
+    // Cut inside the last number (its line break gone), the last tetrahedron would read another
+    // node; the same for the last point of the `.node` file.
+    let cut = &ele[..ele.trim_end().len() - 1];
+    assert_eq!(parse(cut).0, ImportErrorKind::Truncated);
+    let node_text = String::from_utf8(node.clone()).unwrap();
+    let cut = &node_text[..node_text.trim_end().len() - 1];
+    let (kind, at, _) = kind_and_location(tetgen::parse(
+        cut.as_bytes(),
+        "cube.node",
+        ele.as_bytes(),
+        "cube.ele",
+        1.0,
+    ));
+    assert_eq!(
+        (kind, at),
+        (
+            ImportErrorKind::Truncated,
+            FileLocation::Line(node_text.lines().count())
+        )
+    );
+}
+
+#[test]
 fn a_triangle_among_vtu_tetrahedra_is_skipped_but_a_hexahedron_is_an_error() {
     let mixed = vtk::parse_vtu(&bytes("cube_mixed.vtu"), "mixed.vtu", 1.0).unwrap();
     assert_eq!(mixed.tets.len(), 1140);

@@ -215,7 +215,7 @@ const STL_COUNT: usize = 4;
 const STL_RECORD: usize = 50;
 
 /// Whether `stl_io` reads `data` as ASCII: its first line is UTF-8 starting with `solid `.
-fn stl_is_ascii(data: &[u8]) -> bool {
+pub(super) fn stl_is_ascii(data: &[u8]) -> bool {
     let end = data
         .iter()
         .position(|&b| b == b'\n')

@@ -5,7 +5,9 @@
 //! attribute 0|1>`, then `<index> <n1> <n2> <n3> <n4> [region]`. Points are numbered
 //! consecutively from 0 or 1 (the first point says which), and the tetrahedra use the same
 //! numbering. `#` starts a comment; blank lines are ignored. Ten-node (quadratic) tetrahedra
-//! are an [`ImportErrorKind::UnsupportedElement`] error.
+//! are an [`ImportErrorKind::UnsupportedElement`] error. A file must hold exactly the points or
+//! tetrahedra its header announces, and its last one must end with a line break (a file cut
+//! inside a number would read as another number).
 
 use super::text::{Source, end_of_line, parse_finite, parse_point, parse_token, scaled};
 use super::{RawMesh, check_scale};
@@ -51,6 +53,8 @@ pub fn parse(
         )?);
         tet_locations.push(source.location());
     }
+    source.check_line_ended("the last tetrahedron")?;
+    source.check_nothing_follows('#', "tetrahedra", count)?;
     Ok(RawMesh {
         path: ele_path.to_owned(),
         positions,
@@ -216,5 +220,7 @@ fn parse_node(data: &[u8], path: &str, scale: f64) -> Result<(Vec<DVec3>, u64), 
         end_of_line(&source, tokens, ImportErrorKind::BadCount, TOO_MANY_NUMBERS)?;
         positions.push(scaled(&source, p, scale)?);
     }
+    source.check_line_ended("the last point")?;
+    source.check_nothing_follows('#', "points", count)?;
     Ok((positions, base))
 }

@@ -16,6 +16,8 @@ pub(super) struct Source<'a> {
     line: usize,
     /// Whether errors give byte offsets (inside binary data) rather than lines.
     binary: bool,
+    /// Whether the last line returned by [`Source::line`] ended with a line break.
+    line_ended: bool,
 }
 
 impl<'a> Source<'a> {
@@ -27,6 +29,7 @@ impl<'a> Source<'a> {
             pos: 0,
             line: 0,
             binary: false,
+            line_ended: true,
         }
     }
 
@@ -89,6 +92,7 @@ impl<'a> Source<'a> {
         let end = rest.iter().position(|&b| b == b'\n').unwrap_or(rest.len());
         self.pos += (end + 1).min(rest.len());
         self.line += 1;
+        self.line_ended = end < rest.len();
         match std::str::from_utf8(&rest[..end]) {
             Ok(text) => Ok(Some(text.trim())),
             Err(_) => {
@@ -124,6 +128,38 @@ impl<'a> Source<'a> {
                 return Ok(line);
             }
         }
+    }
+
+    /// A [`ImportErrorKind::Truncated`] error if the last line read, holding `what`, is the
+    /// file's last and has no line break: a file cut inside a number reads as another number.
+    pub(super) fn check_line_ended(&self, what: &str) -> Result<(), Error> {
+        if self.line_ended {
+            return Ok(());
+        }
+        Err(self.error(
+            ImportErrorKind::Truncated,
+            format!("the file ends inside {what}, without a line break: it may be cut short"),
+        ))
+    }
+
+    /// A [`ImportErrorKind::BadCount`] error at the next line that is neither blank nor a
+    /// comment (starting with `comment`), if there is one: the file holds more `what` than
+    /// its header announces (`count`).
+    pub(super) fn check_nothing_follows(
+        &mut self,
+        comment: char,
+        what: &str,
+        count: usize,
+    ) -> Result<(), Error> {
+        while let Some(line) = self.line()? {
+            if !line.split(comment).next().unwrap_or("").trim().is_empty() {
+                return Err(self.error(
+                    ImportErrorKind::BadCount,
+                    format!("more {what} than the {count} the header announces"),
+                ));
+            }
+        }
+        Ok(())
     }
 
     /// Skips whitespace (spaces, tabs, line endings) in binary mode, counting lines.

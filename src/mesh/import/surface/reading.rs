@@ -1,7 +1,9 @@
 //! Reading surface files: Wavefront OBJ with `tobj`, STL (ASCII and binary) with `stl_io`.
 //!
 //! Both give a [`Surface`] of welded vertices (m) and triangles; OBJ polygons are triangulated,
-//! its objects and groups joined, its material libraries never opened. A file the crate
+//! its objects and groups joined, its material libraries never opened; every solid of an ASCII
+//! STL file is read (gmsh writes one per surface), each by `stl_io`, their vertices welded. A
+//! binary STL must hold the records its count announces, and no more. A file the crate
 //! rejects, a face referring to a missing vertex and a coordinate that is not finite once scaled,
 //! or beyond ±[`MAX_COORDINATE`](crate::mesh::MAX_COORDINATE) m, are errors; since neither crate
 //! says where, the file is scanned again to find the line (or, in binary STL, the byte offset) at
@@ -102,59 +104,145 @@ fn obj_models(source: &Source<'_>, data: &[u8]) -> Result<Vec<tobj::Model>, Erro
     Ok(models)
 }
 
-/// Reads an STL surface, ASCII or binary, with `stl_io` (which merges vertices of identical
-/// coordinates), coordinates times `scale` (m per file unit).
+/// Reads an STL surface, ASCII (every solid of the file) or binary, with `stl_io` (which
+/// merges vertices of identical coordinates within a solid; the solids' vertices are welded
+/// here), coordinates times `scale` (m per file unit).
 ///
 /// # Errors
 /// [`Error::InvalidSetting`] for a bad `scale`; [`Error::MeshImport`] for a file `stl_io`
-/// rejects or non-finite coordinates, at the line of the first statement at fault (ASCII) or
-/// the byte offset of the incomplete or non-finite record (binary); `stl_io` gives no position,
-/// so the file is scanned again to find it.
+/// rejects, text outside the solids of an ASCII file, a binary file holding more records than
+/// its count, or non-finite coordinates, at the line of the first statement at fault (ASCII)
+/// or the byte offset of the record (binary); `stl_io` gives no position, so the file is
+/// scanned again to find it.
 pub fn parse_stl(data: &[u8], path: &str, scale: f64) -> Result<Surface, Error> {
     check_scale(scale)?;
     let source = Source::new(path, data);
-    let mesh = stl_io::read_stl(&mut std::io::Cursor::new(data)).map_err(|e| {
+    let parts = if locate::stl_is_ascii(data) {
+        ascii_solids(&source, data)?
+    } else {
+        check_record_count(&source, data)?;
+        vec![(0, data)]
+    };
+    let mut surface = Surface {
+        path: path.to_owned(),
+        vertices: Vec::new(),
+        triangles: Vec::new(),
+    };
+    let mut welded: HashMap<[u64; 3], u32> = HashMap::new();
+    for (lines_before, part) in parts {
+        let mesh = read_stl_part(&source, part, lines_before)?;
+        let mut global = Vec::with_capacity(mesh.vertices.len());
+        for v in &mesh.vertices {
+            let p = DVec3::new(f64::from(v[0]), f64::from(v[1]), f64::from(v[2]));
+            let vertex = scaled_vertex(&source, p, scale, || {
+                locate::stl_bad_vertex_location(part, scale)
+                    .map_or(FileLocation::Whole, |at| shifted(at, lines_before))
+            })?;
+            let key = vertex.to_array().map(f64::to_bits);
+            global.push(*welded.entry(key).or_insert_with(|| {
+                surface.vertices.push(vertex);
+                (surface.vertices.len() - 1) as u32
+            }));
+        }
+        for face in &mesh.faces {
+            let mut triangle = [0u32; 3];
+            for (corner, &i) in triangle.iter_mut().zip(&face.vertices) {
+                *corner = *global.get(i).ok_or_else(|| {
+                    source.error_at(
+                        FileLocation::Whole,
+                        ImportErrorKind::IndexOutOfRange,
+                        format!("a facet refers to vertex {i} of {}", global.len()),
+                    )
+                })?;
+            }
+            surface.triangles.push(triangle);
+        }
+    }
+    Ok(surface)
+}
+
+/// `stl_io`'s mesh of `part`, a solid (or a whole binary file) after `lines_before` lines of
+/// the file, its errors placed in the file.
+fn read_stl_part(
+    source: &Source<'_>,
+    part: &[u8],
+    lines_before: usize,
+) -> Result<stl_io::IndexedMesh, Error> {
+    stl_io::read_stl(&mut std::io::Cursor::new(part)).map_err(|e| {
         let kind = if e.kind() == std::io::ErrorKind::UnexpectedEof {
             ImportErrorKind::Truncated
         } else {
             ImportErrorKind::Syntax
         };
         source.error_at(
-            locate::stl_error_location(data).unwrap_or(FileLocation::Whole),
+            locate::stl_error_location(part)
+                .map_or(FileLocation::Whole, |at| shifted(at, lines_before)),
             kind,
             format!("invalid STL file: {e}"),
         )
-    })?;
-    let vertices = mesh
-        .vertices
-        .iter()
-        .map(|v| {
-            let p = DVec3::new(f64::from(v[0]), f64::from(v[1]), f64::from(v[2]));
-            scaled_vertex(&source, p, scale, || {
-                locate::stl_bad_vertex_location(data, scale).unwrap_or(FileLocation::Whole)
-            })
-        })
-        .collect::<Result<Vec<_>, _>>()?;
-    let mut triangles = Vec::with_capacity(mesh.faces.len());
-    for face in &mesh.faces {
-        let mut triangle = [0u32; 3];
-        for (corner, &i) in triangle.iter_mut().zip(&face.vertices) {
-            if i >= vertices.len() {
+    })
+}
+
+/// `at`, a place in a part of a file, as a place in the file when `lines_before` lines come
+/// before the part (byte offsets are those of binary files, read whole).
+fn shifted(at: FileLocation, lines_before: usize) -> FileLocation {
+    match at {
+        FileLocation::Line(line) => FileLocation::Line(line + lines_before),
+        other => other,
+    }
+}
+
+/// The solids of the ASCII STL file `data`, each from its `solid` line to its `endsolid` line
+/// (or to the end of the file, where `stl_io` will report the missing end), with the number of
+/// lines before it. Text other than blank lines between solids is an error at its line.
+fn ascii_solids<'d>(source: &Source<'_>, data: &'d [u8]) -> Result<Vec<(usize, &'d [u8])>, Error> {
+    let mut solids = Vec::new();
+    // The open solid's first byte and line count before it.
+    let mut open: Option<(usize, usize)> = None;
+    let mut start = 0;
+    for (index, line) in data.split_inclusive(|&b| b == b'\n').enumerate() {
+        let end = start + line.len();
+        let words = line.trim_ascii_start();
+        match open {
+            None if words.is_empty() => {}
+            None if words.starts_with(b"solid") => open = Some((start, index)),
+            None => {
                 return Err(source.error_at(
-                    FileLocation::Whole,
-                    ImportErrorKind::IndexOutOfRange,
-                    format!("a facet refers to vertex {i} of {}", vertices.len()),
+                    FileLocation::Line(index + 1),
+                    ImportErrorKind::Syntax,
+                    "invalid STL file: text after `endsolid` that starts no new `solid`",
                 ));
             }
-            *corner = i as u32;
+            Some((first, lines_before)) if words.starts_with(b"endsolid") => {
+                solids.push((lines_before, &data[first..end]));
+                open = None;
+            }
+            Some(_) => {}
         }
-        triangles.push(triangle);
+        start = end;
     }
-    Ok(Surface {
-        path: path.to_owned(),
-        vertices,
-        triangles,
-    })
+    if let Some((first, lines_before)) = open {
+        solids.push((lines_before, &data[first..]));
+    }
+    Ok(solids)
+}
+
+/// Checks that the binary STL file `data` holds no complete record past the count its header
+/// announces (`stl_io` would ignore them); a short file is `stl_io`'s to report.
+fn check_record_count(source: &Source<'_>, data: &[u8]) -> Result<(), Error> {
+    let Some(count) = data.get(80..84) else {
+        return Ok(());
+    };
+    let count = u32::from_le_bytes([count[0], count[1], count[2], count[3]]) as usize;
+    let records = (data.len() - 84) / 50;
+    if records > count {
+        return Err(source.error_at(
+            FileLocation::Byte(84 + count * 50),
+            ImportErrorKind::BadCount,
+            format!("the header announces {count} triangles, the file holds {records} records"),
+        ));
+    }
+    Ok(())
 }
 
 /// `p * scale` if a mesh can use it, else an [`ImportErrorKind::NonFinite`] or
