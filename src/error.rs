@@ -183,6 +183,18 @@ pub enum Error {
         /// Its signed rest volume (m^3).
         volume: f64,
     },
+    /// A curved quadratic element folds: the Jacobian determinant of its rest map is not
+    /// positive at a corner or a quadrature point (a mid-edge node too far off its edge for the
+    /// element's size, or the corners ordered clockwise).
+    #[error(
+        "element {element} folds: its rest map's Jacobian determinant is {determinant:e} at a corner or quadrature point (a mid-edge node lies too far off its edge for the element's size)"
+    )]
+    FoldedElement {
+        /// Index of the offending element.
+        element: usize,
+        /// The smallest Jacobian determinant found (m³ per unit natural volume).
+        determinant: f64,
+    },
     /// A tetrahedron is too thin to simulate: its quality (smallest altitude over longest edge) is
     /// below the body's threshold.
     #[error(

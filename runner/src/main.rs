@@ -59,9 +59,10 @@ enum Command {
     ///
     /// Reads Gmsh .msh (2.2, 4.1, ASCII or binary), TetGen .node/.ele, VTK .vtu/.vtk, or a
     /// closed .obj/.stl surface (filled with tetrahedra), and prints the element and node
-    /// counts, the volume, the smallest dihedral angle and radius ratio, the inverted and
-    /// degenerate elements, and the explicit integrator's critical and stable time steps for
-    /// the material given.
+    /// counts, the volume (of the curved elements for quadratic tetrahedra), the smallest
+    /// dihedral angle and radius ratio, the inverted and degenerate elements (and the folded
+    /// quadratic ones), and the explicit integrator's critical and stable time steps for the
+    /// material given.
     Check {
         /// The mesh file.
         mesh: PathBuf,
@@ -261,34 +262,47 @@ fn check(
     }
     let raw = import::load_raw(&mesh, scale, &SurfaceOptions { cells_across })
         .map_err(|e| e.to_string())?;
-    let r = import::check(&raw.positions, &raw.tets);
+    let r = import::check_raw(&raw);
+    let quadratic = !raw.mid_edge_nodes.is_empty();
     // The time steps need a mesh a body can be built of: no invalid or degenerate element. They
     // are those of the linear tetrahedra on the corners (mid-edge nodes of quadratic ones unused).
     let corners = import::RawMesh {
         mid_edge_nodes: Vec::new(),
         ..raw
     };
-    let steps = (r.invalid == 0 && r.degenerate == 0)
+    let steps = (r.invalid == 0 && r.degenerate == 0 && r.folded == 0)
         .then(|| corners.into_mesh().ok())
         .flatten()
         .and_then(|mesh| SymplecticEuler::mesh_time_steps(mesh, &material).ok());
     let step =
         |s: Option<f64>| s.map_or_else(|| "- (mesh unusable)".to_owned(), |s| format!("{s:.4e} s"));
     println!("{}", mesh.display());
-    println!("  tetrahedra          {}", r.tets);
+    let order = if quadratic { "quadratic" } else { "linear" };
+    println!("  tetrahedra          {} ({order})", r.tets);
     println!(
         "  nodes               {} ({} unused)",
         r.nodes, r.unused_nodes
     );
     println!("  volume              {:.6e} m³", r.volume);
+    let corners_only = if quadratic {
+        " (corner tetrahedra)"
+    } else {
+        ""
+    };
     println!(
-        "  dihedral angles     {:.2}° to {:.2}°",
+        "  dihedral angles     {:.2}° to {:.2}°{corners_only}",
         r.min_dihedral_angle, r.max_dihedral_angle
     );
-    println!("  min radius ratio    {:.4}", r.min_radius_ratio);
+    println!(
+        "  min radius ratio    {:.4}{corners_only}",
+        r.min_radius_ratio
+    );
     println!("  inverted            {}", r.inverted);
     println!("  degenerate          {}", r.degenerate);
     println!("  invalid             {}", r.invalid);
+    if quadratic {
+        println!("  folded              {}", r.folded);
+    }
     println!("  material            E = {young:e} Pa, nu = {poisson}, rho = {density} kg/m³");
     println!("  critical time step  {}", step(steps.map(|s| s.critical)));
     println!("  stable time step    {}", step(steps.map(|s| s.stable)));

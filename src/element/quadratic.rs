@@ -153,14 +153,13 @@ impl QuadraticElements {
     /// element) at rest positions `positions` (m), one per node.
     ///
     /// # Errors
-    /// [`Error::InvertedTet`] naming the first element whose rest map folds (its Jacobian
+    /// [`Error::FoldedElement`] naming the first element whose rest map folds (its Jacobian
     /// determinant is not positive at a quadrature point or corner): a badly curved element.
     pub fn new(shape: ElementShape, positions: &[DVec3], nodes: &[u32]) -> Result<Self, Error> {
         let per_element = shape.node_count();
         let rule = shape.quadrature();
         let corners = shape.corners();
         let element_count = nodes.len() / per_element;
-        let reference_volume: f64 = rule.iter().map(|(_, weight)| weight).sum();
         let mut gradients = Vec::with_capacity(nodes.len() * rule.len());
         let mut weights = Vec::with_capacity(element_count * rule.len());
         for (element, element_nodes) in nodes.chunks_exact(per_element).enumerate() {
@@ -168,9 +167,9 @@ impl QuadraticElements {
                 .iter()
                 .map(|&n| positions[n as usize])
                 .collect();
-            let inverted = |determinant: f64| Error::InvertedTet {
-                tet: element,
-                volume: determinant * reference_volume,
+            let inverted = |determinant: f64| Error::FoldedElement {
+                element,
+                determinant,
             };
             for corner in &corners {
                 rest_gradients(shape, &p, *corner).map_err(inverted)?;
@@ -404,6 +403,9 @@ mod tests {
         rest[4] = DVec3::new(1.2, 0.0, 0.0);
         let nodes: Vec<u32> = (0..10).collect();
         let error = QuadraticElements::new(shape, &rest, &nodes);
-        assert!(matches!(error, Err(Error::InvertedTet { tet: 0, .. })));
+        assert!(matches!(
+            error,
+            Err(Error::FoldedElement { element: 0, .. })
+        ));
     }
 }

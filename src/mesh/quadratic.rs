@@ -4,7 +4,7 @@
 
 use super::TetMesh;
 use crate::Error;
-use crate::shape::tet10::{EDGES, NODES, reference_nodes};
+use crate::shape::tet10::{self, EDGES, NODES, reference_nodes};
 use rapier3d::glamx::DVec3;
 use std::collections::HashMap;
 
@@ -40,12 +40,15 @@ impl QuadraticTetMesh {
     /// # Errors
     /// The errors of [`TetMesh::new`] for the node indices and coordinates, naming the element;
     /// [`Error::NonConformingEdge`] when two elements put different mid-edge nodes on a shared
-    /// edge; [`Error::InvertedTet`] or [`Error::DegenerateTet`] naming the element when one of its
+    /// edge; [`Error::FoldedElement`] naming the first element whose rest map folds (its
+    /// Jacobian determinant not positive at a corner or quadrature point, where the elements'
+    /// integration would meet it); [`Error::InvertedTet`] or [`Error::DegenerateTet`] naming the element when one of its
     /// linear sub-tetrahedra is inverted or flat (corners ordered clockwise, or a mid-edge node
     /// far off its edge).
     pub fn new(positions: Vec<DVec3>, elements: Vec<[u32; NODES]>) -> Result<Self, Error> {
         super::validate_topology(&positions, &elements)?;
         check_conforming(&elements)?;
+        check_not_folded(&positions, &elements)?;
         let sub_tets = elements
             .iter()
             .flat_map(|e| subdivision(&positions, e))
@@ -262,6 +265,22 @@ fn local_tets(
 }
 
 /// Checks that elements sharing an edge share its mid-edge node.
+/// [`Error::FoldedElement`] for the first of `elements` (nodes at `positions`) whose rest map
+/// folds.
+fn check_not_folded(positions: &[DVec3], elements: &[[u32; NODES]]) -> Result<(), Error> {
+    for (element, nodes) in elements.iter().enumerate() {
+        let determinant =
+            tet10::smallest_jacobian_determinant(&nodes.map(|n| positions[n as usize]));
+        if determinant.is_nan() || determinant <= 0.0 {
+            return Err(Error::FoldedElement {
+                element,
+                determinant,
+            });
+        }
+    }
+    Ok(())
+}
+
 fn check_conforming(elements: &[[u32; NODES]]) -> Result<(), Error> {
     let mut midpoints: HashMap<[u32; 2], u32> = HashMap::new();
     for (tet, nodes) in elements.iter().enumerate() {

@@ -80,12 +80,107 @@ pub fn natural_gradients(l: [f64; 4]) -> [DVec3; NODES] {
     by_barycentric.map(|d| DVec3::new(d[1] - d[0], d[2] - d[0], d[3] - d[0]))
 }
 
+/// The smallest Jacobian determinant `det ∂x/∂ξ` of the element with nodes at `p` (m³ per unit
+/// natural volume) over its corners and quadrature points, where a curved element folds first:
+/// not positive (or NaN) for an element whose rest map folds.
+pub fn smallest_jacobian_determinant(p: &[DVec3; NODES]) -> f64 {
+    let corners = [
+        [1.0, 0.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0, 0.0],
+        [0.0, 0.0, 1.0, 0.0],
+        [0.0, 0.0, 0.0, 1.0],
+    ];
+    let mut smallest = f64::INFINITY;
+    for l in corners.iter().chain(&QUADRATURE) {
+        let determinant = jacobian_determinant(p, *l);
+        if determinant.is_nan() {
+            return f64::NAN;
+        }
+        smallest = smallest.min(determinant);
+    }
+    smallest
+}
+
+/// The rest volume (m³) of the element with nodes at `p`, curved edges included: its Jacobian
+/// determinant is cubic in the natural coordinates, so the five-point rule of degree 3 (the
+/// centroid with weight −4/5, the points `(1/2, 1/6, 1/6, 1/6)` with 9/20 each) integrates it
+/// exactly.
+pub fn volume(p: &[DVec3; NODES]) -> f64 {
+    const A: f64 = 0.5;
+    const B: f64 = 1.0 / 6.0;
+    let rule = [
+        ([0.25; 4], -0.8),
+        ([A, B, B, B], 0.45),
+        ([B, A, B, B], 0.45),
+        ([B, B, A, B], 0.45),
+        ([B, B, B, A], 0.45),
+    ];
+    rule.iter()
+        .map(|(l, weight)| weight * jacobian_determinant(p, *l))
+        .sum::<f64>()
+        / 6.0
+}
+
+/// `det ∂x/∂ξ` of the element with nodes at `p` at barycentric coordinates `l`.
+fn jacobian_determinant(p: &[DVec3; NODES], l: [f64; 4]) -> f64 {
+    let mut columns = [DVec3::ZERO; 3];
+    for (position, gradient) in p.iter().zip(natural_gradients(l)) {
+        for (k, column) in columns.iter_mut().enumerate() {
+            *column += *position * gradient[k];
+        }
+    }
+    columns[0].dot(columns[1].cross(columns[2]))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     fn barycentric(p: DVec3) -> [f64; 4] {
         [1.0 - p.x - p.y - p.z, p.x, p.y, p.z]
+    }
+
+    #[test]
+    fn the_volume_of_a_straight_and_a_curved_element_is_exact() {
+        // Straight: the reference element scaled by 2 holds 8/6 m³.
+        let straight = reference_nodes().map(|p| p * 2.0);
+        assert!((volume(&straight) - 8.0 / 6.0).abs() < 1e-15);
+        // The mid-edge node of edge (0,1) moved by d along y: x = ξ + d N_4(ξ) e_y, so
+        // det J = 1 + d ∂N_4/∂ξ_2 = 1 - 4 d L1, and the volume is 1/6 - d/6 (∫ L1 = 1/24).
+        let mut bent = reference_nodes();
+        bent[4].y += 0.1;
+        assert!((volume(&bent) - (1.0 / 6.0 - 0.1 / 6.0)).abs() < 1e-15);
+        // Every mid-edge node moved: det J is a cubic. Against Gauss-Legendre products on the
+        // unit cube mapped onto the element (ξ = (u, (1-u) v, (1-u)(1-v) w), Jacobian
+        // (1-u)² (1-v)): four points per direction integrate the degree-6 integrand exactly.
+        let mut curved = reference_nodes();
+        for (k, node) in curved[4..].iter_mut().enumerate() {
+            let k = k as f64;
+            *node += DVec3::new(0.07 * (k - 2.5), 0.05 * (1.5 - k).abs(), 0.09 - 0.03 * k);
+        }
+        let gauss = [
+            (-0.861_136_311_594_052_6, 0.347_854_845_137_453_8),
+            (-0.339_981_043_584_856_3, 0.652_145_154_862_546_1),
+            (0.339_981_043_584_856_3, 0.652_145_154_862_546_1),
+            (0.861_136_311_594_052_6, 0.347_854_845_137_453_8),
+        ]
+        .map(|(x, w)| ((x + 1.0) / 2.0, w / 2.0));
+        let mut integral = 0.0;
+        for (u, wu) in gauss {
+            for (v, wv) in gauss {
+                for (w, ww) in gauss {
+                    let xi = DVec3::new(u, (1.0 - u) * v, (1.0 - u) * (1.0 - v) * w);
+                    let l = [1.0 - xi.x - xi.y - xi.z, xi.x, xi.y, xi.z];
+                    let duffy = (1.0 - u).powi(2) * (1.0 - v);
+                    integral += wu * wv * ww * duffy * jacobian_determinant(&curved, l);
+                }
+            }
+        }
+        assert!(
+            (volume(&curved) - integral).abs() < 1e-15,
+            "{} {integral}",
+            volume(&curved)
+        );
     }
 
     #[test]

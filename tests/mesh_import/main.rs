@@ -317,6 +317,36 @@ fn quadratic_tetrahedra_from_a_vtu_keep_their_mid_edge_nodes() {
             assert!(p(node).distance((p(tet[a]) + p(tet[b])) / 2.0) < 1e-11);
         }
     }
+    // `check_raw` counts the mid-edge nodes as used and measures the curved volume.
+    let report = import::check_raw(&raw);
+    assert_eq!((report.unused_nodes, report.folded), (0, 0));
+    assert!((report.volume - 1.0).abs() < 1e-12, "{}", report.volume);
+    // Element 7's first mid-edge node pushed past the far corner of its edge: the elements
+    // around that edge fold, and the first is reported by its number and its place in the file
+    // (the line of the connectivity).
+    let mut folded = raw.clone();
+    let node = folded.mid_edge_nodes[7][0];
+    let [a, b] = [0, 1].map(|k| folded.positions[folded.tets[7][k] as usize]);
+    folded.positions[node as usize] = a + (b - a) * 1.6;
+    assert!(import::check_raw(&folded).folded >= 1);
+    let Err(Error::MeshImport {
+        kind,
+        location,
+        message,
+        ..
+    }) = folded.into_quadratic_mesh()
+    else {
+        panic!("a folded element was accepted");
+    };
+    let element: usize = message
+        .strip_prefix("element ")
+        .and_then(|m| m.split(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("{message}"));
+    assert_eq!(kind, ImportErrorKind::InvalidMesh);
+    assert!(message.contains("folds"), "{message}");
+    assert!(raw.mid_edge_nodes[element].contains(&node), "{message}");
+    assert_eq!(location, raw.tet_locations[element]);
     let mesh = raw.into_quadratic_mesh().unwrap();
     assert_eq!((mesh.element_count(), mesh.node_count()), (1140, 2091));
     assert!((mesh.subdivided().volume() - 1.0).abs() < 1e-12);

@@ -49,7 +49,7 @@ mod text;
 pub mod vtk;
 
 pub use crate::error::{FileLocation, ImportErrorKind};
-pub use quality::{QualityReport, check};
+pub use quality::{QualityReport, check, check_raw};
 pub use surface::SurfaceOptions;
 
 use crate::Error;
@@ -205,7 +205,8 @@ impl RawMesh {
             | Error::TetTooSmall { tet, .. }
             | Error::RepeatedNode { tet, .. }
             | Error::InvertedTet { tet, .. }
-            | Error::NonConformingEdge { tet, .. } => self.location(tet),
+            | Error::NonConformingEdge { tet, .. }
+            | Error::FoldedElement { element: tet, .. } => self.location(tet),
             _ => FileLocation::Whole,
         };
         self.error(at, ImportErrorKind::InvalidMesh, e.to_string())

@@ -6,7 +6,9 @@
 //! material as well: the integrator layer computes it
 //! ([`SymplecticEuler::mesh_time_steps`](crate::integrate::SymplecticEuler::mesh_time_steps)).
 
+use super::RawMesh;
 use crate::mesh::{DEGENERATE_RELATIVE_VOLUME, signed_volume};
+use crate::shape::tet10;
 use rapier3d::glamx::DVec3;
 
 /// What [`check`] finds in a mesh.
@@ -36,6 +38,9 @@ pub struct QualityReport {
     /// Tetrahedra referring to a node that does not exist or twice to the same node; they are
     /// left out of every other measure.
     pub invalid: usize,
+    /// Quadratic tetrahedra whose rest map folds (see
+    /// [`Error::FoldedElement`](crate::Error::FoldedElement)); 0 for linear ones.
+    pub folded: usize,
 }
 
 /// Measures the mesh of `positions` (m) and `tets` without requiring it to be valid. Never
@@ -66,6 +71,7 @@ pub fn check(positions: &[DVec3], tets: &[[u32; 4]]) -> QualityReport {
         inverted: 0,
         degenerate: 0,
         invalid: 0,
+        folded: 0,
     };
     for tet in tets {
         let in_range = tet.iter().all(|&n| (n as usize) < positions.len());
@@ -103,6 +109,40 @@ pub fn check(positions: &[DVec3], tets: &[[u32; 4]]) -> QualityReport {
     if report.min_radius_ratio.is_infinite() {
         report.min_radius_ratio = 0.0;
     }
+    report
+}
+
+/// Measures `raw` as [`check`] does its corner tetrahedra; for a mesh of quadratic tetrahedra
+/// the mid-edge nodes count as used, the volume is that of the curved elements (exact: see
+/// [`tet10::volume`]) and the elements whose rest map folds are counted. Never panics.
+pub fn check_raw(raw: &RawMesh) -> QualityReport {
+    let mut report = check(&raw.positions, &raw.tets);
+    if raw.mid_edge_nodes.is_empty() {
+        return report;
+    }
+    let count = raw.positions.len();
+    let mut used = vec![false; count];
+    let mut volume = 0.0;
+    for (corners, mids) in raw.tets.iter().zip(&raw.mid_edge_nodes) {
+        let nodes: Vec<u32> = corners.iter().chain(mids).copied().collect();
+        for &n in &nodes {
+            if let Some(slot) = used.get_mut(n as usize) {
+                *slot = true;
+            }
+        }
+        let Ok(element) = <[u32; tet10::NODES]>::try_from(nodes) else {
+            continue;
+        };
+        if element.iter().any(|&n| n as usize >= count) {
+            continue;
+        }
+        let p = element.map(|n| raw.positions[n as usize]);
+        volume += tet10::volume(&p);
+        let determinant = tet10::smallest_jacobian_determinant(&p);
+        report.folded += usize::from(determinant.is_nan() || determinant <= 0.0);
+    }
+    report.volume = volume;
+    report.unused_nodes = used.iter().filter(|&&u| !u).count();
     report
 }
 
