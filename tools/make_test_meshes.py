@@ -127,6 +127,25 @@ def surfaces():
         f.write("endsolid sphere\n")
 
 
+def cube_msh_other_forms():
+    """cube_msh's cube in the other forms gmsh writes: MSH 4.0 (ASCII, the only form gmsh
+    writes it in) and MSH 2.2 with parametric coordinates ($ParametricNodes)."""
+    gmsh.initialize()
+    gmsh.option.setNumber("General.Terminal", 0)
+    gmsh.model.add("cube")
+    gmsh.model.occ.addBox(0, 0, 0, 1, 1, 1)
+    gmsh.model.occ.synchronize()
+    gmsh.option.setNumber("Mesh.MeshSizeMax", 0.35)
+    gmsh.model.mesh.generate(3)
+    gmsh.option.setNumber("Mesh.Binary", 0)
+    gmsh.option.setNumber("Mesh.MshFileVersion", 4.0)
+    gmsh.write(os.path.join(OUT, "cube_v40_ascii.msh"))
+    gmsh.option.setNumber("Mesh.MshFileVersion", 2.2)
+    gmsh.option.setNumber("Mesh.SaveParametric", 1)
+    gmsh.write(os.path.join(OUT, "cube_v22_parametric.msh"))
+    gmsh.finalize()
+
+
 def cube_points_tets():
     """The cube of cube_v41_ascii.msh as cube_others reads it: the points its tetrahedra use,
     renumbered in sorted order (341 points), and those tetrahedra (1140), as numpy arrays."""
@@ -292,7 +311,7 @@ def multi_solid_stl():
 
 
 STEPS = [cube_msh, cube_others, surfaces, cube_meshio_compressed, cube_vtk_library,
-         multi_solid_stl]
+         multi_solid_stl, cube_msh_other_forms]
 
 if __name__ == "__main__":
     import sys

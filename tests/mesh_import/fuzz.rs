@@ -68,11 +68,13 @@ fn bytes_cached_ele() -> Vec<u8> {
 }
 
 /// (reader, valid file) pairs mutated by the fuzz properties.
-const SEEDS: [(usize, &str); 19] = [
+const SEEDS: [(usize, &str); 21] = [
     (0, "cube_v22_ascii.msh"),
     (0, "cube_v22_binary.msh"),
     (0, "cube_v41_ascii.msh"),
     (0, "cube_v41_binary.msh"),
+    (0, "cube_v40_ascii.msh"),
+    (0, "cube_v22_parametric.msh"),
     (1, "cube.node"),
     (2, "cube.ele"),
     (3, "cube_ascii.vtu"),

@@ -38,8 +38,9 @@ const CUBE_FILES: [&str; 9] = [
 
 /// The same cube in the layouts meshio (zlib `.vtu`) and the VTK 9 library write (see
 /// `tools/make_test_meshes.py`): appended raw and base64, inline base64, ASCII, uncompressed and
-/// zlib (one and many blocks), 32- and 64-bit headers, 32-bit indices; legacy `.vtk` with METADATA.
-const CUBE_FROM_OTHER_WRITERS: [&str; 12] = [
+/// zlib (one and many blocks), 32- and 64-bit headers, 32-bit indices; legacy `.vtk` with METADATA;
+/// and gmsh's MSH 4.0 and MSH 2.2 with `$ParametricNodes`.
+const CUBE_FROM_OTHER_WRITERS: [&str; 14] = [
     "cube_zlib.vtu",
     "cube_vtk_defaults.vtu",
     "cube_vtk_appended_raw_zlib.vtu",
@@ -52,6 +53,8 @@ const CUBE_FROM_OTHER_WRITERS: [&str; 12] = [
     "cube_vtk_header_uint64.vtu",
     "cube_vtk9_legacy.vtk",
     "cube_vtk9_legacy_binary.vtk",
+    "cube_v40_ascii.msh",
+    "cube_v22_parametric.msh",
 ];
 
 #[test]
@@ -365,4 +368,25 @@ fn vtu_compressed_other_than_by_zlib_is_refused_naming_the_compressor() {
         assert_ne!(at, FileLocation::Whole, "{name}");
         assert!(message.contains(compressor), "{name}: {message}");
     }
+}
+
+#[test]
+fn msh_4_0_is_read_in_ascii_and_refused_in_binary_with_the_reason() {
+    // gmsh writes MSH 4.0 in ASCII only; a binary 4.0 header is refused at its line, saying
+    // which version to save instead.
+    let text = String::from_utf8(bytes("cube_v40_ascii.msh")).unwrap();
+    let binary = text.replacen("\n4 0 8\n", "\n4 1 8\n", 1);
+    let (kind, at, message) =
+        kind_and_location(gmsh::parse(binary.as_bytes(), "cube_v40.msh", 1.0));
+    assert_eq!(
+        (kind, at),
+        (ImportErrorKind::UnknownVersion, FileLocation::Line(2))
+    );
+    assert!(message.contains("4.1"), "{message}");
+    // A 4.0 file's node block cut short: the element section starts where a node was due.
+    let nodes_header = text.find("$Nodes\n27 341\n").unwrap();
+    let short = text.replacen("$Nodes\n27 341\n", "$Nodes\n27 342\n", 1);
+    assert!(nodes_header > 0);
+    let (kind, _, _) = kind_and_location(gmsh::parse(short.as_bytes(), "short.msh", 1.0));
+    assert_eq!(kind, ImportErrorKind::BadCount);
 }

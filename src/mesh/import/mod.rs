@@ -3,7 +3,7 @@
 //!
 //! | format | extension | reader |
 //! |---|---|---|
-//! | Gmsh MSH 2.2 and 4.1, ASCII and binary | `.msh` | [`gmsh`] |
+//! | Gmsh MSH 2.2 and 4.1, ASCII and binary; 4.0 (ASCII) | `.msh` | [`gmsh`] |
 //! | `TetGen` | `.node` + `.ele` | [`tetgen`] |
 //! | VTK XML unstructured grid (ASCII, base64, appended raw or base64; uncompressed or zlib) | `.vtu` | [`vtk`] |
 //! | VTK legacy unstructured grid (ASCII and binary, 2.0 to 5.1) | `.vtk` | [`vtk`] |

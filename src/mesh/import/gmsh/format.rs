@@ -1,7 +1,7 @@
 //! The `$MeshFormat` section of a Gmsh file and the binary values it announces.
 //!
-//! Reads `version file-type data-size` (versions 2.0 to 2.2 with a data size of 8, and 4.1 with
-//! 4 or 8; file type 0 for ASCII, 1 for binary) and, in binary files, the byte-order mark (the
+//! Reads `version file-type data-size` (versions 2.0 to 2.2 and 4.0 (ASCII) with a data size of
+//! 8, and 4.1 with 4 or 8; file type 0 for ASCII, 1 for binary) and, in binary files, the byte-order mark (the
 //! integer 1); refuses any other version ([`ImportErrorKind::UnknownVersion`]), data size or
 //! byte-order mark. The binary readers here take `int`s, `double`s and `size_t`s in the byte
 //! order and size the header gave, each checked (non-negative, finite) where the format needs it.
@@ -19,6 +19,9 @@ pub(super) enum Version {
     V2,
     /// 4.1: nodes and elements in entity blocks.
     V4,
+    /// 4.0 (ASCII only, as gmsh writes it): entity blocks whose headers give the entity tag
+    /// before its dimension, each node's tag on its coordinates' line.
+    V40,
 }
 
 /// What `$MeshFormat` says about the rest of the file.
@@ -50,8 +53,14 @@ pub(super) fn read_format(source: &mut Source<'_>) -> Result<MshFormat, Error> {
             ));
         }
     };
+    if version == Version::V40 && binary {
+        return Err(source.error(
+            ImportErrorKind::UnknownVersion,
+            "binary MSH 4.0 is not read (gmsh writes 4.0 in ASCII only): save as 4.1",
+        ));
+    }
     let size_ok = match version {
-        Version::V2 => data_size == 8,
+        Version::V2 | Version::V40 => data_size == 8,
         Version::V4 => data_size == 4 || data_size == 8,
     };
     if !size_ok {
@@ -75,10 +84,11 @@ fn read_version(source: &Source<'_>, version_text: &str) -> Result<Version, Erro
     match version_text {
         "2" | "2.0" | "2.1" | "2.2" => Ok(Version::V2),
         "4.1" => Ok(Version::V4),
+        "4" | "4.0" => Ok(Version::V40),
         _ => Err(source.error(
             ImportErrorKind::UnknownVersion,
             format!(
-                "MSH version `{}` is not supported (2.2 and 4.1 are)",
+                "MSH version `{}` is not supported (2.0 to 2.2, 4.0 and 4.1 are)",
                 shorten(version_text)
             ),
         )),

@@ -1,12 +1,14 @@
-//! Gmsh `.msh` files, versions 2.2 and 4.1, ASCII and binary.
+//! Gmsh `.msh` files, versions 2.2 and 4.1, ASCII and binary, and 4.0 (ASCII, as gmsh writes
+//! it).
 //!
 //! Linear tetrahedra (element type 4) and quadratic ones (type 11, `gmsh -order 2`; their
 //! mid-edge nodes go to [`RawMesh::mid_edge_nodes`]) are read; points, lines, triangles and
 //! quadrangles (boundary and geometry elements Gmsh saves beside the volume) are skipped; other
 //! volume elements, and linear and quadratic tetrahedra mixed in one file, are an
 //! [`ImportErrorKind::UnsupportedElement`] error, since dropping them would silently lose
-//! material. Sections other than `$MeshFormat`, `$Nodes` and `$Elements` are skipped; a second
-//! `$Nodes` section (a partitioned file) is refused.
+//! material. Sections other than `$MeshFormat`, `$Nodes` (or, in version 2, `$ParametricNodes`:
+//! nodes with their place on the geometry, ASCII) and `$Elements` are skipped; a second nodes
+//! section (a partitioned file) is refused.
 //!
 //! Hand-written rather than built on the `mshio` crate (0.4.2, the only MSH crate): it reads
 //! version 4.1 only, while 2.2, which many tools still write, needs this reader anyway; and it
@@ -16,13 +18,14 @@
 //!
 //! This module reads the file's sections in order and resolves the tetrahedra's node tags;
 //! its submodules read the `$MeshFormat` header and binary values (`format`), the element
-//! types (`elements`), and the `$Nodes` and `$Elements` sections of versions 2.2 (`v2`) and
-//! 4.1 (`v4`).
+//! types (`elements`), and the `$Nodes` and `$Elements` sections of versions 2.2 (`v2`), 4.1
+//! (`v4`) and 4.0 (`v40`).
 
 mod elements;
 mod format;
 mod v2;
 mod v4;
+mod v40;
 
 use super::text::{Source, scaled, shorten};
 use super::{RawMesh, check_scale};
@@ -108,26 +111,41 @@ impl Reader {
     fn section(&mut self, source: &mut Source<'_>, line: &str) -> Result<(), Error> {
         match line {
             "" => Ok(()),
-            "$Nodes" => {
+            "$Nodes" | "$ParametricNodes" => {
                 if self.saw_nodes {
                     return Err(source.error(
                         ImportErrorKind::Syntax,
-                        "a second `$Nodes` section: partitioned files are not supported",
+                        "a second nodes section: partitioned files are not supported",
                     ));
                 }
                 self.saw_nodes = true;
-                if self.format.version == Version::V2 {
-                    self.nodes_v2(source)?;
-                } else {
-                    self.nodes_v4(source)?;
+                let parametric = line == "$ParametricNodes";
+                match self.format.version {
+                    Version::V2 if parametric => self.parametric_nodes_v2(source)?,
+                    Version::V2 => self.nodes_v2(source)?,
+                    _ if parametric => {
+                        return Err(source.error(
+                            ImportErrorKind::UnknownVersion,
+                            "`$ParametricNodes` belongs to version 2 files",
+                        ));
+                    }
+                    Version::V4 => self.nodes_v4(source)?,
+                    Version::V40 => self.nodes_v40(source)?,
                 }
-                expect_end(source, "$EndNodes")
+                expect_end(
+                    source,
+                    if parametric {
+                        "$EndParametricNodes"
+                    } else {
+                        "$EndNodes"
+                    },
+                )
             }
             "$Elements" => {
-                if self.format.version == Version::V2 {
-                    self.elements_v2(source)?;
-                } else {
-                    self.elements_v4(source)?;
+                match self.format.version {
+                    Version::V2 => self.elements_v2(source)?,
+                    Version::V4 => self.elements_v4(source)?,
+                    Version::V40 => self.elements_v40(source)?,
                 }
                 expect_end(source, "$EndElements")
             }

@@ -1,4 +1,5 @@
-//! The `$Nodes` and `$Elements` sections of MSH 2.2 (and 2.0, 2.1) files.
+//! The `$Nodes` (or `$ParametricNodes`) and `$Elements` sections of MSH 2.2 (and 2.0, 2.1)
+//! files.
 //!
 //! ASCII: a count line, then one node `tag x y z` or one element `tag type tag-count tags...
 //! nodes...` per line. Binary: after the count line, nodes as `int tag, double x y z` records,
@@ -10,7 +11,7 @@ use super::Reader;
 use super::elements::{MAX_NODES, nodes_per_element};
 use crate::Error;
 use crate::error::ImportErrorKind;
-use crate::mesh::import::text::{Source, parse_point, parse_token};
+use crate::mesh::import::text::{Source, end_of_line, parse_finite, parse_point, parse_token};
 
 impl Reader {
     /// Reads the body of a version 2 `$Nodes` section (after its first line).
@@ -35,6 +36,50 @@ impl Reader {
                 let p = parse_point(source, &mut tokens)?;
                 self.add_node(source, tag, p)?;
             }
+        }
+        Ok(())
+    }
+
+    /// Reads the body of a version 2 `$ParametricNodes` section (after its first line): ASCII
+    /// lines `tag x y z dim entity` followed by the node's `dim` parametric coordinates on a
+    /// curve (1) or a surface (2), none on a point or in a volume.
+    pub(super) fn parametric_nodes_v2(&mut self, source: &mut Source<'_>) -> Result<(), Error> {
+        if self.format.binary {
+            return Err(source.error(
+                ImportErrorKind::UnknownVersion,
+                "binary `$ParametricNodes` are not read: save without parametric coordinates",
+            ));
+        }
+        let line = source.content_line(None, "the node count")?;
+        let count: usize = parse_token(source, Some(line), "node count")?;
+        self.positions.reserve(source.capacity(count, 12));
+        for _ in 0..count {
+            let line = source.content_line(None, "a node line `tag x y z dim entity u v`")?;
+            let mut tokens = line.split_ascii_whitespace();
+            let tag: u64 = parse_token(source, tokens.next(), "node tag")?;
+            let p = parse_point(source, &mut tokens)?;
+            let dim: u32 = parse_token(source, tokens.next(), "geometric entity dimension")?;
+            let _: i64 = parse_token(source, tokens.next(), "geometric entity tag")?;
+            let parameters = match dim {
+                0 | 3 => 0,
+                1 | 2 => dim as usize,
+                _ => {
+                    return Err(source.error(
+                        ImportErrorKind::Syntax,
+                        format!("geometric entity dimension {dim} is not 0 to 3"),
+                    ));
+                }
+            };
+            for _ in 0..parameters {
+                parse_finite(source, tokens.next(), "parametric coordinate")?;
+            }
+            end_of_line(
+                source,
+                tokens,
+                ImportErrorKind::BadCount,
+                "more numbers than a parametric node's",
+            )?;
+            self.add_node(source, tag, p)?;
         }
         Ok(())
     }

@@ -167,7 +167,16 @@ fn ascii_block_header(
 /// more.
 fn ascii_node_coordinates(source: &mut Source<'_>, extra: usize) -> Result<DVec3, Error> {
     let line = source.content_line(None, "a node's coordinates")?;
-    let mut tokens = line.split_ascii_whitespace();
+    ascii_node_coordinates_after(source, line.split_ascii_whitespace(), extra)
+}
+
+/// The rest `tokens` of a node line: `x y z` (file units) followed by `extra` parametric
+/// coordinates, nothing more.
+pub(super) fn ascii_node_coordinates_after<'t>(
+    source: &Source<'_>,
+    mut tokens: impl Iterator<Item = &'t str>,
+    extra: usize,
+) -> Result<DVec3, Error> {
     let p = parse_point(source, &mut tokens)?;
     for _ in 0..extra {
         parse_finite(source, tokens.next(), "parametric coordinate")?;
@@ -182,7 +191,7 @@ fn ascii_node_coordinates(source: &mut Source<'_>, extra: usize) -> Result<DVec3
 }
 
 /// The items a 4.1 section's blocks have announced so far, against the section's total.
-struct BlockCount {
+pub(super) struct BlockCount {
     /// "a node block" / "an element block", for messages.
     block: &'static str,
     /// "node" / "element".
@@ -195,7 +204,7 @@ struct BlockCount {
 
 impl BlockCount {
     /// No block counted yet of a section announcing `total` items.
-    fn new(block: &'static str, kind: &'static str, total: usize) -> Self {
+    pub(super) fn new(block: &'static str, kind: &'static str, total: usize) -> Self {
         Self {
             block,
             kind,
@@ -206,7 +215,7 @@ impl BlockCount {
 
     /// Counts a block of `count` items, or [`ImportErrorKind::BadCount`] at `location` if it
     /// holds more than the section has left.
-    fn take(
+    pub(super) fn take(
         &mut self,
         source: &Source<'_>,
         location: FileLocation,
@@ -227,7 +236,7 @@ impl BlockCount {
     }
 
     /// [`ImportErrorKind::BadCount`] unless the blocks held the announced total.
-    fn finish(&self, source: &Source<'_>) -> Result<(), Error> {
+    pub(super) fn finish(&self, source: &Source<'_>) -> Result<(), Error> {
         if self.read == self.total {
             return Ok(());
         }
