@@ -129,7 +129,8 @@ def surfaces():
 
 def cube_msh_other_forms():
     """cube_msh's cube in the other forms gmsh writes: MSH 4.0 (ASCII, the only form gmsh
-    writes it in) and MSH 2.2 with parametric coordinates ($ParametricNodes)."""
+    writes it in) and MSH 2.2 with parametric coordinates ($ParametricNodes); and a
+    surface-only file, a unit sphere's triangles."""
     gmsh.initialize()
     gmsh.option.setNumber("General.Terminal", 0)
     gmsh.model.add("cube")
@@ -143,6 +144,18 @@ def cube_msh_other_forms():
     gmsh.option.setNumber("Mesh.MshFileVersion", 2.2)
     gmsh.option.setNumber("Mesh.SaveParametric", 1)
     gmsh.write(os.path.join(OUT, "cube_v22_parametric.msh"))
+    gmsh.finalize()
+    # A surface-only file: gmsh's 2D mesh of a unit sphere (MSH 4.1, ASCII).
+    gmsh.initialize()
+    gmsh.option.setNumber("General.Terminal", 0)
+    gmsh.model.add("sphere")
+    gmsh.model.occ.addSphere(0, 0, 0, 1)
+    gmsh.model.occ.synchronize()
+    gmsh.option.setNumber("Mesh.MeshSizeMax", 0.25)
+    gmsh.model.mesh.generate(2)
+    gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
+    gmsh.option.setNumber("Mesh.Binary", 0)
+    gmsh.write(os.path.join(OUT, "sphere_surface.msh"))
     gmsh.finalize()
 
 

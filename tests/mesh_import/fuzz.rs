@@ -4,9 +4,9 @@
 use super::bytes;
 use super::file_numbers::assert_mesh_is_the_files;
 use proptest::prelude::*;
-use rapier_fvm::FileLocation;
 use rapier_fvm::mesh::import::{SurfaceOptions, gmsh, surface, tetgen, vtk};
 use rapier_fvm::prelude::*;
+use rapier_fvm::{FileLocation, ImportErrorKind};
 
 // Fuzzing: arbitrary bytes and mutations of the valid files, for every reader. Each must
 // return Ok or a typed error, never panic (a panic fails the test); a mesh must be the file's
@@ -25,7 +25,15 @@ fn cases() -> u32 {
 
 fn run_reader(reader: usize, data: &[u8]) {
     let result = match reader {
-        0 => gmsh::parse(data, "fuzz.msh", 1.0),
+        // As `load` reads a `.msh` file: a surface-only one is filled.
+        0 => gmsh::parse(data, "fuzz.msh", 1.0).or_else(|e| match e {
+            Error::MeshImport {
+                kind: ImportErrorKind::NoTetrahedra,
+                ..
+            } => gmsh::parse_surface(data, "fuzz.msh", 1.0)
+                .and_then(|s| surface::fill(&s, &SurfaceOptions { cells_across: 4 })),
+            other => Err(other),
+        }),
         1 => tetgen::parse(data, "fuzz.node", &bytes_cached_ele(), "cube.ele", 1.0),
         2 => tetgen::parse(&bytes_cached_node(), "cube.node", data, "fuzz.ele", 1.0),
         3 => vtk::parse_vtu(data, "fuzz.vtu", 1.0),
@@ -68,13 +76,14 @@ fn bytes_cached_ele() -> Vec<u8> {
 }
 
 /// (reader, valid file) pairs mutated by the fuzz properties.
-const SEEDS: [(usize, &str); 21] = [
+const SEEDS: [(usize, &str); 22] = [
     (0, "cube_v22_ascii.msh"),
     (0, "cube_v22_binary.msh"),
     (0, "cube_v41_ascii.msh"),
     (0, "cube_v41_binary.msh"),
     (0, "cube_v40_ascii.msh"),
     (0, "cube_v22_parametric.msh"),
+    (0, "sphere_surface.msh"),
     (1, "cube.node"),
     (2, "cube.ele"),
     (3, "cube_ascii.vtu"),

@@ -7,7 +7,7 @@
 //! | `TetGen` | `.node` + `.ele` | [`tetgen`] |
 //! | VTK XML unstructured grid (ASCII, base64, appended raw or base64; uncompressed or zlib) | `.vtu` | [`vtk`] |
 //! | VTK legacy unstructured grid (ASCII and binary, 2.0 to 5.1) | `.vtk` | [`vtk`] |
-//! | surface: Wavefront OBJ, STL (ASCII and binary) | `.obj`, `.stl` | [`surface`] |
+//! | surface: Wavefront OBJ, STL (ASCII and binary), Gmsh triangles only | `.obj`, `.stl`, `.msh` | [`surface`], [`gmsh::parse_surface`] |
 //!
 //! Every reader takes a `scale` in metres per file unit (1 for files in metres, 0.001 for
 //! millimetres) and first returns a [`RawMesh`]: positions and tetrahedra as the file has them,
@@ -262,8 +262,8 @@ impl Format {
 }
 
 /// Reads the mesh file at `path` (format by extension, see [`Format`]) into a [`RawMesh`] with
-/// positions in metres: `scale` metres per file unit. Surfaces are filled with tetrahedra
-/// following `surface_options`.
+/// positions in metres: `scale` metres per file unit. Surfaces (OBJ, STL, a `.msh` file holding
+/// triangles but no tetrahedra) are filled with tetrahedra following `surface_options`.
 ///
 /// # Errors
 /// [`Error::InvalidSetting`] for a `scale` that is not finite and positive, [`Error::Io`] when
@@ -287,7 +287,16 @@ pub fn load_raw(
         });
     };
     match format {
-        Format::Gmsh => gmsh::parse(&read_file(path)?, &name, scale),
+        Format::Gmsh => {
+            let data = read_file(path)?;
+            match gmsh::parse(&data, &name, scale) {
+                Err(Error::MeshImport {
+                    kind: ImportErrorKind::NoTetrahedra,
+                    ..
+                }) => surface::fill(&gmsh::parse_surface(&data, &name, scale)?, surface_options),
+                other => other,
+            }
+        }
         Format::TetGen => {
             let node = path.with_extension("node");
             let ele = path.with_extension("ele");

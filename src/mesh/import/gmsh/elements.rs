@@ -10,6 +10,8 @@ use crate::Error;
 use crate::error::{FileLocation, ImportErrorKind};
 use crate::mesh::import::text::{Source, parse_token};
 
+/// Gmsh's linear triangle.
+const TRIANGLE: u32 = 2;
 /// Gmsh's linear tetrahedron.
 const TETRAHEDRON: u32 = 4;
 /// Gmsh's quadratic (10-node) tetrahedron.
@@ -103,6 +105,11 @@ impl Reader {
                     self.mid_edge_tags
                         .push([nodes[4], nodes[5], nodes[6], nodes[7], nodes[9], nodes[8]]);
                 }
+                Ok(())
+            }
+            TRIANGLE => {
+                self.triangles
+                    .push(([nodes[0], nodes[1], nodes[2]], location));
                 Ok(())
             }
             _ => match element_shape(element_type) {

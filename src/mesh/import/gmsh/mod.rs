@@ -6,7 +6,8 @@
 //! quadrangles (boundary and geometry elements Gmsh saves beside the volume) are skipped; other
 //! volume elements, and linear and quadratic tetrahedra mixed in one file, are an
 //! [`ImportErrorKind::UnsupportedElement`] error, since dropping them would silently lose
-//! material. Sections other than `$MeshFormat`, `$Nodes` (or, in version 2, `$ParametricNodes`:
+//! material. A file holding triangles but no tetrahedra is a surface ([`parse_surface`]), which
+//! [`load`](super::load) fills as an OBJ or STL surface. Sections other than `$MeshFormat`, `$Nodes` (or, in version 2, `$ParametricNodes`:
 //! nodes with their place on the geometry, ASCII) and `$Elements` are skipped; a second nodes
 //! section (a partitioned file) is refused.
 //!
@@ -27,6 +28,7 @@ mod v2;
 mod v4;
 mod v40;
 
+use super::surface::Surface;
 use super::text::{Source, scaled, shorten};
 use super::{RawMesh, check_scale};
 use crate::Error;
@@ -42,6 +44,25 @@ use std::collections::HashMap;
 /// [`Error::InvalidSetting`] for a bad `scale`; [`Error::MeshImport`] for a malformed file, an
 /// unknown version, an unsupported element type or a file without tetrahedra.
 pub fn parse(data: &[u8], path: &str, scale: f64) -> Result<RawMesh, Error> {
+    let (reader, source) = read(data, path, scale)?;
+    reader.finish(&source)
+}
+
+/// Reads the triangles of the Gmsh file `data` (named `path` in errors), a surface mesh
+/// (gmsh's 2D mesh of a volume's boundary, as [`surface::fill`](super::surface::fill) takes),
+/// coordinates times `scale` (m per file unit). [`load`](super::load) reads a `.msh` file
+/// holding no tetrahedra so.
+///
+/// # Errors
+/// Those of [`parse`], except that the file needs linear triangles (element type 2) instead of
+/// tetrahedra: [`ImportErrorKind::InvalidSurface`] for a file without any.
+pub fn parse_surface(data: &[u8], path: &str, scale: f64) -> Result<Surface, Error> {
+    let (reader, source) = read(data, path, scale)?;
+    reader.finish_surface(&source)
+}
+
+/// Reads every section of the Gmsh file `data`.
+fn read<'d>(data: &'d [u8], path: &'d str, scale: f64) -> Result<(Reader, Source<'d>), Error> {
     check_scale(scale)?;
     let mut source = Source::new(path, data);
     let header = source.content_line(None, "`$MeshFormat`")?;
@@ -62,11 +83,12 @@ pub fn parse(data: &[u8], path: &str, scale: f64) -> Result<RawMesh, Error> {
         positions: Vec::new(),
         tets: Vec::new(),
         mid_edge_tags: Vec::new(),
+        triangles: Vec::new(),
     };
     while let Some(line) = source.line()? {
         reader.section(&mut source, line)?;
     }
-    reader.finish(&source)
+    Ok((reader, source))
 }
 
 /// Skips whitespace and requires the line `marker`.
@@ -102,6 +124,8 @@ struct Reader {
     tets: Vec<([u64; 4], FileLocation)>,
     /// The mid-edge node tags of quadratic tetrahedra, in VTK's order, one per tetrahedron.
     mid_edge_tags: Vec<[u64; 6]>,
+    /// Linear triangles as node tags, with where they were read (a surface-only file's mesh).
+    triangles: Vec<([u64; 3], FileLocation)>,
 }
 
 impl Reader {
@@ -188,7 +212,8 @@ impl Reader {
             return Err(source.error_at(
                 FileLocation::Whole,
                 ImportErrorKind::NoTetrahedra,
-                "the file holds no tetrahedra (element type 4 or 11)",
+                "the file holds no tetrahedra (element type 4 or 11); a surface of triangles is \
+                 filled by `load`",
             ));
         }
         let mut tets = Vec::with_capacity(self.tets.len());
@@ -210,7 +235,28 @@ impl Reader {
         })
     }
 
-    /// The node indices of the node `tags` of the tetrahedron at `location`.
+    /// The [`Surface`] of the triangles read, their node tags resolved to indices (every node
+    /// of the file kept: the fill uses only the triangles').
+    fn finish_surface(self, source: &Source<'_>) -> Result<Surface, Error> {
+        if self.triangles.is_empty() {
+            return Err(source.error_at(
+                FileLocation::Whole,
+                ImportErrorKind::InvalidSurface,
+                "the file holds neither tetrahedra (element type 4 or 11) nor triangles (type 2)",
+            ));
+        }
+        let mut triangles = Vec::with_capacity(self.triangles.len());
+        for (tags, location) in &self.triangles {
+            triangles.push(self.indices(source, tags, *location)?);
+        }
+        Ok(Surface {
+            path: source.path().to_owned(),
+            vertices: self.positions,
+            triangles,
+        })
+    }
+
+    /// The node indices of the node `tags` of the element at `location`.
     fn indices<const N: usize>(
         &self,
         source: &Source<'_>,
@@ -223,7 +269,7 @@ impl Reader {
                 source.error_at(
                     location,
                     ImportErrorKind::IndexOutOfRange,
-                    format!("the tetrahedron refers to node {tag}, which is not defined"),
+                    format!("the element refers to node {tag}, which is not defined"),
                 )
             })?;
         }
