@@ -121,6 +121,16 @@ pub(crate) fn dot(a: &[f64], b: &[f64], chunk: usize) -> f64 {
     })
 }
 
+/// Sorts `items` (unstable: equal items may move, so give every item a distinct key for a
+/// result that does not depend on the number of threads), on rayon's threads with the `parallel`
+/// feature.
+pub(crate) fn sort_unstable<T: Ord + Send>(items: &mut [T]) {
+    #[cfg(feature = "parallel")]
+    items.par_sort_unstable();
+    #[cfg(not(feature = "parallel"))]
+    items.sort_unstable();
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
