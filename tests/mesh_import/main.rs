@@ -390,3 +390,20 @@ fn msh_4_0_is_read_in_ascii_and_refused_in_binary_with_the_reason() {
     let (kind, _, _) = kind_and_location(gmsh::parse(short.as_bytes(), "short.msh", 1.0));
     assert_eq!(kind, ImportErrorKind::BadCount);
 }
+
+#[test]
+fn a_legacy_vtk_file_cut_inside_its_last_number_is_refused() {
+    // meshio's ASCII cube ends with cell types `10`: cut to `1`, the last tetrahedron would be
+    // a vertex (skipped) and the mesh one tetrahedron short.
+    let text = String::from_utf8(bytes("cube_ascii.vtk")).unwrap();
+    assert!(text.ends_with("\n10\n"));
+    let cut = &text[..text.len() - 2];
+    let (kind, at, _) = kind_and_location(vtk::parse_legacy(cut.as_bytes(), "cut.vtk", 1.0));
+    assert_eq!(
+        (kind, at),
+        (
+            ImportErrorKind::Truncated,
+            FileLocation::Line(text.lines().count())
+        )
+    );
+}

@@ -2,11 +2,13 @@
 //!
 //! Accepts versions 2.0 to 5.1 (`# vtk DataFile Version x.y`, the major version 1 to 5
 //! checked), a title line, `ASCII` or `BINARY` (big-endian) and `DATASET UNSTRUCTURED_GRID`,
-//! followed by `POINTS`, `CELLS` and `CELL_TYPES` in any order: `CELLS` as one list of `n i_1 ... i_n` before version 5, as
-//! `OFFSETS` and `CONNECTIVITY` arrays (the first offset 0) from version 5 on. A `METADATA`
-//! block after an array (written by the VTK 9 library: component names, information keys, up to
-//! a blank line) is skipped. Any other keyword before all three are read, another data set or encoding, and counts that disagree
-//! with the data are errors at the line (or, in binary data, the byte offset) at fault.
+//! followed by `POINTS`, `CELLS` and `CELL_TYPES` in any order: `CELLS` as one list of
+//! `n i_1 ... i_n` before version 5, as `OFFSETS` and `CONNECTIVITY` arrays (the first offset 0)
+//! from version 5 on. A `METADATA` block after an array (written by the VTK 9 library:
+//! component names, information keys, up to a blank line) is skipped. Any other keyword before
+//! all three are read, another data set or encoding, counts that disagree with the data, and an
+//! ASCII file whose last data line has no line break (a file cut inside a number would read as
+//! another number) are errors at the line (or, in binary data, the byte offset) at fault.
 
 use super::legacy_data::{DataType, Legacy, data_type};
 use super::{Cells, build};
@@ -39,6 +41,10 @@ pub fn parse_legacy(data: &[u8], path: &str, scale: f64) -> Result<RawMesh, Erro
             ));
         };
         sections.read(&mut file, line, major, scale)?;
+    }
+    if !binary {
+        // A file cut inside its last number would read as another number.
+        file.source.check_line_ended("its last data line")?;
     }
     let Sections {
         positions: Some(positions),
