@@ -192,7 +192,7 @@ pub enum Error {
     FoldedElement {
         /// Index of the offending element.
         element: usize,
-        /// The smallest Jacobian determinant found (m³ per unit natural volume).
+        /// A Jacobian determinant found not positive, or NaN (m³ per unit natural volume).
         determinant: f64,
     },
     /// A tetrahedron is too thin to simulate: its quality (smallest altitude over longest edge) is

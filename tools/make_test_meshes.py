@@ -1,4 +1,4 @@
-"""Writes the mesh files under assets/meshes/ used by tests/mesh_import.rs.
+"""Writes the mesh files under assets/meshes/ used by tests/mesh_import/.
 
 Needs gmsh and meshio from PyPI (and vtk and numpy for cube_vtk_library):
     python3 -m venv /tmp/venv-gmsh && /tmp/venv-gmsh/bin/pip install gmsh meshio vtk numpy

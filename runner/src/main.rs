@@ -58,7 +58,7 @@ enum Command {
     /// Reports a mesh file's size, volume, quality and stable explicit time step.
     ///
     /// Reads Gmsh .msh (2.2, 4.1, ASCII or binary; 4.0), TetGen .node/.ele, VTK .vtu/.vtk, or a
-    /// closed .obj/.stl surface (filled with tetrahedra), and prints the element and node
+    /// closed .obj/.stl/.msh surface (filled with tetrahedra), and prints the element and node
     /// counts, the volume (of the curved elements for quadratic tetrahedra), the smallest
     /// dihedral angle and radius ratio, the inverted and degenerate elements (and the folded
     /// quadratic ones), and the explicit integrator's critical and stable time steps for the

@@ -40,11 +40,11 @@ impl QuadraticTetMesh {
     /// # Errors
     /// The errors of [`TetMesh::new`] for the node indices and coordinates, naming the element;
     /// [`Error::NonConformingEdge`] when two elements put different mid-edge nodes on a shared
-    /// edge; [`Error::FoldedElement`] naming the first element whose rest map folds (its
-    /// Jacobian determinant not positive at a corner or quadrature point, where the elements'
-    /// integration would meet it); [`Error::InvertedTet`] or [`Error::DegenerateTet`] naming the element when one of its
-    /// linear sub-tetrahedra is inverted or flat (corners ordered clockwise, or a mid-edge node
-    /// far off its edge).
+    /// edge; [`Error::FoldedElement`] naming the first element, its corners counter-clockwise,
+    /// whose rest map folds (its Jacobian determinant not positive at a corner or quadrature
+    /// point, where the elements' integration would meet it: a mid-edge node too far off its
+    /// edge); [`Error::InvertedTet`] or [`Error::DegenerateTet`] naming the element when one of
+    /// its linear sub-tetrahedra is inverted or flat (corners ordered clockwise).
     pub fn new(positions: Vec<DVec3>, elements: Vec<[u32; NODES]>) -> Result<Self, Error> {
         super::validate_topology(&positions, &elements)?;
         check_conforming(&elements)?;
@@ -264,14 +264,21 @@ fn local_tets(
     })
 }
 
-/// Checks that elements sharing an edge share its mid-edge node.
-/// [`Error::FoldedElement`] for the first of `elements` (nodes at `positions`) whose rest map
-/// folds.
+/// [`Error::FoldedElement`] for the first of `elements` (nodes at `positions`) whose corners
+/// are ordered counter-clockwise but whose rest map folds (clockwise or flat corners are the
+/// subdivision's [`Error::InvertedTet`] or [`Error::DegenerateTet`]).
 fn check_not_folded(positions: &[DVec3], elements: &[[u32; NODES]]) -> Result<(), Error> {
     for (element, nodes) in elements.iter().enumerate() {
+        let corners = [nodes[0], nodes[1], nodes[2], nodes[3]];
+        // NaN volumes (non-finite nodes) are `TetMesh::new`'s to refuse.
+        if super::signed_volume(positions, &corners).partial_cmp(&0.0)
+            != Some(std::cmp::Ordering::Greater)
+        {
+            continue;
+        }
         let determinant =
             tet10::smallest_jacobian_determinant(&nodes.map(|n| positions[n as usize]));
-        if determinant.is_nan() || determinant <= 0.0 {
+        if !tet10::unfolded(determinant) {
             return Err(Error::FoldedElement {
                 element,
                 determinant,
@@ -281,6 +288,7 @@ fn check_not_folded(positions: &[DVec3], elements: &[[u32; NODES]]) -> Result<()
     Ok(())
 }
 
+/// Checks that elements sharing an edge share its mid-edge node.
 fn check_conforming(elements: &[[u32; NODES]]) -> Result<(), Error> {
     let mut midpoints: HashMap<[u32; 2], u32> = HashMap::new();
     for (tet, nodes) in elements.iter().enumerate() {

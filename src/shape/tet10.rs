@@ -101,6 +101,12 @@ pub fn smallest_jacobian_determinant(p: &[DVec3; NODES]) -> f64 {
     smallest
 }
 
+/// Whether `determinant`, an element's [`smallest_jacobian_determinant`], says its rest map does
+/// not fold (positive, not NaN).
+pub fn unfolded(determinant: f64) -> bool {
+    determinant > 0.0
+}
+
 /// The rest volume (m³) of the element with nodes at `p`, curved edges included: its Jacobian
 /// determinant is cubic in the natural coordinates, so the five-point rule of degree 3 (the
 /// centroid with weight −4/5, the points `(1/2, 1/6, 1/6, 1/6)` with 9/20 each) integrates it
@@ -142,6 +148,7 @@ mod tests {
 
     #[test]
     fn the_volume_of_a_straight_and_a_curved_element_is_exact() {
+        // Round-off only (1e-15 on volumes of order 1/6: sums of a few products of order 1).
         // Straight: the reference element scaled by 2 holds 8/6 m³.
         let straight = reference_nodes().map(|p| p * 2.0);
         assert!((volume(&straight) - 8.0 / 6.0).abs() < 1e-15);

@@ -50,10 +50,10 @@ fn a_decompression_bomb_is_refused_before_it_inflates() {
     let (kind, _, message) = kind_and_location(vtk::parse_vtu(&file, "bomb.vtu", 1.0));
     assert_eq!(kind, ImportErrorKind::BadCount, "{message}");
     assert!(message.contains("inflates to 97 bytes"), "{message}");
-    // An honest block of the 96 bytes reads: four points at the origin.
+    // An honest block of the 96 bytes passes every check of the points: the file is refused
+    // only for holding no tetrahedra (it declares no cells).
     let raw_points = zlib_points(&zeros(96), 96);
     let error = vtk::parse_vtu(&raw_points, "zeros.vtu", 1.0).unwrap_err();
-    // (No cells: no tetrahedra, the points read.)
     let (kind, _, _) = kind_and_location(Err(error));
     assert_eq!(kind, ImportErrorKind::NoTetrahedra);
 }
@@ -103,4 +103,80 @@ fn binary_data_cut_short_or_out_of_place_is_an_error_at_its_array() {
         (kind, at),
         (ImportErrorKind::Truncated, FileLocation::Line(points + 1))
     );
+}
+
+/// A grid of `pieces`, each `(points, cells, [types, offsets, connectivity])` as ASCII text,
+/// the points those of the unit right tetrahedron (shifted by 2 m in x per piece).
+fn ascii_grid(pieces: &[(u64, u64, [&str; 3])]) -> String {
+    let mut file = String::from(
+        "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n\
+         <UnstructuredGrid>\n",
+    );
+    for (number, (points, cells, [types, offsets, connectivity])) in pieces.iter().enumerate() {
+        let x = 2.0 * number as f64;
+        let corners: String = (0..*points)
+            .map(|k| match k % 4 {
+                0 => format!("{x} 0 0 "),
+                1 => format!("{} 0 0 ", x + 1.0),
+                2 => format!("{x} 1 0 "),
+                _ => format!("{x} 0 1 "),
+            })
+            .collect();
+        file += &format!(
+            "<Piece NumberOfPoints=\"{points}\" NumberOfCells=\"{cells}\">\n<Points>\n\
+             <DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">{corners}</DataArray>\n\
+             </Points>\n<Cells>\n\
+             <DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">{connectivity}</DataArray>\n\
+             <DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">{offsets}</DataArray>\n\
+             <DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">{types}</DataArray>\n\
+             </Cells>\n</Piece>\n"
+        );
+    }
+    file + "</UnstructuredGrid>\n</VTKFile>\n"
+}
+
+#[test]
+fn pieces_join_and_every_count_holds_exactly_its_data() {
+    // Two pieces of one tetrahedron each, the second's offsets with a leading zero: two
+    // tetrahedra of 1/6 m³, the second's points after the first's.
+    let good = ascii_grid(&[
+        (4, 1, ["10", "4", "0 1 2 3"]),
+        (4, 1, ["10", "0 4", "0 1 2 3"]),
+    ]);
+    let raw = vtk::parse_vtu(good.as_bytes(), "two.vtu", 1.0).unwrap();
+    assert_eq!(raw.tets, vec![[0, 1, 2, 3], [4, 5, 6, 7]]);
+    assert!((raw.into_mesh().unwrap().volume() - 2.0 / 6.0).abs() < 1e-15);
+    // Counts that would overflow or hide data: a cell count of 2^64 - 1, an end past the
+    // connectivity in a second piece, a piece declaring no cells (or points) while holding
+    // some. Each a count error, none a panic or a dropped cell.
+    let huge = u64::MAX;
+    for (name, file) in [
+        ("huge count", ascii_grid(&[(0, huge, ["10", "4", ""])])),
+        (
+            "end past the connectivity",
+            ascii_grid(&[
+                (4, 1, ["10", "4", "0 1 2 3"]),
+                (4, 2, ["10 10", &format!("{huge} 4"), "0 1 2 3"]),
+            ]),
+        ),
+        (
+            "cells beyond a count of 0",
+            ascii_grid(&[
+                (4, 1, ["10", "4", "0 1 2 3"]),
+                (4, 0, ["10", "4", "0 1 2 3"]),
+            ]),
+        ),
+        (
+            "points beyond a count of 0",
+            ascii_grid(&[(0, 0, ["", "", ""])]).replacen(
+                "format=\"ascii\"></DataArray>",
+                "format=\"ascii\">0 0 0</DataArray>",
+                1,
+            ),
+        ),
+    ] {
+        let (kind, at, message) = kind_and_location(vtk::parse_vtu(file.as_bytes(), name, 1.0));
+        assert_eq!(kind, ImportErrorKind::BadCount, "{name}: {message}");
+        assert!(matches!(at, FileLocation::Line(_)), "{name}: {at:?}");
+    }
 }

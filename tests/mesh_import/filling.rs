@@ -233,3 +233,17 @@ fn a_surface_only_msh_file_is_filled_like_an_obj() {
     );
     assert!(error.abs() < 0.01, "{error}");
 }
+
+#[test]
+fn indented_and_unnamed_stl_solids_are_read_as_text() {
+    // The 6 solids of gmsh's file, the second indented and the third unnamed: the same 540
+    // facets enclosing the unit volume.
+    let text = String::from_utf8(bytes("cube_multi_solid.stl")).unwrap();
+    let edited = text
+        .replacen("\nsolid Gmsh Surface 2", "\n   solid Gmsh Surface 2", 1)
+        .replacen("\nsolid Gmsh Surface 3", "\nsolid", 1);
+    assert_ne!(edited, text);
+    let surface = surface::parse_stl(edited.as_bytes(), "edited.stl", 1.0).unwrap();
+    assert_eq!(surface.triangles.len(), 540);
+    assert!((surface.enclosed_volume() - 1.0).abs() < 1e-12);
+}

@@ -23,7 +23,7 @@
 //! OBJ and STL readers, whose crates (`tobj`, `stl_io`) say what is wrong but not where, by
 //! scanning the file again once it has failed (the first statement the crate rejects; binary STL
 //! by the offset of the incomplete record). Only what no single place causes (no tetrahedra at
-//! all) carries [`FileLocation::Whole`]. No reader panics or allocates more than its input can
+//! all, a surface that is not closed) carries [`FileLocation::Whole`]. No reader panics or allocates more than its input can
 //! fill, whatever the bytes (fuzzed in `tests/mesh_import`).
 //!
 //! # Example

@@ -124,22 +124,29 @@ pub fn check_raw(raw: &RawMesh) -> QualityReport {
     let mut used = vec![false; count];
     let mut volume = 0.0;
     for (corners, mids) in raw.tets.iter().zip(&raw.mid_edge_nodes) {
-        let nodes: Vec<u32> = corners.iter().chain(mids).copied().collect();
-        for &n in &nodes {
-            if let Some(slot) = used.get_mut(n as usize) {
-                *slot = true;
-            }
+        let mut element = [0u32; tet10::NODES];
+        element[..4].copy_from_slice(corners);
+        element[4..].copy_from_slice(mids);
+        let corners_valid = corners.iter().all(|&n| (n as usize) < count)
+            && (0..4).all(|i| !corners[i + 1..].contains(&corners[i]));
+        if !corners_valid {
+            // Counted invalid by `check`, left out here too.
+            continue;
         }
-        let Ok(element) = <[u32; tet10::NODES]>::try_from(nodes) else {
+        if mids.iter().any(|&n| n as usize >= count) {
+            report.invalid += 1;
             continue;
-        };
-        if element.iter().any(|&n| n as usize >= count) {
-            continue;
+        }
+        for &n in &element {
+            used[n as usize] = true;
         }
         let p = element.map(|n| raw.positions[n as usize]);
         volume += tet10::volume(&p);
-        let determinant = tet10::smallest_jacobian_determinant(&p);
-        report.folded += usize::from(determinant.is_nan() || determinant <= 0.0);
+        // Clockwise or flat corners are `check`'s inverted or degenerate elements.
+        if signed_volume(&raw.positions, corners) > 0.0 {
+            let determinant = tet10::smallest_jacobian_determinant(&p);
+            report.folded += usize::from(!tet10::unfolded(determinant));
+        }
     }
     report.volume = volume;
     report.unused_nodes = used.iter().filter(|&&u| !u).count();

@@ -121,6 +121,12 @@ impl Reader {
                          linear tetrahedra (type 4) can be used"
                     ),
                 )),
+                Some((_, 2)) => {
+                    // Quadrangles, curved triangles: not part of a surface this crate fills.
+                    self.other_surface_element
+                        .get_or_insert((element_type, location));
+                    Ok(())
+                }
                 Some(_) => Ok(()),
                 None => Err(source.error_at(
                     location,

@@ -7,9 +7,9 @@
 //! volume elements, and linear and quadratic tetrahedra mixed in one file, are an
 //! [`ImportErrorKind::UnsupportedElement`] error, since dropping them would silently lose
 //! material. A file holding triangles but no tetrahedra is a surface ([`parse_surface`]), which
-//! [`load`](super::load) fills as an OBJ or STL surface. Sections other than `$MeshFormat`, `$Nodes` (or, in version 2, `$ParametricNodes`:
-//! nodes with their place on the geometry, ASCII) and `$Elements` are skipped; a second nodes
-//! section (a partitioned file) is refused.
+//! [`load`](super::load) fills as an OBJ or STL surface. Sections other than `$MeshFormat`,
+//! `$Nodes` (or, in version 2, `$ParametricNodes`: nodes with their place on the geometry,
+//! ASCII) and `$Elements` are skipped; a second nodes section (a partitioned file) is refused.
 //!
 //! Hand-written rather than built on the `mshio` crate (0.4.2, the only MSH crate): it reads
 //! version 4.1 only, while 2.2, which many tools still write, needs this reader anyway; and it
@@ -55,7 +55,9 @@ pub fn parse(data: &[u8], path: &str, scale: f64) -> Result<RawMesh, Error> {
 ///
 /// # Errors
 /// Those of [`parse`], except that the file needs linear triangles (element type 2) instead of
-/// tetrahedra: [`ImportErrorKind::InvalidSurface`] for a file without any.
+/// tetrahedra: [`ImportErrorKind::NoTetrahedra`] for a file with neither,
+/// [`ImportErrorKind::UnsupportedElement`] for other surface elements (quadrangles, curved
+/// triangles) beside them.
 pub fn parse_surface(data: &[u8], path: &str, scale: f64) -> Result<Surface, Error> {
     let (reader, source) = read(data, path, scale)?;
     reader.finish_surface(&source)
@@ -84,6 +86,7 @@ fn read<'d>(data: &'d [u8], path: &'d str, scale: f64) -> Result<(Reader, Source
         tets: Vec::new(),
         mid_edge_tags: Vec::new(),
         triangles: Vec::new(),
+        other_surface_element: None,
     };
     while let Some(line) = source.line()? {
         reader.section(&mut source, line)?;
@@ -126,6 +129,8 @@ struct Reader {
     mid_edge_tags: Vec<[u64; 6]>,
     /// Linear triangles as node tags, with where they were read (a surface-only file's mesh).
     triangles: Vec<([u64; 3], FileLocation)>,
+    /// The type and place of the first surface element other than a linear triangle.
+    other_surface_element: Option<(u32, FileLocation)>,
 }
 
 impl Reader {
@@ -235,23 +240,41 @@ impl Reader {
         })
     }
 
-    /// The [`Surface`] of the triangles read, their node tags resolved to indices (every node
-    /// of the file kept: the fill uses only the triangles').
+    /// The [`Surface`] of the triangles read: the nodes they use (in order of first use) and
+    /// the triangles on them.
     fn finish_surface(self, source: &Source<'_>) -> Result<Surface, Error> {
+        if let Some((element_type, location)) = self.other_surface_element {
+            return Err(source.error_at(
+                location,
+                ImportErrorKind::UnsupportedElement,
+                format!(
+                    "element type {element_type} in a surface: only linear triangles (type 2) \
+                     can be filled"
+                ),
+            ));
+        }
         if self.triangles.is_empty() {
             return Err(source.error_at(
                 FileLocation::Whole,
-                ImportErrorKind::InvalidSurface,
+                ImportErrorKind::NoTetrahedra,
                 "the file holds neither tetrahedra (element type 4 or 11) nor triangles (type 2)",
             ));
         }
+        let mut vertex_of: HashMap<u32, u32> = HashMap::new();
+        let mut vertices = Vec::new();
         let mut triangles = Vec::with_capacity(self.triangles.len());
         for (tags, location) in &self.triangles {
-            triangles.push(self.indices(source, tags, *location)?);
+            let nodes = self.indices(source, tags, *location)?;
+            triangles.push(nodes.map(|node| {
+                *vertex_of.entry(node).or_insert_with(|| {
+                    vertices.push(self.positions[node as usize]);
+                    (vertices.len() - 1) as u32
+                })
+            }));
         }
         Ok(Surface {
             path: source.path().to_owned(),
-            vertices: self.positions,
+            vertices,
             triangles,
         })
     }

@@ -42,7 +42,8 @@ impl Reader {
 
     /// Reads the body of a version 2 `$ParametricNodes` section (after its first line): ASCII
     /// lines `tag x y z dim entity` followed by the node's `dim` parametric coordinates on a
-    /// curve (1) or a surface (2), none on a point or in a volume.
+    /// curve (1) or a surface (2), none on a point or in a volume; `tag x y z` alone for a node
+    /// on no geometric entity.
     pub(super) fn parametric_nodes_v2(&mut self, source: &mut Source<'_>) -> Result<(), Error> {
         if self.format.binary {
             return Err(source.error(
@@ -58,6 +59,12 @@ impl Reader {
             let mut tokens = line.split_ascii_whitespace();
             let tag: u64 = parse_token(source, tokens.next(), "node tag")?;
             let p = parse_point(source, &mut tokens)?;
+            let mut tokens = tokens.peekable();
+            if tokens.peek().is_none() {
+                // A node on no geometric entity.
+                self.add_node(source, tag, p)?;
+                continue;
+            }
             let dim: u32 = parse_token(source, tokens.next(), "geometric entity dimension")?;
             let _: i64 = parse_token(source, tokens.next(), "geometric entity tag")?;
             let parameters = match dim {

@@ -16,6 +16,7 @@ use crate::mesh::import::locate;
 use crate::mesh::import::text::Source;
 use crate::mesh::import::{check_scale, scaled_defect};
 use rapier3d::glamx::DVec3;
+use std::borrow::Cow;
 use std::collections::HashMap;
 
 /// Reads a Wavefront OBJ surface (all its objects and groups; polygons are triangulated) with
@@ -121,7 +122,7 @@ pub fn parse_stl(data: &[u8], path: &str, scale: f64) -> Result<Surface, Error> 
         ascii_solids(&source, data)?
     } else {
         check_record_count(&source, data)?;
-        vec![(0, data)]
+        vec![(0, Cow::Borrowed(data))]
     };
     let mut surface = Surface {
         path: path.to_owned(),
@@ -130,6 +131,7 @@ pub fn parse_stl(data: &[u8], path: &str, scale: f64) -> Result<Surface, Error> 
     };
     let mut welded: HashMap<[u64; 3], u32> = HashMap::new();
     for (lines_before, part) in parts {
+        let part: &[u8] = &part;
         let mesh = read_stl_part(&source, part, lines_before)?;
         let mut global = Vec::with_capacity(mesh.vertices.len());
         for v in &mesh.vertices {
@@ -192,10 +194,14 @@ fn shifted(at: FileLocation, lines_before: usize) -> FileLocation {
     }
 }
 
-/// The solids of the ASCII STL file `data`, each from its `solid` line to its `endsolid` line
-/// (or to the end of the file, where `stl_io` will report the missing end), with the number of
-/// lines before it. Text other than blank lines between solids is an error at its line.
-fn ascii_solids<'d>(source: &Source<'_>, data: &'d [u8]) -> Result<Vec<(usize, &'d [u8])>, Error> {
+/// A part of an STL file read on its own: the lines before it and its bytes.
+type SolidPart<'d> = (usize, Cow<'d, [u8]>);
+
+/// The solids of the ASCII STL file `data`, each from its `solid` keyword to its `endsolid`
+/// line (or to the end of the file, where `stl_io` will report the missing end), with the
+/// number of lines before it. An unnamed `solid` gets a space after it, as `stl_io` needs to
+/// read the part as text. Text other than blank lines between solids is an error at its line.
+fn ascii_solids<'d>(source: &Source<'_>, data: &'d [u8]) -> Result<Vec<SolidPart<'d>>, Error> {
     let mut solids = Vec::new();
     // The open solid's first byte and line count before it.
     let mut open: Option<(usize, usize)> = None;
@@ -205,7 +211,9 @@ fn ascii_solids<'d>(source: &Source<'_>, data: &'d [u8]) -> Result<Vec<(usize, &
         let words = line.trim_ascii_start();
         match open {
             None if words.is_empty() => {}
-            None if words.starts_with(b"solid") => open = Some((start, index)),
+            None if words.starts_with(b"solid") => {
+                open = Some((end - words.len(), index));
+            }
             None => {
                 return Err(source.error_at(
                     FileLocation::Line(index + 1),
@@ -214,7 +222,7 @@ fn ascii_solids<'d>(source: &Source<'_>, data: &'d [u8]) -> Result<Vec<(usize, &
                 ));
             }
             Some((first, lines_before)) if words.starts_with(b"endsolid") => {
-                solids.push((lines_before, &data[first..end]));
+                solids.push((lines_before, named(&data[first..end])));
                 open = None;
             }
             Some(_) => {}
@@ -222,9 +230,19 @@ fn ascii_solids<'d>(source: &Source<'_>, data: &'d [u8]) -> Result<Vec<(usize, &
         start = end;
     }
     if let Some((first, lines_before)) = open {
-        solids.push((lines_before, &data[first..]));
+        solids.push((lines_before, named(&data[first..])));
     }
     Ok(solids)
+}
+
+/// `solid`, a part starting with the keyword `solid`, with a space after the keyword if it has
+/// none (`stl_io` reads a part as text only if it starts with `solid `).
+fn named(solid: &[u8]) -> Cow<'_, [u8]> {
+    if solid.get(5) == Some(&b' ') {
+        Cow::Borrowed(solid)
+    } else {
+        Cow::Owned([&solid[..5], b" ", &solid[5..]].concat())
+    }
 }
 
 /// Checks that the binary STL file `data` holds no complete record past the count its header

@@ -25,7 +25,7 @@ use std::str::SplitAsciiWhitespace;
 /// # Errors
 /// [`Error::InvalidSetting`] for a bad `scale`; [`Error::MeshImport`] with the line (or byte
 /// offset in binary data) for a malformed file, an unsupported version or dataset, cells that
-/// are not linear tetrahedra or lower-dimensional, indices out of range, non-finite
+/// are not tetrahedra (linear or quadratic) or lower-dimensional, indices out of range, non-finite
 /// coordinates.
 pub fn parse_legacy(data: &[u8], path: &str, scale: f64) -> Result<RawMesh, Error> {
     check_scale(scale)?;

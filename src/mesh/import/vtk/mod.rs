@@ -8,19 +8,18 @@
 //! error naming the cell: dropping it would silently lose material.
 //!
 //! `.vtu` files are read by this crate (`xml`: the layout walked with `quick-xml` in
-//! `xml_document`, the values decoded in `xml_data`, binary blocks in `xml_block`): ASCII, base64 `binary` and appended raw or
-//! base64 data, uncompressed or zlib-compressed (inflated within the sizes the file declares),
-//! every count checked against the data. Errors name the line of the `<DataArray>` or
-//! `<Piece>` at fault, a token that is not a number at its own line, appended binary data at its
-//! byte offset. No input makes the reader panic or allocate beyond what its counts and data
-//! can fill (fuzzed in `tests/mesh_import`).
+//! `xml_document`, the values decoded in `xml_data`, binary blocks in `xml_block`): ASCII,
+//! base64 `binary` and appended raw or base64 data, uncompressed or zlib-compressed (inflated
+//! within the sizes the file declares), every count checked against the data. Errors name the
+//! line of the `<DataArray>` or `<Piece>` at fault, a token that is not a number at its own
+//! line, appended binary data at its byte offset. No input makes the reader panic or allocate
+//! beyond what its counts and data can fill (fuzzed in `tests/mesh_import`).
 //!
 //! Legacy `.vtk` files (versions 2.0 to 5.1, ASCII or big-endian BINARY, `DATASET
-//! UNSTRUCTURED_GRID`) are read by hand: `vtkio`'s legacy parser reports only the nom error
-//! kind (`Parse(Digit)`), with no line, while the format is a few keywords and number lists.
+//! UNSTRUCTURED_GRID`) are read by hand too (`legacy`, its data blocks in `legacy_data`): the
+//! format is a few keywords and number lists.
 //!
-//! This module turns the cells both readers collect into tetrahedra; the submodules read the
-//! XML files (`xml`) and the legacy ones (`legacy`, its data blocks in `legacy_data`).
+//! This module turns the cells both readers collect into tetrahedra.
 
 mod legacy;
 mod legacy_data;
@@ -43,11 +42,12 @@ const VTK_TETRA: u64 = 10;
 /// VTK's quadratic (10-node) tetrahedron.
 const VTK_QUADRATIC_TETRA: u64 = 24;
 
-/// Whether VTK cell type `cell_type` is a vertex, curve or surface cell, skipped on import.
+/// Whether VTK cell type `cell_type` is empty (0), a vertex, curve or surface cell, skipped on
+/// import.
 fn is_lower_dimensional(cell_type: u64) -> bool {
     matches!(
         cell_type,
-        1..=9 | 21 | 22 | 23 | 28 | 30 | 34 | 35 | 36 | 68 | 69 | 70 | 75 | 76 | 77
+        0..=9 | 21 | 22 | 23 | 28 | 30 | 34 | 35 | 36 | 68 | 69 | 70 | 75 | 76 | 77
     )
 }
 

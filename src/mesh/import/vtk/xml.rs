@@ -5,10 +5,11 @@
 //! (raw or base64) data, uncompressed or zlib-compressed, either byte order, 32- or 64-bit
 //! headers; its points as numbers (three coordinates each, finite once scaled) and its cells'
 //! offsets (a leading zero tolerated), connectivity and types. Every array must hold exactly
-//! what its piece's `NumberOfPoints` and `NumberOfCells` declare, and each cell's points must
-//! be its own piece's; the pieces' points are numbered one after the other. Errors are placed
-//! at the line of the `<DataArray>` (a token that is not a number at its own line; binary
-//! appended data at its byte offset), count mismatches at the `<Piece>`.
+//! what its piece's `NumberOfPoints` and `NumberOfCells` declare (nothing for a count of 0), and
+//! each cell's points must be its own piece's; the pieces' points are numbered one after the
+//! other. Errors are placed at the line of the `<DataArray>` at fault (a token that is not a
+//! number at its own line; appended data at its byte offset), a missing array at its
+//! `<Piece>`.
 
 use super::xml_data::Decoder;
 use super::xml_document::{self, ArrayDecl, PieceDecl};
@@ -25,10 +26,10 @@ use rapier3d::glamx::DVec3;
 /// # Errors
 /// [`Error::InvalidSetting`] for a bad `scale`; [`Error::MeshImport`] for malformed XML or
 /// data, a count that disagrees with the data, pieces in other files, compressors other than
-/// zlib, cells that are not linear tetrahedra or lower-dimensional, indices out of range,
-/// non-finite coordinates. Malformed XML is reported at the line where it stops being
+/// zlib, cells that are not tetrahedra (linear or quadratic) or lower-dimensional, indices out
+/// of range, non-finite coordinates. Malformed XML is reported at the line where it stops being
 /// well-formed, errors about a data array at the line of its `<DataArray>` (appended data at
-/// its byte offset), count mismatches at the line of the `<Piece>`.
+/// its byte offset), a missing array at the line of its `<Piece>`.
 pub fn parse_vtu(data: &[u8], path: &str, scale: f64) -> Result<RawMesh, Error> {
     check_scale(scale)?;
     let source = Source::new(path, data);
@@ -52,6 +53,14 @@ pub fn parse_vtu(data: &[u8], path: &str, scale: f64) -> Result<RawMesh, Error> 
         grid.add_piece(&decoder, number, piece)?;
     }
     grid.build()
+}
+
+/// The cells of one piece, read and checked, with the line of its connectivity.
+struct PieceCells {
+    types: Vec<u64>,
+    ends: Vec<u64>,
+    connectivity: Vec<u64>,
+    at: FileLocation,
 }
 
 /// Where a piece's data lies, for errors about its cells.
@@ -87,12 +96,12 @@ fn line_of(array: Option<&ArrayDecl>, piece: &PieceDecl) -> FileLocation {
 }
 
 impl Grid<'_> {
-    /// A count error about piece `piece` at `at`.
+    /// A [`ImportErrorKind::BadCount`] error at `at`.
     fn bad_count(&self, at: FileLocation, message: String) -> Error {
         self.source.error_at(at, ImportErrorKind::BadCount, message)
     }
 
-    /// The array `array` of piece `number` (`what`), or an error if it is missing.
+    /// `array` (the `what` array of `piece`), or an error at the piece if it is missing.
     fn required<'p>(
         &self,
         array: Option<&'p ArrayDecl>,
@@ -116,25 +125,62 @@ impl Grid<'_> {
         piece: &PieceDecl,
     ) -> Result<(), Error> {
         let first_point = self.positions.len() as u64;
-        if piece.point_count > 0 {
-            let points = self.required(piece.points.as_ref(), piece, "Points")?;
-            self.add_points(decoder, number, piece, points)?;
-        }
+        self.add_points(decoder, number, piece)?;
         self.pieces.push(PieceLines {
             first_cell: self.types.len(),
             offsets: line_of(piece.offsets.as_ref(), piece),
             connectivity: line_of(piece.connectivity.as_ref(), piece),
             types: line_of(piece.types.as_ref(), piece),
         });
-        if piece.cell_count == 0 {
+        let Some(cells) = self.read_cells(decoder, number, piece)? else {
             return Ok(());
+        };
+        let base = self.connectivity.len() as u64;
+        // Every end is at most the connectivity's length (checked): no overflow.
+        self.offsets
+            .extend(cells.ends.iter().map(|&end| base + end));
+        for &node in &cells.connectivity {
+            if node >= piece.point_count {
+                return Err(self.source.error_at(
+                    cells.at,
+                    ImportErrorKind::IndexOutOfRange,
+                    format!(
+                        "piece {number} refers to point {node}, but has {} points",
+                        piece.point_count
+                    ),
+                ));
+            }
+            self.connectivity.push(first_point + node);
         }
+        self.types.extend(cells.types);
+        Ok(())
+    }
+
+    /// The cells of piece `number`: its types, the ends of its cells in its connectivity (a
+    /// leading zero dropped) and the connectivity, each array holding exactly what the piece
+    /// declares; `None` for a piece of no cells, whose arrays (if any) must then be empty.
+    fn read_cells(
+        &self,
+        decoder: &Decoder<'_, '_>,
+        number: usize,
+        piece: &PieceDecl,
+    ) -> Result<Option<PieceCells>, Error> {
         let cells = piece.cell_count;
         let what = |name: &str| format!("{name} of piece {number}");
+        if cells == 0 {
+            for (array, name) in [
+                (&piece.types, "cell types"),
+                (&piece.offsets, "cell offsets"),
+                (&piece.connectivity, "connectivity"),
+            ] {
+                if let Some(array) = array {
+                    decoder.indices(array, 0, &what(name))?;
+                }
+            }
+            return Ok(None);
+        }
         let types_array = self.required(piece.types.as_ref(), piece, "types")?;
         let types = decoder.indices(types_array, cells, &what("cell types"))?;
-        let offsets_array = self.required(piece.offsets.as_ref(), piece, "offsets")?;
-        let offsets = decoder.indices(offsets_array, cells + 1, &what("cell offsets"))?;
         if types.len() as u64 != cells {
             return Err(self.bad_count(
                 FileLocation::Line(types_array.line),
@@ -144,11 +190,16 @@ impl Grid<'_> {
                 ),
             ));
         }
+        let offsets_array = self.required(piece.offsets.as_ref(), piece, "offsets")?;
+        let mut ends = decoder.indices(
+            offsets_array,
+            cells.saturating_add(1),
+            &what("cell offsets"),
+        )?;
         // XML offsets are the cells' ends; some writers put a leading zero.
-        let ends = match offsets.first() {
-            Some(0) if offsets.len() as u64 == cells + 1 => &offsets[1..],
-            _ => &offsets[..],
-        };
+        if ends.first() == Some(&0) && ends.len() as u64 == cells + 1 {
+            ends.remove(0);
+        }
         if ends.len() as u64 != cells {
             return Err(self.bad_count(
                 FileLocation::Line(offsets_array.line),
@@ -163,42 +214,36 @@ impl Grid<'_> {
             self.required(piece.connectivity.as_ref(), piece, "connectivity")?;
         let connectivity = decoder.indices(connectivity_array, used, &what("connectivity"))?;
         let at = FileLocation::Line(connectivity_array.line);
-        if connectivity.len() as u64 != used {
+        if connectivity.len() as u64 != used || ends.iter().any(|&end| end > used) {
             return Err(self.bad_count(
                 at,
                 format!(
-                    "piece {number}'s connectivity has {} entries, its last cell ends at {used}",
-                    connectivity.len()
+                    "piece {number}'s connectivity has {} entries, its cells end at up to {}",
+                    connectivity.len(),
+                    ends.iter().max().copied().unwrap_or(0)
                 ),
             ));
         }
-        let base = self.connectivity.len() as u64;
-        self.offsets.extend(ends.iter().map(|&end| base + end));
-        for &node in &connectivity {
-            if node >= piece.point_count {
-                return Err(self.source.error_at(
-                    at,
-                    ImportErrorKind::IndexOutOfRange,
-                    format!(
-                        "piece {number} refers to point {node}, but has {} points",
-                        piece.point_count
-                    ),
-                ));
-            }
-            self.connectivity.push(first_point + node);
-        }
-        self.types.extend(types);
-        Ok(())
+        Ok(Some(PieceCells {
+            types,
+            ends,
+            connectivity,
+            at,
+        }))
     }
 
-    /// Appends the points of piece `number` from `points`, scaled to m and checked finite.
+    /// Appends the points of piece `number`, scaled to m and checked finite; a piece of no
+    /// points may have no `<Points>` array, or an empty one.
     fn add_points(
         &mut self,
         decoder: &Decoder<'_, '_>,
         number: usize,
         piece: &PieceDecl,
-        points: &ArrayDecl,
     ) -> Result<(), Error> {
+        let points = match (&piece.points, piece.point_count) {
+            (None, 0) => return Ok(()),
+            (points, _) => self.required(points.as_ref(), piece, "Points")?,
+        };
         let (source, scale) = (self.source, self.scale);
         let at = FileLocation::Line(points.line);
         if points.components != 3 {

@@ -118,7 +118,7 @@ impl BinaryBlock<'_> {
                 .ok_or_else(|| self.truncated("compressed blocks"))?;
             let before = inflated.len();
             flate2::read::ZlibDecoder::new(stream)
-                .take(expected + 1)
+                .take(expected.saturating_add(1))
                 .read_to_end(&mut inflated)
                 .map_err(|e| {
                     self.error(
