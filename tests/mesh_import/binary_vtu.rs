@@ -180,3 +180,31 @@ fn pieces_join_and_every_count_holds_exactly_its_data() {
         assert!(matches!(at, FileLocation::Line(_)), "{name}: {at:?}");
     }
 }
+
+#[test]
+fn a_big_endian_file_reads_as_its_little_endian_original() {
+    // The VTK library's uncompressed appended raw cube with every header and value byte-swapped
+    // and `byte_order="BigEndian"`: the same points (to the bit) and tetrahedra.
+    let text = bytes("cube_vtk_appended_raw.vtu");
+    let little = vtk::parse_vtu(&text, "little.vtu", 1.0).unwrap();
+    let start = text
+        .windows(14)
+        .position(|w| w == b"<AppendedData ")
+        .unwrap();
+    let data = start + text[start..].iter().position(|&b| b == b'_').unwrap() + 1;
+    let mut big = text.clone();
+    // (offset, value size) of the points, connectivity, offsets and types, in file order.
+    for (offset, size) in [(0, 8), (8188, 8), (44672, 8), (53796, 1)] {
+        let at = data + offset;
+        let count = u32::from_le_bytes(text[at..at + 4].try_into().unwrap()) as usize;
+        big[at..at + 4].reverse();
+        for value in big[at + 4..at + 4 + count].chunks_exact_mut(size) {
+            value.reverse();
+        }
+    }
+    let head = String::from_utf8_lossy(&big[..start]).replacen("LittleEndian", "BigEndian", 1);
+    let big = [head.as_bytes(), &big[start..]].concat();
+    let raw = vtk::parse_vtu(&big, "big.vtu", 1.0).unwrap();
+    assert_eq!(raw.positions, little.positions);
+    assert_eq!(raw.tets, little.tets);
+}
