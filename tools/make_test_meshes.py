@@ -159,6 +159,27 @@ def cube_msh_other_forms():
     gmsh.finalize()
 
 
+def cube_regions():
+    """cube_msh's cube with physical groups: the face x = 0 as surface "clamp" (tag 1), the
+    volume as "body" (tag 2), in MSH 2.2 ASCII and 4.1 binary."""
+    gmsh.initialize()
+    gmsh.option.setNumber("General.Terminal", 0)
+    gmsh.model.add("cube")
+    gmsh.model.occ.addBox(0, 0, 0, 1, 1, 1)
+    gmsh.model.occ.synchronize()
+    left = [tag for _, tag in gmsh.model.getEntitiesInBoundingBox(-0.1, -0.1, -0.1, 0.1, 1.1, 1.1, 2)]
+    gmsh.model.addPhysicalGroup(2, left, 1, name="clamp")
+    gmsh.model.addPhysicalGroup(3, [1], 2, name="body")
+    gmsh.option.setNumber("Mesh.MeshSizeMax", 0.35)
+    gmsh.model.mesh.generate(3)
+    for version, binary, name in [(2.2, 0, "cube_regions_v22.msh"),
+                                  (4.1, 1, "cube_regions_v41_binary.msh")]:
+        gmsh.option.setNumber("Mesh.MshFileVersion", version)
+        gmsh.option.setNumber("Mesh.Binary", binary)
+        gmsh.write(os.path.join(OUT, name))
+    gmsh.finalize()
+
+
 def cube_points_tets():
     """The cube of cube_v41_ascii.msh as cube_others reads it: the points its tetrahedra use,
     renumbered in sorted order (341 points), and those tetrahedra (1140), as numpy arrays."""
@@ -324,7 +345,7 @@ def multi_solid_stl():
 
 
 STEPS = [cube_msh, cube_others, surfaces, cube_meshio_compressed, cube_vtk_library,
-         multi_solid_stl, cube_msh_other_forms]
+         multi_solid_stl, cube_msh_other_forms, cube_regions]
 
 if __name__ == "__main__":
     import sys

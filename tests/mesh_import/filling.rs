@@ -107,6 +107,7 @@ fn raw_mesh(positions: &[DVec3], tets: &[[u32; 4]]) -> RawMesh {
         tets: tets.to_vec(),
         mid_edge_nodes: Vec::new(),
         tet_locations: Vec::new(),
+        regions: Vec::new(),
     }
 }
 

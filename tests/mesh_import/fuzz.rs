@@ -76,7 +76,7 @@ fn bytes_cached_ele() -> Vec<u8> {
 }
 
 /// (reader, valid file) pairs mutated by the fuzz properties.
-const SEEDS: [(usize, &str); 22] = [
+const SEEDS: [(usize, &str); 24] = [
     (0, "cube_v22_ascii.msh"),
     (0, "cube_v22_binary.msh"),
     (0, "cube_v41_ascii.msh"),
@@ -84,6 +84,8 @@ const SEEDS: [(usize, &str); 22] = [
     (0, "cube_v40_ascii.msh"),
     (0, "cube_v22_parametric.msh"),
     (0, "sphere_surface.msh"),
+    (0, "cube_regions_v22.msh"),
+    (0, "cube_regions_v41_binary.msh"),
     (1, "cube.node"),
     (2, "cube.ele"),
     (3, "cube_ascii.vtu"),

@@ -9,6 +9,10 @@
 //! | VTK legacy unstructured grid (ASCII and binary, 2.0 to 5.1) | `.vtk` | [`vtk`] |
 //! | surface: Wavefront OBJ, STL (ASCII and binary), Gmsh triangles only | `.obj`, `.stl`, `.msh` | [`surface`], [`gmsh::parse_surface`] |
 //!
+//! Gmsh's physical groups are kept as named [`MeshRegion`]s of the raw mesh (the nodes of their
+//! elements, a volume group's tetrahedra); [`RawMesh::mesh_node_indices`] maps their nodes into
+//! the validated mesh.
+//!
 //! Every reader takes a `scale` in metres per file unit (1 for files in metres, 0.001 for
 //! millimetres) and first returns a [`RawMesh`]: positions and tetrahedra as the file has them,
 //! lower-dimensional elements (points, lines, boundary triangles) skipped. [`check`] reports a raw
@@ -74,6 +78,24 @@ pub struct RawMesh {
     pub mid_edge_nodes: Vec<[u32; 6]>,
     /// Where each tetrahedron was defined in the file (same length as `tets`).
     pub tet_locations: Vec<FileLocation>,
+    /// The file's named parts (Gmsh physical groups), in order of dimension and tag; empty for
+    /// formats that keep none.
+    pub regions: Vec<MeshRegion>,
+}
+
+/// A named part of a mesh file: a Gmsh physical group of points, curves, surfaces or volumes.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct MeshRegion {
+    /// Its name (`$PhysicalNames`), empty if the file gives none.
+    pub name: String,
+    /// Its dimension: 0 points, 1 curves, 2 surfaces, 3 volumes.
+    pub dimension: u8,
+    /// Its physical tag.
+    pub tag: i64,
+    /// The nodes of its elements, indices into [`RawMesh::positions`], sorted, each once.
+    pub nodes: Vec<u32>,
+    /// For a volume group, its tetrahedra: indices into [`RawMesh::tets`], in file order.
+    pub tets: Vec<u32>,
 }
 
 impl RawMesh {
@@ -136,6 +158,29 @@ impl RawMesh {
             }
         }
         QuadraticTetMesh::new(positions, elements).map_err(|e| self.invalid(e))
+    }
+
+    /// The index each node of [`RawMesh::positions`] gets in the mesh [`RawMesh::into_mesh`]
+    /// and [`RawMesh::into_quadratic_mesh`] build (nodes numbered in order of first use by the
+    /// elements, corners then mid-edge nodes), `None` for a node no element uses or past the
+    /// positions; with it, a [`MeshRegion`]'s nodes select the validated mesh's nodes.
+    pub fn mesh_node_indices(&self) -> Vec<Option<u32>> {
+        let mut index = vec![None; self.positions.len()];
+        let mut next = 0u32;
+        let mids = self
+            .mid_edge_nodes
+            .iter()
+            .map(Some)
+            .chain(std::iter::repeat(None));
+        for (corners, mids) in self.tets.iter().zip(mids) {
+            for &node in corners.iter().chain(mids.into_iter().flatten()) {
+                if let Some(slot @ None) = index.get_mut(node as usize) {
+                    *slot = Some(next);
+                    next += 1;
+                }
+            }
+        }
+        index
     }
 
     /// The nodes `elements` use, in order of first use, and the elements renumbered to them.

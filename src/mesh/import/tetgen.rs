@@ -61,6 +61,7 @@ pub fn parse(
         tets,
         mid_edge_nodes: Vec::new(),
         tet_locations,
+        regions: Vec::new(),
     })
 }
 

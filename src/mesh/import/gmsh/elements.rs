@@ -97,6 +97,8 @@ impl Reader {
         }
         match element_type {
             TETRAHEDRON | QUADRATIC_TETRAHEDRON => {
+                let tet = u32::try_from(self.tets.len()).ok();
+                self.regions.record(3, nodes, tet);
                 self.tets
                     .push(([nodes[0], nodes[1], nodes[2], nodes[3]], location));
                 if quadratic {
@@ -108,6 +110,7 @@ impl Reader {
                 Ok(())
             }
             TRIANGLE => {
+                self.regions.record(2, nodes, None);
                 self.triangles
                     .push(([nodes[0], nodes[1], nodes[2]], location));
                 Ok(())
@@ -122,12 +125,16 @@ impl Reader {
                     ),
                 )),
                 Some((_, 2)) => {
+                    self.regions.record(2, nodes, None);
                     // Quadrangles, curved triangles: not part of a surface this crate fills.
                     self.other_surface_element
                         .get_or_insert((element_type, location));
                     Ok(())
                 }
-                Some(_) => Ok(()),
+                Some((_, dim)) => {
+                    self.regions.record(dim, nodes, None);
+                    Ok(())
+                }
                 None => Err(source.error_at(
                     location,
                     ImportErrorKind::UnsupportedElement,

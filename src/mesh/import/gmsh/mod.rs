@@ -9,7 +9,8 @@
 //! material. A file holding triangles but no tetrahedra is a surface ([`parse_surface`]), which
 //! [`load`](super::load) fills as an OBJ or STL surface. Sections other than `$MeshFormat`,
 //! `$Nodes` (or, in version 2, `$ParametricNodes`: nodes with their place on the geometry,
-//! ASCII) and `$Elements` are skipped; a second nodes section (a partitioned file) is refused.
+//! ASCII), `$Elements`, `$PhysicalNames` and (in 4.1) `$Entities` are skipped; physical groups
+//! become [`RawMesh::regions`] (`regions`); a second nodes section (a partitioned file) is refused.
 //!
 //! Hand-written rather than built on the `mshio` crate (0.4.2, the only MSH crate): it reads
 //! version 4.1 only, while 2.2, which many tools still write, needs this reader anyway; and it
@@ -24,13 +25,14 @@
 
 mod elements;
 mod format;
+mod regions;
 mod v2;
 mod v4;
 mod v40;
 
 use super::surface::Surface;
 use super::text::{Source, scaled, shorten};
-use super::{RawMesh, check_scale};
+use super::{MeshRegion, RawMesh, check_scale};
 use crate::Error;
 use crate::error::{FileLocation, ImportErrorKind};
 use format::{MshFormat, Version};
@@ -87,6 +89,7 @@ fn read<'d>(data: &'d [u8], path: &'d str, scale: f64) -> Result<(Reader, Source
         mid_edge_tags: Vec::new(),
         triangles: Vec::new(),
         other_surface_element: None,
+        regions: regions::Regions::default(),
     };
     while let Some(line) = source.line()? {
         reader.section(&mut source, line)?;
@@ -131,6 +134,8 @@ struct Reader {
     triangles: Vec<([u64; 3], FileLocation)>,
     /// The type and place of the first surface element other than a linear triangle.
     other_surface_element: Option<(u32, FileLocation)>,
+    /// The physical groups.
+    regions: regions::Regions,
 }
 
 impl Reader {
@@ -169,6 +174,14 @@ impl Reader {
                         "$EndNodes"
                     },
                 )
+            }
+            "$PhysicalNames" => {
+                self.regions.read_names(source)?;
+                expect_end(source, "$EndPhysicalNames")
+            }
+            "$Entities" if self.format.version == Version::V4 => {
+                self.regions.read_entities(source, self.format)?;
+                expect_end(source, "$EndEntities")
             }
             "$Elements" => {
                 match self.format.version {
@@ -212,7 +225,7 @@ impl Reader {
     /// The [`RawMesh`] of the nodes and tetrahedra read, their node tags resolved to indices;
     /// [`ImportErrorKind::NoTetrahedra`] for a file without any, and
     /// [`ImportErrorKind::IndexOutOfRange`] at the tetrahedron for a tag no node has.
-    fn finish(self, source: &Source<'_>) -> Result<RawMesh, Error> {
+    fn finish(mut self, source: &Source<'_>) -> Result<RawMesh, Error> {
         if self.tets.is_empty() {
             return Err(source.error_at(
                 FileLocation::Whole,
@@ -231,12 +244,16 @@ impl Reader {
         for (tags, (_, location)) in self.mid_edge_tags.iter().zip(&self.tets) {
             mid_edge_nodes.push(self.indices(source, tags, *location)?);
         }
+        let node_index = &self.node_index;
+        let regions = std::mem::take(&mut self.regions)
+            .finish(source, |tag| node_index.get(&tag).copied())?;
         Ok(RawMesh {
             path: source.path().to_owned(),
             positions: self.positions,
             tets,
             mid_edge_nodes,
             tet_locations,
+            regions,
         })
     }
 

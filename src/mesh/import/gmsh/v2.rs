@@ -108,8 +108,13 @@ impl Reader {
                 let _tag: u64 = parse_token(source, tokens.next(), "element tag")?;
                 let element_type: u32 = parse_token(source, tokens.next(), "element type")?;
                 let tag_count: usize = parse_token(source, tokens.next(), "tag count")?;
-                for _ in 0..tag_count {
-                    let _: i64 = parse_token(source, tokens.next(), "element tag")?;
+                self.regions.current.clear();
+                for k in 0..tag_count {
+                    let tag: i64 = parse_token(source, tokens.next(), "element tag")?;
+                    // The first tag is the physical group (0: none).
+                    if k == 0 && tag != 0 {
+                        self.regions.current.push(tag);
+                    }
                 }
                 self.element_line(source, element_type, tokens)?;
             }
@@ -145,8 +150,13 @@ impl Reader {
         for _ in 0..following {
             let location = source.location();
             format.read_i32(source, "an element tag")?;
-            for _ in 0..tag_count {
-                format.read_i32(source, "an element's tag")?;
+            self.regions.current.clear();
+            for k in 0..tag_count {
+                let tag = format.read_i32(source, "an element's tag")?;
+                // The first tag is the physical group (0: none).
+                if k == 0 && tag != 0 {
+                    self.regions.current.push(i64::from(tag));
+                }
             }
             for node in nodes.iter_mut().take(node_count) {
                 *node = format.read_i32(source, "an element's node")? as u32 as u64;

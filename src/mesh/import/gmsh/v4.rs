@@ -15,9 +15,9 @@ use crate::error::{FileLocation, ImportErrorKind};
 use crate::mesh::import::text::{Source, end_of_line, parse_finite, parse_point, parse_token};
 use rapier3d::glamx::DVec3;
 
-/// A block header's numbers: entity dimension, the third field (the parametric flag of a node
-/// block, the element type of an element block) and the block's size.
-type BlockHeader = (u32, u32, u64);
+/// A block header's numbers: entity dimension and tag, the third field (the parametric flag of
+/// a node block, the element type of an element block) and the block's size.
+type BlockHeader = (u32, i64, u32, u64);
 
 impl Reader {
     /// Reads the body of a version 4.1 `$Nodes` section (after its first line).
@@ -26,13 +26,13 @@ impl Reader {
         let mut blocks_read = BlockCount::new("a node block", "node", total);
         for _ in 0..blocks {
             let location = source.location();
-            let (dim, parametric, count) = if self.format.binary {
+            let (dim, _, parametric, count) = if self.format.binary {
                 let format = self.format;
                 let dim = format.read_u32(source, "an entity dimension")?;
                 format.read_i32(source, "an entity tag")?;
                 let parametric = format.read_u32(source, "the parametric flag")?;
                 let count = format.read_size(source, "a node block size")?;
-                (dim, parametric, count)
+                (dim, 0, parametric, count)
             } else {
                 ascii_block_header(source, "a node block header", "parametric flag", "node")?
             };
@@ -91,15 +91,17 @@ impl Reader {
         let format = self.format;
         for _ in 0..blocks {
             let location = source.location();
-            let (_, element_type, count) = if format.binary {
-                format.read_i32(source, "an entity dimension")?;
-                format.read_i32(source, "an entity tag")?;
+            let (dim, entity, element_type, count) = if format.binary {
+                let dim = format.read_u32(source, "an entity dimension")?;
+                let entity = i64::from(format.read_i32(source, "an entity tag")?);
                 let element_type = format.read_u32(source, "an element type")?;
                 let count = format.read_size(source, "an element block size")?;
-                (0, element_type, count)
+                (dim, entity, element_type, count)
             } else {
                 ascii_block_header(source, "an element block header", "element type", "element")?
             };
+            self.regions
+                .enter_entity(u8::try_from(dim).unwrap_or(u8::MAX), entity);
             let count = blocks_read.take(source, location, count)?;
             let node_count = nodes_per_element(source, location, element_type)?;
             let mut nodes = [0u64; MAX_NODES];
@@ -157,10 +159,10 @@ fn ascii_block_header(
     let line = source.content_line(None, header)?;
     let mut tokens = line.split_ascii_whitespace();
     let dim: u32 = parse_token(source, tokens.next(), "entity dimension")?;
-    let _: i64 = parse_token(source, tokens.next(), "entity tag")?;
+    let entity: i64 = parse_token(source, tokens.next(), "entity tag")?;
     let third: u32 = parse_token(source, tokens.next(), third)?;
     let count: u64 = parse_token(source, tokens.next(), &format!("{kind} block size"))?;
-    Ok((dim, third, count))
+    Ok((dim, entity, third, count))
 }
 
 /// An ASCII node line `x y z` (file units) followed by `extra` parametric coordinates, nothing

@@ -49,6 +49,8 @@ impl Reader {
             let location = source.location();
             let (_, element_type, count) =
                 block_header(source, "an element block", "element type")?;
+            // Version 4.0 entities are not read: no regions.
+            self.regions.current.clear();
             let count = blocks_read.take(source, location, count)?;
             for _ in 0..count {
                 let line = source.content_line(None, "an element line")?;

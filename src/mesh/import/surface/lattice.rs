@@ -211,6 +211,7 @@ fn compacted(path: &str, positions: &[DVec3], tets: &[[u32; 4]]) -> RawMesh {
         positions: used,
         mid_edge_nodes: Vec::new(),
         tet_locations: vec![FileLocation::Whole; tets.len()],
+        regions: Vec::new(),
         tets,
     }
 }

@@ -131,6 +131,7 @@ fn build(
         tets,
         mid_edge_nodes,
         tet_locations,
+        regions: Vec::new(),
     })
 }
 
