@@ -388,6 +388,17 @@ pub enum Error {
         /// What is wrong, in words.
         message: String,
     },
+    /// A mesh file's region (Gmsh physical group) asked for by name or tag is not there, is
+    /// ambiguous, or is not of the kind asked (a body's mesh needs a volume).
+    #[error("{path}: {region}: {reason}")]
+    MeshRegion {
+        /// The file, as given.
+        path: String,
+        /// The region asked for (`region "clamp"`, `region tag 2`).
+        region: String,
+        /// Why it cannot be used, with the file's regions where that helps.
+        reason: String,
+    },
     /// A file could not be read (missing, unreadable).
     #[error("{path}: {message}")]
     Io {

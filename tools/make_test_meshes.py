@@ -18,6 +18,17 @@ import meshio
 OUT = os.path.join(os.path.dirname(__file__), "..", "assets", "meshes")
 
 
+def mesh_and_write_v41_ascii(size, dimension, name):
+    """Meshes gmsh's current model up to `dimension` with elements of at most `size`, writes it
+    to `name` in MSH 4.1 ASCII and finalizes gmsh."""
+    gmsh.option.setNumber("Mesh.MeshSizeMax", size)
+    gmsh.model.mesh.generate(dimension)
+    gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
+    gmsh.option.setNumber("Mesh.Binary", 0)
+    gmsh.write(os.path.join(OUT, name))
+    gmsh.finalize()
+
+
 def cube_msh():
     """A unit cube [0, 1]^3 meshed by gmsh, written in MSH 2.2 and 4.1, ASCII and binary."""
     gmsh.initialize()
@@ -151,12 +162,7 @@ def cube_msh_other_forms():
     gmsh.model.add("sphere")
     gmsh.model.occ.addSphere(0, 0, 0, 1)
     gmsh.model.occ.synchronize()
-    gmsh.option.setNumber("Mesh.MeshSizeMax", 0.25)
-    gmsh.model.mesh.generate(2)
-    gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
-    gmsh.option.setNumber("Mesh.Binary", 0)
-    gmsh.write(os.path.join(OUT, "sphere_surface.msh"))
-    gmsh.finalize()
+    mesh_and_write_v41_ascii(0.25, 2, "sphere_surface.msh")
 
 
 def cube_regions():
@@ -178,6 +184,33 @@ def cube_regions():
         gmsh.option.setNumber("Mesh.Binary", binary)
         gmsh.write(os.path.join(OUT, name))
     gmsh.finalize()
+
+
+def two_volumes():
+    """Two unit boxes side by side, [0, 1] x [0, 1]^2 and [1, 2] x [0, 1]^2, meshed conformingly
+    (fragmented) with physical groups: volumes "left" (tag 1) and "right" (tag 2), surfaces
+    "clamp" (the face x = 0, tag 3) and "load" (the face x = 2, tag 4); MSH 4.1 ASCII."""
+    gmsh.initialize()
+    gmsh.option.setNumber("General.Terminal", 0)
+    gmsh.model.add("two_volumes")
+    left = gmsh.model.occ.addBox(0, 0, 0, 1, 1, 1)
+    right = gmsh.model.occ.addBox(1, 0, 0, 1, 1, 1)
+    gmsh.model.occ.fragment([(3, left)], [(3, right)])
+    gmsh.model.occ.synchronize()
+
+    def volume_at(x):
+        return [t for _, t in gmsh.model.getEntitiesInBoundingBox(
+            x - 0.6, -0.1, -0.1, x + 0.6, 1.1, 1.1, 3)]
+
+    def face_at(x):
+        return [t for _, t in gmsh.model.getEntitiesInBoundingBox(
+            x - 0.01, -0.1, -0.1, x + 0.01, 1.1, 1.1, 2)]
+
+    gmsh.model.addPhysicalGroup(3, volume_at(0.5), 1, name="left")
+    gmsh.model.addPhysicalGroup(3, volume_at(1.5), 2, name="right")
+    gmsh.model.addPhysicalGroup(2, face_at(0.0), 3, name="clamp")
+    gmsh.model.addPhysicalGroup(2, face_at(2.0), 4, name="load")
+    mesh_and_write_v41_ascii(0.4, 3, "two_volumes_v41.msh")
 
 
 def cube_points_tets():
@@ -345,7 +378,7 @@ def multi_solid_stl():
 
 
 STEPS = [cube_msh, cube_others, surfaces, cube_meshio_compressed, cube_vtk_library,
-         multi_solid_stl, cube_msh_other_forms, cube_regions]
+         multi_solid_stl, cube_msh_other_forms, cube_regions, two_volumes]
 
 if __name__ == "__main__":
     import sys

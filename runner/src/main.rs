@@ -246,7 +246,7 @@ fn flag(flag: Option<&rapier_fvm_runner::sim::Flag>) -> String {
     })
 }
 
-/// `check`: prints the mesh's quality report.
+/// `check`: prints the mesh's quality report and its regions (Gmsh physical groups).
 fn check(
     mesh: PathBuf,
     scale: f64,
@@ -260,10 +260,11 @@ fn check(
             "--cells-across must lie in 2 to 128, got {cells_across}"
         ));
     }
-    let raw = import::load_raw(&mesh, scale, &SurfaceOptions { cells_across })
+    let mut raw = import::load_raw(&mesh, scale, &SurfaceOptions { cells_across })
         .map_err(|e| e.to_string())?;
     let r = import::check_raw(&raw);
     let quadratic = !raw.mid_edge_nodes.is_empty();
+    let regions = std::mem::take(&mut raw.regions);
     // The time steps need a mesh a body can be built of: no invalid or degenerate element. They
     // are those of the linear tetrahedra on the corners (mid-edge nodes of quadratic ones unused).
     let corners = import::RawMesh {
@@ -302,6 +303,17 @@ fn check(
     println!("  invalid             {}", r.invalid);
     if quadratic {
         println!("  folded              {}", r.folded);
+    }
+    for region in &regions {
+        let tets = if region.tets.is_empty() {
+            String::new()
+        } else {
+            format!(", {} tetrahedra", region.tets.len())
+        };
+        println!(
+            "  region              {region}: {} nodes{tets}",
+            region.nodes.len()
+        );
     }
     println!("  material            E = {young:e} Pa, nu = {poisson}, rho = {density} kg/m³");
     println!("  critical time step  {}", step(steps.map(|s| s.critical)));

@@ -91,6 +91,22 @@ fn check_reports_a_shipped_mesh() {
 }
 
 #[test]
+fn check_lists_a_file_s_regions() {
+    // gmsh's two boxes: 1 455 tetrahedra, 718 of them in "left" and 737 in "right".
+    let output = rapier_fvm(&["check", "assets/meshes/two_volumes_v41.msh"]);
+    assert!(output.status.success());
+    let text = String::from_utf8_lossy(&output.stdout);
+    for line in [
+        "  tetrahedra          1455 (linear)",
+        "  region              \"clamp\" (surface, tag 3): 44 nodes",
+        "  region              \"left\" (volume, tag 1): 235 nodes, 718 tetrahedra",
+        "  region              \"right\" (volume, tag 2): 237 nodes, 737 tetrahedra",
+    ] {
+        assert!(text.lines().any(|l| l == line), "{line:?} in {text}");
+    }
+}
+
+#[test]
 fn wrong_arguments_exit_with_status_two() {
     let output = rapier_fvm(&["run"]);
     assert_eq!(output.status.code(), Some(2));

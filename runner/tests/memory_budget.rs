@@ -184,7 +184,7 @@ fn the_estimates_count_what_the_generators_make() {
     );
     let scene = Scene::parse_within(&path, text, MemoryBudget::given(1e12)).unwrap();
     let surface = &scene.soft_body[0].mesh;
-    let filled = surface.build("mesh", &scene.source).unwrap();
+    let filled = surface.build("mesh", &scene.source).unwrap().mesh;
     let estimate = budget::estimate_mesh(surface, ElementsSpec::Linear);
     let actual = count(&filled, 0);
     assert!(

@@ -66,7 +66,7 @@ fn the_spin_and_region_velocities_are_read_from_the_scene() {
     assert_eq!(block.angvel, [0.0, 0.0, 3.0]);
     assert_eq!(block.linvel, [0.1, 0.0, 0.0]);
     assert_eq!(block.velocity.len(), 1);
-    assert_eq!(block.velocity[0].min, [0.1, -1.0, -1.0]);
+    assert_eq!(block.velocity[0].min, Some([0.1, -1.0, -1.0]));
     assert_eq!(block.velocity[0].linvel, [0.0, 1.0, 0.0]);
     // Left out, they are zero and none.
     let plain = Scene::load(scene_path("drop.toml")).unwrap();

@@ -4,7 +4,7 @@
 use super::bytes;
 use super::file_numbers::assert_mesh_is_the_files;
 use proptest::prelude::*;
-use rapier_fvm::mesh::import::{SurfaceOptions, gmsh, surface, tetgen, vtk};
+use rapier_fvm::mesh::import::{RawMesh, RegionId, SurfaceOptions, gmsh, surface, tetgen, vtk};
 use rapier_fvm::prelude::*;
 use rapier_fvm::{FileLocation, ImportErrorKind};
 
@@ -45,7 +45,10 @@ fn run_reader(reader: usize, data: &[u8]) {
     };
     let outcome = result.and_then(|raw| Ok((raw.clone(), raw.into_mesh()?)));
     match outcome {
-        Ok((raw, mesh)) => assert_mesh_is_the_files(&raw, &mesh),
+        Ok((raw, mesh)) => {
+            assert_mesh_is_the_files(&raw, &mesh);
+            assert_regions_fit(&raw, mesh.node_count());
+        }
         Err(e @ Error::MeshImport { .. }) => {
             // One line of printable text, whatever bytes the file held.
             let shown = e.to_string();
@@ -53,6 +56,22 @@ fn run_reader(reader: usize, data: &[u8]) {
         }
         Err(Error::InvalidSetting { .. }) => {}
         Err(other) => panic!("untyped import error {other:?}"),
+    }
+}
+
+/// Every region's nodes, renumbered, are nodes of the mesh of `node_count` nodes and its
+/// tetrahedra the file's; every volume region keeps alone into a mesh or a typed error.
+fn assert_regions_fit(raw: &RawMesh, node_count: usize) {
+    for region in raw.regions_in_mesh() {
+        assert!(region.nodes.iter().all(|&n| (n as usize) < node_count));
+        assert!(region.tets.iter().all(|&t| (t as usize) < raw.tets.len()));
+        if region.dimension == 3 {
+            let kept = raw.clone().keep_volume(&RegionId::Tag(region.tag));
+            match kept.and_then(RawMesh::into_mesh) {
+                Ok(_) | Err(Error::MeshRegion { .. } | Error::MeshImport { .. }) => {}
+                Err(other) => panic!("untyped region error {other:?}"),
+            }
+        }
     }
 }
 
@@ -76,7 +95,7 @@ fn bytes_cached_ele() -> Vec<u8> {
 }
 
 /// (reader, valid file) pairs mutated by the fuzz properties.
-const SEEDS: [(usize, &str); 24] = [
+const SEEDS: [(usize, &str); 25] = [
     (0, "cube_v22_ascii.msh"),
     (0, "cube_v22_binary.msh"),
     (0, "cube_v41_ascii.msh"),
@@ -86,6 +105,7 @@ const SEEDS: [(usize, &str); 24] = [
     (0, "sphere_surface.msh"),
     (0, "cube_regions_v22.msh"),
     (0, "cube_regions_v41_binary.msh"),
+    (0, "two_volumes_v41.msh"),
     (1, "cube.node"),
     (2, "cube.ele"),
     (3, "cube_ascii.vtu"),

@@ -12,6 +12,7 @@ mod file_numbers;
 mod filling;
 mod fuzz;
 mod malformed;
+mod regions;
 
 fn asset(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -405,59 +406,4 @@ fn a_legacy_vtk_file_cut_inside_its_last_number_is_refused() {
             FileLocation::Line(text.lines().count())
         )
     );
-}
-
-#[test]
-fn gmsh_physical_groups_are_kept_as_named_regions() {
-    // gmsh's cube with its face x = 0 as surface group "clamp" (1) and its volume as "body"
-    // (2), in MSH 2.2 ASCII (groups from element tags) and 4.1 binary (from `$Entities`): the
-    // clamp's nodes are exactly the nodes at x = 0, the body's tetrahedra all 1140.
-    for name in ["cube_regions_v22.msh", "cube_regions_v41_binary.msh"] {
-        let raw = gmsh::parse(&bytes(name), name, 1.0).unwrap();
-        assert_eq!(raw.tets.len(), 1140, "{name}");
-        let names: Vec<(&str, u8, i64)> = raw
-            .regions
-            .iter()
-            .map(|r| (r.name.as_str(), r.dimension, r.tag))
-            .collect();
-        assert_eq!(names, [("clamp", 2, 1), ("body", 3, 2)], "{name}");
-        let on_face: Vec<u32> = (0..raw.positions.len() as u32)
-            .filter(|&n| raw.positions[n as usize].x == 0.0)
-            .collect();
-        assert!(!on_face.is_empty());
-        assert_eq!(raw.regions[0].nodes, on_face, "{name}");
-        assert!(raw.regions[0].tets.is_empty());
-        assert_eq!(
-            raw.regions[1].tets,
-            (0..1140).collect::<Vec<u32>>(),
-            "{name}"
-        );
-    }
-}
-
-#[test]
-fn a_region_selects_the_validated_mesh_s_nodes() {
-    // The clamp's nodes mapped into the mesh `into_mesh` builds lie where the file puts them,
-    // for the linear cube and for the quadratic one (tetra10 corners and mid-edge nodes).
-    let raw = gmsh::parse(&bytes("cube_regions_v22.msh"), "cube.msh", 1.0).unwrap();
-    let index = raw.mesh_node_indices();
-    let mesh = raw.clone().into_mesh().unwrap();
-    for &node in &raw.regions[0].nodes {
-        let in_mesh = index[node as usize].unwrap();
-        assert_eq!(
-            mesh.positions()[in_mesh as usize],
-            raw.positions[node as usize]
-        );
-    }
-    let quadratic = vtk::parse_vtu(&bytes("cube_tet10_ascii.vtu"), "q.vtu", 1.0).unwrap();
-    let index = quadratic.mesh_node_indices();
-    let mesh = quadratic.clone().into_quadratic_mesh().unwrap();
-    assert_eq!(index.iter().flatten().count(), mesh.node_count());
-    for (node, in_mesh) in index.iter().enumerate() {
-        let in_mesh = in_mesh.unwrap();
-        assert_eq!(
-            mesh.positions()[in_mesh as usize],
-            quadratic.positions[node]
-        );
-    }
 }

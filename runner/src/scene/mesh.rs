@@ -6,14 +6,19 @@
 //! mesh = { cylinder = { radius = 0.05, half_height = 0.1, cells_across = 6, cells_along = 8 } }
 //! mesh = { sphere = { radius = 0.05, cells_across = 6 } }
 //! mesh = { file = "../meshes/sphere.obj", scale = 0.05, cells_across = 8 }
+//! mesh = { file = "../meshes/two_blocks.msh", region = "left" }
 //! ```
 //! Lengths in m; a file's `scale` is metres per file unit (default 1), and its path is relative
 //! to the scene file. Surfaces (`.obj`, `.stl`) are filled with tetrahedra, `cells_across`
-//! lattice cells over their largest extent (default 16).
+//! lattice cells over their largest extent (default 16). A file's `region` (a Gmsh physical
+//! volume's name or tag) keeps only that volume's tetrahedra, so one file's volumes can be
+//! bodies of their own; the file's other regions still select nodes of it.
 
 use super::check::Checker;
 use super::error::{SceneError, SceneSource};
+use super::soft_body::RegionName;
 use rapier_fvm::glamx::DVec3;
+use rapier_fvm::mesh::import::{MeshRegion, RawMesh};
 use rapier_fvm::mesh::{self, QuadraticHexMesh, QuadraticTetMesh, TetMesh, import};
 use serde::Deserialize;
 
@@ -35,6 +40,18 @@ pub struct MeshSpec {
     /// Lattice cells across a surface file's largest extent when it is filled with tetrahedra
     /// (only with an `.obj` or `.stl` file), 2 to 128; default 16.
     pub cells_across: Option<usize>,
+    /// The file's volume to keep (only with `file`); default all the file's tetrahedra.
+    pub region: Option<RegionName>,
+}
+
+/// A mesh built from its description, with the named parts of its file.
+pub struct BuiltMesh<M> {
+    /// The mesh.
+    pub mesh: M,
+    /// The file's regions, their nodes numbered as the mesh's; empty for a generator's mesh.
+    pub regions: Vec<MeshRegion>,
+    /// The file the regions come from (for errors), empty for a generator's mesh.
+    pub path: String,
 }
 
 /// `cuboid = { half_extents, cells }`.
@@ -92,6 +109,7 @@ impl MeshSpec {
             for (name, set) in [
                 ("scale", self.scale.is_some()),
                 ("cells_across", self.cells_across.is_some()),
+                ("region", self.region.is_some()),
             ] {
                 if set {
                     c.fail(&format!("{key}.{name}"), "only applies to a mesh `file`");
@@ -127,7 +145,8 @@ impl MeshSpec {
 
     /// Builds the mesh as quadratic tetrahedra: spheres and cylinders with boundary edges curved
     /// to the true surface, a Gmsh file of second-order tetrahedra with its own mid-edge nodes,
-    /// any other mesh with nodes at its edges' midpoints.
+    /// any other mesh with nodes at its edges' midpoints (and a first-order file's regions
+    /// [widened](MeshRegion::with_mid_edge_nodes) to them).
     ///
     /// # Errors
     /// A [`SceneError`] at `key` naming the generator's or the file's problem.
@@ -135,25 +154,39 @@ impl MeshSpec {
         &self,
         key: &str,
         source: &SceneSource,
-    ) -> Result<QuadraticTetMesh, SceneError> {
-        let result = if let Some(c) = &self.cylinder {
+    ) -> Result<BuiltMesh<QuadraticTetMesh>, SceneError> {
+        let library = |at: String| move |e: rapier_fvm::Error| source.error(&at, e.to_string());
+        if let Some(raw) = self.read_file(key, source)? {
+            let (path, second_order) = (raw.path.clone(), !raw.mid_edge_nodes.is_empty());
+            let regions = raw.regions_in_mesh();
+            let mesh = raw
+                .into_quadratic_mesh()
+                .map_err(library(format!("{key}.file")))?;
+            let regions = if second_order {
+                regions
+            } else {
+                regions
+                    .iter()
+                    .map(|r| r.with_mid_edge_nodes(&mesh))
+                    .collect()
+            };
+            return Ok(BuiltMesh {
+                mesh,
+                regions,
+                path,
+            });
+        }
+        let mesh = if let Some(c) = &self.cylinder {
             QuadraticTetMesh::cylinder(c.radius, c.half_height, c.cells_across, c.cells_along)
-                .map_err(|e| (format!("{key}.cylinder"), e.to_string()))
+                .map_err(library(format!("{key}.cylinder")))?
         } else if let Some(s) = &self.sphere {
             QuadraticTetMesh::sphere(s.radius, s.cells_across)
-                .map_err(|e| (format!("{key}.sphere"), e.to_string()))
-        } else if let Some(file) = &self.file {
-            import::load_quadratic(
-                source.folder().join(file),
-                self.scale.unwrap_or(1.0),
-                &self.surface_options(),
-            )
-            .map_err(|e| (format!("{key}.file"), e.to_string()))
+                .map_err(library(format!("{key}.sphere")))?
         } else {
-            QuadraticTetMesh::from_linear(&self.build(key, source)?)
-                .map_err(|e| (key.to_owned(), e.to_string()))
+            QuadraticTetMesh::from_linear(&self.build(key, source)?.mesh)
+                .map_err(library(key.to_owned()))?
         };
-        result.map_err(|(key, message)| source.error(&key, message))
+        Ok(BuiltMesh::generated(mesh))
     }
 
     /// Builds a cage of quadratic hexahedra over a cuboid mesh's cells.
@@ -191,11 +224,42 @@ impl MeshSpec {
         }
     }
 
+    /// The file's raw mesh (its `region` kept), `None` for a generator's mesh.
+    fn read_file(&self, key: &str, source: &SceneSource) -> Result<Option<RawMesh>, SceneError> {
+        let Some(file) = &self.file else {
+            return Ok(None);
+        };
+        let raw = import::load_raw(
+            source.folder().join(file),
+            self.scale.unwrap_or(1.0),
+            &self.surface_options(),
+        )
+        .map_err(|e| source.error(&format!("{key}.file"), e.to_string()))?;
+        match &self.region {
+            Some(region) => raw
+                .keep_volume(&region.id())
+                .map(Some)
+                .map_err(|e| source.error(&format!("{key}.region"), e.to_string())),
+            None => Ok(Some(raw)),
+        }
+    }
+
     /// Builds the mesh (rest positions in m); files are resolved from the scene's folder.
     ///
     /// # Errors
     /// A [`SceneError`] at `key` naming the generator's or the file's problem.
-    pub fn build(&self, key: &str, source: &SceneSource) -> Result<TetMesh, SceneError> {
+    pub fn build(&self, key: &str, source: &SceneSource) -> Result<BuiltMesh<TetMesh>, SceneError> {
+        if let Some(raw) = self.read_file(key, source)? {
+            let (path, regions) = (raw.path.clone(), raw.regions_in_mesh());
+            let mesh = raw
+                .into_mesh()
+                .map_err(|e| source.error(&format!("{key}.file"), e.to_string()))?;
+            return Ok(BuiltMesh {
+                mesh,
+                regions,
+                path,
+            });
+        }
         let result = if let Some(c) = &self.cuboid {
             mesh::cuboid(DVec3::from_array(c.half_extents), c.cells)
                 .map_err(|e| (format!("{key}.cuboid"), e.to_string()))
@@ -205,16 +269,22 @@ impl MeshSpec {
         } else if let Some(s) = &self.sphere {
             mesh::sphere(s.radius, s.cells_across)
                 .map_err(|e| (format!("{key}.sphere"), e.to_string()))
-        } else if let Some(file) = &self.file {
-            import::load(
-                source.folder().join(file),
-                self.scale.unwrap_or(1.0),
-                &self.surface_options(),
-            )
-            .map_err(|e| (format!("{key}.file"), e.to_string()))
         } else {
             Err((key.to_owned(), "no mesh source".to_owned()))
         };
-        result.map_err(|(key, message)| source.error(&key, message))
+        result
+            .map(BuiltMesh::generated)
+            .map_err(|(key, message)| source.error(&key, message))
+    }
+}
+
+impl<M> BuiltMesh<M> {
+    /// A generator's mesh, without regions.
+    fn generated(mesh: M) -> Self {
+        Self {
+            mesh,
+            regions: Vec::new(),
+            path: String::new(),
+        }
     }
 }

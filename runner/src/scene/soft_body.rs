@@ -27,13 +27,16 @@
 //!                                 # the box's nodes start at `linvel` (m/s) instead
 //! ```
 //! Regions are boxes `min`..`max` (m) in the mesh's rest coordinates, before the translation and
-//! rotation; each must hold at least one node.
+//! rotation, or, for a mesh file with named parts (Gmsh physical groups), `region = "clamp"` (a
+//! group's name) or `region = 3` (its physical tag): the nodes of that group's elements, as in
+//! `pinned = [{ region = "clamp" }]`. Each region must hold at least one node.
 
 use super::check::Checker;
 use super::material::{DampingSpec, MaterialSpec};
 use super::mesh::MeshSpec;
 use rapier_fvm::glamx::DVec3;
 use rapier_fvm::mesh::TetMesh;
+use rapier_fvm::mesh::import::{MeshRegion, RegionId};
 use serde::Deserialize;
 
 /// A soft body.
@@ -117,14 +120,16 @@ pub enum ElementsSpec {
     QuadraticHex,
 }
 
-/// A box of rest coordinates (m).
+/// The nodes a pin selects: a box of rest coordinates or a region of the mesh file.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RegionSpec {
-    /// Lower corner (m).
-    pub min: [f64; 3],
-    /// Upper corner (m).
-    pub max: [f64; 3],
+    /// Lower corner of the box (m).
+    pub min: Option<[f64; 3]>,
+    /// Upper corner of the box (m).
+    pub max: Option<[f64; 3]>,
+    /// The mesh file's region, in place of a box.
+    pub region: Option<RegionName>,
 }
 
 /// Nodes of a region glued to a rigid body.
@@ -133,42 +138,104 @@ pub struct RegionSpec {
 pub struct AttachmentSpec {
     /// The rigid body's name.
     pub rigid: String,
-    /// Lower corner of the region (m, rest coordinates).
-    pub min: [f64; 3],
-    /// Upper corner of the region (m, rest coordinates).
-    pub max: [f64; 3],
+    /// Lower corner of the box (m, rest coordinates).
+    pub min: Option<[f64; 3]>,
+    /// Upper corner of the box (m, rest coordinates).
+    pub max: Option<[f64; 3]>,
+    /// The mesh file's region, in place of a box.
+    pub region: Option<RegionName>,
 }
 
 /// Nodes of a region given their own initial velocity.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RegionVelocitySpec {
-    /// Lower corner of the region (m, rest coordinates).
-    pub min: [f64; 3],
-    /// Upper corner of the region (m, rest coordinates).
-    pub max: [f64; 3],
+    /// Lower corner of the box (m, rest coordinates).
+    pub min: Option<[f64; 3]>,
+    /// Upper corner of the box (m, rest coordinates).
+    pub max: Option<[f64; 3]>,
+    /// The mesh file's region, in place of a box.
+    pub region: Option<RegionName>,
     /// The nodes' initial velocity (m/s).
     pub linvel: [f64; 3],
 }
 
-impl RegionSpec {
-    /// The nodes of `mesh` inside the box (bounds included).
-    pub fn nodes(&self, mesh: &TetMesh) -> Vec<u32> {
-        nodes_in(mesh, self.min, self.max)
+/// A region of a mesh file as a scene names it: `"clamp"` (its name) or `3` (its tag).
+#[derive(Debug, Clone, PartialEq, Eq, Deserialize)]
+#[serde(untagged)]
+pub enum RegionName {
+    /// The physical group's tag.
+    Tag(i64),
+    /// The physical group's name.
+    Name(String),
+}
+
+impl RegionName {
+    /// The library's name for it.
+    pub fn id(&self) -> RegionId {
+        match self {
+            Self::Tag(tag) => RegionId::Tag(*tag),
+            Self::Name(name) => RegionId::Name(name.clone()),
+        }
     }
 }
 
-impl AttachmentSpec {
-    /// The nodes of `mesh` inside the box (bounds included).
-    pub fn nodes(&self, mesh: &TetMesh) -> Vec<u32> {
-        nodes_in(mesh, self.min, self.max)
-    }
+/// Which nodes a pin, an attachment or an initial velocity takes: a box or a file's region.
+#[derive(Debug, Clone, Copy)]
+pub struct Selection<'a> {
+    /// Lower corner of the box (m, rest coordinates).
+    pub min: Option<[f64; 3]>,
+    /// Upper corner of the box (m, rest coordinates).
+    pub max: Option<[f64; 3]>,
+    /// The mesh file's region.
+    pub region: Option<&'a RegionName>,
 }
 
-impl RegionVelocitySpec {
-    /// The nodes of `mesh` inside the box (bounds included).
-    pub fn nodes(&self, mesh: &TetMesh) -> Vec<u32> {
-        nodes_in(mesh, self.min, self.max)
+/// `selection()` for each spec that selects nodes by a box or a region.
+macro_rules! selects_nodes {
+    ($($spec:ty),*) => {$(
+        impl $spec {
+            /// The nodes it selects.
+            pub fn selection(&self) -> Selection<'_> {
+                Selection {
+                    min: self.min,
+                    max: self.max,
+                    region: self.region.as_ref(),
+                }
+            }
+        }
+    )*};
+}
+
+selects_nodes!(RegionSpec, AttachmentSpec, RegionVelocitySpec);
+
+impl Selection<'_> {
+    /// The nodes of `mesh` (rest coordinates) inside the box (bounds included), or those of the
+    /// region among `regions` (numbered as `mesh`'s nodes) read from the file `path`.
+    ///
+    /// # Errors
+    /// The library's words when the region is not in the file or is ambiguous.
+    pub fn nodes(
+        &self,
+        mesh: &TetMesh,
+        regions: &[MeshRegion],
+        path: &str,
+    ) -> Result<Vec<u32>, rapier_fvm::Error> {
+        match (self.region, self.min, self.max) {
+            (Some(name), _, _) => Ok(MeshRegion::find(regions, &name.id(), path)?.nodes.clone()),
+            (None, Some(min), Some(max)) => Ok(nodes_in(mesh, min, max)),
+            _ => Ok(Vec::new()),
+        }
+    }
+
+    /// Checks that it is a box or a region, not both, and the box's corners.
+    fn check(&self, key: &str, c: &mut Checker<'_>) {
+        match (self.region, self.min, self.max) {
+            (None, Some(min), Some(max)) => check_box(key, min, max, c),
+            (Some(_), None, None) => {}
+            (None, _, _) => c.fail(key, "give a box (`min` and `max`) or a `region`"),
+            (Some(_), _, _) => c.fail(key, "give a box (`min` and `max`) or a `region`, not both"),
+        }
     }
 }
 
@@ -211,12 +278,22 @@ impl SoftBodySpec {
         c.speed(&format!("{key}.linvel"), self.linvel);
         c.finite_vector(&format!("{key}.angvel"), self.angvel);
         c.non_negative(&format!("{key}.friction"), self.friction, "dimensionless");
+        let selections = (self.pinned.iter().map(RegionSpec::selection))
+            .chain(self.attach.iter().map(AttachmentSpec::selection))
+            .chain(self.velocity.iter().map(RegionVelocitySpec::selection));
+        if self.mesh.file.is_none() && selections.into_iter().any(|s| s.region.is_some()) {
+            c.fail(
+                &format!("{key}.mesh"),
+                "a `region` selects nodes of a mesh file's named parts; this mesh is not a file"
+                    .to_owned(),
+            );
+        }
         for (i, region) in self.pinned.iter().enumerate() {
-            check_box(&format!("{key}.pinned[{i}]"), region.min, region.max, c);
+            region.selection().check(&format!("{key}.pinned[{i}]"), c);
         }
         for (i, attachment) in self.attach.iter().enumerate() {
             let key = format!("{key}.attach[{i}]");
-            check_box(&key, attachment.min, attachment.max, c);
+            attachment.selection().check(&key, c);
             if !rigid_names.contains(&attachment.rigid.as_str()) {
                 c.fail(
                     &format!("{key}.rigid"),
@@ -226,7 +303,7 @@ impl SoftBodySpec {
         }
         for (i, region) in self.velocity.iter().enumerate() {
             let key = format!("{key}.velocity[{i}]");
-            check_box(&key, region.min, region.max, c);
+            region.selection().check(&key, c);
             c.speed(&format!("{key}.linvel"), region.linvel);
         }
     }

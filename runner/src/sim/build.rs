@@ -220,6 +220,8 @@ fn insert_soft(
         quadratic,
         cage,
         embedded,
+        regions,
+        path,
     } = BodyMeshes::build(spec, (key, source), memory)?;
     let library = |key: String| move |e: rapier_fvm::Error| source.error(&key, e.to_string());
     let material = spec
@@ -230,7 +232,7 @@ fn insert_soft(
         pinned,
         velocities,
         attachments,
-    } = BodyRegions::select(spec, &mesh, rigid, (key, source))?;
+    } = BodyRegions::select(spec, (&mesh, &regions, &path), rigid, (key, source))?;
     let mut builder = match (quadratic, cage) {
         (Some(quadratic), _) => DeformableBodyBuilder::quadratic(quadratic, material),
         (_, Some(cage)) => DeformableBodyBuilder::quadratic_hex(cage, material),

@@ -6,6 +6,7 @@
 use crate::scene::budget::{MemoryUse, MeshCount};
 use crate::scene::soft_body::{ElementsSpec, SoftBodySpec};
 use crate::scene::{SceneError, SceneSource};
+use rapier_fvm::mesh::import::MeshRegion;
 use rapier_fvm::mesh::{QuadraticHexMesh, QuadraticTetMesh, TetMesh};
 
 /// The meshes of a soft body.
@@ -18,6 +19,10 @@ pub(super) struct BodyMeshes {
     pub(super) cage: Option<QuadraticHexMesh>,
     /// The fine mesh the elements carry, if any.
     pub(super) embedded: Option<TetMesh>,
+    /// The mesh file's regions, their nodes numbered as `mesh`'s; empty for a generator's mesh.
+    pub(super) regions: Vec<MeshRegion>,
+    /// The mesh file, for the regions' errors; empty for a generator's mesh.
+    pub(super) path: String,
 }
 
 impl BodyMeshes {
@@ -29,22 +34,33 @@ impl BodyMeshes {
         memory: &mut MemoryUse,
     ) -> Result<Self, SceneError> {
         let mesh_key = format!("{key}.mesh");
-        let (mesh, quadratic, cage) = match spec.elements {
-            ElementsSpec::Linear => (spec.mesh.build(&mesh_key, source)?, None, None),
+        let (mesh, quadratic, cage, regions, path) = match spec.elements {
+            ElementsSpec::Linear => {
+                let built = spec.mesh.build(&mesh_key, source)?;
+                (built.mesh, None, None, built.regions, built.path)
+            }
             ElementsSpec::Quadratic => {
-                let quadratic = spec.mesh.build_quadratic(&mesh_key, source)?;
-                (quadratic.subdivided().clone(), Some(quadratic), None)
+                let built = spec.mesh.build_quadratic(&mesh_key, source)?;
+                let subdivided = built.mesh.subdivided().clone();
+                (
+                    subdivided,
+                    Some(built.mesh),
+                    None,
+                    built.regions,
+                    built.path,
+                )
             }
             ElementsSpec::QuadraticHex => {
                 let cage = spec.mesh.build_cage(&mesh_key, source)?;
-                (cage.subdivided().clone(), None, Some(cage))
+                let subdivided = cage.subdivided().clone();
+                (subdivided, None, Some(cage), Vec::new(), String::new())
             }
         };
         let hexahedra = cage.as_ref().map_or(0, QuadraticHexMesh::element_count);
         memory.add(MeshCount::of(&mesh, hexahedra), &mesh_key, source)?;
         let embedded_key = format!("{key}.embedded");
         let embedded = match &spec.embedded {
-            Some(embedded) => Some(embedded.build(&embedded_key, source)?),
+            Some(embedded) => Some(embedded.build(&embedded_key, source)?.mesh),
             None => None,
         };
         if let Some(fine) = &embedded {
@@ -55,6 +71,8 @@ impl BodyMeshes {
             quadratic,
             cage,
             embedded,
+            regions,
+            path,
         })
     }
 }

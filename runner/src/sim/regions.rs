@@ -1,12 +1,13 @@
-//! A soft body's regions: the nodes its boxes (rest coordinates) select to be pinned, to start
-//! at their own velocity, and to be glued to rigid bodies, each box refused at its key if it
-//! holds no node.
+//! A soft body's regions: the nodes its boxes (rest coordinates) or its mesh file's regions
+//! select to be pinned, to start at their own velocity, and to be glued to rigid bodies, each
+//! refused at its key if it holds no node or names no region of the file.
 
 use super::build::RigidEntry;
-use crate::scene::soft_body::SoftBodySpec;
+use crate::scene::soft_body::{Selection, SoftBodySpec};
 use crate::scene::{SceneError, SceneSource};
 use rapier_fvm::glamx::DVec3;
 use rapier_fvm::mesh::TetMesh;
+use rapier_fvm::mesh::import::MeshRegion;
 use rapier3d::prelude::RigidBodyHandle;
 
 /// Nodes glued to a rigid body, with the key of the attachment that glues them.
@@ -30,38 +31,47 @@ pub(super) struct BodyRegions {
 }
 
 impl BodyRegions {
-    /// The nodes of `mesh` (rest coordinates) in the boxes of `spec`, `key` in the scene of
-    /// `source`, attachments bound to the bodies of `rigid`.
+    /// The nodes of `mesh` (rest coordinates) in the boxes or `regions` (of the file `path`)
+    /// that `spec` selects, `key` in the scene of `source`, attachments bound to the bodies of
+    /// `rigid`.
     ///
     /// # Errors
-    /// A [`SceneError`] at a box that holds no node or an attachment to a rigid body not in
-    /// `rigid`.
+    /// A [`SceneError`] at a selection that holds no node or names no region of the file, or an
+    /// attachment to a rigid body not in `rigid`.
     pub(super) fn select(
         spec: &SoftBodySpec,
-        mesh: &TetMesh,
+        (mesh, regions, path): (&TetMesh, &[MeshRegion], &str),
         rigid: &[RigidEntry],
         (key, source): (&str, &SceneSource),
     ) -> Result<Self, SceneError> {
-        let in_box = |nodes: Vec<u32>, at: &str| {
+        let nodes = |selection: Selection<'_>, at: &str| {
+            let nodes = selection
+                .nodes(mesh, regions, path)
+                .map_err(|e| source.error(&format!("{at}.region"), e.to_string()))?;
             if nodes.is_empty() {
-                Err(source.error(at, "the box holds no node"))
+                let what = if selection.region.is_some() {
+                    "region"
+                } else {
+                    "box"
+                };
+                Err(source.error(at, format!("the {what} holds no node")))
             } else {
                 Ok(nodes)
             }
         };
         let mut pinned = Vec::new();
         for (i, region) in spec.pinned.iter().enumerate() {
-            pinned.extend(in_box(region.nodes(mesh), &format!("{key}.pinned[{i}]"))?);
+            pinned.extend(nodes(region.selection(), &format!("{key}.pinned[{i}]"))?);
         }
         let mut velocities = Vec::new();
         for (i, region) in spec.velocity.iter().enumerate() {
-            let nodes = in_box(region.nodes(mesh), &format!("{key}.velocity[{i}]"))?;
+            let nodes = nodes(region.selection(), &format!("{key}.velocity[{i}]"))?;
             velocities.push((nodes, DVec3::from_array(region.linvel)));
         }
         let mut attachments = Vec::new();
         for (i, attachment) in spec.attach.iter().enumerate() {
             let key = format!("{key}.attach[{i}]");
-            let nodes = in_box(attachment.nodes(mesh), &key)?;
+            let nodes = nodes(attachment.selection(), &key)?;
             let body = rigid
                 .iter()
                 .find(|r| r.name == attachment.rigid)

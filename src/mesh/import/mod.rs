@@ -10,8 +10,9 @@
 //! | surface: Wavefront OBJ, STL (ASCII and binary), Gmsh triangles only | `.obj`, `.stl`, `.msh` | [`surface`], [`gmsh::parse_surface`] |
 //!
 //! Gmsh's physical groups are kept as named [`MeshRegion`]s of the raw mesh (the nodes of their
-//! elements, a volume group's tetrahedra); [`RawMesh::mesh_node_indices`] maps their nodes into
-//! the validated mesh.
+//! elements, a volume group's tetrahedra); [`RawMesh::regions_in_mesh`] numbers their nodes as
+//! the validated mesh's, [`MeshRegion::find`] picks one by name or tag ([`RegionId`]) and
+//! [`RawMesh::keep_volume`] keeps one volume's tetrahedra (see the `region` module's example).
 //!
 //! Every reader takes a `scale` in metres per file unit (1 for files in metres, 0.001 for
 //! millimetres) and first returns a [`RawMesh`]: positions and tetrahedra as the file has them,
@@ -47,6 +48,7 @@
 pub mod gmsh;
 mod locate;
 pub mod quality;
+mod region;
 pub mod surface;
 pub mod tetgen;
 mod text;
@@ -54,6 +56,7 @@ pub mod vtk;
 
 pub use crate::error::{FileLocation, ImportErrorKind};
 pub use quality::{QualityReport, check, check_raw};
+pub use region::{MeshRegion, RegionId};
 pub use surface::SurfaceOptions;
 
 use crate::Error;
@@ -81,21 +84,6 @@ pub struct RawMesh {
     /// The file's named parts (Gmsh physical groups), in order of dimension and tag; empty for
     /// formats that keep none.
     pub regions: Vec<MeshRegion>,
-}
-
-/// A named part of a mesh file: a Gmsh physical group of points, curves, surfaces or volumes.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct MeshRegion {
-    /// Its name (`$PhysicalNames`), empty if the file gives none.
-    pub name: String,
-    /// Its dimension: 0 points, 1 curves, 2 surfaces, 3 volumes.
-    pub dimension: u8,
-    /// Its physical tag.
-    pub tag: i64,
-    /// The nodes of its elements, indices into [`RawMesh::positions`], sorted, each once.
-    pub nodes: Vec<u32>,
-    /// For a volume group, its tetrahedra: indices into [`RawMesh::tets`], in file order.
-    pub tets: Vec<u32>,
 }
 
 impl RawMesh {
@@ -158,29 +146,6 @@ impl RawMesh {
             }
         }
         QuadraticTetMesh::new(positions, elements).map_err(|e| self.invalid(e))
-    }
-
-    /// The index each node of [`RawMesh::positions`] gets in the mesh [`RawMesh::into_mesh`]
-    /// and [`RawMesh::into_quadratic_mesh`] build (nodes numbered in order of first use by the
-    /// elements, corners then mid-edge nodes), `None` for a node no element uses or past the
-    /// positions; with it, a [`MeshRegion`]'s nodes select the validated mesh's nodes.
-    pub fn mesh_node_indices(&self) -> Vec<Option<u32>> {
-        let mut index = vec![None; self.positions.len()];
-        let mut next = 0u32;
-        let mids = self
-            .mid_edge_nodes
-            .iter()
-            .map(Some)
-            .chain(std::iter::repeat(None));
-        for (corners, mids) in self.tets.iter().zip(mids) {
-            for &node in corners.iter().chain(mids.into_iter().flatten()) {
-                if let Some(slot @ None) = index.get_mut(node as usize) {
-                    *slot = Some(next);
-                    next += 1;
-                }
-            }
-        }
-        index
     }
 
     /// The nodes `elements` use, in order of first use, and the elements renumbered to them.

@@ -1,0 +1,182 @@
+//! A mesh file's regions (Gmsh physical groups) in scenes: a body pinned by its physical surface
+//! runs as the same body pinned by the equivalent box, each volume of a file can be a body of
+//! its own, and a region the file does not have is refused at its key with the file's regions.
+
+use rapier_fvm_runner::scene::{Scene, SceneError};
+use rapier_fvm_runner::sim::{self, RunOptions, Simulation};
+use std::path::{Path, PathBuf};
+
+/// Where the scenes below pretend to live, so that `../meshes/` is the shipped meshes' folder.
+fn scene_path(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../assets/scenes/{name}.toml"))
+}
+
+/// A 10 cm cube read from gmsh's `cube_regions_v22.msh` (its face x = 0 the surface group
+/// "clamp", tag 1), hanging from that face under gravity and sagging; `pinned` selects the face.
+fn hanging_cube(pinned: &str, elements: &str) -> String {
+    format!(
+        r#"name = "hanging"
+
+[world]
+duration = 0.15
+
+[[soft_body]]
+name = "cube"
+mesh = {{ file = "../meshes/cube_regions_v22.msh", scale = 0.1 }}
+material = {{ model = "stable_neo_hookean", young = 2e4, poisson = 0.3, density = 1000.0 }}
+damping = {{ stiffness_time = 2e-3 }}
+elements = "{elements}"
+pinned = [{pinned}]
+
+[[probe]]
+name = "sag"
+kind = "displacement"
+body = "cube"
+point = [0.1, 0.0, 0.05]
+component = "y"
+"#
+    )
+}
+
+/// The report of running `text` (scene `name`) for its whole duration.
+fn run(name: &str, text: String) -> sim::Report {
+    let scene = Scene::parse(scene_path(name), text).unwrap_or_else(|e| panic!("{e}"));
+    let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
+    let _ = std::fs::remove_dir_all(&out);
+    let options = RunOptions {
+        out,
+        duration: None,
+        progress: false,
+    };
+    sim::run(&scene, &options).unwrap_or_else(|e| panic!("{e}"))
+}
+
+#[test]
+fn a_body_pinned_by_its_physical_surface_runs_as_one_pinned_by_the_same_box() {
+    // The box around x = 0 (the cube spans [0, 0.1] m) holds exactly the clamp's nodes, so the
+    // two runs must agree to the bit, for linear and for quadratic tetrahedra (whose clamp
+    // takes the face's mid-edge nodes too). The cube sags by millimetres: the pins hold.
+    let the_box = "{ min = [-0.001, -1.0, -1.0], max = [0.001, 1.0, 1.0] }";
+    for elements in ["linear", "quadratic"] {
+        let by_region = run(
+            &format!("pinned_by_region_{elements}"),
+            hanging_cube(r#"{ region = "clamp" }"#, elements),
+        );
+        let by_tag = run(
+            &format!("pinned_by_tag_{elements}"),
+            hanging_cube("{ region = 1 }", elements),
+        );
+        let by_box = run(
+            &format!("pinned_by_box_{elements}"),
+            hanging_cube(the_box, elements),
+        );
+        let sag = |report: &sim::Report| report.probes[0].values.clone();
+        assert_eq!(sag(&by_region), sag(&by_box), "{elements}");
+        assert_eq!(sag(&by_tag), sag(&by_box), "{elements}");
+        let last = by_box.probes[0].final_value;
+        assert!(last < -1e-4 && last > -0.05, "{elements}: sag {last} m");
+        assert!(by_region.stability.stable, "{elements}");
+    }
+}
+
+#[test]
+fn each_volume_of_a_file_becomes_a_body_of_its_own() {
+    // Two unit boxes side by side in one gmsh file, scaled to 10 cm: "left" and "right" as two
+    // bodies, the left pinned by the file's "clamp", the right given a velocity by its "load".
+    let text = r#"name = "two"
+
+[world]
+duration = 0.02
+
+[[soft_body]]
+name = "left"
+mesh = { file = "../meshes/two_volumes_v41.msh", scale = 0.1, region = "left" }
+material = { model = "stable_neo_hookean", young = 1e5, poisson = 0.3, density = 1000.0 }
+pinned = [{ region = "clamp" }]
+
+[[soft_body]]
+name = "right"
+mesh = { file = "../meshes/two_volumes_v41.msh", scale = 0.1, region = 2 }
+material = { model = "stable_neo_hookean", young = 1e5, poisson = 0.3, density = 1000.0 }
+velocity = [{ region = "load", linvel = [0.0, 0.0, 0.1] }]
+"#;
+    let scene = Scene::parse(scene_path("two_volumes"), text.to_owned()).unwrap();
+    let simulation = Simulation::build(&scene).unwrap_or_else(|e| panic!("{e}"));
+    let whole = rapier_fvm::mesh::import::load(
+        scene_path("x").with_file_name("../meshes/two_volumes_v41.msh"),
+        0.1,
+        &Default::default(),
+    )
+    .unwrap();
+    let mut tets = 0;
+    for (entry, side) in simulation.soft.iter().zip([0.0, 0.1]) {
+        let body = &simulation.world.soft_bodies[entry.handle];
+        tets += body.mesh().tet_count();
+        let volume = body.mesh().volume();
+        assert!(
+            (volume - 1e-3).abs() < 1e-15,
+            "{}: {volume} m^3",
+            entry.name
+        );
+        for p in &entry.rest {
+            assert!(
+                p.x >= side - 1e-12 && p.x <= side + 0.1 + 1e-12,
+                "{}",
+                entry.name
+            );
+        }
+    }
+    assert_eq!(tets, whole.tet_count());
+}
+
+/// The error of building `text`.
+fn build_error(text: String) -> SceneError {
+    let scene = Scene::parse(scene_path("bad_region"), text).unwrap();
+    match Simulation::build(&scene) {
+        Ok(_) => panic!("the scene should be refused"),
+        Err(error) => error,
+    }
+}
+
+#[test]
+fn a_region_the_file_lacks_is_refused_at_its_key_with_the_file_s_regions() {
+    let error = build_error(hanging_cube(r#"{ region = "lid" }"#, "linear"));
+    assert_eq!(error.key.as_deref(), Some("soft_body[0].pinned[0].region"));
+    assert_eq!(error.line, Some(12));
+    assert!(
+        error.message.ends_with(
+            "cube_regions_v22.msh: region \"lid\": the file's regions are \"clamp\" (surface, \
+             tag 1), \"body\" (volume, tag 2)"
+        ),
+        "{error}"
+    );
+    // A surface is not a body.
+    let text = hanging_cube(r#"{ region = "clamp" }"#, "linear")
+        .replace("scale = 0.1 }", r#"scale = 0.1, region = "clamp" }"#);
+    let error = build_error(text);
+    assert_eq!(error.key.as_deref(), Some("soft_body[0].mesh.region"));
+    assert!(
+        error.message.ends_with("is not a volume of tetrahedra"),
+        "{error}"
+    );
+    // A generator's mesh has no regions: refused when the scene is read.
+    let text = hanging_cube(r#"{ region = "clamp" }"#, "linear").replace(
+        r#"{ file = "../meshes/cube_regions_v22.msh", scale = 0.1 }"#,
+        "{ cuboid = { half_extents = [0.05, 0.05, 0.05], cells = [2, 2, 2] } }",
+    );
+    let error = Scene::parse(scene_path("generator"), text).unwrap_err();
+    assert_eq!(error.key.as_deref(), Some("soft_body[0].mesh"));
+    assert!(error.message.contains("this mesh is not a file"), "{error}");
+    // A box and a region at once, or half a box.
+    for pinned in [
+        r#"{ region = "clamp", min = [0.0, 0.0, 0.0], max = [1.0, 1.0, 1.0] }"#,
+        "{ min = [0.0, 0.0, 0.0] }",
+    ] {
+        let error = Scene::parse(scene_path("both"), hanging_cube(pinned, "linear")).unwrap_err();
+        assert_eq!(
+            error.key.as_deref(),
+            Some("soft_body[0].pinned[0]"),
+            "{pinned}"
+        );
+    }
+}

@@ -1,0 +1,256 @@
+//! Named parts of a mesh file (Gmsh physical groups): finding one by name or tag, numbering its
+//! nodes as the validated mesh does, and keeping one volume's tetrahedra as a mesh of its own.
+//!
+//! A [`MeshRegion`] read from a file holds the nodes of its elements as indices into
+//! [`RawMesh::positions`]. The validated mesh numbers the nodes its elements use in order of
+//! first use ([`RawMesh::mesh_node_indices`]), so [`RawMesh::regions_in_mesh`] gives the regions
+//! in that numbering: the node indices a pin, an attachment or a load takes. The tetrahedra of a
+//! volume group keep their indices, since validation keeps the elements in file order.
+//!
+//! # Example
+//! ```
+//! use rapier_fvm::mesh::import::{self, RegionId};
+//!
+//! // One tetrahedron whose face x = 0 is the surface group "clamp" (Gmsh MSH 2.2).
+//! let msh = b"$MeshFormat\n2.2 0 8\n$EndMeshFormat\n\
+//!     $PhysicalNames\n2\n2 1 \"clamp\"\n3 2 \"body\"\n$EndPhysicalNames\n\
+//!     $Nodes\n4\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n$EndNodes\n\
+//!     $Elements\n2\n1 2 2 1 1 1 3 4\n2 4 2 2 1 1 2 3 4\n$EndElements\n";
+//! let raw = import::gmsh::parse(msh, "tet.msh", 1.0)?;
+//! let regions = raw.regions_in_mesh();
+//! let clamp = import::MeshRegion::find(&regions, &RegionId::Name("clamp".into()), "tet.msh")?;
+//! let mesh = raw.into_mesh()?;
+//! for &node in &clamp.nodes {
+//!     assert_eq!(mesh.positions()[node as usize].x, 0.0);
+//! }
+//! assert_eq!(clamp.nodes.len(), 3);
+//! # Ok::<(), rapier_fvm::Error>(())
+//! ```
+
+use super::RawMesh;
+use crate::Error;
+use crate::mesh::QuadraticTetMesh;
+use crate::shape::tet10::EDGES;
+use std::fmt;
+
+/// A named part of a mesh file: a Gmsh physical group of points, curves, surfaces or volumes.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct MeshRegion {
+    /// Its name (`$PhysicalNames`), empty if the file gives none.
+    pub name: String,
+    /// Its dimension: 0 points, 1 curves, 2 surfaces, 3 volumes.
+    pub dimension: u8,
+    /// Its physical tag.
+    pub tag: i64,
+    /// The nodes of its elements, sorted, each once: indices into [`RawMesh::positions`] as
+    /// read, into the validated mesh's nodes once [renumbered](RawMesh::regions_in_mesh).
+    pub nodes: Vec<u32>,
+    /// For a volume group, its tetrahedra (the quadratic elements of a second-order file), in
+    /// file order: indices into [`RawMesh::tets`], which are also those of the validated mesh.
+    pub tets: Vec<u32>,
+}
+
+/// How a program or a scene names a region: by the name the file gives it or by its tag.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum RegionId {
+    /// The group's name (Gmsh's `$PhysicalNames`).
+    Name(String),
+    /// The group's physical tag.
+    Tag(i64),
+}
+
+impl fmt::Display for RegionId {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Name(name) => write!(f, "region {name:?}"),
+            Self::Tag(tag) => write!(f, "region tag {tag}"),
+        }
+    }
+}
+
+impl fmt::Display for MeshRegion {
+    /// `"clamp" (surface, tag 1)`, or `unnamed (volume, tag 2)`.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let kind = ["points", "curve", "surface", "volume"]
+            .get(usize::from(self.dimension))
+            .copied()
+            .unwrap_or("group");
+        if self.name.is_empty() {
+            write!(f, "unnamed ({kind}, tag {})", self.tag)
+        } else {
+            write!(f, "{:?} ({kind}, tag {})", self.name, self.tag)
+        }
+    }
+}
+
+impl MeshRegion {
+    /// The one region of `regions` that `id` names; `path` is the file they come from (for the
+    /// error).
+    ///
+    /// # Errors
+    /// [`Error::MeshRegion`] when no region or more than one answers to `id` (a tag a surface
+    /// group and a volume group share: name it instead), listing the file's regions.
+    pub fn find<'a>(regions: &'a [Self], id: &RegionId, path: &str) -> Result<&'a Self, Error> {
+        let matching: Vec<&Self> = regions
+            .iter()
+            .filter(|region| match id {
+                RegionId::Name(name) => region.name == *name,
+                RegionId::Tag(tag) => region.tag == *tag,
+            })
+            .collect();
+        let error = |reason: String| Error::MeshRegion {
+            path: path.to_owned(),
+            region: id.to_string(),
+            reason,
+        };
+        match matching.as_slice() {
+            [region] => Ok(region),
+            [] if regions.is_empty() => Err(error(
+                "the file names no regions (Gmsh physical groups)".into(),
+            )),
+            [] => Err(error(format!("the file's regions are {}", list(regions)))),
+            several => Err(error(format!(
+                "more than one group answers to it: {}; select one by its other identifier",
+                list(several.iter().copied())
+            ))),
+        }
+    }
+}
+
+/// The regions as `"clamp" (surface, tag 1), "body" (volume, tag 2)`.
+fn list<'a>(regions: impl IntoIterator<Item = &'a MeshRegion>) -> String {
+    let names: Vec<String> = regions.into_iter().map(ToString::to_string).collect();
+    names.join(", ")
+}
+
+impl RawMesh {
+    /// The index each node of [`RawMesh::positions`] gets in the mesh [`RawMesh::into_mesh`]
+    /// and [`RawMesh::into_quadratic_mesh`] build (nodes numbered in order of first use by the
+    /// elements, corners then mid-edge nodes), `None` for a node no element uses or past the
+    /// positions; with it, a [`MeshRegion`]'s nodes select the validated mesh's nodes.
+    pub fn mesh_node_indices(&self) -> Vec<Option<u32>> {
+        let mut index = vec![None; self.positions.len()];
+        let mut next = 0u32;
+        let mids = self
+            .mid_edge_nodes
+            .iter()
+            .map(Some)
+            .chain(std::iter::repeat(None));
+        for (corners, mids) in self.tets.iter().zip(mids) {
+            for &node in corners.iter().chain(mids.into_iter().flatten()) {
+                if let Some(slot @ None) = index.get_mut(node as usize) {
+                    *slot = Some(next);
+                    next += 1;
+                }
+            }
+        }
+        index
+    }
+
+    /// The file's regions with their nodes numbered as in the mesh [`RawMesh::into_mesh`] and
+    /// [`RawMesh::into_quadratic_mesh`] build, sorted; nodes no element uses (a surface group's
+    /// nodes outside the volume [kept](RawMesh::keep_volume)) are left out.
+    pub fn regions_in_mesh(&self) -> Vec<MeshRegion> {
+        let index = self.mesh_node_indices();
+        self.regions
+            .iter()
+            .map(|region| {
+                let mut nodes: Vec<u32> = region
+                    .nodes
+                    .iter()
+                    .filter_map(|&node| index.get(node as usize).copied().flatten())
+                    .collect();
+                nodes.sort_unstable();
+                MeshRegion {
+                    nodes,
+                    ..region.clone()
+                }
+            })
+            .collect()
+    }
+
+    /// The mesh of one volume group's tetrahedra, so that a file's volumes can become bodies
+    /// of their own: the other tetrahedra are dropped, the positions kept (validation drops the
+    /// nodes left unused), and every region's tetrahedra renumbered to those kept.
+    ///
+    /// # Errors
+    /// [`Error::MeshRegion`] when `id` names no region, more than one, or a region that is not
+    /// a volume of tetrahedra.
+    pub fn keep_volume(mut self, id: &RegionId) -> Result<Self, Error> {
+        let region = MeshRegion::find(&self.regions, id, &self.path)?;
+        if region.dimension != 3 || region.tets.is_empty() {
+            return Err(Error::MeshRegion {
+                path: self.path.clone(),
+                region: id.to_string(),
+                reason: format!("{region} is not a volume of tetrahedra"),
+            });
+        }
+        let kept = region.tets.clone();
+        let mut new_index = vec![None; self.tets.len()];
+        for (new, &old) in kept.iter().enumerate() {
+            new_index[old as usize] = Some(new as u32);
+        }
+        let pick = |i: &u32| kept_element(&new_index, *i);
+        self.tets = kept.iter().map(|&i| self.tets[i as usize]).collect();
+        self.tet_locations = kept
+            .iter()
+            .map(|&i| self.tet_locations[i as usize])
+            .collect();
+        if !self.mid_edge_nodes.is_empty() {
+            self.mid_edge_nodes = kept
+                .iter()
+                .map(|&i| self.mid_edge_nodes[i as usize])
+                .collect();
+        }
+        for region in &mut self.regions {
+            region.tets = region.tets.iter().filter_map(pick).collect();
+        }
+        Ok(self)
+    }
+}
+
+/// The new index of element `old`, if kept.
+fn kept_element(new_index: &[Option<u32>], old: u32) -> Option<u32> {
+    new_index.get(old as usize).copied().flatten()
+}
+
+impl MeshRegion {
+    /// The region on `mesh`, a quadratic mesh built from the linear one its nodes number (by
+    /// [`QuadraticTetMesh::from_linear`], which keeps the corners' numbers): with the mid-edge
+    /// node of each edge whose two ends it holds, if that node lies on the boundary (or the
+    /// region is a volume), so that a surface group of a first-order file selects its whole
+    /// face of the quadratic body. A second-order file's groups hold their mid-edge nodes
+    /// already and need no widening.
+    #[must_use]
+    pub fn with_mid_edge_nodes(&self, mesh: &QuadraticTetMesh) -> Self {
+        let node_count = mesh.positions().len();
+        let mut inside = vec![false; node_count];
+        for &node in &self.nodes {
+            if let Some(slot) = inside.get_mut(node as usize) {
+                *slot = true;
+            }
+        }
+        let mut on_boundary = vec![self.dimension == 3; node_count];
+        for triangle in mesh.subdivided().surface_triangles() {
+            for node in triangle {
+                on_boundary[node as usize] = true;
+            }
+        }
+        let mut nodes = self.nodes.clone();
+        for element in mesh.elements() {
+            for (k, [i, j]) in EDGES.iter().enumerate() {
+                let mid = element[4 + k];
+                let ends_inside = inside[element[*i] as usize] && inside[element[*j] as usize];
+                if ends_inside && on_boundary[mid as usize] && !inside[mid as usize] {
+                    inside[mid as usize] = true;
+                    nodes.push(mid);
+                }
+            }
+        }
+        nodes.sort_unstable();
+        Self {
+            nodes,
+            ..self.clone()
+        }
+    }
+}

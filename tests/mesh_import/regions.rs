@@ -1,0 +1,177 @@
+//! Regions (Gmsh physical groups): read from the file, found by name or tag, numbered as the
+//! validated mesh's nodes, one volume kept as a mesh of its own, and widened to a quadratic
+//! body's mid-edge nodes.
+
+use super::bytes;
+use rapier_fvm::Error;
+use rapier_fvm::mesh::QuadraticTetMesh;
+use rapier_fvm::mesh::import::{MeshRegion, RegionId, gmsh, vtk};
+
+#[test]
+fn gmsh_physical_groups_are_kept_as_named_regions() {
+    // gmsh's cube with its face x = 0 as surface group "clamp" (1) and its volume as "body"
+    // (2), in MSH 2.2 ASCII (groups from element tags) and 4.1 binary (from `$Entities`): the
+    // clamp's nodes are exactly the nodes at x = 0, the body's tetrahedra all 1140.
+    for name in ["cube_regions_v22.msh", "cube_regions_v41_binary.msh"] {
+        let raw = gmsh::parse(&bytes(name), name, 1.0).unwrap();
+        assert_eq!(raw.tets.len(), 1140, "{name}");
+        let names: Vec<(&str, u8, i64)> = raw
+            .regions
+            .iter()
+            .map(|r| (r.name.as_str(), r.dimension, r.tag))
+            .collect();
+        assert_eq!(names, [("clamp", 2, 1), ("body", 3, 2)], "{name}");
+        let on_face: Vec<u32> = (0..raw.positions.len() as u32)
+            .filter(|&n| raw.positions[n as usize].x == 0.0)
+            .collect();
+        assert!(!on_face.is_empty());
+        assert_eq!(raw.regions[0].nodes, on_face, "{name}");
+        assert!(raw.regions[0].tets.is_empty());
+        assert_eq!(
+            raw.regions[1].tets,
+            (0..1140).collect::<Vec<u32>>(),
+            "{name}"
+        );
+    }
+}
+
+#[test]
+fn a_region_selects_the_validated_mesh_s_nodes() {
+    // The clamp's nodes mapped into the mesh `into_mesh` builds lie where the file puts them,
+    // for the linear cube and for the quadratic one (tetra10 corners and mid-edge nodes).
+    let raw = gmsh::parse(&bytes("cube_regions_v22.msh"), "cube.msh", 1.0).unwrap();
+    let index = raw.mesh_node_indices();
+    let mesh = raw.clone().into_mesh().unwrap();
+    for &node in &raw.regions[0].nodes {
+        let in_mesh = index[node as usize].unwrap();
+        assert_eq!(
+            mesh.positions()[in_mesh as usize],
+            raw.positions[node as usize]
+        );
+    }
+    let quadratic = vtk::parse_vtu(&bytes("cube_tet10_ascii.vtu"), "q.vtu", 1.0).unwrap();
+    let index = quadratic.mesh_node_indices();
+    let mesh = quadratic.clone().into_quadratic_mesh().unwrap();
+    assert_eq!(index.iter().flatten().count(), mesh.node_count());
+    for (node, in_mesh) in index.iter().enumerate() {
+        let in_mesh = in_mesh.unwrap();
+        assert_eq!(
+            mesh.positions()[in_mesh as usize],
+            quadratic.positions[node]
+        );
+    }
+}
+
+/// The file of two unit boxes side by side: volumes "left" (tag 1, x in [0, 1]) and "right"
+/// (tag 2, x in [1, 2]), surfaces "clamp" (tag 3, x = 0) and "load" (tag 4, x = 2).
+fn two_volumes() -> rapier_fvm::mesh::import::RawMesh {
+    gmsh::parse(&bytes("two_volumes_v41.msh"), "two_volumes_v41.msh", 1.0).unwrap()
+}
+
+fn name(text: &str) -> RegionId {
+    RegionId::Name(text.to_owned())
+}
+
+#[test]
+fn each_volume_of_a_file_is_a_mesh_of_its_own() {
+    // Each box alone: its volume 1 m^3 to rounding, its nodes on its side of x = 1, and the two
+    // together all the file's tetrahedra.
+    let raw = two_volumes();
+    let total = raw.tets.len();
+    let mut counted = 0;
+    for (id, side) in [(name("left"), 0.0), (RegionId::Tag(2), 1.0)] {
+        let part = raw.clone().keep_volume(&id).unwrap();
+        counted += part.tets.len();
+        assert_eq!(part.tet_locations.len(), part.tets.len());
+        let mesh = part.into_mesh().unwrap();
+        assert!(
+            (mesh.volume() - 1.0).abs() < 1e-12,
+            "{id}: {}",
+            mesh.volume()
+        );
+        for p in mesh.positions() {
+            assert!(
+                p.x >= side - 1e-12 && p.x <= side + 1.0 + 1e-12,
+                "{id}: {p}"
+            );
+        }
+    }
+    assert_eq!(counted, total);
+}
+
+#[test]
+fn a_kept_volume_keeps_the_regions_that_touch_it() {
+    // The left box keeps the clamp (its face x = 0, exactly its nodes there), loses the load
+    // (on the right box), and its own tetrahedra are renumbered to all of the kept ones.
+    let left = two_volumes().keep_volume(&name("left")).unwrap();
+    let regions = left.regions_in_mesh();
+    let clamp = MeshRegion::find(&regions, &name("clamp"), &left.path).unwrap();
+    let load = MeshRegion::find(&regions, &RegionId::Tag(4), &left.path).unwrap();
+    let own = MeshRegion::find(&regions, &name("left"), &left.path).unwrap();
+    let other = MeshRegion::find(&regions, &name("right"), &left.path).unwrap();
+    let tets = left.tets.len() as u32;
+    let mesh = left.into_mesh().unwrap();
+    let at_zero = mesh.nodes_where(|p| p.x == 0.0);
+    assert!(!at_zero.is_empty());
+    assert_eq!(clamp.nodes, at_zero);
+    assert!(load.nodes.is_empty() && other.tets.is_empty());
+    // The right box's nodes in the left one are those of the face they share.
+    assert_eq!(other.nodes, mesh.nodes_where(|p| p.x == 1.0));
+    assert_eq!(own.tets, (0..tets).collect::<Vec<u32>>());
+    assert_eq!(own.nodes.len(), mesh.node_count());
+}
+
+#[test]
+fn an_unknown_ambiguous_or_flat_region_is_refused_with_the_file_s_regions() {
+    let raw = two_volumes();
+    let message = |e: Error| {
+        assert!(matches!(e, Error::MeshRegion { .. }), "{e:?}");
+        e.to_string()
+    };
+    let unknown = message(MeshRegion::find(&raw.regions, &name("lid"), &raw.path).unwrap_err());
+    assert_eq!(
+        unknown,
+        "two_volumes_v41.msh: region \"lid\": the file's regions are \"clamp\" (surface, tag \
+         3), \"load\" (surface, tag 4), \"left\" (volume, tag 1), \"right\" (volume, tag 2)"
+    );
+    let flat = message(raw.clone().keep_volume(&RegionId::Tag(3)).unwrap_err());
+    assert_eq!(
+        flat,
+        "two_volumes_v41.msh: region tag 3: \"clamp\" (surface, tag 3) is not a volume of \
+         tetrahedra"
+    );
+    // cube_regions numbers its surface and its volume 1 and 2; a second group tagged 1 makes
+    // the tag ambiguous.
+    let mut cube = gmsh::parse(&bytes("cube_regions_v22.msh"), "cube.msh", 1.0).unwrap();
+    cube.regions[1].tag = 1;
+    let ambiguous =
+        message(MeshRegion::find(&cube.regions, &RegionId::Tag(1), "cube.msh").unwrap_err());
+    assert!(
+        ambiguous.contains("more than one group answers to it"),
+        "{ambiguous}"
+    );
+    let none = message(MeshRegion::find(&[], &name("clamp"), "cube.vtu").unwrap_err());
+    assert!(
+        none.ends_with("the file names no regions (Gmsh physical groups)"),
+        "{none}"
+    );
+}
+
+#[test]
+fn a_first_order_face_widened_to_a_quadratic_body_is_its_whole_face() {
+    // The clamp of the linear cube, on the quadratic mesh built from it: exactly the quadratic
+    // mesh's nodes at x = 0 (corners and mid-edge nodes), no interior mid-edge node.
+    let raw = gmsh::parse(&bytes("cube_regions_v22.msh"), "cube.msh", 1.0).unwrap();
+    let clamp = raw.regions_in_mesh()[0].clone();
+    let quadratic = QuadraticTetMesh::from_linear(&raw.into_mesh().unwrap()).unwrap();
+    let widened = clamp.with_mid_edge_nodes(&quadratic);
+    let at_zero: Vec<u32> = (0..quadratic.positions().len() as u32)
+        .filter(|&n| quadratic.positions()[n as usize].x == 0.0)
+        .collect();
+    assert!(widened.nodes.len() > clamp.nodes.len());
+    assert_eq!(widened.nodes, at_zero);
+    // The body as a volume region takes every node.
+    let body = gmsh::parse(&bytes("cube_regions_v22.msh"), "cube.msh", 1.0).unwrap();
+    let whole = body.regions_in_mesh()[1].with_mid_edge_nodes(&quadratic);
+    assert_eq!(whole.nodes.len(), quadratic.positions().len());
+}
