@@ -249,32 +249,28 @@ impl MeshSpec {
     /// # Errors
     /// A [`SceneError`] at `key` naming the generator's or the file's problem.
     pub fn build(&self, key: &str, source: &SceneSource) -> Result<BuiltMesh<TetMesh>, SceneError> {
+        let library = |at: String| move |e: rapier_fvm::Error| source.error(&at, e.to_string());
         if let Some(raw) = self.read_file(key, source)? {
             let (path, regions) = (raw.path.clone(), raw.regions_in_mesh());
-            let mesh = raw
-                .into_mesh()
-                .map_err(|e| source.error(&format!("{key}.file"), e.to_string()))?;
+            let mesh = raw.into_mesh().map_err(library(format!("{key}.file")))?;
             return Ok(BuiltMesh {
                 mesh,
                 regions,
                 path,
             });
         }
-        let result = if let Some(c) = &self.cuboid {
+        let mesh = if let Some(c) = &self.cuboid {
             mesh::cuboid(DVec3::from_array(c.half_extents), c.cells)
-                .map_err(|e| (format!("{key}.cuboid"), e.to_string()))
+                .map_err(library(format!("{key}.cuboid")))?
         } else if let Some(c) = &self.cylinder {
             mesh::cylinder(c.radius, c.half_height, c.cells_across, c.cells_along)
-                .map_err(|e| (format!("{key}.cylinder"), e.to_string()))
+                .map_err(library(format!("{key}.cylinder")))?
         } else if let Some(s) = &self.sphere {
-            mesh::sphere(s.radius, s.cells_across)
-                .map_err(|e| (format!("{key}.sphere"), e.to_string()))
+            mesh::sphere(s.radius, s.cells_across).map_err(library(format!("{key}.sphere")))?
         } else {
-            Err((key.to_owned(), "no mesh source".to_owned()))
+            return Err(source.error(key, "no mesh source"));
         };
-        result
-            .map(BuiltMesh::generated)
-            .map_err(|(key, message)| source.error(&key, message))
+        Ok(BuiltMesh::generated(mesh))
     }
 }
 
