@@ -294,6 +294,14 @@ pub enum Error {
         /// Name of the input.
         parameter: &'static str,
     },
+    /// A load cannot be applied as given (see [`crate::load::Load::check`]).
+    #[error("{load}: {reason}")]
+    InvalidLoad {
+        /// The load's kind (`pressure`, `cable`, ...).
+        load: &'static str,
+        /// What is wrong.
+        reason: String,
+    },
     /// A solver setting is outside its valid range.
     #[error("invalid setting `{parameter}` = {value}: {reason}")]
     InvalidSetting {

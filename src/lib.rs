@@ -93,6 +93,7 @@ pub mod integrate;
 mod lanes;
 mod limits;
 pub mod linear_solver;
+pub mod load;
 pub mod material;
 pub mod mesh;
 mod newton;
@@ -133,6 +134,7 @@ pub mod prelude {
         SolverWorkspace, StepReport, Substeps, SymplecticEuler,
     };
     pub use crate::linear_solver::LinearSolver;
+    pub use crate::load::{Load, LoadHandle, LoadValue};
     pub use crate::material::{LameParameters, Material, MaterialModel, YoungPoisson};
     pub use crate::mesh::{self, TetMesh};
     pub use crate::world::FvmWorld;

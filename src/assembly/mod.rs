@@ -57,12 +57,18 @@ pub(crate) struct Stiffness {
 }
 
 impl Stiffness {
-    /// The pattern of `body`'s mesh, values zero: nodes sharing a tetrahedron, and with nodal
-    /// averaging also nodes sharing a neighbour (the patches' coupling).
+    /// The pattern of `body`'s mesh, values zero: nodes sharing a tetrahedron, nodes a load
+    /// couples (a cable's neighbours on its path), and with nodal averaging also nodes sharing a
+    /// neighbour (the patches' coupling).
     pub(crate) fn new(body: &DeformableBody) -> Self {
         let n = body.node_count();
         let mut lower_neighbours: Vec<Vec<u32>> = (0..n as u32).map(|b| vec![b]).collect();
-        couple_all_pairs(&mut lower_neighbours, body.elements.element_nodes());
+        let load_pairs = body.load_pairs();
+        let pairs = load_pairs.iter().map(|pair| &pair[..]);
+        couple_all_pairs(
+            &mut lower_neighbours,
+            body.elements.element_nodes().chain(pairs),
+        );
         if body.elements.nodal_averaging().is_some() {
             // A node's patch: itself and every node sharing a tetrahedron with it.
             let mut patches: Vec<Vec<u32>> = lower_neighbours.clone();
@@ -164,8 +170,9 @@ impl Stiffness {
     /// integration point (see [`crate::element`]) `w ∇N_aᵀ A ∇N_b` with `A` the stress tangent of
     /// the elastic stress differential plus `extra(point, F, dF)` (a further stress differential,
     /// Pa), projected to be positive
-    /// semi-definite if `project`; the coupling of nodal averaging if the body uses it; and
-    /// `diagonal[n] I` on each free node.
+    /// semi-definite if `project`; the coupling of nodal averaging if the body uses it; the
+    /// Hessians of its follower loads' potentials ([`crate::load`]); and `diagonal[n] I` on each
+    /// free node.
     pub(crate) fn assemble(
         &mut self,
         body: &DeformableBody,
@@ -209,6 +216,7 @@ impl Stiffness {
                     self.add_outer(gradient, weight, &body.pinned)
                 });
         });
+        crate::load::add_follower_tangents(body, self);
         for (node, &pinned) in body.pinned.iter().enumerate() {
             for i in 0..3 {
                 let e = self.entry(node, i, node, i);
@@ -232,6 +240,16 @@ impl Stiffness {
                     weight * block.col(j)[i]
                 });
             }
+        }
+    }
+
+    /// Adds the block `K_ab = block` (N/m) and its transpose `K_ba` (for `a == b`, the
+    /// symmetric `block` once), skipping pinned nodes.
+    pub(crate) fn add_pair(&mut self, a: usize, b: usize, block: &DMat3, pinned: &[bool]) {
+        if a >= b {
+            self.add_pair_block(a, b, pinned, |i, j| block.col(j)[i]);
+        } else {
+            self.add_pair_block(b, a, pinned, |i, j| block.col(i)[j]);
         }
     }
 

@@ -452,6 +452,7 @@ impl DeformableBodyBuilder {
             velocities,
             pinned,
             embedding,
+            loads: Vec::new(),
             collision_groups: self.collision_groups,
             friction: self.friction,
             friction_combine_rule: self.friction_combine_rule,

@@ -4,6 +4,7 @@
 //! raw slices; a step refuses a state it cannot take ([`DeformableBody::check_state`]).
 
 mod builder;
+mod loads;
 #[cfg(feature = "serde-serialize")]
 mod record;
 mod set;
@@ -50,6 +51,8 @@ pub struct DeformableBody {
     pub(crate) surface: BodySurface,
     /// A fine mesh carried by the nodes, whose surface contacts with colliders act on.
     pub(crate) embedding: Option<Embedding>,
+    /// The loads besides gravity ([`DeformableBody::add_load`]).
+    pub(crate) loads: Vec<crate::load::Load>,
     /// How many times the state was edited from outside the integrators
     /// ([`DeformableBody::positions_mut`], [`DeformableBody::velocities_mut`], a static solve):
     /// two-step integrators restart after an edit.
@@ -230,15 +233,6 @@ impl DeformableBody {
     /// Counts an edit of the state from outside the integrators (a static solve).
     pub(crate) fn count_state_edit(&mut self) {
         self.state_edits += 1;
-    }
-
-    /// The weight of every free node, `m g` (N); zero on pinned nodes.
-    pub(crate) fn gravity_load(&self, gravity: DVec3) -> Vec<DVec3> {
-        self.masses
-            .iter()
-            .zip(&self.pinned)
-            .map(|(m, &pinned)| if pinned { DVec3::ZERO } else { gravity * *m })
-            .collect()
     }
 
     /// Elastic strain energy (J) at the current positions.

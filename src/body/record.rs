@@ -1,6 +1,6 @@
 //! What a [`DeformableBody`] is written as with the feature `serde-serialize`: what it was built
 //! from (rest mesh, elements, material, damping, volumetric treatment, embedded mesh, pins,
-//! contact coefficients, user data) and its nodal state. Read back, the body is built again by
+//! contact coefficients, user data, loads) and its nodal state. Read back, the body is built again by
 //! [`DeformableBodyBuilder`], so every check of a new body applies to a file (a typed error,
 //! never a panic), and the rest data comes out as it was: the build is deterministic.
 
@@ -9,6 +9,7 @@ use crate::Error;
 use crate::damping::RayleighDamping;
 use crate::element::ElementShape;
 use crate::fvm::VolumetricTreatment;
+use crate::load::Load;
 use crate::material::Material;
 use crate::mesh::TetMesh;
 use rapier3d::dynamics::CoefficientCombineRule;
@@ -35,6 +36,9 @@ pub(super) struct BodyRecord {
     restitution_combine_rule: CoefficientCombineRule,
     self_contact: bool,
     user_data: u128,
+    /// The loads besides gravity (none in files written before loads existed).
+    #[serde(default)]
+    loads: Vec<Load>,
     /// Positions (m) and velocities (m/s) of the nodes.
     positions: Vec<DVec3>,
     velocities: Vec<DVec3>,
@@ -64,6 +68,7 @@ impl From<&DeformableBody> for BodyRecord {
             restitution_combine_rule: body.restitution_combine_rule,
             self_contact: body.self_contact,
             user_data: body.user_data,
+            loads: body.loads.clone(),
             positions: body.positions.clone(),
             velocities: body.velocities.clone(),
             state_edits: body.state_edits,
@@ -108,6 +113,9 @@ impl TryFrom<BodyRecord> for DeformableBody {
                     node_count: nodes,
                 });
             }
+        }
+        for load in record.loads {
+            body.add_load(load)?;
         }
         body.positions = record.positions;
         body.velocities = record.velocities;

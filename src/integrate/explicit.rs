@@ -333,10 +333,10 @@ fn soft_bodies<'a>(steps: &'a mut [BodyInStep<'_>]) -> Vec<&'a mut DeformableBod
     steps.iter_mut().map(|s| &mut *s.body).collect()
 }
 
-/// The substep's velocity update `v ← v + h (f/m + g)`, then the constraints readied for the
-/// sweeps.
+/// The substep's velocity update `v ← v + h (f/m + g)` (`f` the internal forces and the loads'),
+/// then the constraints readied for the sweeps.
 fn update_velocities(step: &mut BodyInStep<'_>, h: f64, gravity: DVec3) {
-    step.workspace.compute_internal_forces(step.body);
+    step.workspace.compute_forces(step.body);
     let DeformableBody {
         velocities,
         masses,

@@ -145,10 +145,12 @@ impl SolverWorkspace {
         })
     }
 
-    /// Recomputes [`SolverWorkspace::forces`] for `body`.
-    pub(crate) fn compute_internal_forces(&mut self, body: &mut DeformableBody) {
+    /// Recomputes [`SolverWorkspace::forces`] for `body`: its internal forces and its loads'
+    /// but gravity's.
+    pub(crate) fn compute_forces(&mut self, body: &mut DeformableBody) {
         self.fit(body);
         body.internal_forces_into(&mut self.forces);
+        body.add_load_forces(&mut self.forces);
     }
 
     /// Copies `body`'s positions and velocities aside (no allocation after the first call).
@@ -168,6 +170,19 @@ impl SolverWorkspace {
     /// `self.tangent = Some(..)`.
     pub(crate) fn take_tangent(&mut self, body: &DeformableBody) -> Stiffness {
         self.fit(body);
+        let load_pairs = body.load_pairs();
+        if let Some(tangent) = self.tangent.take() {
+            // A load added since the pattern was made may couple nodes it does not.
+            let missing: Vec<[u32; 2]> = (load_pairs.into_iter())
+                .filter(|&[a, b]| !tangent.couples(a, b))
+                .collect();
+            return match missing.is_empty() {
+                true => tangent,
+                false => tangent
+                    .widened(&missing)
+                    .unwrap_or_else(|| Stiffness::new(body)),
+            };
+        }
         self.tangent.take().unwrap_or_else(|| {
             let mesh = Stiffness::new(body);
             #[cfg(feature = "serde-serialize")]

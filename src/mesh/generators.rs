@@ -1,4 +1,4 @@
-//! Structured tetrahedral meshes of boxes, cylinders and spheres.
+//! Structured tetrahedral meshes of boxes, cylinders, tubes and spheres.
 //!
 //! Boxes are a lattice of cubes, each split into five tetrahedra (four corner tetrahedra around a
 //! central one) with the split mirrored on alternate cubes, so neighbouring cubes share face
@@ -104,6 +104,68 @@ pub fn cylinder(
             DVec3::new(q.x, height(u.y), q.y)
         });
     }
+    hexes.finish()
+}
+
+/// A tube (hollow cylinder) along the y axis, centred at the origin, between the radii
+/// `inner_radius` and `outer_radius` (m), of height `2 half_height` (m): `cells_around` cells
+/// around, `cells_through` through the wall and `cells_along` along the axis, each hexahedral
+/// cell split into twelve tetrahedra around its centre. Its inner surface is the boundary a
+/// pneumatic chamber's or a pressure vessel's pressure acts on.
+///
+/// # Errors
+/// [`Error::InvalidGeneratorParameter`] for an inner radius not below the outer one, fewer than
+/// 3 cells around, zero cells through or along, a non-positive, non-finite size or more nodes
+/// than 32-bit indices address; [`Error::AllocationFailed`] when the machine cannot hold the
+/// mesh.
+///
+/// # Example
+/// ```
+/// use rapier_fvm::mesh;
+/// let tube = mesh::tube(0.01, 0.02, 0.05, 24, 2, 10)?;
+/// let exact = std::f64::consts::PI * (0.02f64.powi(2) - 0.01f64.powi(2)) * 0.1;
+/// // The polygonal section is a little smaller than the round one.
+/// assert!((tube.volume() / exact - 1.0).abs() < 0.012);
+/// # Ok::<(), rapier_fvm::Error>(())
+/// ```
+pub fn tube(
+    inner_radius: f64,
+    outer_radius: f64,
+    half_height: f64,
+    cells_around: usize,
+    cells_through: usize,
+    cells_along: usize,
+) -> Result<TetMesh, Error> {
+    check_length("inner_radius", inner_radius)?;
+    check_length("outer_radius", outer_radius)?;
+    check_length("half_height", half_height)?;
+    if inner_radius >= outer_radius {
+        return Err(Error::InvalidGeneratorParameter {
+            parameter: "inner_radius",
+            value: inner_radius,
+            reason: "must be below the outer radius",
+        });
+    }
+    if cells_around < 3 {
+        return Err(Error::InvalidGeneratorParameter {
+            parameter: "cells_around",
+            value: cells_around as f64,
+            reason: "a tube needs at least 3 cells around",
+        });
+    }
+    check_cells_along(cells_through)?;
+    check_cells_along(cells_along)?;
+    let cells = [cells_around, cells_along, cells_through];
+    let mut hexes = HexMesher::with_capacity(outer_radius.max(half_height), &[(1, cells)])?;
+    hexes.add_block(cells, |u| {
+        let angle = std::f64::consts::TAU * u.x;
+        let radius = inner_radius + (outer_radius - inner_radius) * u.z;
+        DVec3::new(
+            radius * angle.cos(),
+            (2.0 * u.y - 1.0) * half_height,
+            radius * angle.sin(),
+        )
+    });
     hexes.finish()
 }
 

@@ -14,7 +14,7 @@ mod quadratic_hex;
 mod surface;
 mod validate;
 
-pub use generators::{cuboid, cylinder, sphere};
+pub use generators::{cuboid, cylinder, sphere, tube};
 pub use quadratic::QuadraticTetMesh;
 pub(crate) use quadratic::SUB_TETS;
 pub use quadratic_hex::QuadraticHexMesh;
@@ -206,6 +206,15 @@ impl TetMesh {
     /// normals `(b - a) x (c - a)` point out of the body.
     pub fn surface_triangles(&self) -> Vec<[u32; 3]> {
         surface::boundary_faces(&self.tets)
+    }
+
+    /// The boundary triangles (as [`TetMesh::surface_triangles`]) whose three corners' rest
+    /// positions satisfy `predicate`: the face a traction or a pressure acts on, e.g. a beam's
+    /// free end `mesh.surface_triangles_where(|p| p.x >= 1.0 - 1e-9)`.
+    pub fn surface_triangles_where(&self, predicate: impl Fn(DVec3) -> bool) -> Vec<[u32; 3]> {
+        let mut triangles = self.surface_triangles();
+        triangles.retain(|t| t.iter().all(|&n| predicate(self.positions[n as usize])));
+        triangles
     }
 }
 

@@ -1,5 +1,5 @@
-//! Static analysis: the equilibrium `f_int(x) + M g = 0` of a body under gravity with its pinned
-//! nodes held, found by Newton's method on the total potential energy, and the natural
+//! Static analysis: the equilibrium `f_int(x) + M g + f_load(x) = 0` of a body under gravity and
+//! its loads ([`crate::load`]) with its pinned nodes held, found by Newton's method on the total potential energy, and the natural
 //! frequencies of small vibrations about the current configuration.
 //!
 //! Both use the sparse tangent stiffness `K = -∂f_int/∂x` and faer's sparse Cholesky
@@ -45,7 +45,8 @@ pub struct StaticReport {
     pub relative_residual: f64,
 }
 
-/// Moves `body` to static equilibrium under `gravity` (m/s²), starting from its current positions,
+/// Moves `body` to static equilibrium under `gravity` (m/s²) and its loads, starting from its
+/// current positions,
 /// with pinned nodes held where they are and all velocities set to zero.
 ///
 /// # Errors
@@ -87,7 +88,7 @@ fn newton(
     settings: &StaticSettings,
 ) -> Result<StaticReport, Error> {
     body.velocities.fill(DVec3::ZERO);
-    let load = body.gravity_load(gravity);
+    let load = body.dead_load(gravity);
     let mut residual = out_of_balance(body, &load);
     let reference = norm(&load).max(norm(&residual));
     if reference == 0.0 {
@@ -238,7 +239,8 @@ fn assemble_elastic(stiffness: &mut Stiffness, body: &DeformableBody, project: b
 /// `f_int(x) + load`, zero on pinned nodes (N).
 fn out_of_balance(body: &mut DeformableBody, load: &[DVec3]) -> Vec<DVec3> {
     // The velocities are zero, so the damping adds nothing.
-    let forces = body.internal_forces();
+    let mut forces = body.internal_forces();
+    body.add_follower_forces(&mut forces);
     (0..load.len())
         .map(|n| {
             if body.pinned[n] {
@@ -250,15 +252,15 @@ fn out_of_balance(body: &mut DeformableBody, load: &[DVec3]) -> Vec<DVec3> {
         .collect()
 }
 
-/// Total potential energy (J): elastic energy minus the work of the constant load, measured
-/// from the positions `start` (m) the solve began at.
+/// Total potential energy (J): elastic energy plus the follower loads' potential minus the work
+/// of the constant load, measured from the positions `start` (m) the solve began at.
 fn potential_energy(body: &DeformableBody, load: &[DVec3], start: &[DVec3]) -> f64 {
     let load_work: f64 = load
         .iter()
         .zip(body.positions.iter().zip(start))
         .map(|(f, (x, x0))| f.dot(*x - *x0))
         .sum();
-    body.elastic_energy() - load_work
+    body.elastic_energy() + body.follower_potential(start) - load_work
 }
 
 /// A fixed pseudo-random number in [-1, 1) for index `i` (`SplitMix64`).

@@ -2,7 +2,8 @@
 //! `E(x) = Σ m/(2ĥ²) |x − x̂|² + Ψ(x) + ĥ D((x − x₀)/ĥ) − W(x)`, with `x̂` the inertial target
 //! (backward Euler `x₀ + ĥ v₀`; BDF2 from the two previous states), `Ψ` the elastic energy, `D`
 //! the damping's dissipation on the strain rate measured from the step's start, and `W` the work
-//! of gravity, contacts and attachments, plus the response `½ ιᵀ W ι` of the dynamic rigid
+//! of gravity, the body's loads ([`crate::load`]: the follower ones through their potentials),
+//! contacts and attachments, plus the response `½ ιᵀ W ι` of the dynamic rigid
 //! bodies those act against, minimized over their impulses `ι` for each `x`. Its gradient is the out-of-balance force and its Hessian
 //! the Newton tangent; the new velocity is `(x − a)/ĥ`.
 
@@ -101,7 +102,7 @@ impl StepStart {
                 }
             })
             .collect();
-        let load = body.gravity_load(gravity);
+        let load = body.dead_load(gravity);
         Self {
             h: effective_h,
             positions,
@@ -124,7 +125,7 @@ pub(super) struct Potential<'a> {
 }
 
 impl Potential<'_> {
-    /// `-∇E` (N): elastic and damping forces, gravity, contact penalties and the inertial pull
+    /// `-∇E` (N): elastic and damping forces, gravity and loads, contact penalties and the inertial pull
     /// toward `x̂`; zero on pinned nodes. `forces` is scratch for the internal forces.
     pub(super) fn residual(
         &self,
@@ -133,6 +134,7 @@ impl Potential<'_> {
     ) -> Vec<DVec3> {
         body.velocities.fill(DVec3::ZERO);
         body.internal_forces_into(forces);
+        body.add_follower_forces(forces);
         let start = self.start;
         let mut residual: Vec<DVec3> = (0..body.positions.len())
             .map(|n| {
@@ -211,7 +213,8 @@ impl Potential<'_> {
         let mut rigid = self.rigid.borrow_mut();
         let response = rigid.solve(body, self.constraints);
         let penalty = constraint::implicit_energy(body, self.constraints, rigid.step());
-        inertia + body.elastic_energy() + dissipation + penalty + response - load
+        let follower = body.follower_potential(&self.start.positions);
+        inertia + body.elastic_energy() + follower + dissipation + penalty + response - load
     }
 
     /// `M/h² + K_elastic + K_damping + K_contact`, each element's stress tangent projected to be positive

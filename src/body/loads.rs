@@ -1,0 +1,112 @@
+//! A body's loads besides gravity ([`crate::load`]): added, read and set by handle, and what
+//! the integrators take from them: the dead loads with gravity's weight as one constant force
+//! per node, the follower loads' forces and potential at the current positions.
+
+use super::DeformableBody;
+use crate::Error;
+use crate::load::{Load, LoadHandle, LoadValue};
+use rapier3d::glamx::DVec3;
+
+impl DeformableBody {
+    /// Adds a load (see [`crate::load`]); it acts from the next step on.
+    ///
+    /// # Errors
+    /// [`Error::InvalidLoad`] for a load naming a node the body does not have, a degenerate
+    /// triangle or path, or a non-finite value (see [`Load::check`]).
+    ///
+    /// ```
+    /// use rapier_fvm::prelude::*;
+    ///
+    /// // A 10 cm rubber cube, clamped at its base, pulled up by 10 kPa on its top face.
+    /// let mesh = mesh::cuboid(DVec3::splat(0.05), [4, 4, 4])?;
+    /// let top = mesh.surface_triangles_where(|p| p.y > 0.05 - 1e-9);
+    /// let base = mesh.nodes_where(|p| p.y < -0.05 + 1e-9);
+    /// let rubber = Material::new(MaterialModel::StableNeoHookean, 1e6, 0.45, 1100.0)?;
+    /// let mut cube = DeformableBodyBuilder::new(mesh, rubber).pinned_nodes(base).build()?;
+    /// let pull = cube.add_load(Load::Traction { triangles: top, traction: DVec3::new(0.0, 1e4, 0.0) })?;
+    /// // A controller changes it between frames.
+    /// cube.set_load(pull, LoadValue::Vector(DVec3::new(0.0, 2e4, 0.0)))?;
+    /// # Ok::<(), rapier_fvm::Error>(())
+    /// ```
+    pub fn add_load(&mut self, load: Load) -> Result<LoadHandle, Error> {
+        load.check(self.node_count())?;
+        self.loads.push(load);
+        Ok(LoadHandle(self.loads.len() as u32 - 1))
+    }
+
+    /// The body's loads, in the order they were added (a [`LoadHandle`] is the index).
+    pub fn loads(&self) -> &[Load] {
+        &self.loads
+    }
+
+    /// The load `handle`, if the body has it.
+    pub fn load(&self, handle: LoadHandle) -> Option<&Load> {
+        self.loads.get(handle.0 as usize)
+    }
+
+    /// Sets the magnitude of the load `handle` (a pressure in Pa, a tension in N, a traction in
+    /// Pa or a force density in N/m³), as a controller does between frames.
+    ///
+    /// # Errors
+    /// [`Error::InvalidLoad`] for a handle the body does not have or a value [`Load::set`]
+    /// refuses; the load is then unchanged.
+    pub fn set_load(&mut self, handle: LoadHandle, value: LoadValue) -> Result<(), Error> {
+        match self.loads.get_mut(handle.0 as usize) {
+            Some(load) => load.set(value),
+            None => Err(Error::InvalidLoad {
+                load: "load",
+                reason: format!("the body has no load {}", handle.0),
+            }),
+        }
+    }
+
+    /// The node pairs the loads' tangents couple (`[a, b]`, `a > b`).
+    pub(crate) fn load_pairs(&self) -> Vec<[u32; 2]> {
+        self.loads.iter().flat_map(Load::coupled_pairs).collect()
+    }
+
+    /// The constant force on every free node over a step (N): its weight `m g` and the dead
+    /// loads (traction, body force); zero on pinned nodes.
+    pub(crate) fn dead_load(&self, gravity: DVec3) -> Vec<DVec3> {
+        let mut load: Vec<DVec3> = self.masses.iter().map(|m| gravity * *m).collect();
+        self.add_dead_forces(&mut load);
+        for (f, &pinned) in load.iter_mut().zip(&self.pinned) {
+            if pinned {
+                *f = DVec3::ZERO;
+            }
+        }
+        load
+    }
+
+    /// Adds the dead loads' forces (traction, body force; N per node) to `forces`.
+    fn add_dead_forces(&self, forces: &mut [DVec3]) {
+        let density = self.material.density();
+        for load in &self.loads {
+            load.add_dead_forces(self.mesh.positions(), &self.masses, density, forces);
+        }
+    }
+
+    /// Adds the follower loads' forces (pressure, cable; N per node) at the current positions
+    /// to `forces`.
+    pub(crate) fn add_follower_forces(&self, forces: &mut [DVec3]) {
+        for load in &self.loads {
+            load.add_follower_forces(&self.positions, forces);
+        }
+    }
+
+    /// Adds every load's force but gravity's (N per node) at the current positions to
+    /// `forces`: what an explicit substep adds to the internal forces.
+    pub(crate) fn add_load_forces(&self, forces: &mut [DVec3]) {
+        if !self.loads.is_empty() {
+            self.add_dead_forces(forces);
+            self.add_follower_forces(forces);
+        }
+    }
+
+    /// The follower loads' potential (J) at the current positions, measured from `start` (m).
+    pub(crate) fn follower_potential(&self, start: &[DVec3]) -> f64 {
+        (self.loads.iter())
+            .map(|load| load.follower_potential(start, &self.positions))
+            .sum()
+    }
+}

@@ -1,0 +1,276 @@
+//! Loads applied to a deformable body besides gravity, each a force field on its nodes that the
+//! caller sets and changes between frames as a controller does:
+//!
+//! - **traction** `t` (Pa) on boundary triangles, a dead load on their rest area `A₀`: each
+//!   corner carries `t A₀ / 3` (N), whatever the body does;
+//! - **body force** `b` (N/m³), such as a magnetic or an inertial field: node `n` carries
+//!   `b V_n` with `V_n = m_n / ρ` its lumped control volume (m³);
+//! - **pressure** `p` (Pa), a follower load on boundary triangles, pushing against the body along
+//!   their current normals: each corner carries `-p a / 3` with `a = ½ (x_b − x_a) × (x_c − x_a)`
+//!   the triangle's area vector (m², out of the body). On the closed inner surface of a cavity it
+//!   is the cavity's pressure (a pneumatic actuator), and [`Load::enclosed_volume`] the cavity's
+//!   volume;
+//! - **cable** of tension `T` (N) running through a path of nodes (eyelets), anchored at both
+//!   ends in the body: node `i` is pulled toward its neighbours on the path,
+//!   `T (ê_{i→i−1} + ê_{i→i+1})`, as a tendon pulled by an actuator in the body is.
+//!
+//! Traction and body force are constant over a step. Pressure and cable derive from the
+//! potentials `U = p V(x)`, `V = Σ (x_a − o)·((x_b − o) × (x_c − o)) / 6` over the triangles
+//! (the signed volume of the cone they span from a point `o`; minus a cavity's volume), and
+//! `U = T L(x)` with `L` the path's length: an implicit step and a static solve take their exact,
+//! symmetric Hessians into the Newton tangent ([`follower`]). A pressure's force is the gradient
+//! of its potential on a closed surface, or on an open one wherever the rim's nodes are pinned;
+//! on an open surface with a free rim the applied force is still the exact follower load, and
+//! only the Newton tangent and the line search's energy lack the rim's (non-symmetric) term.
+//! Every load is internal in the sense of momentum where it should be: a cavity's pressure and
+//! a cable exert no net force or torque on the body.
+
+mod follower;
+
+pub(crate) use follower::add_follower_tangents;
+
+use crate::Error;
+use rapier3d::glamx::DVec3;
+
+/// A load on a deformable body (see the module documentation).
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(
+    feature = "serde-serialize",
+    derive(serde::Serialize, serde::Deserialize)
+)]
+pub enum Load {
+    /// A dead traction (Pa) on boundary triangles' rest area.
+    Traction {
+        /// The triangles, node indices oriented out of the body (as
+        /// [`TetMesh::surface_triangles`](crate::mesh::TetMesh::surface_triangles) gives them).
+        triangles: Vec<[u32; 3]>,
+        /// The traction (Pa), in the world frame.
+        traction: DVec3,
+    },
+    /// A follower pressure (Pa) on boundary triangles, positive pushing into the body.
+    Pressure {
+        /// The triangles, node indices oriented out of the body.
+        triangles: Vec<[u32; 3]>,
+        /// The pressure (Pa).
+        pressure: f64,
+    },
+    /// A force per unit volume (N/m³) on every node.
+    BodyForce {
+        /// The force density (N/m³), in the world frame.
+        density: DVec3,
+    },
+    /// A cable of tension `tension` (N) through the nodes of `path`, in order.
+    Cable {
+        /// The eyelets, from one anchor to the other (at least two nodes, no node twice in a
+        /// row).
+        path: Vec<u32>,
+        /// The tension (N), not negative: a cable pulls, it cannot push.
+        tension: f64,
+    },
+}
+
+/// A load's index on its body, given by
+/// [`DeformableBody::add_load`](crate::body::DeformableBody::add_load).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(
+    feature = "serde-serialize",
+    derive(serde::Serialize, serde::Deserialize)
+)]
+pub struct LoadHandle(pub u32);
+
+/// The magnitude a controller sets on a load each frame: what [`Load::set`] changes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum LoadValue {
+    /// A traction (Pa) or force density (N/m³), for [`Load::Traction`] and [`Load::BodyForce`].
+    Vector(DVec3),
+    /// A pressure (Pa) or tension (N), for [`Load::Pressure`] and [`Load::Cable`].
+    Scalar(f64),
+}
+
+impl Load {
+    /// The load's name, for messages.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Self::Traction { .. } => "traction",
+            Self::Pressure { .. } => "pressure",
+            Self::BodyForce { .. } => "body force",
+            Self::Cable { .. } => "cable",
+        }
+    }
+
+    /// The load's current magnitude.
+    pub fn value(&self) -> LoadValue {
+        match self {
+            Self::Traction { traction, .. } => LoadValue::Vector(*traction),
+            Self::BodyForce { density } => LoadValue::Vector(*density),
+            Self::Pressure { pressure, .. } => LoadValue::Scalar(*pressure),
+            Self::Cable { tension, .. } => LoadValue::Scalar(*tension),
+        }
+    }
+
+    /// Sets the load's magnitude, checked as [`Load::check`] does.
+    ///
+    /// # Errors
+    /// [`Error::InvalidLoad`] for a value of the other kind (a vector for a pressure), a
+    /// non-finite value or a negative tension; the load is then unchanged.
+    pub fn set(&mut self, value: LoadValue) -> Result<(), Error> {
+        let mut changed = self.clone();
+        match (&mut changed, value) {
+            (Self::Traction { traction: v, .. } | Self::BodyForce { density: v }, LoadValue::Vector(new)) => *v = new,
+            (Self::Pressure { pressure: v, .. } | Self::Cable { tension: v, .. }, LoadValue::Scalar(new)) => *v = new,
+            _ => return Err(self.invalid("a vector is the value of a traction or body force, a number that of a pressure or cable")),
+        }
+        changed.check_value()?;
+        *self = changed;
+        Ok(())
+    }
+
+    /// Checks that the load's nodes exist among `node_count` and that its value is finite (and
+    /// a tension not negative).
+    ///
+    /// # Errors
+    /// [`Error::InvalidLoad`] saying what is wrong.
+    pub fn check(&self, node_count: usize) -> Result<(), Error> {
+        let in_range =
+            |mut nodes: std::slice::Iter<'_, u32>| nodes.all(|&n| (n as usize) < node_count);
+        match self {
+            Self::Traction { triangles, .. } | Self::Pressure { triangles, .. } => {
+                if !in_range(triangles.as_flattened().iter()) {
+                    return Err(self.invalid("a triangle names a node the body does not have"));
+                }
+                if triangles.iter().any(|[a, b, c]| a == b || b == c || c == a) {
+                    return Err(self.invalid("a triangle names a node twice"));
+                }
+            }
+            Self::Cable { path, .. } => {
+                if path.len() < 2 {
+                    return Err(self.invalid("a cable's path needs at least two nodes"));
+                }
+                if !in_range(path.iter()) {
+                    return Err(self.invalid("the path names a node the body does not have"));
+                }
+                if path.windows(2).any(|w| w[0] == w[1]) {
+                    return Err(self.invalid("the path names a node twice in a row"));
+                }
+            }
+            Self::BodyForce { .. } => {}
+        }
+        self.check_value()
+    }
+
+    /// [`Error::InvalidLoad`] for a non-finite value or a negative tension.
+    fn check_value(&self) -> Result<(), Error> {
+        let finite = match self.value() {
+            LoadValue::Vector(v) => v.is_finite(),
+            LoadValue::Scalar(s) => s.is_finite(),
+        };
+        if !finite {
+            return Err(self.invalid("its value must be finite"));
+        }
+        if let Self::Cable { tension, .. } = self
+            && *tension < 0.0
+        {
+            return Err(self.invalid("a cable's tension cannot be negative (a cable only pulls)"));
+        }
+        Ok(())
+    }
+
+    fn invalid(&self, reason: &str) -> Error {
+        Error::InvalidLoad {
+            load: self.kind(),
+            reason: reason.to_owned(),
+        }
+    }
+
+    /// Adds the load's force (N per node) to `forces` if it is a dead load (traction, body
+    /// force), at the rest positions `rest` (m) with the nodal `masses` (kg) of a body of
+    /// `density` (kg/m³).
+    pub(crate) fn add_dead_forces(
+        &self,
+        rest: &[DVec3],
+        masses: &[f64],
+        density: f64,
+        forces: &mut [DVec3],
+    ) {
+        match self {
+            Self::Traction {
+                triangles,
+                traction,
+            } => {
+                for &[a, b, c] in triangles {
+                    let [xa, xb, xc] = [a, b, c].map(|n| rest[n as usize]);
+                    let area = 0.5 * (xb - xa).cross(xc - xa).length();
+                    for n in [a, b, c] {
+                        forces[n as usize] += *traction * (area / 3.0);
+                    }
+                }
+            }
+            Self::BodyForce { density: b } => {
+                for (f, m) in forces.iter_mut().zip(masses) {
+                    *f += *b * (m / density);
+                }
+            }
+            Self::Pressure { .. } | Self::Cable { .. } => {}
+        }
+    }
+
+    /// Adds the load's force (N per node) at the positions `x` (m) to `forces` if it is a
+    /// follower load (pressure, cable).
+    pub(crate) fn add_follower_forces(&self, x: &[DVec3], forces: &mut [DVec3]) {
+        match self {
+            Self::Pressure {
+                triangles,
+                pressure,
+            } => follower::add_pressure_forces(triangles, *pressure, x, forces),
+            Self::Cable { path, tension } => follower::add_cable_forces(path, *tension, x, forces),
+            Self::Traction { .. } | Self::BodyForce { .. } => {}
+        }
+    }
+
+    /// The follower load's potential `U(x) − U(x₀)` (J) between the positions `start` and `x`
+    /// (m); zero for a dead load (whose work the caller counts with gravity's).
+    pub(crate) fn follower_potential(&self, start: &[DVec3], x: &[DVec3]) -> f64 {
+        match self {
+            Self::Pressure {
+                triangles,
+                pressure,
+            } => {
+                let origin = follower::centre(triangles, start);
+                pressure
+                    * (follower::cone_volume(triangles, x, origin)
+                        - follower::cone_volume(triangles, start, origin))
+            }
+            Self::Cable { path, tension } => {
+                tension * (follower::path_length(path, x) - follower::path_length(path, start))
+            }
+            Self::Traction { .. } | Self::BodyForce { .. } => 0.0,
+        }
+    }
+
+    /// For a pressure on a closed surface, the volume (m³) it encloses at the positions `x`
+    /// (m): a cavity's volume, whose faces are oriented out of the body and so into the cavity.
+    /// `None` for other loads; for an open surface the volume of the cone its triangles span
+    /// from their centre.
+    pub fn enclosed_volume(&self, x: &[DVec3]) -> Option<f64> {
+        match self {
+            Self::Pressure { triangles, .. } => {
+                let origin = follower::centre(triangles, x);
+                Some(-follower::cone_volume(triangles, x, origin))
+            }
+            _ => None,
+        }
+    }
+
+    /// The node pairs the load's tangent couples (`[a, b]`, `a > b`).
+    pub(crate) fn coupled_pairs(&self) -> Vec<[u32; 2]> {
+        let ordered = |a: u32, b: u32| if a > b { [a, b] } else { [b, a] };
+        match self {
+            Self::Pressure { triangles, .. } => triangles
+                .iter()
+                .flat_map(|&[a, b, c]| [ordered(a, b), ordered(b, c), ordered(c, a)])
+                .collect(),
+            Self::Cable { path, .. } => path.windows(2).map(|w| ordered(w[0], w[1])).collect(),
+            Self::Traction { .. } | Self::BodyForce { .. } => Vec::new(),
+        }
+    }
+}
