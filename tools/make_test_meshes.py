@@ -1,4 +1,4 @@
-"""Writes the mesh files under assets/meshes/ used by tests/mesh_import/.
+"""Writes the mesh files under assets/meshes/ used by tests/mesh_import/ and the scenes.
 
 Needs gmsh and meshio from PyPI (and vtk and numpy for cube_vtk_library):
     python3 -m venv /tmp/venv-gmsh && /tmp/venv-gmsh/bin/pip install gmsh meshio vtk numpy
@@ -377,8 +377,32 @@ def multi_solid_stl():
               % (name, words.count("solid"), words.count("facet")))
 
 
+def pneumatic_finger():
+    """A pneumatic finger: a 10 x 2 x 2 cm beam along +x from x = 0 with an inner chamber 8 cm
+    long, 1 cm wide and 1 cm high whose floor (7.5 mm) is three times as thick as its roof
+    (2.5 mm), meshed by gmsh (elements up to 3 mm) with physical groups: the volume "finger"
+    (tag 1), the base x = 0 "base" (tag 2) and the chamber's six walls "chamber" (tag 3); MSH
+    4.1 ASCII. assets/scenes/pneumatic_finger.toml inflates it."""
+    gmsh.initialize()
+    gmsh.option.setNumber("General.Terminal", 0)
+    gmsh.model.add("pneumatic_finger")
+    outer = gmsh.model.occ.addBox(0, -0.01, -0.01, 0.1, 0.02, 0.02)
+    chamber = gmsh.model.occ.addBox(0.01, -0.0025, -0.005, 0.08, 0.01, 0.01)
+    gmsh.model.occ.cut([(3, outer)], [(3, chamber)])
+    gmsh.model.occ.synchronize()
+    volumes = [t for _, t in gmsh.model.getEntities(3)]
+    base = [t for _, t in gmsh.model.getEntitiesInBoundingBox(
+        -1e-4, -0.011, -0.011, 1e-4, 0.011, 0.011, 2)]
+    walls = [t for _, t in gmsh.model.getEntitiesInBoundingBox(
+        0.0099, -0.0026, -0.0051, 0.0901, 0.0076, 0.0051, 2)]
+    gmsh.model.addPhysicalGroup(3, volumes, 1, name="finger")
+    gmsh.model.addPhysicalGroup(2, base, 2, name="base")
+    gmsh.model.addPhysicalGroup(2, walls, 3, name="chamber")
+    mesh_and_write_v41_ascii(0.003, 3, "pneumatic_finger_v41.msh")
+
+
 STEPS = [cube_msh, cube_others, surfaces, cube_meshio_compressed, cube_vtk_library,
-         multi_solid_stl, cube_msh_other_forms, cube_regions, two_volumes]
+         multi_solid_stl, cube_msh_other_forms, cube_regions, two_volumes, pneumatic_finger]
 
 if __name__ == "__main__":
     import sys

@@ -453,6 +453,8 @@ impl DeformableBodyBuilder {
             pinned,
             embedding,
             loads: Vec::new(),
+            load_edits: 0,
+            load_change_work: 0.0,
             collision_groups: self.collision_groups,
             friction: self.friction,
             friction_combine_rule: self.friction_combine_rule,

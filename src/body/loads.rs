@@ -30,7 +30,9 @@ impl DeformableBody {
     /// ```
     pub fn add_load(&mut self, load: Load) -> Result<LoadHandle, Error> {
         load.check(self.node_count())?;
+        self.load_change_work += self.potential_of(&load);
         self.loads.push(load);
+        self.load_edits += 1;
         Ok(LoadHandle(self.loads.len() as u32 - 1))
     }
 
@@ -45,19 +47,56 @@ impl DeformableBody {
     }
 
     /// Sets the magnitude of the load `handle` (a pressure in Pa, a tension in N, a traction in
-    /// Pa or a force density in N/m³), as a controller does between frames.
+    /// Pa or a force density in N/m³), as a controller does between frames. A sleeping body
+    /// wakes when one of its loads changes.
     ///
     /// # Errors
     /// [`Error::InvalidLoad`] for a handle the body does not have or a value [`Load::set`]
     /// refuses; the load is then unchanged.
     pub fn set_load(&mut self, handle: LoadHandle, value: LoadValue) -> Result<(), Error> {
         match self.loads.get_mut(handle.0 as usize) {
-            Some(load) => load.set(value),
+            Some(load) if load.value() == value => Ok(()),
+            Some(load) => {
+                let mut changed = load.clone();
+                changed.set(value)?;
+                let before = self.potential_of(&self.loads[handle.0 as usize]);
+                self.load_change_work += self.potential_of(&changed) - before;
+                self.loads[handle.0 as usize] = changed;
+                self.load_edits += 1;
+                Ok(())
+            }
             None => Err(Error::InvalidLoad {
                 load: "load",
                 reason: format!("the body has no load {}", handle.0),
             }),
         }
+    }
+
+    /// The potential energy of the body's loads (J) at its current positions: `−Σ f·x` of the
+    /// tractions and body forces, `p V` of each pressure (`V` the signed volume of the cone its
+    /// triangles span from the world's origin, minus a cavity's volume), `T L` of each cable
+    /// (`L` its length). With the kinetic, elastic and gravitational energies it makes the
+    /// energy the loads conserve while their values stay as they are.
+    pub fn load_potential_energy(&self) -> f64 {
+        self.loads.iter().map(|load| self.potential_of(load)).sum()
+    }
+
+    /// The work (J) changes of the loads' values did, summed since the body was built: each
+    /// change (and each load added) adds the change of its potential energy at the positions
+    /// then. An energy balance counts it as work done on the body from outside.
+    pub(crate) fn load_change_work(&self) -> f64 {
+        self.load_change_work
+    }
+
+    /// `load`'s potential energy (J) at the body's current positions.
+    fn potential_of(&self, load: &Load) -> f64 {
+        let density = self.material.density();
+        load.potential(
+            self.mesh.positions(),
+            &self.masses,
+            density,
+            &self.positions,
+        )
     }
 
     /// The node pairs the loads' tangents couple (`[a, b]`, `a > b`).

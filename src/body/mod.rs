@@ -53,6 +53,10 @@ pub struct DeformableBody {
     pub(crate) embedding: Option<Embedding>,
     /// The loads besides gravity ([`DeformableBody::add_load`]).
     pub(crate) loads: Vec<crate::load::Load>,
+    /// How many times a load was added or changed: a sleeping body wakes when it is.
+    pub(crate) load_edits: u64,
+    /// The work (J) the changes of the loads' values did ([`DeformableBody::load_change_work`]).
+    pub(crate) load_change_work: f64,
     /// How many times the state was edited from outside the integrators
     /// ([`DeformableBody::positions_mut`], [`DeformableBody::velocities_mut`], a static solve):
     /// two-step integrators restart after an edit.

@@ -39,6 +39,8 @@ pub(super) struct BodyRecord {
     /// The loads besides gravity (none in files written before loads existed).
     #[serde(default)]
     loads: Vec<Load>,
+    #[serde(default)]
+    load_edits: u64,
     /// Positions (m) and velocities (m/s) of the nodes.
     positions: Vec<DVec3>,
     velocities: Vec<DVec3>,
@@ -69,6 +71,7 @@ impl From<&DeformableBody> for BodyRecord {
             self_contact: body.self_contact,
             user_data: body.user_data,
             loads: body.loads.clone(),
+            load_edits: body.load_edits,
             positions: body.positions.clone(),
             velocities: body.velocities.clone(),
             state_edits: body.state_edits,
@@ -117,6 +120,7 @@ impl TryFrom<BodyRecord> for DeformableBody {
         for load in record.loads {
             body.add_load(load)?;
         }
+        body.load_edits = record.load_edits;
         body.positions = record.positions;
         body.velocities = record.velocities;
         body.state_edits = record.state_edits;

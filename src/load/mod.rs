@@ -247,6 +247,31 @@ impl Load {
         }
     }
 
+    /// The load's potential energy `U` (J) at the positions `x` (m), measured from the origin
+    /// (rest positions `rest` (m), nodal `masses` (kg) and `density` (kg/m³) as for
+    /// [`Load::add_dead_forces`]): `−Σ f·x` for a dead load, `p V` (the cone from the world's
+    /// origin) for a pressure, `T L` for a cable. Its changes are the work the load did not do.
+    pub(crate) fn potential(
+        &self,
+        rest: &[DVec3],
+        masses: &[f64],
+        density: f64,
+        x: &[DVec3],
+    ) -> f64 {
+        match self {
+            Self::Traction { .. } | Self::BodyForce { .. } => {
+                let mut forces = vec![DVec3::ZERO; x.len()];
+                self.add_dead_forces(rest, masses, density, &mut forces);
+                -forces.iter().zip(x).map(|(f, x)| f.dot(*x)).sum::<f64>()
+            }
+            Self::Pressure {
+                triangles,
+                pressure,
+            } => pressure * follower::cone_volume(triangles, x, DVec3::ZERO),
+            Self::Cable { path, tension } => tension * follower::path_length(path, x),
+        }
+    }
+
     /// For a pressure on a closed surface, the volume (m³) it encloses at the positions `x`
     /// (m): a cavity's volume, whose faces are oriented out of the body and so into the cavity.
     /// `None` for other loads; for an open surface the volume of the cone its triangles span

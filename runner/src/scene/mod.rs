@@ -24,6 +24,7 @@
 pub mod budget;
 mod check;
 mod error;
+pub mod load;
 pub mod material;
 pub mod mesh;
 pub mod probe;

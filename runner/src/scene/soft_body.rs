@@ -1,6 +1,6 @@
 //! `[[soft_body]]`: a finite-volume soft body: its mesh, material, placement, initial velocity
-//! (linear, angular and per region), contact properties, pinned regions and attachments to
-//! rigid bodies.
+//! (linear, angular and per region), contact properties, pinned regions, attachments to
+//! rigid bodies and loads.
 //!
 //! ```toml
 //! [[soft_body]]
@@ -25,6 +25,8 @@
 //! attach = [{ rigid = "ball", min = [-1, -0.26, -1], max = [1, -0.24, 1] }]
 //! velocity = [{ min = [0.4, -1, -1], max = [0.6, 1, 1], linvel = [0, 1, 0] }]
 //!                                 # the box's nodes start at `linvel` (m/s) instead
+//! loads = [{ traction = [0, -1e3, 0], min = [0.49, -1, -1], max = [0.51, 1, 1] }]
+//!                                 # pressure, traction, body force, cable (see `load`)
 //! ```
 //! Regions are boxes `min`..`max` (m) in the mesh's rest coordinates, before the translation and
 //! rotation, or, for a mesh file with named parts (Gmsh physical groups), `region = "clamp"` (a
@@ -32,6 +34,7 @@
 //! `pinned = [{ region = "clamp" }]`. Each region must hold at least one node.
 
 use super::check::Checker;
+use super::load::LoadSpec;
 use super::material::{DampingSpec, MaterialSpec};
 use super::mesh::MeshSpec;
 use rapier_fvm::glamx::DVec3;
@@ -88,6 +91,9 @@ pub struct SoftBodySpec {
     /// later region wins where two overlap, pinned nodes stay at rest.
     #[serde(default)]
     pub velocity: Vec<RegionVelocitySpec>,
+    /// Loads besides gravity (see [`super::load`]).
+    #[serde(default)]
+    pub loads: Vec<LoadSpec>,
 }
 
 fn default_friction() -> f64 {
@@ -229,7 +235,7 @@ impl Selection<'_> {
     }
 
     /// Checks that it is a box or a region, not both, and the box's corners.
-    fn check(&self, key: &str, c: &mut Checker<'_>) {
+    pub(crate) fn check(&self, key: &str, c: &mut Checker<'_>) {
         match (self.region, self.min, self.max) {
             (None, Some(min), Some(max)) => check_box(key, min, max, c),
             (Some(_), None, None) => {}
@@ -280,7 +286,8 @@ impl SoftBodySpec {
         c.non_negative(&format!("{key}.friction"), self.friction, "dimensionless");
         let selections = (self.pinned.iter().map(RegionSpec::selection))
             .chain(self.attach.iter().map(AttachmentSpec::selection))
-            .chain(self.velocity.iter().map(RegionVelocitySpec::selection));
+            .chain(self.velocity.iter().map(RegionVelocitySpec::selection))
+            .chain(self.loads.iter().map(LoadSpec::selection));
         if self.mesh.file.is_none() && selections.into_iter().any(|s| s.region.is_some()) {
             c.fail(
                 &format!("{key}.mesh"),
@@ -305,6 +312,9 @@ impl SoftBodySpec {
             let key = format!("{key}.velocity[{i}]");
             region.selection().check(&key, c);
             c.speed(&format!("{key}.linvel"), region.linvel);
+        }
+        for (i, load) in self.loads.iter().enumerate() {
+            load.check(&format!("{key}.loads[{i}]"), c);
         }
     }
 }

@@ -1,6 +1,7 @@
 //! A [`Scene`] made into a world: soft bodies meshed, placed, set moving, pinned and attached,
 //! rigid bodies and their colliders inserted, probes bound to the bodies they read.
 
+use super::loads::{DrivenLoad, add_loads, build_loads};
 use super::meshes::BodyMeshes;
 use super::probe::Probe;
 use super::regions::BodyRegions;
@@ -27,6 +28,8 @@ pub struct SoftEntry {
     pub handle: DeformableBodyHandle,
     /// Its world positions before the first step (m): displacements are measured from them.
     pub rest: Vec<DVec3>,
+    /// Its loads that keyframes drive.
+    pub loads: Vec<DrivenLoad>,
 }
 
 /// A rigid body of the world.
@@ -123,6 +126,24 @@ impl Simulation {
             probe.sample(t, self);
         }
         self.probes = probes;
+    }
+
+    /// Sets every keyframed load to its value at time `t` (s), for the coming frame.
+    ///
+    /// # Errors
+    /// A [`SceneError`] at a load the library refuses the value of (the scene's check makes
+    /// every keyframe's value one it takes, and so every value between two).
+    pub fn drive_loads(&mut self, t: f64, source: &SceneSource) -> Result<(), SceneError> {
+        for entry in &self.soft {
+            let Some(body) = self.world.soft_bodies.get_mut(entry.handle) else {
+                continue;
+            };
+            for load in &entry.loads {
+                (body.set_load(load.handle, load.schedule.at(t)))
+                    .map_err(|e| source.error(&load.key, e.to_string()))?;
+            }
+        }
+        Ok(())
     }
 
     /// Tells every kinematic body where its keyframes put it at time `t` (s); rapier moves it
@@ -233,6 +254,7 @@ fn insert_soft(
         velocities,
         attachments,
     } = BodyRegions::select(spec, (&mesh, &regions, &path), rigid, (key, source))?;
+    let loads = build_loads(&spec.loads, (&mesh, &regions, &path), (key, source))?;
     let mut builder = match (quadratic, cage) {
         (Some(quadratic), _) => DeformableBodyBuilder::quadratic(quadratic, material),
         (_, Some(cage)) => DeformableBodyBuilder::quadratic_hex(cage, material),
@@ -264,7 +286,8 @@ fn insert_soft(
                 .map_err(library(format!("{key}.damping")))?,
         );
     }
-    let body = builder.build().map_err(library(key.to_owned()))?;
+    let mut body = builder.build().map_err(library(key.to_owned()))?;
+    let driven = add_loads(&mut body, loads, source)?;
     let rest = body.positions().to_vec();
     let handle = world.soft_bodies.insert(body);
     for attachment in attachments {
@@ -276,5 +299,6 @@ fn insert_soft(
         label: spec.material.label(),
         handle,
         rest,
+        loads: driven,
     })
 }

@@ -10,6 +10,7 @@
 //! | `plots/<probe>.png` | each probe against time |
 
 mod build;
+mod loads;
 mod meshes;
 mod probe;
 mod regions;
@@ -18,6 +19,7 @@ mod run;
 mod writer;
 
 pub use build::{RigidEntry, Simulation, SoftEntry};
+pub use loads::{DrivenLoad, LoadSchedule};
 pub use probe::Probe;
 pub use report::{
     BodyFlags, Files, Flag, ProbeReport, Report, RigidBodyReport, Settings, SoftBodyReport,

@@ -75,6 +75,7 @@ pub fn run(scene: &Scene, options: &RunOptions) -> Result<Report, RunError> {
         let t = frame as f64 * dt;
         let step_start = Instant::now();
         sim.drive_kinematic(t);
+        sim.drive_loads(t, &scene.source)?;
         let outcomes = sim.world.step();
         stepping += step_start.elapsed();
         for (handle, outcome) in &outcomes {

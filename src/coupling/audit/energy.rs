@@ -1,9 +1,11 @@
-//! The energy side of the audit: `E = Σ_soft (K + Ψ + V_g) + Σ_dynamic rigid (K + V_g)`, measured
-//! at the end of each frame and compared with the previous frame's plus the work kinematic bodies
-//! did on the deformable bodies over the frame, `gain = E_n - (E_{n-1} + W_n)`.
+//! The energy side of the audit: `E = Σ_soft (K + Ψ + V_g + U) + Σ_dynamic rigid (K + V_g)`,
+//! measured at the end of each frame and compared with the previous frame's plus the work
+//! kinematic bodies and changes of loads did on the deformable bodies over the frame,
+//! `gain = E_n - (E_{n-1} + W_n)`.
 //!
 //! - Soft bodies: kinetic `Σ m v²/2`, elastic `Ψ` (the material's strain energy), gravitational
-//!   `-Σ m g·x`, and after an implicit step the energy its contact penalties hold, `k g²/2` for
+//!   `-Σ m g·x`, the potential `U` of their loads
+//!   ([`DeformableBody::load_potential_energy`]), and after an implicit step the energy its contact penalties hold, `k g²/2` for
 //!   each node inside its contact plane (`g < 0`), with `k = penalty_factor m / ĥ²` (the node's
 //!   own mass: a dynamic rigid partner's share is left out, so this is a lower bound) or the
 //!   stiffness the contact's load called for if more, and `ĥ` the substep's effective step.
@@ -28,7 +30,9 @@
 //! - Work: a kinematic (or fixed) rigid body a deformable body pushed with the mean force `F` and
 //!   torque `τ` over the frame ([`RigidLoad`](crate::coupling::RigidLoad)) while moving its centre
 //!   of mass by `Δx` and turning by `Δθ` did `W = -(F·Δx + τ·Δθ)` on it. Gravity's work is in the
-//!   gravitational terms. Nothing else is counted: forces the caller applies, joint motors,
+//!   gravitational terms. A load whose value the caller changed between frames
+//!   ([`DeformableBody::set_load`]) did the change of its potential at the positions then. Nothing
+//!   else is counted: forces the caller applies, joint motors,
 //!   kinematic bodies pushing rigid bodies through rapier's contacts and state set between
 //!   frames all show as gains.
 //!
@@ -65,6 +69,9 @@ pub(super) struct MemberEnergy {
     /// velocity `v` adds to the total, `½ h m g·v`; zero for a deformable body.
     pub(super) half_step_back: f64,
     pub(super) moving: f64,
+    /// The work (J) changes of a deformable body's loads did since it was built; zero for a
+    /// rigid body.
+    pub(super) load_change_work: f64,
     /// What the energy may change by without a gain (J): for a rigid body the f32 rounding of
     /// its state, `1e-6 (K + m |g| |x|)`; for a deformable body stepped explicitly the
     /// oscillation of symplectic Euler's measured energy about its conserved shadow energy,
@@ -89,7 +96,7 @@ pub(super) fn energies(
             .and_then(|r| r.implicit)
             .map_or(0.0, |r| penalty_energy(input, handle, body, r.substep_dt));
         let moving = body.kinetic_energy() + body.elastic_energy() + penalty;
-        let total = moving + body.gravity_potential_energy(g);
+        let total = moving + body.gravity_potential_energy(g) + body.load_potential_energy();
         let ratio = report.and_then(|r| r.explicit).map_or(0.0, |e| {
             e.substep_dt / SymplecticEuler::critical_time_step(body)
         });
@@ -99,6 +106,7 @@ pub(super) fn energies(
                 total,
                 half_step_back: 0.0,
                 moving,
+                load_change_work: body.load_change_work(),
                 allowance: ratio.min(1.0) * moving,
             },
         );
@@ -199,6 +207,7 @@ fn rigid_energy(body: &RigidBody, g: DVec3, h: f64) -> MemberEnergy {
         total: moving - mass * g.dot(com),
         half_step_back: mass * g.dot(v) * (h / 2.0),
         moving,
+        load_change_work: 0.0,
         // f32 keeps about 7 digits of the position and velocity.
         allowance: 1e-6 * (moving + mass * g.length() * com.length()),
     }

@@ -167,7 +167,14 @@ impl Audit {
                 let work = (members.iter())
                     .filter_map(|m| match m {
                         Member::Soft(soft) => {
-                            Some(energy::kinematic_work(&input, *soft, &before.rigid_poses))
+                            let key = Member::Soft(*soft);
+                            let loads = match (now.energies.get(&key), before.energies.get(&key)) {
+                                (Some(now), Some(then)) => {
+                                    now.load_change_work - then.load_change_work
+                                }
+                                _ => 0.0,
+                            };
+                            Some(energy::kinematic_work(&input, *soft, &before.rigid_poses) + loads)
                         }
                         Member::Rigid(_) => None,
                     })

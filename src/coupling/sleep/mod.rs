@@ -16,7 +16,8 @@
 //! velocity, and the mean loads it exerted while it was still count again in every substep (the
 //! ground still carries its weight, see [`RestingLoads`]). It wakes, with the rigid bodies it rests with and the
 //! sleeping bodies it overlaps, when its state is edited
-//! ([`DeformableBody::positions_mut`], [`DeformableBody::velocities_mut`]), gravity changes, a
+//! ([`DeformableBody::positions_mut`], [`DeformableBody::velocities_mut`]) or one of its loads
+//! is added or changed ([`DeformableBody::set_load`]), gravity changes, a
 //! rigid body it rests with wakes in rapier, moves or leaves, a collider comes within (or leaves)
 //! its bounds, one there moves or is moved (a fixed one set elsewhere by hand), an awake
 //! deformable body comes within them, it is attached to
@@ -84,6 +85,9 @@ impl SleepSettings {
 struct Asleep {
     /// The body's state edits then.
     state_edits: u64,
+    /// The body's load edits then.
+    #[cfg_attr(feature = "serde-serialize", serde(default))]
+    load_edits: u64,
     /// Gravity (m/s²) then.
     gravity: DVec3,
     /// The nodes' bounds (m).
@@ -170,6 +174,7 @@ impl SleepSet {
                 let body = &soft_bodies[handle];
                 let widened = widen(asleep.bounds, margin);
                 body.state_edits() != asleep.state_edits
+                    || body.load_edits != asleep.load_edits
                     || gravity != asleep.gravity
                     || awake.iter().any(|&other| overlap(widened, other))
                     || rigid_disturbs(asleep, widened, rigid, settings.speed_threshold, h)
@@ -312,6 +317,7 @@ impl SleepSet {
                 let state = self.states.entry(handle);
                 state.asleep = Some(Asleep {
                     state_edits: body.state_edits(),
+                    load_edits: body.load_edits,
                     gravity,
                     bounds,
                     colliders,

@@ -1,0 +1,172 @@
+//! A soft body's loads made from its description: the boundary triangles a box or a file's
+//! region selects, a cable's eyelets, each load's value at the start, and what drives it over
+//! time.
+
+use crate::scene::load::{LoadSpec, Schedule};
+use crate::scene::{SceneError, SceneSource};
+use rapier_fvm::body::DeformableBody;
+use rapier_fvm::glamx::DVec3;
+use rapier_fvm::load::{Load, LoadHandle, LoadValue};
+use rapier_fvm::mesh::TetMesh;
+use rapier_fvm::mesh::import::MeshRegion;
+
+/// How a load's value changes over time.
+#[derive(Debug, Clone)]
+pub enum LoadSchedule {
+    /// A pressure (Pa) or tension (N).
+    Scalar(Schedule<f64>),
+    /// A traction (Pa) or force density (N/m³).
+    Vector(Schedule<[f64; 3]>),
+}
+
+impl LoadSchedule {
+    /// The value at time `t` (s).
+    pub fn at(&self, t: f64) -> LoadValue {
+        match self {
+            Self::Scalar(s) => LoadValue::Scalar(s.at(t)),
+            Self::Vector(s) => LoadValue::Vector(DVec3::from_array(s.at(t))),
+        }
+    }
+
+    /// Whether the value changes over time.
+    fn varies(&self) -> bool {
+        match self {
+            Self::Scalar(s) => s.varies(),
+            Self::Vector(s) => s.varies(),
+        }
+    }
+}
+
+/// A load on a body of the world that keyframes drive.
+#[derive(Debug, Clone)]
+pub struct DrivenLoad {
+    /// The load on its body.
+    pub handle: LoadHandle,
+    /// Its values over time.
+    pub schedule: LoadSchedule,
+    /// Its key path in the scene, for the library's refusals.
+    pub key: String,
+}
+
+/// The loads `specs` of a body meshed as `mesh` (rest coordinates), whose file `path` had the
+/// `regions`, `key` in the scene of `source`, each at its value at time 0 with its schedule.
+///
+/// # Errors
+/// A [`SceneError`] at a load whose box or region selects no boundary triangle, whose region
+/// is not in the file, or whose cable's points all fall on one node.
+pub(super) fn build_loads(
+    specs: &[LoadSpec],
+    (mesh, regions, path): (&TetMesh, &[MeshRegion], &str),
+    (key, source): (&str, &SceneSource),
+) -> Result<Vec<(Load, LoadSchedule, String)>, SceneError> {
+    let mut boundary: Option<Vec<[u32; 3]>> = None;
+    let mut loads = Vec::with_capacity(specs.len());
+    for (i, spec) in specs.iter().enumerate() {
+        let key = format!("{key}.loads[{i}]");
+        let mut triangles = || -> Result<Vec<[u32; 3]>, SceneError> {
+            let nodes = (spec.selection())
+                .nodes(mesh, regions, path)
+                .map_err(|e| source.error(&format!("{key}.region"), e.to_string()))?;
+            let mut selected = vec![false; mesh.node_count()];
+            for n in nodes {
+                selected[n as usize] = true;
+            }
+            let boundary = boundary.get_or_insert_with(|| mesh.surface_triangles());
+            let triangles: Vec<[u32; 3]> = (boundary.iter())
+                .filter(|t| t.iter().all(|&n| selected[n as usize]))
+                .copied()
+                .collect();
+            if triangles.is_empty() {
+                return Err(source.error(&key, "it selects no boundary triangle of the body"));
+            }
+            Ok(triangles)
+        };
+        let (load, schedule) = match spec {
+            LoadSpec {
+                pressure: Some(s), ..
+            } => {
+                let load = Load::Pressure {
+                    triangles: triangles()?,
+                    pressure: s.at(0.0),
+                };
+                (load, LoadSchedule::Scalar(s.clone()))
+            }
+            LoadSpec {
+                traction: Some(s), ..
+            } => {
+                let traction = DVec3::from_array(s.at(0.0));
+                (
+                    Load::Traction {
+                        triangles: triangles()?,
+                        traction,
+                    },
+                    LoadSchedule::Vector(s.clone()),
+                )
+            }
+            LoadSpec {
+                body_force: Some(s),
+                ..
+            } => {
+                let density = DVec3::from_array(s.at(0.0));
+                (Load::BodyForce { density }, LoadSchedule::Vector(s.clone()))
+            }
+            LoadSpec {
+                tension: Some(s),
+                path: Some(points),
+                ..
+            } => {
+                let mut eyelets: Vec<u32> = points
+                    .iter()
+                    .map(|p| mesh.nearest_node(DVec3::from_array(*p)))
+                    .collect();
+                eyelets.dedup();
+                if eyelets.len() < 2 {
+                    return Err(
+                        source.error(&format!("{key}.path"), "its points all fall on one node")
+                    );
+                }
+                (
+                    Load::Cable {
+                        path: eyelets,
+                        tension: s.at(0.0),
+                    },
+                    LoadSchedule::Scalar(s.clone()),
+                )
+            }
+            // The scene's check asks for exactly one kind, a cable with its path.
+            _ => {
+                return Err(source.error(
+                    &key,
+                    "give one of `pressure`, `traction`, `body_force` or `tension`",
+                ));
+            }
+        };
+        loads.push((load, schedule, key));
+    }
+    Ok(loads)
+}
+
+/// Adds `loads` to `body`; returns those whose value changes over time.
+///
+/// # Errors
+/// A [`SceneError`] at a load the library refuses.
+pub(super) fn add_loads(
+    body: &mut DeformableBody,
+    loads: Vec<(Load, LoadSchedule, String)>,
+    source: &SceneSource,
+) -> Result<Vec<DrivenLoad>, SceneError> {
+    let mut driven = Vec::new();
+    for (load, schedule, key) in loads {
+        let handle = body
+            .add_load(load)
+            .map_err(|e| source.error(&key, e.to_string()))?;
+        if schedule.varies() {
+            driven.push(DrivenLoad {
+                handle,
+                schedule,
+                key,
+            });
+        }
+    }
+    Ok(driven)
+}
