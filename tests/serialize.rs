@@ -2,7 +2,8 @@
 //! and read back steps on exactly as the original does,
 //! bit for bit (tolerance 0), under the automatic integrator and under forced implicit BDF2
 //! steps (whose two-step history and kept factorization the file carries), with contacts, a
-//! dynamic rigid body on a soft one, an attachment, a quadratic body and an embedded mesh; a
+//! dynamic rigid body on a soft one, an attachment, loads (a pressure and a cable), a quadratic
+//! body and an embedded mesh; a
 //! file that breaks a body's rules is refused with the error a new body would get, never a panic.
 
 mod common;
@@ -24,10 +25,19 @@ fn scene(integrator: Option<IntegratorKind>) -> Result<FvmWorld, Error> {
     );
     let rubber = Material::new(MaterialModel::StableNeoHookean, 1e6, 0.3, 1000.0)?;
     let damping = RayleighDamping::stiffness_proportional(2e-3, rubber.lame())?;
-    let block = DeformableBodyBuilder::new(mesh::cuboid(DVec3::splat(0.1), [3; 3])?, rubber)
+    let block_mesh = mesh::cuboid(DVec3::splat(0.1), [3; 3])?;
+    let side = block_mesh.surface_triangles_where(|p| p.x >= 0.1 - 1e-9);
+    let mut block = DeformableBodyBuilder::new(block_mesh, rubber)
         .damping(damping)
         .translation(DVec3::new(0.0, 0.1, 0.0))
         .build()?;
+    // A follower pressure on one side, its value changed once, so that the loads and the work
+    // of their changes are in the file.
+    let push = block.add_load(Load::Pressure {
+        triangles: side,
+        pressure: 1e3,
+    })?;
+    block.set_load(push, LoadValue::Scalar(2e3))?;
     world.soft_bodies.insert(block);
     world.physics.insert(
         RigidBodyBuilder::dynamic().translation(Vector::new(0.02, 0.27, 0.0)),
@@ -39,10 +49,15 @@ fn scene(integrator: Option<IntegratorKind>) -> Result<FvmWorld, Error> {
     );
     let rod_mesh = mesh::cuboid(DVec3::new(0.02, 0.1, 0.02), [1, 4, 1])?;
     let top = rod_mesh.nodes_where(|p| p.y >= 0.1 - 1e-9);
-    let rod = DeformableBodyBuilder::new(rod_mesh, rubber)
+    let tendon = rod_mesh.nodes_where(|p| p.x <= -0.02 + 1e-9 && p.z <= -0.02 + 1e-9);
+    let mut rod = DeformableBodyBuilder::new(rod_mesh, rubber)
         .damping(damping)
         .translation(DVec3::new(1.05, 0.9, 0.0))
         .build()?;
+    rod.add_load(Load::Cable {
+        path: tendon,
+        tension: 0.5,
+    })?;
     let rod = world.soft_bodies.insert(rod);
     world.attach(rod, top, bar)?;
     let coarse = mesh::QuadraticTetMesh::from_linear(&mesh::cuboid(DVec3::splat(0.05), [1; 3])?)?;

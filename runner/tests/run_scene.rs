@@ -35,6 +35,7 @@ fn every_shipped_scene_parses_and_builds() {
         "hanging_rope.toml",
         "showcase.toml",
         "spinning_block.toml",
+        "pneumatic_finger.toml",
     ];
     let folder = scene_path("");
     let mut found: Vec<String> = std::fs::read_dir(&folder)

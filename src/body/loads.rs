@@ -125,11 +125,42 @@ impl DeformableBody {
         }
     }
 
-    /// Adds the follower loads' forces (pressure, cable; N per node) at the current positions
-    /// to `forces`.
+    /// Adds the follower loads' exact forces (pressure, cable; N per node) at the current
+    /// positions to `forces`.
     pub(crate) fn add_follower_forces(&self, forces: &mut [DVec3]) {
         for load in &self.loads {
             load.add_follower_forces(&self.positions, forces);
+        }
+    }
+
+    /// Per load, the point its potential's cone is measured from at the current positions (see
+    /// [`Load::cone_origin`]), fixed over a solve.
+    pub(crate) fn cone_origins(&self) -> Vec<DVec3> {
+        (self.loads.iter())
+            .map(|load| load.cone_origin(&self.positions))
+            .collect()
+    }
+
+    /// Adds minus the gradient of the follower loads' potentials (N per node) at the current
+    /// positions, cones measured from `origins`, to `forces`.
+    pub(crate) fn add_potential_forces(&self, origins: &[DVec3], forces: &mut [DVec3]) {
+        for (load, origin) in self.loads.iter().zip(origins) {
+            load.add_potential_forces(*origin, &self.positions, forces);
+        }
+    }
+
+    /// Adds the part of the follower forces no potential gives (N per node; a pressure's on the
+    /// free rim of an open surface, see [`crate::load`]) at the current positions, cones
+    /// measured from `origins`, to `forces`; zero on pinned nodes.
+    pub(crate) fn add_rim_forces(&self, origins: &[DVec3], forces: &mut [DVec3]) {
+        let mut rim = vec![DVec3::ZERO; self.node_count()];
+        self.add_follower_forces(&mut rim);
+        let mut conservative = vec![DVec3::ZERO; self.node_count()];
+        self.add_potential_forces(origins, &mut conservative);
+        for (n, force) in forces.iter_mut().enumerate() {
+            if !self.pinned[n] {
+                *force += rim[n] - conservative[n];
+            }
         }
     }
 
@@ -142,10 +173,11 @@ impl DeformableBody {
         }
     }
 
-    /// The follower loads' potential (J) at the current positions, measured from `start` (m).
-    pub(crate) fn follower_potential(&self, start: &[DVec3]) -> f64 {
-        (self.loads.iter())
-            .map(|load| load.follower_potential(start, &self.positions))
+    /// The follower loads' potential (J) at the current positions, measured from `start` (m),
+    /// cones from `origins`.
+    pub(crate) fn follower_potential(&self, origins: &[DVec3], start: &[DVec3]) -> f64 {
+        (self.loads.iter().zip(origins))
+            .map(|(load, origin)| load.follower_potential(*origin, start, &self.positions))
             .sum()
     }
 }

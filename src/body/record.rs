@@ -41,6 +41,8 @@ pub(super) struct BodyRecord {
     loads: Vec<Load>,
     #[serde(default)]
     load_edits: u64,
+    #[serde(default)]
+    load_change_work: f64,
     /// Positions (m) and velocities (m/s) of the nodes.
     positions: Vec<DVec3>,
     velocities: Vec<DVec3>,
@@ -72,6 +74,7 @@ impl From<&DeformableBody> for BodyRecord {
             user_data: body.user_data,
             loads: body.loads.clone(),
             load_edits: body.load_edits,
+            load_change_work: body.load_change_work,
             positions: body.positions.clone(),
             velocities: body.velocities.clone(),
             state_edits: body.state_edits,
@@ -121,6 +124,7 @@ impl TryFrom<BodyRecord> for DeformableBody {
             body.add_load(load)?;
         }
         body.load_edits = record.load_edits;
+        body.load_change_work = record.load_change_work;
         body.positions = record.positions;
         body.velocities = record.velocities;
         body.state_edits = record.state_edits;

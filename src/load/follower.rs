@@ -29,6 +29,25 @@ pub(super) fn add_pressure_forces(
     }
 }
 
+/// Adds minus the gradient (N) of the potential `p V` of a pressure `pressure` (Pa) on
+/// `triangles` at the positions `x` (m), the cone measured from `origin` (m): corner `a` of a
+/// triangle carries `-p (y_b × y_c) / 6`, `y = x − origin`.
+pub(super) fn add_cone_forces(
+    triangles: &[[u32; 3]],
+    pressure: f64,
+    x: &[DVec3],
+    origin: DVec3,
+    forces: &mut [DVec3],
+) {
+    let scale = -pressure / 6.0;
+    for &[a, b, c] in triangles {
+        let [ya, yb, yc] = [a, b, c].map(|n| x[n as usize] - origin);
+        forces[a as usize] += yb.cross(yc) * scale;
+        forces[b as usize] += yc.cross(ya) * scale;
+        forces[c as usize] += ya.cross(yb) * scale;
+    }
+}
+
 /// The mean position (m) of the corners of `triangles` at the positions `x` (m), counted once
 /// per triangle corner.
 pub(super) fn centre(triangles: &[[u32; 3]], x: &[DVec3]) -> DVec3 {
@@ -165,12 +184,16 @@ mod tests {
             .map(|i| DVec3::new((i % 3) as f64 - 1.0, (i % 5) as f64 * 0.5 - 1.0, 0.7))
             .collect();
         let start = body.positions().to_vec();
+        let origins = body.cone_origins();
         let h = 1e-7;
         let at = |body: &mut DeformableBody, step: f64| {
             for ((x, x0), d) in body.positions_mut().iter_mut().zip(&start).zip(&direction) {
                 *x = *x0 + *d * step;
             }
-            (body.follower_potential(&start), follower_forces(body))
+            (
+                body.follower_potential(&origins, &start),
+                follower_forces(body),
+            )
         };
         let (_, forces) = at(&mut body, 0.0);
         let (u_plus, f_plus) = at(&mut body, h);

@@ -19,9 +19,13 @@
 //! (the signed volume of the cone they span from a point `o`; minus a cavity's volume), and
 //! `U = T L(x)` with `L` the path's length: an implicit step and a static solve take their exact,
 //! symmetric Hessians into the Newton tangent ([`follower`]). A pressure's force is the gradient
-//! of its potential on a closed surface, or on an open one wherever the rim's nodes are pinned;
-//! on an open surface with a free rim the applied force is still the exact follower load, and
-//! only the Newton tangent and the line search's energy lack the rim's (non-symmetric) term.
+//! of its potential wherever the surface is closed around a node; what is left, `R = f + ∇U`,
+//! acts on the rim of an open surface alone (`(p/6) Σ (x_a − o) × (x_b − x_c)` over a node's
+//! triangles, which vanishes around a node inside the surface) and has no potential. An
+//! implicit step holds `R` at its value at the step's start, a dead load over the step, so that
+//! its Newton solve descends an energy (exact on a closed surface or a pinned rim, first order
+//! in the step at a free rim); a static solve takes `R` afresh at every Newton iteration and
+//! meets the exact follower load at equilibrium; explicit steps use the exact force.
 //! Every load is internal in the sense of momentum where it should be: a cavity's pressure and
 //! a cable exert no net force or torque on the body.
 
@@ -215,7 +219,7 @@ impl Load {
     }
 
     /// Adds the load's force (N per node) at the positions `x` (m) to `forces` if it is a
-    /// follower load (pressure, cable).
+    /// follower load (pressure, cable): the exact follower force.
     pub(crate) fn add_follower_forces(&self, x: &[DVec3], forces: &mut [DVec3]) {
         match self {
             Self::Pressure {
@@ -227,15 +231,38 @@ impl Load {
         }
     }
 
+    /// The point (m) a pressure's potential measures its cone from at the positions `x` (m):
+    /// its triangles' centre (the world's origin for other loads, which do not use it).
+    pub(crate) fn cone_origin(&self, x: &[DVec3]) -> DVec3 {
+        match self {
+            Self::Pressure { triangles, .. } => follower::centre(triangles, x),
+            _ => DVec3::ZERO,
+        }
+    }
+
+    /// Adds minus the gradient of the follower load's potential (N per node) at the positions
+    /// `x` (m), a pressure's cone measured from `origin` (m), to `forces`: the exact follower
+    /// force but on the free rim of an open surface.
+    pub(crate) fn add_potential_forces(&self, origin: DVec3, x: &[DVec3], forces: &mut [DVec3]) {
+        match self {
+            Self::Pressure {
+                triangles,
+                pressure,
+            } => follower::add_cone_forces(triangles, *pressure, x, origin, forces),
+            Self::Cable { path, tension } => follower::add_cable_forces(path, *tension, x, forces),
+            Self::Traction { .. } | Self::BodyForce { .. } => {}
+        }
+    }
+
     /// The follower load's potential `U(x) − U(x₀)` (J) between the positions `start` and `x`
-    /// (m); zero for a dead load (whose work the caller counts with gravity's).
-    pub(crate) fn follower_potential(&self, start: &[DVec3], x: &[DVec3]) -> f64 {
+    /// (m), a pressure's cone measured from `origin` (m); zero for a dead load (whose work the
+    /// caller counts with gravity's).
+    pub(crate) fn follower_potential(&self, origin: DVec3, start: &[DVec3], x: &[DVec3]) -> f64 {
         match self {
             Self::Pressure {
                 triangles,
                 pressure,
             } => {
-                let origin = follower::centre(triangles, start);
                 pressure
                     * (follower::cone_volume(triangles, x, origin)
                         - follower::cone_volume(triangles, start, origin))

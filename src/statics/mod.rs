@@ -99,7 +99,6 @@ fn newton(
     }
     let mut history: Vec<f64> = Vec::new();
     let start = body.positions.clone();
-    let mut potential = potential_energy(body, &load, &start);
     for iteration in 0..settings.max_iterations {
         let relative = norm(&residual) / reference;
         // Newton more than halves the residual each iteration until round-off in the force sum
@@ -128,7 +127,13 @@ fn newton(
             |stiffness, project| assemble_elastic(stiffness, body, project),
         )?
         .direction;
-        let energy = |body: &DeformableBody| potential_energy(body, &load, &start);
+        // This iteration's energy holds the follower loads' part no potential gives (a free
+        // rim's, see `crate::load`) at its value here: its gradient is the residual here.
+        let origins = body.cone_origins();
+        let mut held = load.clone();
+        body.add_rim_forces(&origins, &mut held);
+        let energy = |body: &DeformableBody| potential_energy(body, (&held, &origins), &start);
+        let potential = energy(body);
         match descend(
             body,
             &residual,
@@ -138,7 +143,7 @@ fn newton(
             energy,
             |body| out_of_balance(body, &load),
         ) {
-            Some((next, energy)) => (residual, potential) = (next, energy),
+            Some((next, _)) => residual = next,
             // No descent left above round-off: accept a tiny residual, refuse anything else.
             None if relative <= ROUND_OFF_CEILING => {
                 return Ok(StaticReport {
@@ -252,15 +257,20 @@ fn out_of_balance(body: &mut DeformableBody, load: &[DVec3]) -> Vec<DVec3> {
         .collect()
 }
 
-/// Total potential energy (J): elastic energy plus the follower loads' potential minus the work
-/// of the constant load, measured from the positions `start` (m) the solve began at.
-fn potential_energy(body: &DeformableBody, load: &[DVec3], start: &[DVec3]) -> f64 {
+/// Total potential energy (J): elastic energy plus the follower loads' potential (cones from
+/// `origins`) minus the work of the constant `load`, measured from the positions `start` (m)
+/// the solve began at.
+fn potential_energy(
+    body: &DeformableBody,
+    (load, origins): (&[DVec3], &[DVec3]),
+    start: &[DVec3],
+) -> f64 {
     let load_work: f64 = load
         .iter()
         .zip(body.positions.iter().zip(start))
         .map(|(f, (x, x0))| f.dot(*x - *x0))
         .sum();
-    body.elastic_energy() + body.follower_potential(start) - load_work
+    body.elastic_energy() + body.follower_potential(origins, start) - load_work
 }
 
 /// A fixed pseudo-random number in [-1, 1) for index `i` (`SplitMix64`).

@@ -439,6 +439,12 @@ pub fn assert_identical(a: &FvmWorld, b: &FvmWorld) {
         assert_eq!(body_a.positions(), body_b.positions(), "{ha:?}");
         assert_eq!(body_a.velocities(), body_b.velocities(), "{ha:?}");
         assert_eq!(body_a.masses(), body_b.masses(), "{ha:?}");
+        assert_eq!(body_a.loads(), body_b.loads(), "{ha:?}");
+        assert_eq!(
+            body_a.load_potential_energy().to_bits(),
+            body_b.load_potential_energy().to_bits(),
+            "{ha:?}"
+        );
     }
     for ((ha, rigid_a), (hb, rigid_b)) in a.physics.bodies.iter().zip(b.physics.bodies.iter()) {
         assert_eq!(ha, hb);

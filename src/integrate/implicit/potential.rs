@@ -34,7 +34,11 @@ pub(super) struct StepStart {
     pub(super) target: Vec<DVec3>,
     /// Per tetrahedron, the Green strain the damping's rate is measured from (when damped).
     pub(super) green: Vec<DMat3>,
+    /// The constant force over the step (N): the weight, the dead loads and the follower
+    /// loads' part no potential gives, at the step's start (see [`crate::load`]).
     pub(super) load: Vec<DVec3>,
+    /// Per load, the point its potential's cone is measured from (m).
+    pub(super) cone_origins: Vec<DVec3>,
 }
 
 impl StepStart {
@@ -102,7 +106,9 @@ impl StepStart {
                 }
             })
             .collect();
-        let load = body.dead_load(gravity);
+        let mut load = body.dead_load(gravity);
+        let cone_origins = body.cone_origins();
+        body.add_rim_forces(&cone_origins, &mut load);
         Self {
             h: effective_h,
             positions,
@@ -111,6 +117,7 @@ impl StepStart {
             target,
             green,
             load,
+            cone_origins,
         }
     }
 }
@@ -134,8 +141,8 @@ impl Potential<'_> {
     ) -> Vec<DVec3> {
         body.velocities.fill(DVec3::ZERO);
         body.internal_forces_into(forces);
-        body.add_follower_forces(forces);
         let start = self.start;
+        body.add_potential_forces(&start.cone_origins, forces);
         let mut residual: Vec<DVec3> = (0..body.positions.len())
             .map(|n| {
                 let inertial =
@@ -213,7 +220,7 @@ impl Potential<'_> {
         let mut rigid = self.rigid.borrow_mut();
         let response = rigid.solve(body, self.constraints);
         let penalty = constraint::implicit_energy(body, self.constraints, rigid.step());
-        let follower = body.follower_potential(&self.start.positions);
+        let follower = body.follower_potential(&self.start.cone_origins, &self.start.positions);
         inertia + body.elastic_energy() + follower + dissipation + penalty + response - load
     }
 
