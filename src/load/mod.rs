@@ -18,7 +18,7 @@
 //! potentials `U = p V(x)`, `V = Σ (x_a − o)·((x_b − o) × (x_c − o)) / 6` over the triangles
 //! (the signed volume of the cone they span from a point `o`; minus a cavity's volume), and
 //! `U = T L(x)` with `L` the path's length: an implicit step and a static solve take their exact,
-//! symmetric Hessians into the Newton tangent ([`follower`]). A pressure's force is the gradient
+//! symmetric Hessians into the Newton tangent. A pressure's force is the gradient
 //! of its potential wherever the surface is closed around a node; what is left, `R = f + ∇U`,
 //! acts on the rim of an open surface alone (`(p/6) Σ (x_a − o) × (x_b − x_c)` over a node's
 //! triangles, which vanishes around a node inside the surface) and has no potential. An
