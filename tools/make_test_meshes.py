@@ -401,8 +401,17 @@ def pneumatic_finger():
     mesh_and_write_v41_ascii(0.003, 3, "pneumatic_finger_v41.msh")
 
 
+def two_volumes_vtu():
+    """two_volumes_v41.msh converted by meshio to VTU (its default: binary, zlib), which keeps
+    each cell's physical tag as the cell data array "gmsh:physical" (the groups' names are
+    lost: VTU has no place for them)."""
+    mesh = meshio.read(os.path.join(OUT, "two_volumes_v41.msh"))
+    meshio.write(os.path.join(OUT, "two_volumes_meshio.vtu"), mesh)
+
+
 STEPS = [cube_msh, cube_others, surfaces, cube_meshio_compressed, cube_vtk_library,
-         multi_solid_stl, cube_msh_other_forms, cube_regions, two_volumes, pneumatic_finger]
+         multi_solid_stl, cube_msh_other_forms, cube_regions, two_volumes, pneumatic_finger,
+         two_volumes_vtu]
 
 if __name__ == "__main__":
     import sys

@@ -180,3 +180,40 @@ fn a_region_the_file_lacks_is_refused_at_its_key_with_the_file_s_regions() {
         );
     }
 }
+
+#[test]
+fn a_vtu_file_s_cell_tags_select_as_the_gmsh_file_s_regions() {
+    // meshio's VTU of the same two boxes keeps the physical tags as cell data, without names:
+    // by tag, the left box is a body of its own pinned by its clamp (tag 3, the 44 nodes at
+    // x = 0), the right one another, as from the gmsh file.
+    let text = r#"name = "two_vtu"
+
+[world]
+duration = 0.02
+
+[[soft_body]]
+name = "left"
+mesh = { file = "../meshes/two_volumes_meshio.vtu", scale = 0.1, region = 1 }
+material = { model = "stable_neo_hookean", young = 1e5, poisson = 0.3, density = 1000.0 }
+pinned = [{ region = 3 }]
+
+[[soft_body]]
+name = "right"
+mesh = { file = "../meshes/two_volumes_meshio.vtu", scale = 0.1, region = 2 }
+material = { model = "stable_neo_hookean", young = 1e5, poisson = 0.3, density = 1000.0 }
+velocity = [{ region = 4, linvel = [0.0, 0.0, 0.1] }]
+"#;
+    let scene = Scene::parse(scene_path("two_volumes_vtu"), text.to_owned()).unwrap();
+    let simulation = Simulation::build(&scene).unwrap_or_else(|e| panic!("{e}"));
+    let left = &simulation.world.soft_bodies[simulation.soft[0].handle];
+    let right = &simulation.world.soft_bodies[simulation.soft[1].handle];
+    for body in [left, right] {
+        assert!((body.mesh().volume() - 1e-3).abs() < 1e-15);
+    }
+    let pinned: Vec<usize> = (0..left.node_count())
+        .filter(|&n| left.is_pinned(n))
+        .collect();
+    assert_eq!(pinned.len(), 44);
+    assert!(pinned.iter().all(|&n| left.positions()[n].x.abs() < 1e-12));
+    assert_eq!(left.mesh().tet_count() + right.mesh().tet_count(), 1455);
+}

@@ -95,7 +95,7 @@ fn bytes_cached_ele() -> Vec<u8> {
 }
 
 /// (reader, valid file) pairs mutated by the fuzz properties.
-const SEEDS: [(usize, &str); 25] = [
+const SEEDS: [(usize, &str); 26] = [
     (0, "cube_v22_ascii.msh"),
     (0, "cube_v22_binary.msh"),
     (0, "cube_v41_ascii.msh"),
@@ -115,6 +115,7 @@ const SEEDS: [(usize, &str); 25] = [
     (3, "cube_vtk_appended_raw_zlib.vtu"),
     (3, "cube_vtk_zlib_small_blocks.vtu"),
     (3, "cube_vtk_binary_uint32.vtu"),
+    (3, "two_volumes_meshio.vtu"),
     (4, "cube_ascii.vtk"),
     (4, "cube_binary.vtk"),
     (4, "cube_vtk9_legacy.vtk"),

@@ -5,7 +5,7 @@
 use super::bytes;
 use rapier_fvm::Error;
 use rapier_fvm::mesh::QuadraticTetMesh;
-use rapier_fvm::mesh::import::{MeshRegion, RegionId, gmsh, vtk};
+use rapier_fvm::mesh::import::{MeshRegion, RawMesh, RegionId, gmsh, vtk};
 
 #[test]
 fn gmsh_physical_groups_are_kept_as_named_regions() {
@@ -174,4 +174,99 @@ fn a_first_order_face_widened_to_a_quadratic_body_is_its_whole_face() {
     let body = gmsh::parse(&bytes("cube_regions_v22.msh"), "cube.msh", 1.0).unwrap();
     let whole = body.regions_in_mesh()[1].with_mid_edge_nodes(&quadratic);
     assert_eq!(whole.nodes.len(), quadratic.positions().len());
+}
+
+/// The positions of a region's nodes and of its tetrahedra's corners in `raw`, each sorted, so
+/// that two files numbering the same mesh differently compare equal.
+fn region_geometry(raw: &RawMesh, region: &MeshRegion) -> (Vec<[u64; 3]>, Vec<[[u64; 3]; 4]>) {
+    let at = |n: u32| raw.positions[n as usize].to_array().map(f64::to_bits);
+    let mut nodes: Vec<[u64; 3]> = region.nodes.iter().map(|&n| at(n)).collect();
+    nodes.sort_unstable();
+    let mut tets: Vec<[[u64; 3]; 4]> = (region.tets.iter())
+        .map(|&t| {
+            let mut corners = raw.tets[t as usize].map(at);
+            corners.sort_unstable();
+            corners
+        })
+        .collect();
+    tets.sort_unstable();
+    (nodes, tets)
+}
+
+#[test]
+fn a_vtu_file_s_cell_tags_are_the_gmsh_file_s_regions() {
+    // meshio's VTU of two_volumes_v41.msh keeps each cell's physical tag as "gmsh:physical":
+    // the same four regions by dimension and tag, unnamed, with the same nodes and tetrahedra
+    // (compared by position, to the bit), found by tag.
+    let msh = two_volumes();
+    let name = "two_volumes_meshio.vtu";
+    let vtu = vtk::parse_vtu(&bytes(name), name, 1.0).unwrap();
+    assert_eq!(vtu.regions.len(), msh.regions.len());
+    for region in &msh.regions {
+        let found = MeshRegion::find(&vtu.regions, &RegionId::Tag(region.tag), name).unwrap();
+        assert_eq!(
+            (found.dimension, found.name.as_str()),
+            (region.dimension, "")
+        );
+        assert_eq!(
+            region_geometry(&vtu, found),
+            region_geometry(&msh, region),
+            "{region}"
+        );
+    }
+    let left = vtu.keep_volume(&RegionId::Tag(1)).unwrap();
+    assert!((left.into_mesh().unwrap().volume() - 1.0).abs() < 1e-12);
+}
+
+#[test]
+fn a_vtu_cell_tag_array_that_does_not_fit_its_cells_is_refused() {
+    // The tag array cut to fewer values than the piece's cells, and a tag array of floats that
+    // are not whole: errors at the array's line, never a region silently short.
+    let text = std::fs::read_to_string(super::asset("cube_ascii.vtu")).unwrap();
+    let cells: usize = text
+        .split("NumberOfCells=\"")
+        .nth(1)
+        .and_then(|rest| rest.split('"').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap();
+    let with_tags = |array: &str| {
+        text.replacen(
+            "</Cells>",
+            &format!("</Cells>\n<CellData>\n{array}\n</CellData>"),
+            1,
+        )
+    };
+    let short = with_tags(&format!(
+        "<DataArray type=\"Int32\" Name=\"gmsh:physical\" format=\"ascii\">{}</DataArray>",
+        vec!["1"; cells - 1].join(" ")
+    ));
+    let error = vtk::parse_vtu(short.as_bytes(), "short.vtu", 1.0)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        error.contains("gmsh:physical") && error.contains(&format!("for {cells} cells")),
+        "{error}"
+    );
+    let floats = with_tags(&format!(
+        "<DataArray type=\"Float64\" Name=\"CellEntityIds\" format=\"ascii\">{}</DataArray>",
+        vec!["1.5"; cells].join(" ")
+    ));
+    let error = vtk::parse_vtu(floats.as_bytes(), "floats.vtu", 1.0)
+        .unwrap_err()
+        .to_string();
+    assert!(error.contains("hold 1.5, not a tag"), "{error}");
+    // Whole numbers stored as floats (as vmtk may write them) are tags.
+    let whole_floats = with_tags(&format!(
+        "<DataArray type=\"Float32\" Name=\"CellEntityIds\" format=\"ascii\">{}</DataArray>",
+        vec!["2"; cells].join(" ")
+    ));
+    let raw = vtk::parse_vtu(whole_floats.as_bytes(), "whole_floats.vtu", 1.0).unwrap();
+    assert_eq!((raw.regions.len(), raw.regions[0].tag), (1, 2));
+    let whole = with_tags(&format!(
+        "<DataArray type=\"Int32\" Name=\"gmsh:physical\" format=\"ascii\">{}</DataArray>",
+        vec!["7"; cells].join(" ")
+    ));
+    let raw = vtk::parse_vtu(whole.as_bytes(), "whole.vtu", 1.0).unwrap();
+    assert_eq!(raw.regions.len(), 1);
+    assert_eq!(raw.regions[0].tets.len(), raw.tets.len());
 }

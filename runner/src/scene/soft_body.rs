@@ -29,8 +29,9 @@
 //!                                 # pressure, traction, body force, cable (see `load`)
 //! ```
 //! Regions are boxes `min`..`max` (m) in the mesh's rest coordinates, before the translation and
-//! rotation, or, for a mesh file with named parts (Gmsh physical groups), `region = "clamp"` (a
-//! group's name) or `region = 3` (its physical tag): the nodes of that group's elements, as in
+//! rotation, or, for a mesh file with named parts (Gmsh physical groups, a `.vtu` file's cell
+//! tags), `region = "clamp"` (a group's name) or `region = 3` (its physical tag): the nodes of
+//! that group's elements, as in
 //! `pinned = [{ region = "clamp" }]`. Each region must hold at least one node.
 
 use super::check::Checker;

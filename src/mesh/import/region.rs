@@ -1,5 +1,6 @@
-//! Named parts of a mesh file (Gmsh physical groups): finding one by name or tag, numbering its
-//! nodes as the validated mesh does, and keeping one volume's tetrahedra as a mesh of its own.
+//! Named parts of a mesh file (Gmsh physical groups; a `.vtu` file's cell tags, unnamed):
+//! finding one by name or tag, numbering its nodes as the validated mesh does, and keeping one
+//! volume's tetrahedra as a mesh of its own.
 //!
 //! A [`MeshRegion`] read from a file holds the nodes of its elements as indices into
 //! [`RawMesh::positions`]. The validated mesh numbers the nodes its elements use in order of
@@ -33,7 +34,8 @@ use crate::mesh::QuadraticTetMesh;
 use crate::shape::tet10::EDGES;
 use std::fmt;
 
-/// A named part of a mesh file: a Gmsh physical group of points, curves, surfaces or volumes.
+/// A named part of a mesh file: a Gmsh physical group of points, curves, surfaces or volumes,
+/// or the cells of a `.vtu` file that share a tag (unnamed).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct MeshRegion {
     /// Its name (`$PhysicalNames`), empty if the file gives none.

@@ -61,6 +61,7 @@ pub fn parse_legacy(data: &[u8], path: &str, scale: f64) -> Result<RawMesh, Erro
         offsets: &offsets,
         connectivity: &connectivity,
         types: &types,
+        tags: &[],
     };
     build(&file.source, positions, &cells, &|_, _| location)
 }

@@ -19,7 +19,10 @@
 //! UNSTRUCTURED_GRID`) are read by hand too (`legacy`, its data blocks in `legacy_data`): the
 //! format is a few keywords and number lists.
 //!
-//! This module turns the cells both readers collect into tetrahedra.
+//! This module turns the cells both readers collect into tetrahedra, and the cells a `.vtu`
+//! file tags (its `gmsh:physical` or `CellEntityIds` cell data) into unnamed regions by
+//! dimension and tag: a tetrahedron's into a volume, a triangle's or quadrangle's into a
+//! surface, as a Gmsh file's physical groups are.
 
 mod legacy;
 mod legacy_data;
@@ -31,8 +34,8 @@ mod xml_document;
 pub use legacy::parse_legacy;
 pub use xml::parse_vtu;
 
-use super::RawMesh;
 use super::text::Source;
+use super::{MeshRegion, RawMesh};
 use crate::Error;
 use crate::error::{FileLocation, ImportErrorKind};
 use rapier3d::glamx::DVec3;
@@ -59,6 +62,8 @@ struct Cells<'c> {
     connectivity: &'c [u64],
     /// VTK's cell type of each cell.
     types: &'c [u64],
+    /// Each cell's region tag, if the file tags its cells (empty, or `None` for a cell, if not).
+    tags: &'c [Option<u64>],
 }
 
 /// Which of a cell's data an error is about, for the location of its data array.
@@ -95,12 +100,21 @@ fn build(
     let mut tets = Vec::new();
     let mut mid_edge_nodes = Vec::new();
     let mut tet_locations = Vec::new();
+    let mut tagged = TaggedCells::default();
     for (cell, &cell_type) in cells.types.iter().enumerate() {
         let nodes = cells.nodes(source, cell, locate)?;
+        let tag = cells.tags.get(cell).copied().flatten();
         let Some(nodes) = tetrahedron(source, cell, cell_type, nodes, positions.len(), locate)?
         else {
+            if let Some(tag) = tag {
+                let at = locate(cell, CellData::Connectivity);
+                tagged.add_boundary(source, (cell, cell_type, tag), nodes, positions.len(), at)?;
+            }
             continue;
         };
+        if let Some(tag) = tag {
+            tagged.add_tet(tag, tets.len() as u32, &nodes);
+        }
         let quadratic = nodes.len() == 10;
         if !tets.is_empty() && quadratic == mid_edge_nodes.is_empty() {
             return Err(source.error_at(
@@ -131,8 +145,88 @@ fn build(
         tets,
         mid_edge_nodes,
         tet_locations,
-        regions: Vec::new(),
+        regions: tagged.regions(source)?,
     })
+}
+
+/// The tagged cells seen so far, by dimension and tag: their nodes and, for volumes, their
+/// tetrahedra.
+#[derive(Default)]
+struct TaggedCells {
+    groups: std::collections::BTreeMap<(u8, u64), (Vec<u32>, Vec<u32>)>,
+}
+
+impl TaggedCells {
+    /// Adds tetrahedron `tet` (index among the mesh's) of `nodes` to the volume tagged `tag`.
+    fn add_tet(&mut self, tag: u64, tet: u32, nodes: &[u32]) {
+        let (group_nodes, tets) = self.groups.entry((3, tag)).or_default();
+        group_nodes.extend_from_slice(nodes);
+        tets.push(tet);
+    }
+
+    /// Adds the lower-dimensional cell `cell` of `cell_type` tagged `tag`, of point indices
+    /// `nodes` (of `point_count` points, checked; errors at `at`), to its group: a vertex, a
+    /// curve or a surface by its type.
+    fn add_boundary(
+        &mut self,
+        source: &Source<'_>,
+        (cell, cell_type, tag): (usize, u64, u64),
+        nodes: &[u64],
+        point_count: usize,
+        at: FileLocation,
+    ) -> Result<(), Error> {
+        let dimension = match cell_type {
+            1 | 2 => 0,
+            3 | 4 | 21 | 35 | 68 => 1,
+            0 => return Ok(()),
+            _ => 2,
+        };
+        let (group_nodes, _) = self.groups.entry((dimension, tag)).or_default();
+        for &node in nodes {
+            match u32::try_from(node)
+                .ok()
+                .filter(|&n| (n as usize) < point_count)
+            {
+                Some(n) => group_nodes.push(n),
+                None => {
+                    return Err(source.error_at(
+                        at,
+                        ImportErrorKind::IndexOutOfRange,
+                        format!(
+                            "tagged cell {cell} refers to point {node}, but there are \
+                             {point_count} points"
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The groups as unnamed regions, nodes sorted and each once; a tag beyond `i64` is an
+    /// error.
+    fn regions(self, source: &Source<'_>) -> Result<Vec<MeshRegion>, Error> {
+        (self.groups.into_iter())
+            .map(|((dimension, tag), (mut nodes, tets))| {
+                nodes.sort_unstable();
+                nodes.dedup();
+                let tag = i64::try_from(tag).map_err(|_| {
+                    source.error_at(
+                        FileLocation::Whole,
+                        ImportErrorKind::BadCount,
+                        format!("a cell tag of {tag} is beyond the tags a region can have"),
+                    )
+                })?;
+                Ok(MeshRegion {
+                    name: String::new(),
+                    dimension,
+                    tag,
+                    nodes,
+                    tets,
+                })
+            })
+            .collect()
+    }
 }
 
 impl Cells<'_> {

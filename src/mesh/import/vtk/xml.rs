@@ -7,7 +7,11 @@
 //! offsets (a leading zero tolerated), connectivity and types. Every array must hold exactly
 //! what its piece's `NumberOfPoints` and `NumberOfCells` declare (nothing for a count of 0), and
 //! each cell's points must be its own piece's; the pieces' points are numbered one after the
-//! other. Errors are placed at the line of the `<DataArray>` at fault (a token that is not a
+//! other. A `<CellData>` array of the cells' physical tags (`gmsh:physical`, as meshio writes a
+//! Gmsh file's, or vmtk's `CellEntityIds`, whole numbers of any type) makes the tagged cells
+//! regions, as a Gmsh file's physical
+//! groups are (unnamed: a VTU file has no names for them). Errors are placed at the line of the
+//! `<DataArray>` at fault (a token that is not a
 //! number at its own line; appended data at its byte offset), a missing array at its
 //! `<Piece>`.
 
@@ -35,9 +39,15 @@ pub fn parse_vtu(data: &[u8], path: &str, scale: f64) -> Result<RawMesh, Error> 
     let source = Source::new(path, data);
     let document = xml_document::read(&source, data)?;
     let arrays = document.pieces.iter().flat_map(|p| {
-        [&p.points, &p.connectivity, &p.offsets, &p.types]
-            .into_iter()
-            .flatten()
+        [
+            &p.points,
+            &p.connectivity,
+            &p.offsets,
+            &p.types,
+            &p.cell_tags,
+        ]
+        .into_iter()
+        .flatten()
     });
     let decoder = Decoder::new(&source, &document.layout, document.appended, arrays);
     let mut grid = Grid {
@@ -47,6 +57,7 @@ pub fn parse_vtu(data: &[u8], path: &str, scale: f64) -> Result<RawMesh, Error> 
         offsets: vec![0u64],
         connectivity: Vec::new(),
         types: Vec::new(),
+        tags: Vec::new(),
         pieces: Vec::new(),
     };
     for (number, piece) in document.pieces.iter().enumerate() {
@@ -86,6 +97,8 @@ struct Grid<'s> {
     connectivity: Vec<u64>,
     /// The cells' VTK types.
     types: Vec<u64>,
+    /// The cells' region tags, `None` for the cells of a piece without a tag array.
+    tags: Vec<Option<u64>>,
     /// Where each piece's cells start and its arrays are.
     pieces: Vec<PieceLines>,
 }
@@ -152,8 +165,60 @@ impl Grid<'_> {
             }
             self.connectivity.push(first_point + node);
         }
+        let tags = self.read_cell_tags(decoder, number, piece)?;
+        match tags {
+            Some(tags) => self.tags.extend(tags.into_iter().map(Some)),
+            None => self.tags.extend(cells.types.iter().map(|_| None)),
+        }
         self.types.extend(cells.types);
         Ok(())
+    }
+
+    /// The region tags of piece `number`'s cells (see
+    /// [`CELL_TAG_NAMES`](xml_document::CELL_TAG_NAMES)), one per cell, or `None` if the piece
+    /// has no tag array.
+    fn read_cell_tags(
+        &self,
+        decoder: &Decoder<'_, '_>,
+        number: usize,
+        piece: &PieceDecl,
+    ) -> Result<Option<Vec<u64>>, Error> {
+        let Some(array) = &piece.cell_tags else {
+            return Ok(None);
+        };
+        let cells = piece.cell_count;
+        let what = format!("cell tags ({}) of piece {number}", array.name);
+        let tags = if array.value_type.starts_with("Float") {
+            // Some writers store the tags as floats (vmtk's, at times): whole numbers only.
+            let values = decoder.floats(array, cells, &what)?;
+            let whole = |v: f64| (v >= 0.0 && v.fract() == 0.0 && v < 9.0e15).then_some(v as u64);
+            values
+                .iter()
+                .map(|&v| {
+                    whole(v).ok_or_else(|| {
+                        self.source.error_at(
+                            FileLocation::Line(array.line),
+                            ImportErrorKind::Syntax,
+                            format!("the {what} hold {v}, not a tag (a whole number from 0)"),
+                        )
+                    })
+                })
+                .collect::<Result<Vec<u64>, Error>>()?
+        } else {
+            decoder.indices(array, cells, &what)?
+        };
+        if tags.len() as u64 != cells || array.components != 1 {
+            return Err(self.bad_count(
+                FileLocation::Line(array.line),
+                format!(
+                    "piece {number} has {} values of {} in {} components for {cells} cells",
+                    tags.len(),
+                    array.name,
+                    array.components
+                ),
+            ));
+        }
+        Ok(Some(tags))
     }
 
     /// The cells of piece `number`: its types, the ends of its cells in its connectivity (a
@@ -289,6 +354,7 @@ impl Grid<'_> {
             offsets,
             connectivity,
             types,
+            tags,
             pieces,
             ..
         } = self;
@@ -296,6 +362,7 @@ impl Grid<'_> {
             offsets: &offsets,
             connectivity: &connectivity,
             types: &types,
+            tags: &tags,
         };
         let locate = |cell: usize, data: CellData| {
             let number = pieces.partition_point(|p| p.first_cell <= cell).max(1) - 1;

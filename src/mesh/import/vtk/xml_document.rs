@@ -80,7 +80,13 @@ pub(super) struct PieceDecl {
     pub(super) connectivity: Option<ArrayDecl>,
     pub(super) offsets: Option<ArrayDecl>,
     pub(super) types: Option<ArrayDecl>,
+    /// The `<CellData>` array of the cells' physical tags (see [`CELL_TAG_NAMES`]), if any.
+    pub(super) cell_tags: Option<ArrayDecl>,
 }
+
+/// The names a `<CellData>` array of the cells' region tags goes by: Gmsh's physical groups as
+/// meshio writes them, and vmtk's cell entity ids.
+pub(super) const CELL_TAG_NAMES: [&str; 2] = ["gmsh:physical", "CellEntityIds"];
 
 /// The `<AppendedData>` region.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -188,7 +194,10 @@ impl<'d> Tree<'d> {
                 let piece = walk.piece(tag, line, self.document.pieces.len())?;
                 self.document.pieces.push(piece);
             }
-            (Some(b"Points" | b"Cells"), b"DataArray") => {
+            (Some(b"CellData"), b"DataArray")
+                if !attribute(tag, b"Name")
+                    .is_some_and(|n| CELL_TAG_NAMES.contains(&n.as_str())) => {}
+            (Some(b"Points" | b"Cells" | b"CellData"), b"DataArray") => {
                 let array = walk.array(tag, line)?;
                 if empty {
                     self.keep(self.open.len(), array);
@@ -229,7 +238,8 @@ impl<'d> Tree<'d> {
     }
 
     /// Keeps `array`, read with `depth` elements open around it, in the last piece if this
-    /// reader needs it (the `<Points>` array, the `<Cells>` arrays it names).
+    /// reader needs it (the `<Points>` array, the `<Cells>` arrays it names, the first cell tag
+    /// array of `<CellData>`).
     fn keep(&mut self, depth: usize, array: ArrayDecl) {
         let parent = depth.checked_sub(1).map(|i| self.open[i].as_slice());
         let Some(piece) = self.document.pieces.last_mut() else {
@@ -240,6 +250,7 @@ impl<'d> Tree<'d> {
             (Some(b"Cells"), "connectivity") => &mut piece.connectivity,
             (Some(b"Cells"), "offsets") => &mut piece.offsets,
             (Some(b"Cells"), "types") => &mut piece.types,
+            (Some(b"CellData"), name) if CELL_TAG_NAMES.contains(&name) => &mut piece.cell_tags,
             _ => return,
         };
         slot.get_or_insert(array);
