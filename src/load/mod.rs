@@ -91,6 +91,10 @@ pub enum LoadValue {
     Scalar(f64),
 }
 
+/// What [`Load::set`] says of a value of the other kind.
+const VALUE_KINDS: &str =
+    "a vector is the value of a traction or body force, a number that of a pressure or cable";
+
 impl Load {
     /// The load's name, for messages.
     pub fn kind(&self) -> &'static str {
@@ -120,9 +124,11 @@ impl Load {
     pub fn set(&mut self, value: LoadValue) -> Result<(), Error> {
         let mut changed = self.clone();
         match (&mut changed, value) {
-            (Self::Traction { traction: v, .. } | Self::BodyForce { density: v }, LoadValue::Vector(new)) => *v = new,
-            (Self::Pressure { pressure: v, .. } | Self::Cable { tension: v, .. }, LoadValue::Scalar(new)) => *v = new,
-            _ => return Err(self.invalid("a vector is the value of a traction or body force, a number that of a pressure or cable")),
+            (Self::Traction { traction: v, .. }, LoadValue::Vector(new))
+            | (Self::BodyForce { density: v }, LoadValue::Vector(new)) => *v = new,
+            (Self::Pressure { pressure: v, .. }, LoadValue::Scalar(new))
+            | (Self::Cable { tension: v, .. }, LoadValue::Scalar(new)) => *v = new,
+            _ => return Err(self.invalid(VALUE_KINDS)),
         }
         changed.check_value()?;
         *self = changed;
