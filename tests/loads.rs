@@ -111,6 +111,20 @@ fn timoshenko_end_load(load: f64, length: f64, side: f64, young: f64, nu: f64) -
     load * length.powi(3) / (3.0 * young * inertia) + load * length / (kappa * shear * area)
 }
 
+/// A cantilever of `half` extents (m) along x, linear material of Young's modulus `young` (Pa)
+/// at ν = 0, on a cage of 27-node hexahedra of `cells` with the element-averaged volumetric
+/// term, its face x = −half.x pinned.
+fn clamped_cage_beam(half: DVec3, cells: [usize; 3], young: f64) -> DeformableBody {
+    let cage = mesh::QuadraticHexMesh::cuboid(half, cells).unwrap();
+    let clamped = cage.nodes_where(|p| p.x <= -half.x + 1e-9);
+    let material = Material::new(MaterialModel::Linear, young, 0.0, 1000.0).unwrap();
+    DeformableBodyBuilder::quadratic_hex(cage, material)
+        .pinned_nodes(clamped)
+        .volumetric(VolumetricTreatment::ElementAverage)
+        .build()
+        .unwrap()
+}
+
 /// A 1 m cantilever of 0.1 m square section (E = 1e8 Pa, ν = 0, clamped face pinned) on a cage
 /// of 27-node hexahedra, loaded by a uniform downward traction of 1 kPa on its free end face (a
 /// 10 N end load): the mean deflection of the end face within 2 % (the bound) of
@@ -124,15 +138,8 @@ fn cantilever_under_end_traction_matches_timoshenko() {
     println!("Timoshenko end load: {:.4} mm", expected * 1e3);
     let mut error = f64::INFINITY;
     for cells in [[5, 1, 1], [10, 2, 2]] {
-        let cage = mesh::QuadraticHexMesh::cuboid(half, cells).unwrap();
-        let clamped = cage.nodes_where(|p| p.x <= -half.x + 1e-9);
-        let tip = cage.nodes_where(|p| p.x >= half.x - 1e-9);
-        let material = Material::new(MaterialModel::Linear, young, 0.0, 1000.0).unwrap();
-        let mut beam = DeformableBodyBuilder::quadratic_hex(cage, material)
-            .pinned_nodes(clamped)
-            .volumetric(VolumetricTreatment::ElementAverage)
-            .build()
-            .unwrap();
+        let mut beam = clamped_cage_beam(half, cells, young);
+        let tip = beam.mesh().nodes_where(|p| p.x >= half.x - 1e-9);
         let end = beam
             .mesh()
             .surface_triangles_where(|p| p.x >= half.x - 1e-9);
@@ -365,20 +372,12 @@ fn free_pneumatic_finger_keeps_its_momentum() {
 #[test]
 fn cable_bends_a_cantilever_by_its_moment() {
     let (half, young, tension, offset) = (DVec3::new(0.5, 0.05, 0.05), 1e8, 20.0, 0.025);
-    let cage = mesh::QuadraticHexMesh::cuboid(half, [10, 2, 2]).unwrap();
-    let clamped = cage.nodes_where(|p| p.x <= -half.x + 1e-9);
-    let mut path = cage.nodes_where(|p| (p.y - offset).abs() < 1e-9 && p.z.abs() < 1e-9);
-    path.sort_by(|a, b| {
-        cage.positions()[*a as usize]
-            .x
-            .total_cmp(&cage.positions()[*b as usize].x)
-    });
-    let material = Material::new(MaterialModel::Linear, young, 0.0, 1000.0).unwrap();
-    let mut beam = DeformableBodyBuilder::quadratic_hex(cage, material)
-        .pinned_nodes(clamped)
-        .volumetric(VolumetricTreatment::ElementAverage)
-        .build()
-        .unwrap();
+    let mut beam = clamped_cage_beam(half, [10, 2, 2], young);
+    let rest = beam.mesh().positions().to_vec();
+    let mut path = beam
+        .mesh()
+        .nodes_where(|p| (p.y - offset).abs() < 1e-9 && p.z.abs() < 1e-9);
+    path.sort_by(|a, b| rest[*a as usize].x.total_cmp(&rest[*b as usize].x));
     println!("the cable runs through {} eyelets", path.len());
     beam.add_load(Load::Cable { path, tension }).unwrap();
     statics::solve_equilibrium(&mut beam, DVec3::ZERO, &StaticSettings::default()).unwrap();
