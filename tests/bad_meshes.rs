@@ -239,6 +239,7 @@ fn a_raw_mesh_with_a_far_node_is_refused_at_the_first_tetrahedron_using_it() {
         mid_edge_nodes: Vec::new(),
         tet_locations: vec![FileLocation::Line(7), FileLocation::Line(8)],
         regions: Vec::new(),
+        hexahedra: Default::default(),
     };
     let (kind, at, message) = import_error(raw.into_mesh());
     assert_eq!(

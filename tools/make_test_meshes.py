@@ -404,14 +404,66 @@ def pneumatic_finger():
 def two_volumes_vtu():
     """two_volumes_v41.msh converted by meshio to VTU (its default: binary, zlib), which keeps
     each cell's physical tag as the cell data array "gmsh:physical" (the groups' names are
-    lost: VTU has no place for them)."""
+    lost: VTU has no place for them); and to legacy VTK (its default: version 5.1, binary),
+    where the tags are a FIELD array of the CELL_DATA."""
     mesh = meshio.read(os.path.join(OUT, "two_volumes_v41.msh"))
     meshio.write(os.path.join(OUT, "two_volumes_meshio.vtu"), mesh)
+    meshio.write(os.path.join(OUT, "two_volumes_meshio.vtk"), mesh)
+
+
+def hexahedra():
+    """A 1 x 0.5 x 0.25 box [0, 1] x [0, 0.5] x [0, 0.25] meshed by gmsh into 4 x 3 x 2
+    hexahedra (transfinite, recombined), with physical groups "block" (the volume, tag 1) and
+    "clamp" (the face x = 0, tag 2): linear (8-node, type 5) in MSH 4.1 ASCII and 2.2 binary,
+    and 27-node (type 12) in MSH 4.1 ASCII; both through meshio to VTU (its default: binary,
+    zlib), and the 27-node one through the VTK library's legacy writer (ASCII)."""
+    from vtkmodules.vtkIOLegacy import vtkUnstructuredGridWriter
+    from vtkmodules.vtkIOXML import vtkXMLUnstructuredGridReader
+
+    for order, names in [(1, ["box_hex8_v41.msh", "box_hex8_v22_binary.msh"]),
+                         (2, ["box_hex27_v41.msh"])]:
+        gmsh.initialize()
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.model.add("hexahedra")
+        gmsh.model.occ.addBox(0, 0, 0, 1, 0.5, 0.25)
+        gmsh.model.occ.synchronize()
+        for _, curve in gmsh.model.getEntities(1):
+            x0, y0, z0, x1, y1, z1 = gmsh.model.getBoundingBox(1, curve)
+            cells = 4 if x1 - x0 > 1e-3 else 3 if y1 - y0 > 1e-3 else 2
+            gmsh.model.mesh.setTransfiniteCurve(curve, cells + 1)
+        for _, surface in gmsh.model.getEntities(2):
+            gmsh.model.mesh.setTransfiniteSurface(surface)
+            gmsh.model.mesh.setRecombine(2, surface)
+        gmsh.model.mesh.setTransfiniteVolume(1)
+        clamp = [t for _, t in gmsh.model.getEntitiesInBoundingBox(
+            -1e-6, -1e-6, -1e-6, 1e-6, 0.51, 0.26, 2)]
+        gmsh.model.addPhysicalGroup(3, [1], 1, name="block")
+        gmsh.model.addPhysicalGroup(2, clamp, 2, name="clamp")
+        gmsh.model.mesh.generate(3)
+        if order == 2:
+            gmsh.option.setNumber("Mesh.SecondOrderIncomplete", 0)
+            gmsh.model.mesh.setOrder(2)
+        for name in names:
+            gmsh.option.setNumber("Mesh.MshFileVersion", 2.2 if "v22" in name else 4.1)
+            gmsh.option.setNumber("Mesh.Binary", 1 if "binary" in name else 0)
+            gmsh.write(os.path.join(OUT, name))
+        gmsh.finalize()
+    for nodes in [8, 27]:
+        mesh = meshio.read(os.path.join(OUT, "box_hex%d_v41.msh" % nodes))
+        meshio.write(os.path.join(OUT, "box_hex%d_meshio.vtu" % nodes), mesh)
+    reader = vtkXMLUnstructuredGridReader()
+    reader.SetFileName(os.path.join(OUT, "box_hex27_meshio.vtu"))
+    reader.Update()
+    writer = vtkUnstructuredGridWriter()
+    writer.SetFileName(os.path.join(OUT, "box_hex27_vtk9.vtk"))
+    writer.SetInputData(reader.GetOutput())
+    writer.SetFileTypeToASCII()
+    writer.Write()
 
 
 STEPS = [cube_msh, cube_others, surfaces, cube_meshio_compressed, cube_vtk_library,
          multi_solid_stl, cube_msh_other_forms, cube_regions, two_volumes, pneumatic_finger,
-         two_volumes_vtu]
+         two_volumes_vtu, hexahedra]
 
 if __name__ == "__main__":
     import sys

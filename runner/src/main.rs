@@ -59,7 +59,8 @@ enum Command {
     ///
     /// Reads Gmsh .msh (2.2, 4.1, ASCII or binary; 4.0), TetGen .node/.ele, VTK .vtu/.vtk, or a
     /// closed .obj/.stl/.msh surface (filled with tetrahedra), and prints the element and node
-    /// counts, the volume (of the curved elements for quadratic tetrahedra), the smallest
+    /// counts (of hexahedra and their tetrahedra for a file of hexahedra), the volume (of the
+    /// curved elements for quadratic tetrahedra and 27-node hexahedra), the smallest
     /// dihedral angle and radius ratio, the inverted and degenerate elements (and the folded
     /// quadratic ones), and the explicit integrator's critical and stable time steps for the
     /// material given.
@@ -264,6 +265,11 @@ fn check(
         .map_err(|e| e.to_string())?;
     let r = import::check_raw(&raw);
     let quadratic = !raw.mid_edge_nodes.is_empty();
+    let hexahedra = match raw.hexahedra {
+        import::Hexahedra::None => None,
+        import::Hexahedra::Linear(_) => Some("linear"),
+        import::Hexahedra::Triquadratic(_) => Some("27-node"),
+    };
     let regions = std::mem::take(&mut raw.regions);
     // The time steps need a mesh a body can be built of: no invalid or degenerate element. They
     // are those of the linear tetrahedra on the corners (mid-edge nodes of quadratic ones unused).
@@ -278,8 +284,15 @@ fn check(
     let step =
         |s: Option<f64>| s.map_or_else(|| "- (mesh unusable)".to_owned(), |s| format!("{s:.4e} s"));
     println!("{}", mesh.display());
-    let order = if quadratic { "quadratic" } else { "linear" };
-    println!("  tetrahedra          {} ({order})", r.tets);
+    if let Some(kind) = hexahedra {
+        println!(
+            "  hexahedra           {} ({kind}), split into {} tetrahedra",
+            r.hexahedra, r.tets
+        );
+    } else {
+        let order = if quadratic { "quadratic" } else { "linear" };
+        println!("  tetrahedra          {} ({order})", r.tets);
+    }
     println!(
         "  nodes               {} ({} unused)",
         r.nodes, r.unused_nodes
@@ -287,6 +300,8 @@ fn check(
     println!("  volume              {:.6e} m³", r.volume);
     let corners_only = if quadratic {
         " (corner tetrahedra)"
+    } else if hexahedra.is_some() {
+        " (their tetrahedra)"
     } else {
         ""
     };
@@ -301,7 +316,7 @@ fn check(
     println!("  inverted            {}", r.inverted);
     println!("  degenerate          {}", r.degenerate);
     println!("  invalid             {}", r.invalid);
-    if quadratic {
+    if quadratic || hexahedra == Some("27-node") {
         println!("  folded              {}", r.folded);
     }
     for region in &regions {

@@ -107,6 +107,24 @@ fn check_lists_a_file_s_regions() {
 }
 
 #[test]
+fn check_counts_a_file_s_hexahedra_and_their_curved_volume() {
+    // gmsh's 1 x 0.5 x 0.25 m box of 4 x 3 x 2 27-node hexahedra through the VTK library's
+    // legacy writer: 9 x 7 x 5 lattice nodes, 48 tetrahedra per hexahedron, its cell tags.
+    let output = rapier_fvm(&["check", "assets/meshes/box_hex27_vtk9.vtk"]);
+    assert!(output.status.success());
+    let text = String::from_utf8_lossy(&output.stdout);
+    for line in [
+        "  hexahedra           24 (27-node), split into 1152 tetrahedra",
+        "  nodes               315 (0 unused)",
+        "  volume              1.250000e-1 m³",
+        "  folded              0",
+        "  region              unnamed (volume, tag 1): 315 nodes, 1152 tetrahedra",
+    ] {
+        assert!(text.lines().any(|l| l == line), "{line:?} in {text}");
+    }
+}
+
+#[test]
 fn wrong_arguments_exit_with_status_two() {
     let output = rapier_fvm(&["run"]);
     assert_eq!(output.status.code(), Some(2));

@@ -217,3 +217,78 @@ velocity = [{ region = 4, linvel = [0.0, 0.0, 0.1] }]
     assert!(pinned.iter().all(|&n| left.positions()[n].x.abs() < 1e-12));
     assert_eq!(left.mesh().tet_count() + right.mesh().tet_count(), 1455);
 }
+
+/// A 10 x 5 x 2.5 cm block of 4 x 3 x 2 hexahedra (gmsh's `box_hex27_v41.msh` or
+/// `box_hex8_v41.msh` at a scale of 0.1, its face x = 0 the surface group "clamp") as a cage, hanging from that face
+/// under gravity; `mesh` is the mesh's table, `pinned` selects the face, `end` is the middle of
+/// the free end in the mesh's coordinates.
+fn hanging_cage(mesh: &str, pinned: &str, end: [f64; 3]) -> String {
+    format!(
+        r#"name = "hanging_cage"
+
+[world]
+duration = 0.1
+
+[[soft_body]]
+name = "block"
+mesh = {mesh}
+material = {{ model = "stable_neo_hookean", young = 1e5, poisson = 0.3, density = 1000.0 }}
+damping = {{ stiffness_time = 2e-3 }}
+elements = "quadratic_hex"
+pinned = [{pinned}]
+
+[[probe]]
+name = "sag"
+kind = "displacement"
+body = "block"
+point = {end:?}
+component = "y"
+"#
+    )
+}
+
+#[test]
+fn a_cage_read_from_a_file_hangs_from_its_physical_surface_as_the_generated_cage() {
+    // The file's clamp and the box around x = 0 select the same nodes: the same run to the bit.
+    // The generator's cage of the same cells, moved onto the file's box, has the same elements
+    // numbered otherwise (and another subdivision, which only contacts and output use): the
+    // same sag up to the rounding of sums taken in another order (1e-9 relative).
+    // The same for the file of linear hexahedra, given their edge, face and centre nodes (the
+    // clamp widened to those of its face).
+    let the_box = "{ min = [-0.001, -1.0, -1.0], max = [0.001, 1.0, 1.0] }";
+    let end = [0.1, 0.025, 0.0125];
+    let clamp = r#"{ region = "clamp" }"#;
+    let mut read = Vec::new();
+    for nodes in [27, 8] {
+        let file = format!(r#"{{ file = "../meshes/box_hex{nodes}_v41.msh", scale = 0.1 }}"#);
+        let by_region = run(
+            &format!("cage{nodes}_by_region"),
+            hanging_cage(&file, clamp, end),
+        );
+        let by_box = run(
+            &format!("cage{nodes}_by_box"),
+            hanging_cage(&file, the_box, end),
+        );
+        let sag = |report: &sim::Report| report.probes[0].values.clone();
+        assert_eq!(sag(&by_region), sag(&by_box), "{nodes}-node hexahedra");
+        assert!(by_region.stability.stable);
+        read.push(by_box.probes[0].final_value);
+    }
+    // The generator's box is centred at the origin: moved by half its size onto the file's.
+    let cuboid = r#"{ cuboid = { half_extents = [0.05, 0.025, 0.0125], cells = [4, 3, 2] } }"#;
+    let centred_box = "{ min = [-0.051, -1.0, -1.0], max = [-0.049, 1.0, 1.0] }";
+    let generated = hanging_cage(cuboid, centred_box, [0.05, 0.0, 0.0]).replace(
+        "elements = \"quadratic_hex\"",
+        "elements = \"quadratic_hex\"\ntranslation = [0.05, 0.025, 0.0125]",
+    );
+    let generated = run("cage_generated", generated);
+    let made = generated.probes[0].final_value;
+    for (read, nodes) in read.into_iter().zip([27, 8]) {
+        println!("cage sag after 0.1 s: {nodes}-node file {read:.9e} m, generator {made:.9e} m");
+        assert!(read < -1e-4 && read > -0.05, "sag {read} m");
+        assert!(
+            (read / made - 1.0).abs() < 1e-9,
+            "file {read}, generator {made}"
+        );
+    }
+}

@@ -7,6 +7,7 @@
 
 mod generators;
 mod hex_mesher;
+pub(crate) mod hex_split;
 #[cfg(feature = "import")]
 pub mod import;
 mod quadratic;

@@ -3,6 +3,7 @@
 //! the same nodes for contacts, surface extraction and output.
 
 use super::TetMesh;
+use super::hex_split::{TETS_PER_LATTICE, split_lattice};
 use crate::Error;
 use crate::shape::hex27::{self, NODES};
 use rapier3d::glamx::DVec3;
@@ -83,6 +84,74 @@ impl QuadraticHexMesh {
         })
     }
 
+    /// A mesh of 27-node hexahedra on `positions` (m), each element's nodes in the lattice
+    /// order of [`crate::shape::hex27`] (as read from a file by
+    /// [`RawMesh::into_cage`](crate::mesh::import::RawMesh::into_cage)). An element numbered
+    /// left-handed (negative volume) is mirrored to right-handed. Its
+    /// [subdivision](QuadraticHexMesh::subdivided) cuts each lattice sub-cube into six
+    /// tetrahedra, every face along its diagonal through its node of least index, so
+    /// neighbours conform whatever their numbering.
+    ///
+    /// # Errors
+    /// [`Error::NodeIndexOutOfRange`] for an element naming a node past `positions` (its `tet`
+    /// is the element); [`Error::EmptyMesh`] for no elements; [`Error::NonFiniteCoordinate`] and the errors of
+    /// [`TetMesh::new`] naming the element a subdivision tetrahedron lies in (a folded,
+    /// flattened or inconsistently numbered element).
+    ///
+    /// # Example
+    /// ```
+    /// use rapier_fvm::{glamx::DVec3, mesh::QuadraticHexMesh};
+    /// // One element on the 3 x 3 x 3 lattice of the cube [0, 2]^3.
+    /// let positions = (0..27)
+    ///     .map(|n| DVec3::new((n % 3) as f64, (n / 3 % 3) as f64, (n / 9) as f64))
+    ///     .collect();
+    /// let cage = QuadraticHexMesh::new(positions, vec![std::array::from_fn(|n| n as u32)])?;
+    /// assert_eq!(cage.subdivided().tet_count(), 48);
+    /// assert!((cage.subdivided().volume() - 8.0).abs() < 1e-12);
+    /// # Ok::<(), rapier_fvm::Error>(())
+    /// ```
+    pub fn new(positions: Vec<DVec3>, mut elements: Vec<[u32; NODES]>) -> Result<Self, Error> {
+        if elements.is_empty() {
+            return Err(Error::EmptyMesh {
+                nodes: positions.len(),
+                tets: 0,
+            });
+        }
+        let mut tets = Vec::with_capacity(elements.len() * TETS_PER_LATTICE);
+        let mut parents = Vec::with_capacity(tets.capacity());
+        for (e, element) in elements.iter_mut().enumerate() {
+            if let Some(&node) = element.iter().find(|&&n| n as usize >= positions.len()) {
+                return Err(Error::NodeIndexOutOfRange {
+                    tet: e,
+                    node,
+                    node_count: positions.len(),
+                });
+            }
+            for &node in element.iter() {
+                super::check_position(node as usize, positions[node as usize])?;
+            }
+            let mut split = split_lattice(element);
+            let volume: f64 = split
+                .iter()
+                .map(|t| super::signed_volume(&positions, t))
+                .sum();
+            if volume < 0.0 {
+                // Mirrored along i: lattice node (i, j, k) takes (2 − i, j, k)'s.
+                *element = std::array::from_fn(|a| element[a - a % 3 + 2 - a % 3]);
+                split = split_lattice(element);
+            }
+            tets.extend_from_slice(&split);
+            parents.extend(std::iter::repeat_n(e as u32, TETS_PER_LATTICE));
+        }
+        let subdivided = TetMesh::new(positions, tets)
+            .map_err(|error| super::name_parent_element(error, |t| t / TETS_PER_LATTICE))?;
+        Ok(Self {
+            elements,
+            subdivided,
+            parents,
+        })
+    }
+
     /// The same cage with every node moved to `map(p)` (m), e.g. sheared, bent or curved to fit
     /// a shape; elements stay conforming, and their lattice is no longer a box's.
     ///
@@ -122,8 +191,8 @@ impl QuadraticHexMesh {
         self.elements.len()
     }
 
-    /// The linear tetrahedra on the same nodes (40 per element): the boundary, contact and
-    /// output mesh.
+    /// The linear tetrahedra on the same nodes (40 per element of a [cuboid](Self::cuboid), 48
+    /// of [one read](Self::new)): the boundary, contact and output mesh.
     pub fn subdivided(&self) -> &TetMesh {
         &self.subdivided
     }

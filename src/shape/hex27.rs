@@ -98,6 +98,47 @@ pub fn natural_gradients(xi: DVec3) -> [DVec3; NODES] {
     })
 }
 
+/// `det ∂x/∂ξ` of the element with nodes at `p` (m) at natural coordinates `xi` (m³ per unit
+/// natural volume).
+pub fn jacobian_determinant(p: &[DVec3; NODES], xi: DVec3) -> f64 {
+    let gradients = natural_gradients(xi);
+    let mut columns = [DVec3::ZERO; 3];
+    for (x, g) in p.iter().zip(&gradients) {
+        for (k, column) in columns.iter_mut().enumerate() {
+            *column += *x * g[k];
+        }
+    }
+    columns[0].dot(columns[1].cross(columns[2]))
+}
+
+/// The smallest Jacobian determinant of the element with nodes at `p` (m) over its corners and
+/// quadrature points (m³ per unit natural volume): not positive (or NaN) for an element whose
+/// rest map folds.
+pub fn smallest_jacobian_determinant(p: &[DVec3; NODES]) -> f64 {
+    let corners = reference_nodes()
+        .into_iter()
+        .filter(|xi| xi.abs() == DVec3::ONE);
+    let mut smallest = f64::INFINITY;
+    for xi in corners.chain(QUADRATURE.iter().map(|(xi, _)| *xi)) {
+        let determinant = jacobian_determinant(p, xi);
+        if determinant.is_nan() {
+            return f64::NAN;
+        }
+        smallest = smallest.min(determinant);
+    }
+    smallest
+}
+
+/// The rest volume (m³) of the element with nodes at `p`, curved faces included: its Jacobian
+/// determinant has degree at most 5 along each natural axis, which [`QUADRATURE`] integrates
+/// exactly.
+pub fn volume(p: &[DVec3; NODES]) -> f64 {
+    QUADRATURE
+        .iter()
+        .map(|(xi, weight)| weight * jacobian_determinant(p, *xi))
+        .sum()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -108,6 +108,7 @@ fn raw_mesh(positions: &[DVec3], tets: &[[u32; 4]]) -> RawMesh {
         mid_edge_nodes: Vec::new(),
         tet_locations: Vec::new(),
         regions: Vec::new(),
+        hexahedra: Default::default(),
     }
 }
 

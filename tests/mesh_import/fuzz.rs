@@ -4,7 +4,9 @@
 use super::bytes;
 use super::file_numbers::assert_mesh_is_the_files;
 use proptest::prelude::*;
-use rapier_fvm::mesh::import::{RawMesh, RegionId, SurfaceOptions, gmsh, surface, tetgen, vtk};
+use rapier_fvm::mesh::import::{
+    Hexahedra, RawMesh, RegionId, SurfaceOptions, gmsh, surface, tetgen, vtk,
+};
 use rapier_fvm::prelude::*;
 use rapier_fvm::{FileLocation, ImportErrorKind};
 
@@ -48,6 +50,7 @@ fn run_reader(reader: usize, data: &[u8]) {
         Ok((raw, mesh)) => {
             assert_mesh_is_the_files(&raw, &mesh);
             assert_regions_fit(&raw, mesh.node_count());
+            assert_cage_builds(&raw);
         }
         Err(e @ Error::MeshImport { .. }) => {
             // One line of printable text, whatever bytes the file held.
@@ -75,6 +78,29 @@ fn assert_regions_fit(raw: &RawMesh, node_count: usize) {
     }
 }
 
+/// A file of hexahedra makes a cage (its regions widened onto it) or a typed error.
+fn assert_cage_builds(raw: &RawMesh) {
+    if raw.hexahedra == Hexahedra::None {
+        return;
+    }
+    let regions = raw.regions_in_mesh();
+    match raw.clone().into_cage() {
+        Ok(cage) => {
+            for region in regions {
+                let widened = region.with_cage_nodes(&cage);
+                assert!(
+                    widened
+                        .nodes
+                        .iter()
+                        .all(|&n| (n as usize) < cage.node_count())
+                );
+            }
+        }
+        Err(Error::MeshImport { .. }) => {}
+        Err(other) => panic!("untyped cage error {other:?}"),
+    }
+}
+
 /// `result`, after checking that an error of the OBJ or STL reader says where: their
 /// locators must find every statement `tobj` or `stl_io` rejects.
 fn located(result: Result<surface::Surface, Error>) -> Result<surface::Surface, Error> {
@@ -95,7 +121,7 @@ fn bytes_cached_ele() -> Vec<u8> {
 }
 
 /// (reader, valid file) pairs mutated by the fuzz properties.
-const SEEDS: [(usize, &str); 26] = [
+const SEEDS: [(usize, &str); 32] = [
     (0, "cube_v22_ascii.msh"),
     (0, "cube_v22_binary.msh"),
     (0, "cube_v41_ascii.msh"),
@@ -106,6 +132,9 @@ const SEEDS: [(usize, &str); 26] = [
     (0, "cube_regions_v22.msh"),
     (0, "cube_regions_v41_binary.msh"),
     (0, "two_volumes_v41.msh"),
+    (0, "box_hex8_v41.msh"),
+    (0, "box_hex8_v22_binary.msh"),
+    (0, "box_hex27_v41.msh"),
     (1, "cube.node"),
     (2, "cube.ele"),
     (3, "cube_ascii.vtu"),
@@ -116,9 +145,12 @@ const SEEDS: [(usize, &str); 26] = [
     (3, "cube_vtk_zlib_small_blocks.vtu"),
     (3, "cube_vtk_binary_uint32.vtu"),
     (3, "two_volumes_meshio.vtu"),
+    (3, "box_hex27_meshio.vtu"),
     (4, "cube_ascii.vtk"),
     (4, "cube_binary.vtk"),
     (4, "cube_vtk9_legacy.vtk"),
+    (4, "two_volumes_meshio.vtk"),
+    (4, "box_hex27_vtk9.vtk"),
     (5, "sphere.obj"),
     (6, "cube.stl"),
     (6, "sphere_ascii.stl"),

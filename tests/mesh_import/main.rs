@@ -11,6 +11,7 @@ mod binary_vtu;
 mod file_numbers;
 mod filling;
 mod fuzz;
+mod hexahedra;
 mod malformed;
 mod regions;
 
@@ -224,16 +225,17 @@ fn tetgen_files_must_hold_what_their_headers_announce() {
 }
 
 #[test]
-fn a_triangle_among_vtu_tetrahedra_is_skipped_but_a_hexahedron_is_an_error() {
+fn a_triangle_among_vtu_tetrahedra_is_skipped_but_a_wedge_is_an_error() {
     let mixed = vtk::parse_vtu(&bytes("cube_mixed.vtu"), "mixed.vtu", 1.0).unwrap();
     assert_eq!(mixed.tets.len(), 1140);
     let text = String::from_utf8(bytes("cube_ascii.vtk")).unwrap();
-    // Make cell 0 a hexahedron (type 12).
+    // Make cell 0 a wedge (type 13).
     let at = text.find("CELL_TYPES 1140\n").unwrap() + "CELL_TYPES 1140\n".len();
-    let hex = format!("{}12{}", &text[..at], &text[at + 2..]);
-    let (kind, _, message) = kind_and_location(vtk::parse_legacy(hex.as_bytes(), "h.vtk", 1.0));
+    let wedge = format!("{}13{}", &text[..at], &text[at + 2..]);
+    let parsed = vtk::parse_legacy(wedge.as_bytes(), "w.vtk", 1.0);
+    let (kind, _, message) = kind_and_location(parsed);
     assert_eq!(kind, ImportErrorKind::UnsupportedElement);
-    assert!(message.contains("cell 0 has type 12"), "{message}");
+    assert!(message.contains("cell 0 has type 13"), "{message}");
 }
 
 #[test]

@@ -277,10 +277,10 @@ fn malformed_vtu_files_name_the_line() {
         )
     );
     assert!(message.contains("99999"), "{message}");
-    // An unknown cell type (a hexahedron) and a non-finite coordinate: their arrays' lines.
+    // An unsupported cell type (a wedge) and a non-finite coordinate: their arrays' lines.
     let types = line_of("<DataArray type=\"Int64\" Name=\"types\"");
     let mut lines: Vec<&str> = text.lines().collect();
-    lines[types] = "12";
+    lines[types] = "13";
     let (kind, at, _) = parse(&lines.join("\n"));
     assert_eq!(
         (kind, at),

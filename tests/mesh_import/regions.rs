@@ -3,9 +3,9 @@
 //! body's mid-edge nodes.
 
 use super::bytes;
-use rapier_fvm::Error;
 use rapier_fvm::mesh::QuadraticTetMesh;
 use rapier_fvm::mesh::import::{MeshRegion, RawMesh, RegionId, gmsh, vtk};
+use rapier_fvm::{Error, FileLocation};
 
 #[test]
 fn gmsh_physical_groups_are_kept_as_named_regions() {
@@ -269,4 +269,69 @@ fn a_vtu_cell_tag_array_that_does_not_fit_its_cells_is_refused() {
     let raw = vtk::parse_vtu(whole.as_bytes(), "whole.vtu", 1.0).unwrap();
     assert_eq!(raw.regions.len(), 1);
     assert_eq!(raw.regions[0].tets.len(), raw.tets.len());
+}
+
+#[test]
+fn a_legacy_vtk_file_s_cell_tags_are_the_gmsh_file_s_regions() {
+    // meshio's legacy VTK (5.1, binary) of two_volumes_v41.msh, whose tags are a FIELD array of
+    // its CELL_DATA after a POINT_DATA field; and the VTK library's ASCII legacy file of the
+    // 27-node box, with the same tags as its Gmsh file. Same regions, compared by position.
+    for (msh, legacy) in [
+        ("two_volumes_v41.msh", "two_volumes_meshio.vtk"),
+        ("box_hex27_v41.msh", "box_hex27_vtk9.vtk"),
+    ] {
+        let msh = gmsh::parse(&bytes(msh), msh, 1.0).unwrap();
+        let vtk = vtk::parse_legacy(&bytes(legacy), legacy, 1.0).unwrap();
+        assert_eq!(vtk.regions.len(), msh.regions.len(), "{legacy}");
+        for region in &msh.regions {
+            let found = MeshRegion::find(&vtk.regions, &RegionId::Tag(region.tag), legacy)
+                .unwrap_or_else(|e| panic!("{e}"));
+            assert_eq!(found.dimension, region.dimension, "{legacy}: {region}");
+            assert_eq!(found.nodes.len(), region.nodes.len(), "{legacy}: {region}");
+            assert_eq!(found.tets.len(), region.tets.len(), "{legacy}: {region}");
+            if legacy.starts_with("two") {
+                // Written to the bit (binary doubles); the VTK library's ASCII rounds.
+                assert_eq!(
+                    region_geometry(&vtk, found),
+                    region_geometry(&msh, region),
+                    "{region}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn legacy_cell_data_that_does_not_fit_its_grid_is_refused_at_its_line() {
+    let text = std::fs::read_to_string(super::asset("box_hex27_vtk9.vtk")).unwrap();
+    let line_of = |text: &str, start: &str| text.lines().position(|l| l.starts_with(start));
+    let cell_data = line_of(&text, "CELL_DATA").unwrap();
+    let parse = |text: &str| vtk::parse_legacy(text.as_bytes(), "box.vtk", 1.0);
+    let error_at = |text: &str| match parse(text).unwrap_err() {
+        Error::MeshImport {
+            location, message, ..
+        } => (location, message),
+        other => panic!("{other}"),
+    };
+    // A section size other than the grid's cells.
+    let wrong_size = text.replacen("CELL_DATA 30", "CELL_DATA 29", 1);
+    let (at, message) = error_at(&wrong_size);
+    assert_eq!(at, FileLocation::Line(cell_data + 1), "{message}");
+    assert!(message.contains("30 cells"), "{message}");
+    // A tag that is not a whole number (the array retyped as floats).
+    let floats = text.replacen(
+        "gmsh:physical 1 30 vtktypeint64\n2",
+        "gmsh:physical 1 30 double\n2.5",
+        1,
+    );
+    let (_, message) = error_at(&floats);
+    assert!(message.contains("2.5 is not a whole number"), "{message}");
+    // An attribute the format does not define.
+    let unknown = text.replacen("FIELD FieldData 3", "COLOURS FieldData 3", 1);
+    let (at, message) = error_at(&unknown);
+    assert_eq!(at, FileLocation::Line(cell_data + 2), "{message}");
+    assert!(message.contains("unknown attribute `COLOURS`"), "{message}");
+    // A field array cut short: its values run into the next array's header.
+    let short = text.replacen("gmsh:physical 1 30", "gmsh:physical 1 31", 1);
+    assert!(parse(&short).is_err());
 }

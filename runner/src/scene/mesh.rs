@@ -22,6 +22,10 @@ use rapier_fvm::mesh::import::{MeshRegion, RawMesh};
 use rapier_fvm::mesh::{self, QuadraticHexMesh, QuadraticTetMesh, TetMesh, import};
 use serde::Deserialize;
 
+/// What a cage of quadratic hexahedra is built over.
+pub(crate) const CAGE_MESHES: &str =
+    "\"quadratic_hex\" cages are built over a cuboid mesh or a file of hexahedra";
+
 /// Where a soft body's mesh comes from.
 #[derive(Debug, Clone, Default, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -189,19 +193,35 @@ impl MeshSpec {
         Ok(BuiltMesh::generated(mesh))
     }
 
-    /// Builds a cage of quadratic hexahedra over a cuboid mesh's cells.
+    /// Builds a cage of quadratic hexahedra over a cuboid mesh's cells, or of a file's
+    /// hexahedra (with its regions, [widened](MeshRegion::with_cage_nodes) to the nodes a
+    /// linear hexahedron's cage adds).
     ///
     /// # Errors
-    /// A [`SceneError`] at `key` for another mesh or the generator's problem.
+    /// A [`SceneError`] at `key` for another mesh, the generator's problem or a file without
+    /// hexahedra.
     pub fn build_cage(
         &self,
         key: &str,
         source: &SceneSource,
-    ) -> Result<QuadraticHexMesh, SceneError> {
+    ) -> Result<BuiltMesh<QuadraticHexMesh>, SceneError> {
+        if let Some(raw) = self.read_file(key, source)? {
+            let (path, regions) = (raw.path.clone(), raw.regions_in_mesh());
+            let mesh = raw
+                .into_cage()
+                .map_err(|e| source.error(&format!("{key}.file"), e.to_string()))?;
+            let regions = regions.iter().map(|r| r.with_cage_nodes(&mesh)).collect();
+            return Ok(BuiltMesh {
+                mesh,
+                regions,
+                path,
+            });
+        }
         let Some(c) = &self.cuboid else {
-            return Err(source.error(key, "\"quadratic_hex\" cages are built over a cuboid mesh"));
+            return Err(source.error(key, CAGE_MESHES));
         };
         QuadraticHexMesh::cuboid(DVec3::from_array(c.half_extents), c.cells)
+            .map(BuiltMesh::generated)
             .map_err(|e| source.error(&format!("{key}.cuboid"), e.to_string()))
     }
 

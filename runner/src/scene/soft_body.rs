@@ -17,7 +17,8 @@
 //! volumetric = "per_element"      # or "nodal_average" / "element_average" (nearly incompressible:
 //!                                 # linear / quadratic elements), default per_element
 //! elements = "linear"             # or "quadratic" (10-node tetrahedra, accurate in bending), or
-//!                                 # "quadratic_hex" (a cage of 27-node hexahedra; cuboid meshes)
+//!                                 # "quadratic_hex" (a cage of 27-node hexahedra: over a cuboid
+//!                                 # mesh's cells, or a file's hexahedra)
 //! embedded = { cuboid = { half_extents = [0.5, 0.05, 0.05], cells = [40, 4, 4] } }
 //!                                 # a fine mesh carried by the elements: contacts and output
 //!                                 # use its surface; default none
@@ -37,7 +38,7 @@
 use super::check::Checker;
 use super::load::LoadSpec;
 use super::material::{DampingSpec, MaterialSpec};
-use super::mesh::MeshSpec;
+use super::mesh::{CAGE_MESHES, MeshSpec};
 use rapier_fvm::glamx::DVec3;
 use rapier_fvm::mesh::TetMesh;
 use rapier_fvm::mesh::import::{MeshRegion, RegionId};
@@ -123,7 +124,7 @@ pub enum ElementsSpec {
     Linear,
     /// 10-node tetrahedra: the mesh's, or mid-edge nodes added to it.
     Quadratic,
-    /// A cage of 27-node hexahedra over a cuboid mesh's cells.
+    /// A cage of 27-node hexahedra over a cuboid mesh's cells or a file's hexahedra.
     QuadraticHex,
 }
 
@@ -270,11 +271,9 @@ impl SoftBodySpec {
         if let Some(embedded) = &self.embedded {
             embedded.check(&format!("{key}.embedded"), c);
         }
-        if self.elements == ElementsSpec::QuadraticHex && self.mesh.cuboid.is_none() {
-            c.fail(
-                &format!("{key}.elements"),
-                "\"quadratic_hex\" cages are built over a cuboid mesh".to_owned(),
-            );
+        let cage_mesh = self.mesh.cuboid.is_some() || self.mesh.file.is_some();
+        if self.elements == ElementsSpec::QuadraticHex && !cage_mesh {
+            c.fail(&format!("{key}.elements"), CAGE_MESHES.to_owned());
         }
         self.material.check(&format!("{key}.material"), c);
         if let Some(damping) = &self.damping {

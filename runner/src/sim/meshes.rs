@@ -51,9 +51,15 @@ impl BodyMeshes {
                 )
             }
             ElementsSpec::QuadraticHex => {
-                let cage = spec.mesh.build_cage(&mesh_key, source)?;
-                let subdivided = cage.subdivided().clone();
-                (subdivided, None, Some(cage), Vec::new(), String::new())
+                let built = spec.mesh.build_cage(&mesh_key, source)?;
+                let subdivided = built.mesh.subdivided().clone();
+                (
+                    subdivided,
+                    None,
+                    Some(built.mesh),
+                    built.regions,
+                    built.path,
+                )
             }
         };
         let hexahedra = cage.as_ref().map_or(0, QuadraticHexMesh::element_count);

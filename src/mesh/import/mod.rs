@@ -9,14 +9,17 @@
 //! | VTK legacy unstructured grid (ASCII and binary, 2.0 to 5.1) | `.vtk` | [`vtk`] |
 //! | surface: Wavefront OBJ, STL (ASCII and binary), Gmsh triangles only | `.obj`, `.stl`, `.msh` | [`surface`], [`gmsh::parse_surface`] |
 //!
-//! Gmsh's physical groups are kept as named [`MeshRegion`]s of the raw mesh (the nodes of their
-//! elements, a volume group's tetrahedra); [`RawMesh::regions_in_mesh`] numbers their nodes as
-//! the validated mesh's, [`MeshRegion::find`] picks one by name or tag ([`RegionId`]) and
+//! Gmsh's physical groups (and the cell tags of `.vtu` and legacy `.vtk` files, unnamed) are
+//! kept as [`MeshRegion`]s of the raw mesh (the nodes of their elements, a volume group's
+//! tetrahedra); [`RawMesh::regions_in_mesh`] numbers their nodes as the validated mesh's, [`MeshRegion::find`] picks one by name or tag ([`RegionId`]) and
 //! [`RawMesh::keep_volume`] keeps one volume's tetrahedra (see the `region` module's example).
 //!
 //! Every reader takes a `scale` in metres per file unit (1 for files in metres, 0.001 for
 //! millimetres) and first returns a [`RawMesh`]: positions and tetrahedra as the file has them,
-//! lower-dimensional elements (points, lines, boundary triangles) skipped. [`check`] reports a raw
+//! lower-dimensional elements (points, lines, boundary triangles) skipped. Hexahedra (Gmsh and
+//! VTK, linear and 27-node) are split into tetrahedra on their own nodes, conforming between
+//! neighbours ([`Hexahedra`]); [`RawMesh::into_cage`] makes 27-node ones a
+//! [`QuadraticHexMesh`](crate::mesh::QuadraticHexMesh) cage. [`check`] reports a raw
 //! mesh's quality, defects included; [`RawMesh::into_mesh`] drops the nodes no tetrahedron uses
 //! (geometry points of Gmsh files), fixes the orientation of inverted tetrahedra and validates
 //! the result into a [`TetMesh`]. [`load`] does both, choosing the reader by extension.
@@ -46,6 +49,7 @@
 //! ```
 
 pub mod gmsh;
+mod hexahedra;
 mod locate;
 pub mod quality;
 mod region;
@@ -55,6 +59,7 @@ mod text;
 pub mod vtk;
 
 pub use crate::error::{FileLocation, ImportErrorKind};
+pub use hexahedra::{GMSH_TRIQUADRATIC, Hexahedra, VTK_TRIQUADRATIC};
 pub use quality::{QualityReport, check, check_raw};
 pub use region::{MeshRegion, RegionId};
 pub use surface::SurfaceOptions;
@@ -73,7 +78,8 @@ pub struct RawMesh {
     pub path: String,
     /// Node positions (m).
     pub positions: Vec<DVec3>,
-    /// Tetrahedra, four indices into `positions` each (the corners), in file order.
+    /// Tetrahedra, four indices into `positions` each (the corners), in file order; a
+    /// hexahedron's split follow one another ([`RawMesh::hexahedra`]).
     pub tets: Vec<[u32; 4]>,
     /// For a mesh of quadratic tetrahedra, the six mid-edge nodes of each (indices into
     /// `positions`, VTK's edge order `(0,1) (1,2) (0,2) (0,3) (1,3) (2,3)`); empty for linear
@@ -84,6 +90,8 @@ pub struct RawMesh {
     /// The file's named parts (Gmsh physical groups), in order of dimension and tag; empty for
     /// formats that keep none.
     pub regions: Vec<MeshRegion>,
+    /// The hexahedra `tets` were split from, for a file of hexahedra.
+    pub hexahedra: Hexahedra,
 }
 
 impl RawMesh {
@@ -105,6 +113,9 @@ impl RawMesh {
     pub fn into_mesh(self) -> Result<TetMesh, Error> {
         if !self.mid_edge_nodes.is_empty() {
             return Ok(self.into_quadratic_mesh()?.subdivided().clone());
+        }
+        if matches!(self.hexahedra, Hexahedra::Triquadratic(_)) {
+            return Ok(self.into_cage()?.subdivided().clone());
         }
         let (positions, tets) = self.renumbered(&self.tets)?;
         match TetMesh::new_reoriented(positions, tets) {

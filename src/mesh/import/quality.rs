@@ -6,9 +6,9 @@
 //! material as well: the integrator layer computes it
 //! ([`SymplecticEuler::mesh_time_steps`](crate::integrate::SymplecticEuler::mesh_time_steps)).
 
-use super::RawMesh;
+use super::{Hexahedra, RawMesh};
 use crate::mesh::{DEGENERATE_RELATIVE_VOLUME, signed_volume};
-use crate::shape::tet10;
+use crate::shape::{hex27, tet10};
 use rapier3d::glamx::DVec3;
 
 /// What [`check`] finds in a mesh.
@@ -38,9 +38,12 @@ pub struct QualityReport {
     /// Tetrahedra referring to a node that does not exist or twice to the same node; they are
     /// left out of every other measure.
     pub invalid: usize,
-    /// Quadratic tetrahedra whose rest map folds (see
-    /// [`Error::FoldedElement`](crate::Error::FoldedElement)); 0 for linear ones.
+    /// Quadratic tetrahedra or 27-node hexahedra whose rest map folds (see
+    /// [`Error::FoldedElement`](crate::Error::FoldedElement)); 0 for linear elements.
     pub folded: usize,
+    /// Hexahedra the tetrahedra were split from (see [`Hexahedra`]); 0 for a mesh of
+    /// tetrahedra.
+    pub hexahedra: usize,
 }
 
 /// Measures the mesh of `positions` (m) and `tets` without requiring it to be valid. Never
@@ -72,6 +75,7 @@ pub fn check(positions: &[DVec3], tets: &[[u32; 4]]) -> QualityReport {
         degenerate: 0,
         invalid: 0,
         folded: 0,
+        hexahedra: 0,
     };
     for tet in tets {
         let in_range = tet.iter().all(|&n| (n as usize) < positions.len());
@@ -114,9 +118,18 @@ pub fn check(positions: &[DVec3], tets: &[[u32; 4]]) -> QualityReport {
 
 /// Measures `raw` as [`check`] does its corner tetrahedra; for a mesh of quadratic tetrahedra
 /// the mid-edge nodes count as used, the volume is that of the curved elements (exact: see
-/// [`tet10::volume`]) and the elements whose rest map folds are counted. Never panics.
+/// [`tet10::volume`]) and the elements whose rest map folds are counted; for a mesh of
+/// hexahedra their number is given, and for 27-node ones the volume of the curved elements
+/// (exact: [`hex27::volume`]) and the folded ones. Never panics.
 pub fn check_raw(raw: &RawMesh) -> QualityReport {
     let mut report = check(&raw.positions, &raw.tets);
+    report.hexahedra = match &raw.hexahedra {
+        Hexahedra::None => 0,
+        hexahedra => raw.tets.len() / hexahedra.tets_per_element(),
+    };
+    if let Hexahedra::Triquadratic(elements) = &raw.hexahedra {
+        measure_cage(raw, elements, &mut report);
+    }
     if raw.mid_edge_nodes.is_empty() {
         return report;
     }
@@ -151,6 +164,31 @@ pub fn check_raw(raw: &RawMesh) -> QualityReport {
     report.volume = volume;
     report.unused_nodes = used.iter().filter(|&&u| !u).count();
     report
+}
+
+/// The curved volume and the folded elements of a raw mesh's 27-node hexahedra `elements`;
+/// an element naming a node past the positions is left out (its tetrahedra count invalid).
+fn measure_cage(raw: &RawMesh, elements: &[[u32; hex27::NODES]], report: &mut QualityReport) {
+    let mut volume = 0.0;
+    let mut folded = 0;
+    for element in elements {
+        let Some(p) = element
+            .iter()
+            .map(|&n| raw.positions.get(n as usize).copied())
+            .collect::<Option<Vec<DVec3>>>()
+        else {
+            continue;
+        };
+        let p: [DVec3; hex27::NODES] = std::array::from_fn(|a| p[a]);
+        let element_volume = hex27::volume(&p);
+        // A left-handed element (mirrored when built) counts by its size.
+        volume += element_volume.abs();
+        let sign = if element_volume < 0.0 { -1.0 } else { 1.0 };
+        let smallest = sign * hex27::smallest_jacobian_determinant(&p);
+        folded += usize::from(smallest.is_nan() || smallest <= 0.0);
+    }
+    report.volume = volume;
+    report.folded = folded;
 }
 
 fn longest_edge(p: &[DVec3; 4]) -> f64 {

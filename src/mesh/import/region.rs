@@ -28,9 +28,10 @@
 //! # Ok::<(), rapier_fvm::Error>(())
 //! ```
 
-use super::RawMesh;
+use super::hexahedra::lattice_corners;
+use super::{Hexahedra, RawMesh};
 use crate::Error;
-use crate::mesh::QuadraticTetMesh;
+use crate::mesh::{QuadraticHexMesh, QuadraticTetMesh};
 use crate::shape::tet10::EDGES;
 use std::fmt;
 
@@ -126,13 +127,33 @@ fn list<'a>(regions: impl IntoIterator<Item = &'a MeshRegion>) -> String {
 }
 
 impl RawMesh {
-    /// The index each node of [`RawMesh::positions`] gets in the mesh [`RawMesh::into_mesh`]
-    /// and [`RawMesh::into_quadratic_mesh`] build (nodes numbered in order of first use by the
-    /// elements, corners then mid-edge nodes), `None` for a node no element uses or past the
+    /// The index each node of [`RawMesh::positions`] gets in the mesh [`RawMesh::into_mesh`],
+    /// [`RawMesh::into_quadratic_mesh`] and [`RawMesh::into_cage`] build (nodes numbered in
+    /// order of first use by the elements, corners then mid-edge nodes; a cage's in their
+    /// order in the file), `None` for a node no element uses or past the
     /// positions; with it, a [`MeshRegion`]'s nodes select the validated mesh's nodes.
     pub fn mesh_node_indices(&self) -> Vec<Option<u32>> {
         let mut index = vec![None; self.positions.len()];
         let mut next = 0u32;
+        let mut number = |node: u32| {
+            if let Some(slot @ None) = index.get_mut(node as usize) {
+                *slot = Some(next);
+                next += 1;
+            }
+        };
+        if let Hexahedra::Triquadratic(elements) = &self.hexahedra {
+            // A cage keeps its nodes' order, so that its subdivision is the file's.
+            let mut used = vec![false; self.positions.len()];
+            for &node in elements.iter().flatten() {
+                if let Some(slot) = used.get_mut(node as usize) {
+                    *slot = true;
+                }
+            }
+            (0..used.len())
+                .filter(|&n| used[n])
+                .for_each(|n| number(n as u32));
+            return index;
+        }
         let mids = self
             .mid_edge_nodes
             .iter()
@@ -140,10 +161,7 @@ impl RawMesh {
             .chain(std::iter::repeat(None));
         for (corners, mids) in self.tets.iter().zip(mids) {
             for &node in corners.iter().chain(mids.into_iter().flatten()) {
-                if let Some(slot @ None) = index.get_mut(node as usize) {
-                    *slot = Some(next);
-                    next += 1;
-                }
+                number(node);
             }
         }
         index
@@ -207,8 +225,25 @@ impl RawMesh {
         for region in &mut self.regions {
             region.tets = region.tets.iter().filter_map(pick).collect();
         }
+        // A region holds all of a hexahedron's tetrahedra or none.
+        let per_element = self.hexahedra.tets_per_element();
+        let kept_element = |e: usize| new_index[e * per_element].is_some();
+        match &mut self.hexahedra {
+            Hexahedra::Linear(elements) => retain_indexed(elements, kept_element),
+            Hexahedra::Triquadratic(elements) => retain_indexed(elements, kept_element),
+            Hexahedra::None => {}
+        }
         Ok(self)
     }
+}
+
+/// Keeps the elements `e` of `elements` for which `keep(e)`.
+fn retain_indexed<T>(elements: &mut Vec<T>, keep: impl Fn(usize) -> bool) {
+    let mut e = 0;
+    elements.retain(|_| {
+        e += 1;
+        keep(e - 1)
+    });
 }
 
 /// The new index of element `old`, if kept.
@@ -246,6 +281,49 @@ impl MeshRegion {
                 if ends_inside && on_boundary[mid as usize] && !inside[mid as usize] {
                     inside[mid as usize] = true;
                     nodes.push(mid);
+                }
+            }
+        }
+        nodes.sort_unstable();
+        Self {
+            nodes,
+            ..self.clone()
+        }
+    }
+}
+
+impl MeshRegion {
+    /// The region on `cage`, a cage whose corner nodes its nodes number (as
+    /// [`RawMesh::into_cage`] builds one from linear hexahedra, keeping the corners' numbers):
+    /// with each edge, face and centre node of an element whose corners (two, four or eight) it
+    /// all holds, if that node lies on the boundary (or the region is a volume), so that a
+    /// surface group of a file of linear hexahedra selects its whole face of the cage. A region
+    /// of a 27-node file holds those nodes already and is returned unchanged.
+    #[must_use]
+    pub fn with_cage_nodes(&self, cage: &QuadraticHexMesh) -> Self {
+        let node_count = cage.node_count();
+        let mut inside = vec![false; node_count];
+        for &node in &self.nodes {
+            if let Some(slot) = inside.get_mut(node as usize) {
+                *slot = true;
+            }
+        }
+        let mut on_boundary = vec![self.dimension == 3; node_count];
+        for triangle in cage.subdivided().surface_triangles() {
+            for node in triangle {
+                on_boundary[node as usize] = true;
+            }
+        }
+        let corner_lattice = [0, 2, 6, 8, 18, 20, 24, 26];
+        let mut nodes = self.nodes.clone();
+        for element in cage.elements() {
+            for (a, &node) in element.iter().enumerate() {
+                let corners_inside = lattice_corners(a)
+                    .iter()
+                    .all(|&place| inside[element[corner_lattice[place]] as usize]);
+                if corners_inside && on_boundary[node as usize] && !inside[node as usize] {
+                    inside[node as usize] = true;
+                    nodes.push(node);
                 }
             }
         }

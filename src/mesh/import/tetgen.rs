@@ -60,6 +60,7 @@ pub fn parse(
         positions,
         tets,
         mid_edge_nodes: Vec::new(),
+        hexahedra: super::Hexahedra::None,
         tet_locations,
         regions: Vec::new(),
     })

@@ -2,9 +2,10 @@
 //! it).
 //!
 //! Linear tetrahedra (element type 4) and quadratic ones (type 11, `gmsh -order 2`; their
-//! mid-edge nodes go to [`RawMesh::mid_edge_nodes`]) are read; points, lines, triangles and
+//! mid-edge nodes go to [`RawMesh::mid_edge_nodes`]) are read, and hexahedra, linear (type 5)
+//! and 27-node (type 12), split into tetrahedra ([`RawMesh::hexahedra`]); points, lines, triangles and
 //! quadrangles (boundary and geometry elements Gmsh saves beside the volume) are skipped; other
-//! volume elements, and linear and quadratic tetrahedra mixed in one file, are an
+//! volume elements, and two kinds of volume element mixed in one file, are an
 //! [`ImportErrorKind::UnsupportedElement`] error, since dropping them would silently lose
 //! material. A file holding triangles but no tetrahedra is a surface ([`parse_surface`]), which
 //! [`load`](super::load) fills as an OBJ or STL surface. Sections other than `$MeshFormat`,
@@ -32,9 +33,10 @@ mod v40;
 
 use super::surface::Surface;
 use super::text::{Source, scaled, shorten};
-use super::{MeshRegion, RawMesh, check_scale};
+use super::{Hexahedra, MeshRegion, RawMesh, check_scale};
 use crate::Error;
 use crate::error::{FileLocation, ImportErrorKind};
+use crate::mesh::hex_split::{TETS_PER_HEXAHEDRON, TETS_PER_LATTICE};
 use format::{MshFormat, Version};
 use rapier3d::glamx::DVec3;
 use std::collections::HashMap;
@@ -87,6 +89,9 @@ fn read<'d>(data: &'d [u8], path: &'d str, scale: f64) -> Result<(Reader, Source
         positions: Vec::new(),
         tets: Vec::new(),
         mid_edge_tags: Vec::new(),
+        volume_type: None,
+        hexahedron_tags: Vec::new(),
+        cage_tags: Vec::new(),
         triangles: Vec::new(),
         other_surface_element: None,
         regions: regions::Regions::default(),
@@ -130,6 +135,14 @@ struct Reader {
     tets: Vec<([u64; 4], FileLocation)>,
     /// The mid-edge node tags of quadratic tetrahedra, in VTK's order, one per tetrahedron.
     mid_edge_tags: Vec<[u64; 6]>,
+    /// The element type of the first volume element (all must have it).
+    volume_type: Option<u32>,
+    /// The corner tags of linear hexahedra in file order, one per element (whose tetrahedra
+    /// are in `tets`).
+    hexahedron_tags: Vec<[u64; 8]>,
+    /// The node tags of 27-node hexahedra in lattice order, one per element (whose
+    /// tetrahedra are in `tets`).
+    cage_tags: Vec<[u64; 27]>,
     /// Linear triangles as node tags, with where they were read (a surface-only file's mesh).
     triangles: Vec<([u64; 3], FileLocation)>,
     /// The type and place of the first surface element other than a linear triangle.
@@ -230,8 +243,8 @@ impl Reader {
             return Err(source.error_at(
                 FileLocation::Whole,
                 ImportErrorKind::NoTetrahedra,
-                "the file holds no tetrahedra (element type 4 or 11); a surface of triangles is \
-                 filled by `load`",
+                "the file holds no tetrahedra or hexahedra (element type 4, 11, 5 or 12); a \
+                 surface of triangles is filled by `load`",
             ));
         }
         let mut tets = Vec::with_capacity(self.tets.len());
@@ -244,6 +257,25 @@ impl Reader {
         for (tags, (_, location)) in self.mid_edge_tags.iter().zip(&self.tets) {
             mid_edge_nodes.push(self.indices(source, tags, *location)?);
         }
+        let hexahedra = match self.volume_type {
+            Some(elements::HEXAHEDRON) => {
+                let mut corners = Vec::with_capacity(self.hexahedron_tags.len());
+                for (e, tags) in self.hexahedron_tags.iter().enumerate() {
+                    let location = self.tets[e * TETS_PER_HEXAHEDRON].1;
+                    corners.push(self.indices(source, tags, location)?);
+                }
+                Hexahedra::Linear(corners)
+            }
+            Some(elements::TRIQUADRATIC_HEXAHEDRON) => {
+                let mut cage = Vec::with_capacity(self.cage_tags.len());
+                for (e, tags) in self.cage_tags.iter().enumerate() {
+                    let location = self.tets[e * TETS_PER_LATTICE].1;
+                    cage.push(self.indices(source, tags, location)?);
+                }
+                Hexahedra::Triquadratic(cage)
+            }
+            _ => Hexahedra::None,
+        };
         let node_index = &self.node_index;
         let regions = std::mem::take(&mut self.regions)
             .finish(source, |tag| node_index.get(&tag).copied())?;
@@ -254,6 +286,7 @@ impl Reader {
             mid_edge_nodes,
             tet_locations,
             regions,
+            hexahedra,
         })
     }
 

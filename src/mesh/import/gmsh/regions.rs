@@ -36,16 +36,19 @@ impl Regions {
         self.current = self.entities.get(&(dim, tag)).cloned().unwrap_or_default();
     }
 
-    /// Records an element of dimension `dim` with node tags `nodes` (tetrahedron `tet`, if one)
-    /// in the groups of [`Regions::current`].
-    pub(super) fn record(&mut self, dim: u8, nodes: &[u64], tet: Option<u32>) {
+    /// Records an element of dimension `dim` with node tags `nodes` (the tetrahedra `tets` it
+    /// became, none for a lower-dimensional element) in the groups of [`Regions::current`].
+    pub(super) fn record(&mut self, dim: u8, nodes: &[u64], tets: std::ops::Range<u32>) {
         for &physical in &self.current {
             self.nodes
                 .entry((dim, physical))
                 .or_default()
                 .extend_from_slice(nodes);
-            if let Some(tet) = tet {
-                self.tets.entry((dim, physical)).or_default().push(tet);
+            if !tets.is_empty() {
+                self.tets
+                    .entry((dim, physical))
+                    .or_default()
+                    .extend(tets.clone());
             }
         }
     }

@@ -210,6 +210,7 @@ fn compacted(path: &str, positions: &[DVec3], tets: &[[u32; 4]]) -> RawMesh {
         path: path.to_owned(),
         positions: used,
         mid_edge_nodes: Vec::new(),
+        hexahedra: crate::mesh::import::Hexahedra::None,
         tet_locations: vec![FileLocation::Whole; tets.len()],
         regions: Vec::new(),
         tets,

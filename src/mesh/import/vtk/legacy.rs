@@ -5,11 +5,13 @@
 //! followed by `POINTS`, `CELLS` and `CELL_TYPES` in any order: `CELLS` as one list of
 //! `n i_1 ... i_n` before version 5, as `OFFSETS` and `CONNECTIVITY` arrays (the first offset 0)
 //! from version 5 on. A `METADATA` block after an array (written by the VTK 9 library:
-//! component names, information keys, up to a blank line) is skipped. Any other keyword before
-//! all three are read, another data set or encoding, counts that disagree with the data, and an
+//! component names, information keys, up to a blank line) is skipped. The attribute data after
+//! the grid is read by `legacy_attributes` (a cell array of region tags kept, the rest read
+//! past). Any other keyword before all three are read, another data set or encoding, counts that disagree with the data, and an
 //! ASCII file whose last data line has no line break (a file cut inside a number would read as
 //! another number) are errors at the line (or, in binary data, the byte offset) at fault.
 
+use super::legacy_attributes;
 use super::legacy_data::{DataType, Legacy, data_type};
 use super::{Cells, build};
 use crate::Error;
@@ -42,10 +44,6 @@ pub fn parse_legacy(data: &[u8], path: &str, scale: f64) -> Result<RawMesh, Erro
         };
         sections.read(&mut file, line, major, scale)?;
     }
-    if !binary {
-        // A file cut inside its last number would read as another number.
-        file.source.check_line_ended("its last data line")?;
-    }
     let Sections {
         positions: Some(positions),
         cells: Some((offsets, connectivity, location)),
@@ -57,11 +55,17 @@ pub fn parse_legacy(data: &[u8], path: &str, scale: f64) -> Result<RawMesh, Erro
             "POINTS, CELLS or CELL_TYPES is missing",
         ));
     };
+    let tags = legacy_attributes::read_cell_tags(&mut file, types.len(), positions.len())?;
+    if !binary {
+        // A file cut inside its last number would read as another number.
+        file.source.check_line_ended("its last data line")?;
+    }
+    let tags: Vec<Option<u64>> = tags.into_iter().flatten().map(Some).collect();
     let cells = Cells {
         offsets: &offsets,
         connectivity: &connectivity,
         types: &types,
-        tags: &[],
+        tags: &tags,
     };
     build(&file.source, positions, &cells, &|_, _| location)
 }

@@ -12,7 +12,7 @@ use crate::mesh::import::text::{Source, finite, parse_token, shorten};
 use std::str::{FromStr, SplitAsciiWhitespace};
 
 /// A legacy VTK data type: its size in binary files and whether it is a float.
-#[derive(Clone, Copy)]
+#[derive(Clone, Copy, PartialEq)]
 pub(super) enum DataType {
     Float(usize),
     Signed(usize),
@@ -138,6 +138,34 @@ impl<'a> Legacy<'a> {
             })
         };
         self.values(count, ty.size(), what, decode, |_, value| Ok(value))
+    }
+
+    /// Reads past `count` values of type `ty` (attribute data this crate does not use): binary
+    /// ones by their size, ASCII ones each checked to be a number (NaN and infinities allowed).
+    pub(super) fn skip(&mut self, count: usize, ty: DataType, what: &str) -> Result<(), Error> {
+        self.values(count, ty.size(), what, |_, _| Ok(0.0), |_, v: f64| Ok(v))
+            .map(drop)
+    }
+
+    /// `count` region tags of type `ty`: non-negative integers, or whole numbers stored as
+    /// floats.
+    pub(super) fn tags(&mut self, count: usize, ty: DataType, what: &str) -> Values<u64> {
+        let DataType::Float(_) = ty else {
+            return self.integers(count, ty, what);
+        };
+        let whole = |source: &Source<'_>, v: f64| {
+            if v >= 0.0 && v.fract() == 0.0 && v < 9.0e15 {
+                Ok(v)
+            } else {
+                Err(source.error(
+                    ImportErrorKind::Syntax,
+                    format!("{what}: {v} is not a whole number of 0 or more"),
+                ))
+            }
+        };
+        let decode = |_: &Source<'_>, bytes: &[u8]| Ok(binary_value(bytes, ty));
+        let values = self.values(count, ty.size(), what, decode, whole)?;
+        Ok(values.into_iter().map(|v| v as u64).collect())
     }
 
     /// `count` values named `what`: binary ones of `size` bytes turned into a `T` by `decode`

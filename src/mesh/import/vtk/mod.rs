@@ -1,11 +1,13 @@
 //! VTK unstructured grids: XML `.vtu` files and legacy `.vtk` files.
 //!
-//! Cells of type 10 (tetra) and 24 (quadratic tetra: its corners, then its mid-edge nodes in
-//! VTK's edge order, kept in [`RawMesh::mid_edge_nodes`]) are read, one kind per file.
-//! Lower-dimensional cells (vertices, lines, triangles, quads and their higher-order forms:
-//! boundary elements written beside the volume) are skipped, as in Gmsh files. Any other volume
-//! cell (hexahedron 12, wedge 13, pyramid 14, ...) is an [`ImportErrorKind::UnsupportedElement`]
-//! error naming the cell: dropping it would silently lose material.
+//! Cells of type 10 (tetra), 24 (quadratic tetra: its corners, then its mid-edge nodes in
+//! VTK's edge order, kept in [`RawMesh::mid_edge_nodes`]), 12 (hexahedron) and 29
+//! (triquadratic hexahedron), the hexahedra split into tetrahedra ([`RawMesh::hexahedra`]), are
+//! read, one kind per file. Lower-dimensional cells (vertices, lines, triangles, quads and
+//! their higher-order forms: boundary elements written beside the volume) are skipped, as in
+//! Gmsh files. Any other volume cell (wedge 13, pyramid 14, ...) is an
+//! [`ImportErrorKind::UnsupportedElement`] error naming the cell: dropping it would silently
+//! lose material.
 //!
 //! `.vtu` files are read by this crate (`xml`: the layout walked with `quick-xml` in
 //! `xml_document`, the values decoded in `xml_data`, binary blocks in `xml_block`): ASCII,
@@ -19,12 +21,13 @@
 //! UNSTRUCTURED_GRID`) are read by hand too (`legacy`, its data blocks in `legacy_data`): the
 //! format is a few keywords and number lists.
 //!
-//! This module turns the cells both readers collect into tetrahedra, and the cells a `.vtu`
-//! file tags (its `gmsh:physical` or `CellEntityIds` cell data) into unnamed regions by
+//! This module turns the cells both readers collect into tetrahedra, and the cells a file tags
+//! (its `gmsh:physical` or `CellEntityIds` cell data) into unnamed regions by
 //! dimension and tag: a tetrahedron's into a volume, a triangle's or quadrangle's into a
 //! surface, as a Gmsh file's physical groups are.
 
 mod legacy;
+mod legacy_attributes;
 mod legacy_data;
 mod xml;
 mod xml_block;
@@ -34,16 +37,22 @@ mod xml_document;
 pub use legacy::parse_legacy;
 pub use xml::parse_vtu;
 
+use super::hexahedra;
 use super::text::Source;
-use super::{MeshRegion, RawMesh};
+use super::{Hexahedra, MeshRegion, RawMesh};
 use crate::Error;
 use crate::error::{FileLocation, ImportErrorKind};
+use crate::mesh::hex_split::split_lattice;
 use rapier3d::glamx::DVec3;
 
 /// VTK's linear tetrahedron.
 const VTK_TETRA: u64 = 10;
 /// VTK's quadratic (10-node) tetrahedron.
 const VTK_QUADRATIC_TETRA: u64 = 24;
+/// VTK's linear hexahedron.
+const VTK_HEXAHEDRON: u64 = 12;
+/// VTK's triquadratic (27-node) hexahedron.
+const VTK_TRIQUADRATIC_HEXAHEDRON: u64 = 29;
 
 /// Whether VTK cell type `cell_type` is empty (0), a vertex, curve or surface cell, skipped on
 /// import.
@@ -97,14 +106,12 @@ fn build(
             ),
         ));
     }
-    let mut tets = Vec::new();
-    let mut mid_edge_nodes = Vec::new();
-    let mut tet_locations = Vec::new();
+    let mut volume = VolumeCells::default();
     let mut tagged = TaggedCells::default();
     for (cell, &cell_type) in cells.types.iter().enumerate() {
         let nodes = cells.nodes(source, cell, locate)?;
         let tag = cells.tags.get(cell).copied().flatten();
-        let Some(nodes) = tetrahedron(source, cell, cell_type, nodes, positions.len(), locate)?
+        let Some(nodes) = volume_nodes(source, cell, cell_type, nodes, positions.len(), locate)?
         else {
             if let Some(tag) = tag {
                 let at = locate(cell, CellData::Connectivity);
@@ -112,41 +119,88 @@ fn build(
             }
             continue;
         };
-        if let Some(tag) = tag {
-            tagged.add_tet(tag, tets.len() as u32, &nodes);
-        }
-        let quadratic = nodes.len() == 10;
-        if !tets.is_empty() && quadratic == mid_edge_nodes.is_empty() {
+        if volume.cell_type.is_some_and(|first| first != cell_type) {
             return Err(source.error_at(
                 locate(cell, CellData::Types),
                 ImportErrorKind::UnsupportedElement,
                 format!(
-                    "cell {cell} has type {cell_type}: linear (10) and quadratic (24) \
-                     tetrahedra cannot be mixed"
+                    "cell {cell} has type {cell_type}, the cells before type {}: one kind of \
+                     volume cell per mesh",
+                    volume.cell_type.unwrap_or_default()
                 ),
             ));
         }
-        tets.push([nodes[0], nodes[1], nodes[2], nodes[3]]);
-        if quadratic {
-            mid_edge_nodes.push([nodes[4], nodes[5], nodes[6], nodes[7], nodes[8], nodes[9]]);
+        let first_tet = volume.tets.len();
+        volume.add(cell_type, &nodes, locate(cell, CellData::Connectivity));
+        if let Some(tag) = tag {
+            tagged.add_tets(tag, first_tet..volume.tets.len(), &nodes);
         }
-        tet_locations.push(locate(cell, CellData::Connectivity));
     }
-    if tets.is_empty() {
+    if volume.tets.is_empty() {
         return Err(source.error_at(
             FileLocation::Whole,
             ImportErrorKind::NoTetrahedra,
-            "the file holds no tetrahedra (cell type 10 or 24)",
+            "the file holds no tetrahedra or hexahedra (cell type 10, 24, 12 or 29)",
         ));
     }
+    let hexahedra = match volume.cell_type {
+        Some(VTK_HEXAHEDRON) => Hexahedra::Linear(volume.hexahedra),
+        Some(VTK_TRIQUADRATIC_HEXAHEDRON) => Hexahedra::Triquadratic(volume.cage),
+        _ => Hexahedra::None,
+    };
     Ok(RawMesh {
         path: source.path().to_owned(),
         positions,
-        tets,
-        mid_edge_nodes,
-        tet_locations,
+        tets: volume.tets,
+        mid_edge_nodes: volume.mid_edge_nodes,
+        tet_locations: volume.tet_locations,
         regions: tagged.regions(source)?,
+        hexahedra,
     })
+}
+
+/// The volume cells read so far, as a [`RawMesh`] holds them.
+#[derive(Default)]
+struct VolumeCells {
+    /// The type of the first volume cell (all must have it).
+    cell_type: Option<u64>,
+    tets: Vec<[u32; 4]>,
+    mid_edge_nodes: Vec<[u32; 6]>,
+    tet_locations: Vec<FileLocation>,
+    /// Linear hexahedra's corners in file order.
+    hexahedra: Vec<[u32; 8]>,
+    /// 27-node hexahedra in lattice order.
+    cage: Vec<[u32; 27]>,
+}
+
+impl VolumeCells {
+    /// Adds the volume cell of `cell_type` on `nodes` (as many as the type has), defined at
+    /// `at`: a tetrahedron as it is, a hexahedron split into tetrahedra.
+    fn add(&mut self, cell_type: u64, nodes: &[u32], at: FileLocation) {
+        self.cell_type = Some(cell_type);
+        let first = self.tets.len();
+        match cell_type {
+            VTK_HEXAHEDRON => {
+                self.tets.extend(hexahedra::split_linear(nodes));
+                self.hexahedra
+                    .push(std::array::from_fn(|corner| nodes[corner]));
+            }
+            VTK_TRIQUADRATIC_HEXAHEDRON => {
+                let lattice = hexahedra::lattice(nodes, &hexahedra::VTK_TRIQUADRATIC);
+                self.tets.extend(split_lattice(&lattice));
+                self.cage.push(lattice);
+            }
+            _ => {
+                self.tets.push([nodes[0], nodes[1], nodes[2], nodes[3]]);
+                if cell_type == VTK_QUADRATIC_TETRA {
+                    let mids = [nodes[4], nodes[5], nodes[6], nodes[7], nodes[8], nodes[9]];
+                    self.mid_edge_nodes.push(mids);
+                }
+            }
+        }
+        let added = self.tets.len() - first;
+        self.tet_locations.extend(std::iter::repeat_n(at, added));
+    }
 }
 
 /// The tagged cells seen so far, by dimension and tag: their nodes and, for volumes, their
@@ -157,11 +211,13 @@ struct TaggedCells {
 }
 
 impl TaggedCells {
-    /// Adds tetrahedron `tet` (index among the mesh's) of `nodes` to the volume tagged `tag`.
-    fn add_tet(&mut self, tag: u64, tet: u32, nodes: &[u32]) {
-        let (group_nodes, tets) = self.groups.entry((3, tag)).or_default();
+    /// Adds the tetrahedra `tets` (indices among the mesh's) of a volume cell of `nodes` to
+    /// the volume tagged `tag`.
+    fn add_tets(&mut self, tag: u64, tets: std::ops::Range<usize>, nodes: &[u32]) {
+        let (group_nodes, group_tets) = self.groups.entry((3, tag)).or_default();
         group_nodes.extend_from_slice(nodes);
-        tets.push(tet);
+        // Saturated: a mesh cannot index more than u32::MAX tetrahedra.
+        group_tets.extend(tets.map(|t| u32::try_from(t).unwrap_or(u32::MAX)));
     }
 
     /// Adds the lower-dimensional cell `cell` of `cell_type` tagged `tag`, of point indices
@@ -248,11 +304,11 @@ impl Cells<'_> {
     }
 }
 
-/// The nodes of the tetrahedron cell `cell` of `cell_type` with point indices `nodes` (of
-/// `point_count` points): four for a linear one, ten for a quadratic one; `None` for a
-/// lower-dimensional cell, an error for a tetrahedron with another number of points or one out
-/// of range, and for any other volume cell.
-fn tetrahedron(
+/// The nodes of the volume cell `cell` of `cell_type` with point indices `nodes` (of
+/// `point_count` points): a tetrahedron's (4 or 10) or a hexahedron's (8 or 27); `None` for a
+/// lower-dimensional cell, an error for a cell with another number of points or one out of
+/// range, and for any other volume cell.
+fn volume_nodes(
     source: &Source<'_>,
     cell: usize,
     cell_type: u64,
@@ -263,6 +319,8 @@ fn tetrahedron(
     let expected = match cell_type {
         VTK_TETRA => 4,
         VTK_QUADRATIC_TETRA => 10,
+        VTK_HEXAHEDRON => 8,
+        VTK_TRIQUADRATIC_HEXAHEDRON => 27,
         _ if is_lower_dimensional(cell_type) => return Ok(None),
         _ => {
             return Err(source.error_at(
@@ -270,7 +328,7 @@ fn tetrahedron(
                 ImportErrorKind::UnsupportedElement,
                 format!(
                     "cell {cell} has type {cell_type}, a volume cell other than a tetrahedron \
-                     (type 10 or 24): it cannot be used"
+                     (type 10 or 24) or a hexahedron (type 12 or 29): it cannot be used"
                 ),
             ));
         }
