@@ -133,7 +133,8 @@ fn malformed_obj_files_name_the_line() {
         "f 2/1 3/1 4/1",       // 11 (texture indices are ignored without `vt`)
         "f -4//1 -1//1 -2//1", // 12 (relative indices, empty texture slot)
     ]
-    .join("\n");
+    .join("\n")
+        + "\n";
     let good = surface::parse_obj(tet.as_bytes(), "tet.obj", 1.0).unwrap();
     assert_eq!(good.triangles.len(), 4);
     let parse = |text: &str| {
@@ -141,6 +142,15 @@ fn malformed_obj_files_name_the_line() {
         shown(&result);
         surface_error(result)
     };
+    // Cut inside its last number (`-2` read as `-`, or a vertex `1.5` as `1.`): without its
+    // final line break the last statement may be cut short, refused at its line; a last comment
+    // without one is harmless.
+    let (kind, at, _) = parse(tet.trim_end());
+    assert_eq!(
+        (kind, at),
+        (ImportErrorKind::Truncated, FileLocation::Line(12))
+    );
+    assert!(surface::parse_obj(format!("{tet}# end").as_bytes(), "c.obj", 1.0).is_ok());
     // A coordinate that is not a number on line 4.
     let (kind, at, message) = parse(&tet.replace("v 0 1 0", "v 0 one 0"));
     assert_eq!((kind, at), (ImportErrorKind::Syntax, FileLocation::Line(4)));

@@ -26,10 +26,13 @@ use std::collections::HashMap;
 /// [`Error::InvalidSetting`] for a bad `scale`; [`Error::MeshImport`] for a file `tobj`
 /// rejects, with the line of the first statement at fault (`tobj` gives none: the file is
 /// scanned again to find it; [`FileLocation::Whole`] if that fails), indices out of range
-/// ([`ImportErrorKind::IndexOutOfRange`]) or non-finite coordinates (at the vertex's line).
+/// ([`ImportErrorKind::IndexOutOfRange`]), non-finite coordinates (at the vertex's line) and a
+/// last statement without a line break ([`ImportErrorKind::Truncated`]: the file may be cut
+/// inside a number).
 pub fn parse_obj(data: &[u8], path: &str, scale: f64) -> Result<Surface, Error> {
     check_scale(scale)?;
     let source = Source::new(path, data);
+    check_last_statement_ended(&source, data)?;
     // tobj gives each object or group its own copy of the vertices it uses: vertices at the same
     // coordinates are welded back into one, so that a closed surface split into groups stays
     // closed.
@@ -73,6 +76,27 @@ pub fn parse_obj(data: &[u8], path: &str, scale: f64) -> Result<Surface, Error> 
         vertices,
         triangles,
     })
+}
+
+/// A [`ImportErrorKind::Truncated`] error at the OBJ file's last line if it holds a statement
+/// (anything but a comment) and has no line break: a file cut inside a number reads as another
+/// number, a vertex moved or a face on another vertex.
+fn check_last_statement_ended(source: &Source<'_>, data: &[u8]) -> Result<(), Error> {
+    if data.last().is_none_or(|&b| b == b'\n' || b == b'\r') {
+        return Ok(());
+    }
+    let start = data.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
+    let last = String::from_utf8_lossy(&data[start..]);
+    let statement = last.trim();
+    if statement.is_empty() || statement.starts_with('#') {
+        return Ok(());
+    }
+    let line = data.iter().filter(|&&b| b == b'\n').count() + 1;
+    Err(source.error_at(
+        FileLocation::Line(line),
+        ImportErrorKind::Truncated,
+        "the file ends inside its last statement, without a line break: it may be cut short",
+    ))
 }
 
 /// The objects and groups `tobj` reads from the OBJ file `data`, triangulated, or its error
