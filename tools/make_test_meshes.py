@@ -461,9 +461,36 @@ def hexahedra():
     writer.Write()
 
 
+def hollow_sphere():
+    """A thick-walled hollow sphere, outer radius 50 mm and inner radius 25 mm, meshed by gmsh
+    into second-order tetrahedra (up to 10 mm, curved to the spheres) in millimetres, with physical groups "shell" (the volume, tag 1) and
+    "cavity" (the inner sphere, tag 2); MSH 4.1 ASCII. tests/loads.rs inflates its cavity to a
+    volume and compares the pressure with Lame's solution."""
+    gmsh.initialize()
+    gmsh.option.setNumber("General.Terminal", 0)
+    gmsh.model.add("hollow_sphere")
+    outer = gmsh.model.occ.addSphere(0, 0, 0, 50)
+    inner = gmsh.model.occ.addSphere(0, 0, 0, 25)
+    gmsh.model.occ.cut([(3, outer)], [(3, inner)])
+    gmsh.model.occ.synchronize()
+    volumes = [t for _, t in gmsh.model.getEntities(3)]
+    cavity = [t for _, t in gmsh.model.getEntitiesInBoundingBox(-26, -26, -26, 26, 26, 26, 2)]
+    gmsh.model.addPhysicalGroup(3, volumes, 1, name="shell")
+    gmsh.model.addPhysicalGroup(2, cavity, 2, name="cavity")
+    gmsh.option.setNumber("Mesh.MeshSizeMax", 10.0)
+    gmsh.model.mesh.generate(3)
+    gmsh.model.mesh.setOrder(2)
+    # Curving the elements next to the spheres folds some; gmsh's optimizer unfolds them.
+    gmsh.model.mesh.optimize("HighOrder")
+    gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
+    gmsh.option.setNumber("Mesh.Binary", 0)
+    gmsh.write(os.path.join(OUT, "hollow_sphere_v41.msh"))
+    gmsh.finalize()
+
+
 STEPS = [cube_msh, cube_others, surfaces, cube_meshio_compressed, cube_vtk_library,
          multi_solid_stl, cube_msh_other_forms, cube_regions, two_volumes, pneumatic_finger,
-         two_volumes_vtu, hexahedra]
+         two_volumes_vtu, hexahedra, hollow_sphere]
 
 if __name__ == "__main__":
     import sys

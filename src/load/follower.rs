@@ -68,6 +68,21 @@ pub(super) fn cone_volume(triangles: &[[u32; 3]], x: &[DVec3], origin: DVec3) ->
         / 6.0
 }
 
+/// Whether `triangles` make a closed, consistently oriented surface: every directed edge once,
+/// its reverse once.
+pub(super) fn is_closed(triangles: &[[u32; 3]]) -> bool {
+    let mut edges = std::collections::HashMap::new();
+    for &[a, b, c] in triangles {
+        for edge in [(a, b), (b, c), (c, a)] {
+            *edges.entry(edge).or_insert(0u32) += 1;
+        }
+    }
+    !edges.is_empty()
+        && edges
+            .iter()
+            .all(|(&(a, b), &count)| count == 1 && edges.get(&(b, a)) == Some(&1))
+}
+
 /// Adds the forces (N) of a cable of tension `tension` (N) through `path` at the positions `x`
 /// (m).
 pub(super) fn add_cable_forces(path: &[u32], tension: f64, x: &[DVec3], forces: &mut [DVec3]) {

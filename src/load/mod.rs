@@ -9,7 +9,8 @@
 //!   their current normals: each corner carries `-p a / 3` with `a = ½ (x_b − x_a) × (x_c − x_a)`
 //!   the triangle's area vector (m², out of the body). On the closed inner surface of a cavity it
 //!   is the cavity's pressure (a pneumatic actuator), and [`Load::enclosed_volume`] the cavity's
-//!   volume;
+//!   volume ([`statics::inflate_to_volume`](crate::statics::inflate_to_volume) finds the
+//!   pressure that fills it to a given volume at equilibrium);
 //! - **cable** of tension `T` (N) running through a path of nodes (eyelets), anchored at both
 //!   ends in the body: node `i` is pulled toward its neighbours on the path,
 //!   `T (ê_{i→i−1} + ê_{i→i+1})`, as a tendon pulled by an actuator in the body is.
@@ -317,6 +318,23 @@ impl Load {
             }
             _ => None,
         }
+    }
+
+    /// For a pressure on a closed, consistently oriented surface, the gradient `∂V/∂x` (m² per
+    /// node) of the volume it encloses at the positions `x` (m): the force of a pressure of one
+    /// pascal. `None` for other loads and open surfaces.
+    pub(crate) fn cavity_volume_gradient(&self, x: &[DVec3]) -> Option<Vec<DVec3>> {
+        let Self::Pressure { triangles, .. } = self else {
+            return None;
+        };
+        if !follower::is_closed(triangles) {
+            return None;
+        }
+        let mut gradient = vec![DVec3::ZERO; x.len()];
+        let origin = follower::centre(triangles, x);
+        // Minus the cone's gradient, as a cavity's faces point into it.
+        follower::add_cone_forces(triangles, 1.0, x, origin, &mut gradient);
+        Some(gradient)
     }
 
     /// The node pairs the load's tangent couples (`[a, b]`, `a > b`).

@@ -1,17 +1,23 @@
 //! Static analysis: the equilibrium `f_int(x) + M g + f_load(x) = 0` of a body under gravity and
-//! its loads ([`crate::load`]) with its pinned nodes held, found by Newton's method on the total potential energy, and the natural
-//! frequencies of small vibrations about the current configuration.
+//! its loads ([`crate::load`]) with its pinned nodes held, found by Newton's method on the total
+//! potential energy; the pressure at which a cavity's equilibrium encloses a given volume
+//! ([`inflate_to_volume`]); and the natural frequencies of small vibrations about the current
+//! configuration.
 //!
 //! Both use the sparse tangent stiffness `K = -∂f_int/∂x` and faer's sparse Cholesky
 //! factorization, so they need `K` positive definite on the free nodes: pin enough nodes to stop
 //! rigid motion.
+
+mod cavity;
+
+pub use cavity::{CavityReport, inflate_to_volume};
 
 use crate::Error;
 use crate::assembly::{Stiffness, factorize, solve};
 use crate::body::DeformableBody;
 use crate::integrate::SolverWorkspace;
 use crate::linear_solver::{Method, solve_newton_system};
-use crate::newton::{Search, check_tolerance, descend, norm};
+use crate::newton::{Search, check_tolerance, descend, norm, round_off_floor};
 use rapier3d::glamx::{DMat3, DVec3};
 
 /// The largest relative residual accepted as round-off when Newton stops reducing it.
@@ -41,7 +47,8 @@ impl Default for StaticSettings {
 pub struct StaticReport {
     /// Newton iterations performed.
     pub iterations: usize,
-    /// Final out-of-balance force norm over the load norm.
+    /// Final out-of-balance force norm over the load norm; 0 under no load (a body at rest,
+    /// whose out-of-balance force is the round-off of its force sum).
     pub relative_residual: f64,
 }
 
@@ -91,7 +98,9 @@ fn newton(
     let load = body.dead_load(gravity);
     let mut residual = out_of_balance(body, &load);
     let reference = norm(&load).max(norm(&residual));
-    if reference == 0.0 {
+    // A body at rest under no load: its residual is the round-off of the force sum, and would
+    // be its own reference.
+    if reference == 0.0 || (norm(&load) == 0.0 && on_round_off_floor(body, &residual, &load)) {
         return Ok(StaticReport {
             iterations: 0,
             relative_residual: 0.0,
@@ -144,8 +153,10 @@ fn newton(
             |body| out_of_balance(body, &load),
         ) {
             Some((next, _)) => residual = next,
-            // No descent left above round-off: accept a tiny residual, refuse anything else.
-            None if relative <= ROUND_OFF_CEILING => {
+            // No descent left above round-off: accept a tiny residual, or one within twice the
+            // round-off floor of the force sum (a body at rest under no load, whose residual is
+            // that round-off and so its own reference), refuse anything else.
+            None if relative <= ROUND_OFF_CEILING || on_round_off_floor(body, &residual, &load) => {
                 return Ok(StaticReport {
                     iterations: iteration,
                     relative_residual: relative,
@@ -255,6 +266,13 @@ fn out_of_balance(body: &mut DeformableBody, load: &[DVec3]) -> Vec<DVec3> {
             }
         })
         .collect()
+}
+
+/// Whether the out-of-balance force `residual` (N) is within twice its round-off floor at the
+/// body's positions ([`round_off_floor`]): no Newton step can lower it further.
+fn on_round_off_floor(body: &mut DeformableBody, residual: &[DVec3], load: &[DVec3]) -> bool {
+    let floor = round_off_floor(body, residual, |body| out_of_balance(body, load));
+    norm(residual) <= 2.0 * floor
 }
 
 /// Total potential energy (J): elastic energy plus the follower loads' potential (cones from
