@@ -99,6 +99,24 @@ impl DeformableBody {
         )
     }
 
+    /// A bound (rad²/s²) on the squared highest angular frequency the follower loads' stiffness
+    /// adds at the current positions: Gershgorin's, `max_n r_n / m_n` over the free nodes with
+    /// `r_n` the row bound of [`Load::add_stiffness_bounds`] (a cable's `2T/d` against a light
+    /// node of a fine mesh can exceed the elements' own stiffness). Zero without follower loads.
+    pub(crate) fn load_frequency_squared(&self) -> f64 {
+        if self.loads.is_empty() {
+            return 0.0;
+        }
+        let mut rows = vec![0.0; self.node_count()];
+        for load in &self.loads {
+            load.add_stiffness_bounds(&self.positions, &mut rows);
+        }
+        (rows.iter().zip(&self.masses).zip(&self.pinned))
+            .filter(|&((_, _), &pinned)| !pinned)
+            .map(|((row, mass), _)| row / mass)
+            .fold(0.0, f64::max)
+    }
+
     /// The node pairs the loads' tangents couple (`[a, b]`, `a > b`).
     pub(crate) fn load_pairs(&self) -> Vec<[u32; 2]> {
         self.loads.iter().flat_map(Load::coupled_pairs).collect()

@@ -86,10 +86,19 @@ pub struct StepReport {
 
 impl SymplecticEuler {
     /// Estimated critical time step (s) of the explicit scheme for `body` in its current shape:
-    /// steps above it make the highest modes grow. Zero if an element is flat.
+    /// steps above it make the highest modes grow. Zero if an element is flat. The elements'
+    /// highest frequency `ω_e = 2c/ℓ` (`c` the pressure wave speed, `ℓ` the
+    /// [wave length scale](DeformableBody::wave_length_scale)) is raised by the follower loads'
+    /// stiffness to `sqrt(ω_e² + ω_l²)` (Gershgorin's bound, `ω_l` from the cables' `2T/d` and
+    /// the pressures' `|p| s/6` over the nodal masses), the step scaled alike.
     pub fn critical_time_step(body: &DeformableBody) -> f64 {
-        let undamped =
+        let mut undamped =
             COURANT_NUMBER * body.wave_length_scale() / body.material().dilatational_wave_speed();
+        let loads = body.load_frequency_squared();
+        if loads > 0.0 {
+            let elements = 2.0 * COURANT_NUMBER / undamped;
+            undamped = 2.0 * COURANT_NUMBER / (elements * elements + loads).sqrt();
+        }
         let Some(damping) = body.damping() else {
             return undamped;
         };

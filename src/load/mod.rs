@@ -320,6 +320,38 @@ impl Load {
         }
     }
 
+    /// Adds to `rows[n]` a bound (N/m) on the row sum of the norms of the 3 x 3 blocks of the
+    /// load's stiffness `−∂f/∂x` at node `n` at the positions `x` (m), for Gershgorin's bound on
+    /// the highest frequency it adds: `2T/d` at each end of a cable segment of length `d` (its
+    /// blocks `±T (I − d̂ d̂ᵀ)/d`), `|p| s/6` at each corner of a pressurized triangle of
+    /// perimeter `s` (its blocks `(p/6) [x_c − x_b]ₓ`, `(p/6) [x_c − x_a]ₓ`, `(p/6) [x_b − x_a]ₓ`
+    /// at corner `a`); dead loads add nothing.
+    pub(crate) fn add_stiffness_bounds(&self, x: &[DVec3], rows: &mut [f64]) {
+        match self {
+            Self::Pressure {
+                triangles,
+                pressure,
+            } => {
+                for &[a, b, c] in triangles {
+                    let [xa, xb, xc] = [a, b, c].map(|n| x[n as usize]);
+                    let perimeter = xa.distance(xb) + xb.distance(xc) + xc.distance(xa);
+                    for n in [a, b, c] {
+                        rows[n as usize] += pressure.abs() * perimeter / 6.0;
+                    }
+                }
+            }
+            Self::Cable { path, tension } => {
+                for segment in path.windows(2) {
+                    let length = x[segment[0] as usize].distance(x[segment[1] as usize]);
+                    for &n in segment {
+                        rows[n as usize] += 2.0 * tension / length;
+                    }
+                }
+            }
+            Self::Traction { .. } | Self::BodyForce { .. } => {}
+        }
+    }
+
     /// For a pressure on a closed, consistently oriented surface, the gradient `∂V/∂x` (m² per
     /// node) of the volume it encloses at the positions `x` (m): the force of a pressure of one
     /// pascal. `None` for other loads and open surfaces.
