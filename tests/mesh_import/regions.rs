@@ -335,3 +335,26 @@ fn legacy_cell_data_that_does_not_fit_its_grid_is_refused_at_its_line() {
     let short = text.replacen("gmsh:physical 1 30", "gmsh:physical 1 31", 1);
     assert!(parse(&short).is_err());
 }
+
+#[test]
+fn legacy_cell_tags_as_scalars_are_the_same_regions_as_in_a_field() {
+    // The VTK library's file with its tag array turned from a FIELD array into the cell data's
+    // SCALARS (as a writer that marks the tags as the active scalars puts them).
+    let text = std::fs::read_to_string(super::asset("box_hex27_vtk9.vtk")).unwrap();
+    let scalars = text
+        .replacen(
+            "FIELD FieldData 3\ngmsh:physical 1 30 vtktypeint64\n",
+            "SCALARS gmsh:physical vtktypeint64 1\nLOOKUP_TABLE default\n",
+            1,
+        )
+        .replacen(
+            "\ngmsh:geometrical 1 30",
+            "\nFIELD FieldData 2\ngmsh:geometrical 1 30",
+            1,
+        );
+    assert_ne!(scalars, text);
+    let from_field = vtk::parse_legacy(text.as_bytes(), "field.vtk", 1.0).unwrap();
+    let from_scalars = vtk::parse_legacy(scalars.as_bytes(), "scalars.vtk", 1.0).unwrap();
+    assert_eq!(from_scalars.regions.len(), 2);
+    assert_eq!(from_scalars.regions, from_field.regions);
+}
