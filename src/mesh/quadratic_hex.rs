@@ -94,7 +94,8 @@ impl QuadraticHexMesh {
     ///
     /// # Errors
     /// [`Error::NodeIndexOutOfRange`] for an element naming a node past `positions` (its `tet`
-    /// is the element); [`Error::EmptyMesh`] for no elements; [`Error::NonFiniteCoordinate`] and the errors of
+    /// is the element); [`Error::EmptyMesh`] for no elements; [`Error::NonFiniteCoordinate`] or
+    /// [`Error::CoordinateOutOfRange`] for a node; the errors of
     /// [`TetMesh::new`] naming the element a subdivision tetrahedron lies in (a folded,
     /// flattened or inconsistently numbered element).
     ///

@@ -117,6 +117,10 @@ pub(crate) fn name_parent_element(error: Error, parent: impl Fn(usize) -> usize)
             tet: parent(tet),
             longest_edge,
         },
+        Error::RepeatedNode { tet, node } => Error::RepeatedNode {
+            tet: parent(tet),
+            node,
+        },
         other => other,
     }
 }

@@ -43,10 +43,10 @@ pub struct CavityReport {
 /// # Errors
 /// [`Error::InvalidLoad`] if `cavity` is not a pressure on a closed, consistently oriented
 /// surface of the body; [`Error::InvalidSetting`] for a volume that is not positive and
-/// finite; the errors of [`solve_equilibrium`] and
-/// [`Error::StaticSolveDidNotConverge`] if the pressure does not converge (an instability:
-/// the volume falls as the pressure rises) or no equilibrium is found. On error the body is
-/// left as it was, its load at its former pressure.
+/// finite; the errors of [`solve_equilibrium`]; [`Error::IndefiniteStiffness`] where the
+/// equilibrium is unstable (its tangent not positive definite: the volume could fall as the
+/// pressure rises); [`Error::StaticSolveDidNotConverge`] if the pressure does not converge in
+/// 30 iterations. On error the body is left as it was, its load at its former pressure.
 ///
 /// # Example
 /// ```
@@ -125,7 +125,11 @@ fn newton_on_pressure(
         }
         let compliance = volume_compliance(body, cavity)?;
         if compliance.is_nan() || compliance <= 0.0 {
-            break;
+            // Round-off on a tangent barely positive definite: no direction to go.
+            return Err(Error::StaticSolveDidNotConverge {
+                iterations: iteration,
+                residual: (volume - target).abs() / target,
+            });
         }
         let mut step = (target - volume) / compliance;
         let mut halvings = 0;

@@ -47,8 +47,8 @@ impl Default for StaticSettings {
 pub struct StaticReport {
     /// Newton iterations performed.
     pub iterations: usize,
-    /// Final out-of-balance force norm over the load norm; 0 under no load (a body at rest,
-    /// whose out-of-balance force is the round-off of its force sum).
+    /// Final out-of-balance force norm over the load norm; 0 for a body found in equilibrium
+    /// under no load (its out-of-balance force the round-off of its force sum).
     pub relative_residual: f64,
 }
 
@@ -98,9 +98,7 @@ fn newton(
     let load = body.dead_load(gravity);
     let mut residual = out_of_balance(body, &load);
     let reference = norm(&load).max(norm(&residual));
-    // A body at rest under no load: its residual is the round-off of the force sum, and would
-    // be its own reference.
-    if reference == 0.0 || (norm(&load) == 0.0 && on_round_off_floor(body, &residual, &load)) {
+    if reference == 0.0 || in_equilibrium_unloaded(body, &residual, &load) {
         return Ok(StaticReport {
             iterations: 0,
             relative_residual: 0.0,
@@ -153,10 +151,8 @@ fn newton(
             |body| out_of_balance(body, &load),
         ) {
             Some((next, _)) => residual = next,
-            // No descent left above round-off: accept a tiny residual, or one within twice the
-            // round-off floor of the force sum (a body at rest under no load, whose residual is
-            // that round-off and so its own reference), refuse anything else.
-            None if relative <= ROUND_OFF_CEILING || on_round_off_floor(body, &residual, &load) => {
+            // No descent left above round-off: accept a tiny residual, refuse anything else.
+            None if relative <= ROUND_OFF_CEILING => {
                 return Ok(StaticReport {
                     iterations: iteration,
                     relative_residual: relative,
@@ -268,9 +264,14 @@ fn out_of_balance(body: &mut DeformableBody, load: &[DVec3]) -> Vec<DVec3> {
         .collect()
 }
 
-/// Whether the out-of-balance force `residual` (N) is within twice its round-off floor at the
-/// body's positions ([`round_off_floor`]): no Newton step can lower it further.
-fn on_round_off_floor(body: &mut DeformableBody, residual: &[DVec3], load: &[DVec3]) -> bool {
+/// Whether the body is in equilibrium under no dead load: its out-of-balance force `residual`
+/// (N, the follower loads' included) within twice its round-off floor at the body's positions
+/// ([`round_off_floor`]), which no Newton step can lower and which would otherwise be its own
+/// reference (a body at rest, its loads at zero).
+fn in_equilibrium_unloaded(body: &mut DeformableBody, residual: &[DVec3], load: &[DVec3]) -> bool {
+    if norm(load) > 0.0 {
+        return false;
+    }
     let floor = round_off_floor(body, residual, |body| out_of_balance(body, load));
     norm(residual) <= 2.0 * floor
 }

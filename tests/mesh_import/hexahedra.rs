@@ -249,6 +249,13 @@ fn a_folded_27_node_hexahedron_is_counted_and_refused_at_its_line() {
     raw.positions[centre].x = raw.positions[face].x + 0.2;
     let report = import::check_raw(&raw);
     assert_eq!(report.folded, 1);
+    // The same element numbered left-handed (lattice i to 2 − i): still one folded.
+    let mut mirrored = raw.clone();
+    if let Hexahedra::Triquadratic(elements) = &mut mirrored.hexahedra {
+        let e = elements[element];
+        elements[element] = std::array::from_fn(|a| e[a - a % 3 + 2 - a % 3]);
+    }
+    assert_eq!(import::check_raw(&mirrored).folded, 1);
     let line = raw.tet_locations[48 * element];
     assert!(matches!(line, FileLocation::Line(_)));
     match raw.into_cage().unwrap_err() {

@@ -194,8 +194,8 @@ impl MeshSpec {
     }
 
     /// Builds a cage of quadratic hexahedra over a cuboid mesh's cells, or of a file's
-    /// hexahedra (with its regions, [widened](MeshRegion::with_cage_nodes) to the nodes a
-    /// linear hexahedron's cage adds).
+    /// hexahedra (with its regions; a linear file's [widened](MeshRegion::with_cage_nodes) to
+    /// the nodes its cage adds).
     ///
     /// # Errors
     /// A [`SceneError`] at `key` for another mesh, the generator's problem or a file without
@@ -207,10 +207,15 @@ impl MeshSpec {
     ) -> Result<BuiltMesh<QuadraticHexMesh>, SceneError> {
         if let Some(raw) = self.read_file(key, source)? {
             let (path, regions) = (raw.path.clone(), raw.regions_in_mesh());
+            let linear = matches!(raw.hexahedra, import::Hexahedra::Linear(_));
             let mesh = raw
                 .into_cage()
                 .map_err(|e| source.error(&format!("{key}.file"), e.to_string()))?;
-            let regions = regions.iter().map(|r| r.with_cage_nodes(&mesh)).collect();
+            let regions = if linear {
+                regions.iter().map(|r| r.with_cage_nodes(&mesh)).collect()
+            } else {
+                regions
+            };
             return Ok(BuiltMesh {
                 mesh,
                 regions,

@@ -2,8 +2,8 @@
 //! ones kept as elements of a [`QuadraticHexMesh`] cage and split on their lattice nodes.
 //!
 //! Both are cut by the conforming rule of `mesh::hex_split` (each face along its diagonal
-//! through its corner of least index), with node indices (or Gmsh node tags, equally
-//! ordered) as the order, so the tetrahedra of neighbouring hexahedra share their faces' cuts.
+//! through its corner of least index), node indices (their order in the file) giving the
+//! order, so the tetrahedra of neighbouring hexahedra share their faces' cuts.
 //! A hexahedron's tetrahedra follow one another in [`RawMesh::tets`], all at the hexahedron's
 //! place in the file.
 //!
@@ -37,6 +37,26 @@ pub enum Hexahedra {
 }
 
 impl Hexahedra {
+    /// Writes each hexahedron's tetrahedra, split by its node indices, over its block of
+    /// `tets` (the readers' tetrahedra, one block per hexahedron in order); nothing for a
+    /// file of tetrahedra.
+    pub(super) fn split_into(&self, tets: &mut [[u32; 4]]) {
+        match self {
+            Self::Linear(elements) => {
+                let blocks = tets.chunks_exact_mut(crate::mesh::hex_split::TETS_PER_HEXAHEDRON);
+                for (block, corners) in blocks.zip(elements) {
+                    block.copy_from_slice(&split_linear(corners));
+                }
+            }
+            Self::Triquadratic(elements) => {
+                for (block, lattice) in tets.chunks_exact_mut(TETS_PER_LATTICE).zip(elements) {
+                    block.copy_from_slice(&crate::mesh::hex_split::split_lattice(lattice));
+                }
+            }
+            Self::None => {}
+        }
+    }
+
     /// The consecutive tetrahedra each element of the file became: 1 for tetrahedra, 6 for
     /// linear hexahedra, 48 for 27-node ones.
     pub fn tets_per_element(&self) -> usize {
@@ -135,8 +155,8 @@ pub(super) fn lattice<T: Copy>(nodes: &[T], places: &[[u8; 3]; 27]) -> [T; 27] {
 
 impl RawMesh {
     /// The cage of the file's hexahedra. 27-node ones keep the nodes they use in their order
-    /// in the file (so that the cage's [subdivision](QuadraticHexMesh::subdivided) is
-    /// [`RawMesh::tets`], renumbered); linear ones keep their corners, numbered as by
+    /// in the file (so that the cage's [subdivision](QuadraticHexMesh::subdivided) holds the
+    /// tetrahedra of [`RawMesh::tets`], renumbered); linear ones keep their corners, numbered as by
     /// [`RawMesh::into_mesh`], and gain a node at the middle of each edge, face and hexahedron
     /// (the trilinear map's, so the cage has the straight-sided shape of the file's elements),
     /// numbered after the corners in order of first use. Each element is checked and oriented
@@ -168,7 +188,8 @@ impl RawMesh {
             let element = match e {
                 Error::DegenerateTet { tet, .. }
                 | Error::TetTooSmall { tet, .. }
-                | Error::InvertedTet { tet, .. } => Some(tet),
+                | Error::InvertedTet { tet, .. }
+                | Error::RepeatedNode { tet, .. } => Some(tet),
                 _ => None,
             };
             let at = element.map_or(FileLocation::Whole, |element| {
@@ -201,6 +222,10 @@ impl RawMesh {
             let mut by_place = [0u32; 8];
             for (file, &place) in FILE_ORDER_CORNERS.iter().enumerate() {
                 let node = hexahedron[file];
+                if let Some(&position) = self.positions.get(node as usize) {
+                    crate::mesh::check_position(node as usize, position)
+                        .map_err(|error| self.coordinate_error(tet, &error))?;
+                }
                 by_place[place] = index.get(node as usize).copied().flatten().ok_or_else(|| {
                     self.error(
                         self.location(tet),

@@ -179,12 +179,14 @@ fn measure_cage(raw: &RawMesh, elements: &[[u32; hex27::NODES]], report: &mut Qu
         else {
             continue;
         };
-        let p: [DVec3; hex27::NODES] = std::array::from_fn(|a| p[a]);
+        let mut p: [DVec3; hex27::NODES] = std::array::from_fn(|a| p[a]);
         let element_volume = hex27::volume(&p);
-        // A left-handed element (mirrored when built) counts by its size.
+        if element_volume < 0.0 {
+            // A left-handed element, mirrored as the cage mirrors it (lattice i to 2 − i).
+            p = std::array::from_fn(|a| p[a - a % 3 + 2 - a % 3]);
+        }
         volume += element_volume.abs();
-        let sign = if element_volume < 0.0 { -1.0 } else { 1.0 };
-        let smallest = sign * hex27::smallest_jacobian_determinant(&p);
+        let smallest = hex27::smallest_jacobian_determinant(&p);
         folded += usize::from(smallest.is_nan() || smallest <= 0.0);
     }
     report.volume = volume;

@@ -293,12 +293,15 @@ impl MeshRegion {
 }
 
 impl MeshRegion {
-    /// The region on `cage`, a cage whose corner nodes its nodes number (as
-    /// [`RawMesh::into_cage`] builds one from linear hexahedra, keeping the corners' numbers):
-    /// with each edge, face and centre node of an element whose corners (two, four or eight) it
-    /// all holds, if that node lies on the boundary (or the region is a volume), so that a
-    /// surface group of a file of linear hexahedra selects its whole face of the cage. A region
-    /// of a 27-node file holds those nodes already and is returned unchanged.
+    /// The region of a file of linear hexahedra on `cage`, the cage
+    /// [`RawMesh::into_cage`] builds of them (which keeps the corners' numbers): with each
+    /// edge, face and centre node of an element whose corners (two, four or eight) it all
+    /// holds, if that node lies on the boundary (or the region is a volume), so that a surface
+    /// group selects its whole face of the cage. The region knows its nodes, not its faces: one
+    /// whose nodes surround a boundary face it does not hold (the four sides of a beam one
+    /// element across hold its end faces' corners) gains that face's nodes too. Its
+    /// tetrahedra stay the file's (six per hexahedron). A 27-node file's regions hold their
+    /// nodes already and need no widening.
     #[must_use]
     pub fn with_cage_nodes(&self, cage: &QuadraticHexMesh) -> Self {
         let node_count = cage.node_count();

@@ -257,25 +257,10 @@ impl Reader {
         for (tags, (_, location)) in self.mid_edge_tags.iter().zip(&self.tets) {
             mid_edge_nodes.push(self.indices(source, tags, *location)?);
         }
-        let hexahedra = match self.volume_type {
-            Some(elements::HEXAHEDRON) => {
-                let mut corners = Vec::with_capacity(self.hexahedron_tags.len());
-                for (e, tags) in self.hexahedron_tags.iter().enumerate() {
-                    let location = self.tets[e * TETS_PER_HEXAHEDRON].1;
-                    corners.push(self.indices(source, tags, location)?);
-                }
-                Hexahedra::Linear(corners)
-            }
-            Some(elements::TRIQUADRATIC_HEXAHEDRON) => {
-                let mut cage = Vec::with_capacity(self.cage_tags.len());
-                for (e, tags) in self.cage_tags.iter().enumerate() {
-                    let location = self.tets[e * TETS_PER_LATTICE].1;
-                    cage.push(self.indices(source, tags, location)?);
-                }
-                Hexahedra::Triquadratic(cage)
-            }
-            _ => Hexahedra::None,
-        };
+        let hexahedra = self.hexahedra(source)?;
+        // Split again by node index (the file's order of nodes), as the cage is: tags need not
+        // follow that order.
+        hexahedra.split_into(&mut tets);
         let node_index = &self.node_index;
         let regions = std::mem::take(&mut self.regions)
             .finish(source, |tag| node_index.get(&tag).copied())?;
@@ -287,6 +272,30 @@ impl Reader {
             tet_locations,
             regions,
             hexahedra,
+        })
+    }
+
+    /// The hexahedra read, their node tags resolved to indices.
+    fn hexahedra(&self, source: &Source<'_>) -> Result<Hexahedra, Error> {
+        let location = |e: usize, per: usize| self.tets[e * per].1;
+        Ok(match self.volume_type {
+            Some(elements::HEXAHEDRON) => {
+                let mut corners = Vec::with_capacity(self.hexahedron_tags.len());
+                for (e, tags) in self.hexahedron_tags.iter().enumerate() {
+                    let at = location(e, TETS_PER_HEXAHEDRON);
+                    corners.push(self.indices(source, tags, at)?);
+                }
+                Hexahedra::Linear(corners)
+            }
+            Some(elements::TRIQUADRATIC_HEXAHEDRON) => {
+                let mut cage = Vec::with_capacity(self.cage_tags.len());
+                for (e, tags) in self.cage_tags.iter().enumerate() {
+                    let at = location(e, TETS_PER_LATTICE);
+                    cage.push(self.indices(source, tags, at)?);
+                }
+                Hexahedra::Triquadratic(cage)
+            }
+            _ => Hexahedra::None,
         })
     }
 

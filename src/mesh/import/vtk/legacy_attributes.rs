@@ -2,11 +2,11 @@
 //! sections of `SCALARS`, `FIELD` arrays and the other attributes of the format.
 //!
 //! A cell array named as a `.vtu` file's tags are (`gmsh:physical`, as meshio writes a Gmsh
-//! file's physical groups, or `CellEntityIds`), one component of whole numbers, gives the
-//! cells' region tags; every other attribute is read past, its values counted (a section whose
-//! size disagrees with the grid's cells or points, a block with more or fewer values than its
-//! header announces, and an unknown keyword are errors at their line). `METADATA` blocks (the
-//! VTK 9 library's) are skipped as after the grid's arrays.
+//! file's physical groups, or `CellEntityIds`) gives the cells' region tags: one component of
+//! whole numbers per cell, else an error. Every other attribute is read past, its values
+//! counted (a section whose size disagrees with the grid's cells or points, a block with more
+//! or fewer values than its header announces, and an unknown keyword are errors at their
+//! line). `METADATA` blocks (the VTK 9 library's) are skipped as after the grid's arrays.
 
 use super::legacy_data::{DataType, Legacy, data_type};
 use super::xml_document::CELL_TAG_NAMES;
@@ -95,7 +95,7 @@ pub(super) fn read_cell_tags(
 
 /// Reads the attribute `keyword` (its header's other `words`) of `tuples` tuples; returns
 /// the region tags it holds when `want_tags` (a cell attribute, no tags read yet) and it is
-/// a tag array.
+/// the cells' tag array (one component, else an error).
 fn read_attribute(
     file: &mut Legacy<'_>,
     keyword: &str,
@@ -119,7 +119,8 @@ fn read_attribute(
                     format!("expected `LOOKUP_TABLE <name>`, found `{}`", shorten(table)),
                 ));
             }
-            if want_tags && components == 1 && CELL_TAG_NAMES.contains(&name) {
+            if want_tags && CELL_TAG_NAMES.contains(&name) {
+                check_tag_shape(file, name, components, (tuples, tuples))?;
                 return file.tags(tuples, ty, name).map(Some);
             }
             (components, ty)
@@ -164,7 +165,8 @@ fn read_attribute(
 
 /// Reads the `arrays` arrays of a field (`<name> <components> <tuples> <type>` each, or
 /// `NULL_ARRAY`, a `METADATA` block after any); returns the region tags one holds when
-/// `want_tags` and it is a one-component tag array of `section_tuples` tuples.
+/// `want_tags` and it is the cells' tag array (one component, `section_tuples` tuples, else an
+/// error).
 fn read_field(
     file: &mut Legacy<'_>,
     arrays: usize,
@@ -192,12 +194,8 @@ fn read_field(
                 let components: usize = parse_token(&file.source, words.next(), "components")?;
                 let tuples: usize = parse_token(&file.source, words.next(), "tuples")?;
                 let ty = data_type(&file.source, words.next())?;
-                let is_tags = want_tags
-                    && tags.is_none()
-                    && components == 1
-                    && tuples == section_tuples
-                    && CELL_TAG_NAMES.contains(&name);
-                if is_tags {
+                if want_tags && tags.is_none() && CELL_TAG_NAMES.contains(&name) {
+                    check_tag_shape(file, name, components, (tuples, section_tuples))?;
                     tags = Some(file.tags(tuples, ty, name)?);
                 } else {
                     file.skip(components.saturating_mul(tuples), ty, name)?;
@@ -207,4 +205,26 @@ fn read_field(
         read += 1;
     }
     Ok(tags)
+}
+
+/// [`ImportErrorKind::BadCount`] unless the cells' tag array `name` has one component and one
+/// tuple per cell (`tuples` of the array, `cells` of the section): regions are never read
+/// short.
+fn check_tag_shape(
+    file: &Legacy<'_>,
+    name: &str,
+    components: usize,
+    (tuples, cells): (usize, usize),
+) -> Result<(), Error> {
+    if components == 1 && tuples == cells {
+        return Ok(());
+    }
+    Err(file.source.error(
+        ImportErrorKind::BadCount,
+        format!(
+            "the cell tag array `{}` has {components} components and {tuples} tuples, for \
+             {cells} cells (one tag per cell)",
+            shorten(name)
+        ),
+    ))
 }

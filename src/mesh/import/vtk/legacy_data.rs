@@ -12,7 +12,7 @@ use crate::mesh::import::text::{Source, finite, parse_token, shorten};
 use std::str::{FromStr, SplitAsciiWhitespace};
 
 /// A legacy VTK data type: its size in binary files and whether it is a float.
-#[derive(Clone, Copy, PartialEq)]
+#[derive(Clone, Copy)]
 pub(super) enum DataType {
     Float(usize),
     Signed(usize),
@@ -143,8 +143,17 @@ impl<'a> Legacy<'a> {
     /// Reads past `count` values of type `ty` (attribute data this crate does not use): binary
     /// ones by their size, ASCII ones each checked to be a number (NaN and infinities allowed).
     pub(super) fn skip(&mut self, count: usize, ty: DataType, what: &str) -> Result<(), Error> {
-        self.values(count, ty.size(), what, |_, _| Ok(0.0), |_, v: f64| Ok(v))
-            .map(drop)
+        if self.binary {
+            self.source.set_binary(true);
+            self.source.take(count.saturating_mul(ty.size()), what)?;
+            self.source.set_binary(false);
+            return Ok(());
+        }
+        for _ in 0..count {
+            let token = self.token(what)?;
+            parse_token::<f64>(&self.source, Some(token), what)?;
+        }
+        Ok(())
     }
 
     /// `count` region tags of type `ty`: non-negative integers, or whole numbers stored as
