@@ -137,8 +137,7 @@ impl QuadraticHexMesh {
                 .map(|t| super::signed_volume(&positions, t))
                 .sum();
             if volume < 0.0 {
-                // Mirrored along i: lattice node (i, j, k) takes (2 − i, j, k)'s.
-                *element = std::array::from_fn(|a| element[a - a % 3 + 2 - a % 3]);
+                *element = hex27::mirrored(element);
                 split = split_lattice(element);
             }
             tets.extend_from_slice(&split);

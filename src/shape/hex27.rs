@@ -98,6 +98,12 @@ pub fn natural_gradients(xi: DVec3) -> [DVec3; NODES] {
     })
 }
 
+/// The element's nodes mirrored along its first natural axis (lattice node `(i, j, k)` takes
+/// `(2 − i, j, k)`'s): the same element numbered with the opposite handedness.
+pub fn mirrored<T: Copy>(nodes: &[T; NODES]) -> [T; NODES] {
+    std::array::from_fn(|a| nodes[a - a % 3 + 2 - a % 3])
+}
+
 /// `det ∂x/∂ξ` of the element with nodes at `p` (m) at natural coordinates `xi` (m³ per unit
 /// natural volume).
 pub fn jacobian_determinant(p: &[DVec3; NODES], xi: DVec3) -> f64 {

@@ -183,7 +183,7 @@ fn measure_cage(raw: &RawMesh, elements: &[[u32; hex27::NODES]], report: &mut Qu
         let element_volume = hex27::volume(&p);
         if element_volume < 0.0 {
             // A left-handed element, mirrored as the cage mirrors it (lattice i to 2 − i).
-            p = std::array::from_fn(|a| p[a - a % 3 + 2 - a % 3]);
+            p = hex27::mirrored(&p);
         }
         volume += element_volume.abs();
         let smallest = hex27::smallest_jacobian_determinant(&p);
