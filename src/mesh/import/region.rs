@@ -31,7 +31,7 @@
 use super::hexahedra::lattice_corners;
 use super::{Hexahedra, RawMesh};
 use crate::Error;
-use crate::mesh::{QuadraticHexMesh, QuadraticTetMesh};
+use crate::mesh::{QuadraticHexMesh, QuadraticTetMesh, TetMesh};
 use crate::shape::tet10::EDGES;
 use std::fmt;
 
@@ -260,7 +260,22 @@ impl MeshRegion {
     /// already and need no widening.
     #[must_use]
     pub fn with_mid_edge_nodes(&self, mesh: &QuadraticTetMesh) -> Self {
-        let node_count = mesh.positions().len();
+        let mids = mesh.elements().iter().flat_map(|element| {
+            (EDGES.iter().enumerate())
+                .map(|(k, [i, j])| (element[4 + k], vec![element[*i], element[*j]]))
+        });
+        self.widened_by(mesh.subdivided(), mids)
+    }
+
+    /// The region with each node of `candidates` (a node and the nodes it lies between) whose
+    /// ends it all holds, if that node lies on the boundary of `subdivided` (or the region is a
+    /// volume); nodes sorted, each once.
+    fn widened_by(
+        &self,
+        subdivided: &TetMesh,
+        candidates: impl Iterator<Item = (u32, Vec<u32>)>,
+    ) -> Self {
+        let node_count = subdivided.node_count();
         let mut inside = vec![false; node_count];
         for &node in &self.nodes {
             if let Some(slot) = inside.get_mut(node as usize) {
@@ -268,20 +283,17 @@ impl MeshRegion {
             }
         }
         let mut on_boundary = vec![self.dimension == 3; node_count];
-        for triangle in mesh.subdivided().surface_triangles() {
+        for triangle in subdivided.surface_triangles() {
             for node in triangle {
                 on_boundary[node as usize] = true;
             }
         }
         let mut nodes = self.nodes.clone();
-        for element in mesh.elements() {
-            for (k, [i, j]) in EDGES.iter().enumerate() {
-                let mid = element[4 + k];
-                let ends_inside = inside[element[*i] as usize] && inside[element[*j] as usize];
-                if ends_inside && on_boundary[mid as usize] && !inside[mid as usize] {
-                    inside[mid as usize] = true;
-                    nodes.push(mid);
-                }
+        for (node, ends) in candidates {
+            let ends_inside = ends.iter().all(|&end| inside[end as usize]);
+            if ends_inside && on_boundary[node as usize] && !inside[node as usize] {
+                inside[node as usize] = true;
+                nodes.push(node);
             }
         }
         nodes.sort_unstable();
@@ -304,36 +316,14 @@ impl MeshRegion {
     /// nodes already and need no widening.
     #[must_use]
     pub fn with_cage_nodes(&self, cage: &QuadraticHexMesh) -> Self {
-        let node_count = cage.node_count();
-        let mut inside = vec![false; node_count];
-        for &node in &self.nodes {
-            if let Some(slot) = inside.get_mut(node as usize) {
-                *slot = true;
-            }
-        }
-        let mut on_boundary = vec![self.dimension == 3; node_count];
-        for triangle in cage.subdivided().surface_triangles() {
-            for node in triangle {
-                on_boundary[node as usize] = true;
-            }
-        }
-        let corner_lattice = [0, 2, 6, 8, 18, 20, 24, 26];
-        let mut nodes = self.nodes.clone();
-        for element in cage.elements() {
-            for (a, &node) in element.iter().enumerate() {
-                let corners_inside = lattice_corners(a)
-                    .iter()
-                    .all(|&place| inside[element[corner_lattice[place]] as usize]);
-                if corners_inside && on_boundary[node as usize] && !inside[node as usize] {
-                    inside[node as usize] = true;
-                    nodes.push(node);
-                }
-            }
-        }
-        nodes.sort_unstable();
-        Self {
-            nodes,
-            ..self.clone()
-        }
+        const CORNER_LATTICE: [usize; 8] = [0, 2, 6, 8, 18, 20, 24, 26];
+        let middles = cage.elements().iter().flat_map(|element| {
+            element.iter().enumerate().map(|(a, &node)| {
+                let corners = lattice_corners(a).into_iter();
+                let ends = corners.map(|place| element[CORNER_LATTICE[place]]);
+                (node, ends.collect())
+            })
+        });
+        self.widened_by(cage.subdivided(), middles)
     }
 }
