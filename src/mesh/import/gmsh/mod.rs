@@ -277,26 +277,30 @@ impl Reader {
 
     /// The hexahedra read, their node tags resolved to indices.
     fn hexahedra(&self, source: &Source<'_>) -> Result<Hexahedra, Error> {
-        let location = |e: usize, per: usize| self.tets[e * per].1;
         Ok(match self.volume_type {
-            Some(elements::HEXAHEDRON) => {
-                let mut corners = Vec::with_capacity(self.hexahedron_tags.len());
-                for (e, tags) in self.hexahedron_tags.iter().enumerate() {
-                    let at = location(e, TETS_PER_HEXAHEDRON);
-                    corners.push(self.indices(source, tags, at)?);
-                }
-                Hexahedra::Linear(corners)
-            }
+            Some(elements::HEXAHEDRON) => Hexahedra::Linear(self.resolved(
+                source,
+                &self.hexahedron_tags,
+                TETS_PER_HEXAHEDRON,
+            )?),
             Some(elements::TRIQUADRATIC_HEXAHEDRON) => {
-                let mut cage = Vec::with_capacity(self.cage_tags.len());
-                for (e, tags) in self.cage_tags.iter().enumerate() {
-                    let at = location(e, TETS_PER_LATTICE);
-                    cage.push(self.indices(source, tags, at)?);
-                }
-                Hexahedra::Triquadratic(cage)
+                Hexahedra::Triquadratic(self.resolved(source, &self.cage_tags, TETS_PER_LATTICE)?)
             }
             _ => Hexahedra::None,
         })
+    }
+
+    /// The elements of node tags `elements` as node indices, element `e`'s errors at the place
+    /// of its first tetrahedron (`e * tets_per_element`).
+    fn resolved<const N: usize>(
+        &self,
+        source: &Source<'_>,
+        elements: &[[u64; N]],
+        tets_per_element: usize,
+    ) -> Result<Vec<[u32; N]>, Error> {
+        (elements.iter().enumerate())
+            .map(|(e, tags)| self.indices(source, tags, self.tets[e * tets_per_element].1))
+            .collect()
     }
 
     /// The [`Surface`] of the triangles read: the nodes they use (in order of first use) and

@@ -163,14 +163,12 @@ impl<'a> Legacy<'a> {
             return self.integers(count, ty, what);
         };
         let whole = |source: &Source<'_>, v: f64| {
-            if v >= 0.0 && v.fract() == 0.0 && v < 9.0e15 {
-                Ok(v)
-            } else {
-                Err(source.error(
+            super::whole_tag(v).map(|_| v).ok_or_else(|| {
+                source.error(
                     ImportErrorKind::Syntax,
                     format!("{what}: {v} is not a whole number of 0 or more"),
-                ))
-            }
+                )
+            })
         };
         let decode = |_: &Source<'_>, bytes: &[u8]| Ok(binary_value(bytes, ty));
         let values = self.values(count, ty.size(), what, decode, whole)?;

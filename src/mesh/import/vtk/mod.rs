@@ -63,6 +63,12 @@ fn is_lower_dimensional(cell_type: u64) -> bool {
     )
 }
 
+/// A region tag stored as a float (vmtk writes them so at times): a whole number from 0, below
+/// 2^53 where floats still count every integer; `None` otherwise.
+fn whole_tag(value: f64) -> Option<u64> {
+    (value >= 0.0 && value.fract() == 0.0 && value < 9.0e15).then_some(value as u64)
+}
+
 /// Cells as offsets into `connectivity` and types, turned into a [`RawMesh`] by [`build`].
 struct Cells<'c> {
     /// `offsets[i]..offsets[i + 1]` is cell `i`'s range in `connectivity`.

@@ -17,7 +17,7 @@
 
 use super::xml_data::Decoder;
 use super::xml_document::{self, ArrayDecl, PieceDecl};
-use super::{CellData, Cells, build};
+use super::{CellData, Cells, build, whole_tag};
 use crate::Error;
 use crate::error::{FileLocation, ImportErrorKind};
 use crate::mesh::import::text::Source;
@@ -191,11 +191,10 @@ impl Grid<'_> {
         let tags = if array.value_type.starts_with("Float") {
             // Some writers store the tags as floats (vmtk's, at times): whole numbers only.
             let values = decoder.floats(array, cells, &what)?;
-            let whole = |v: f64| (v >= 0.0 && v.fract() == 0.0 && v < 9.0e15).then_some(v as u64);
             values
                 .iter()
                 .map(|&v| {
-                    whole(v).ok_or_else(|| {
+                    whole_tag(v).ok_or_else(|| {
                         self.source.error_at(
                             FileLocation::Line(array.line),
                             ImportErrorKind::Syntax,
