@@ -208,6 +208,23 @@ pub enum Error {
         /// The threshold it fell below.
         threshold: f64,
     },
+    /// An element index given to a body (a region's material) does not exist.
+    #[error("element {element} does not exist: the body has {element_count} elements")]
+    ElementOutOfRange {
+        /// The offending element index.
+        element: usize,
+        /// Number of elements in the body (tetrahedra, or quadratic elements).
+        element_count: usize,
+    },
+    /// A region's material differs from its body's in more than Young's modulus and density.
+    #[error(
+        "a region's material must have its body's {what}: regions may change only Young's \
+         modulus and density"
+    )]
+    RegionMaterialMismatch {
+        /// What differs: the model or Poisson's ratio.
+        what: &'static str,
+    },
     /// A node index given to a body (pin, selection) does not exist.
     #[error("node {node} does not exist: the body has {node_count} nodes")]
     NodeOutOfRange {

@@ -27,7 +27,20 @@ fn scene(integrator: Option<IntegratorKind>) -> Result<FvmWorld, Error> {
     let damping = RayleighDamping::stiffness_proportional(2e-3, rubber.lame())?;
     let block_mesh = mesh::cuboid(DVec3::splat(0.1), [3; 3])?;
     let side = block_mesh.surface_triangles_where(|p| p.x >= 0.1 - 1e-9);
+    // Its lower layer of cells three times as stiff and twice as dense, so that region
+    // materials are in the file.
+    let positions = block_mesh.positions();
+    let lower: Vec<u32> = (0..block_mesh.tet_count() as u32)
+        .filter(|&t| {
+            let tet = block_mesh.tets()[t as usize];
+            tet.iter()
+                .all(|&n| positions[n as usize].y <= -0.1 / 3.0 + 1e-9)
+        })
+        .collect();
+    assert!(!lower.is_empty());
+    let hard_rubber = Material::new(MaterialModel::StableNeoHookean, 3e6, 0.3, 2000.0)?;
     let mut block = DeformableBodyBuilder::new(block_mesh, rubber)
+        .region_material(lower, hard_rubber)
         .damping(damping)
         .translation(DVec3::new(0.0, 0.1, 0.0))
         .build()?;
@@ -115,7 +128,7 @@ type Edit = Box<dyn Fn(&mut Value)>;
 #[test]
 fn a_file_breaking_a_bodys_rules_is_refused_with_a_typed_error() {
     // Each message is the one `TetMesh::new`, `Material::new` or the builder gives a new body.
-    let cases: [(&str, Edit, &str); 5] = [
+    let cases: [(&str, Edit, &str); 7] = [
         (
             "a tetrahedron naming a node the mesh lacks",
             Box::new(|b| b["mesh"]["tets"][3][1] = Value::from(100_000)),
@@ -145,6 +158,18 @@ fn a_file_breaking_a_bodys_rules_is_refused_with_a_typed_error() {
             "a pinned node beyond the mesh",
             Box::new(|b| b["pinned"] = Value::from(vec![1_000_000])),
             "node",
+        ),
+        (
+            "a region material on an element beyond the mesh",
+            Box::new(|b| b["region_materials"][0][0][0] = Value::from(1_000_000)),
+            "element 1000000 does not exist: the body has 135 elements",
+        ),
+        (
+            "a region material of another Poisson's ratio",
+            Box::new(|b| {
+                b["region_materials"][0][1]["elasticity"]["poisson_ratio"] = Value::from(0.4)
+            }),
+            "a region's material must have its body's Poisson's ratio",
         ),
     ];
     for (what, edit, expected) in cases {

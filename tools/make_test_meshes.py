@@ -488,9 +488,53 @@ def hollow_sphere():
     gmsh.finalize()
 
 
+def two_blocks_hex():
+    """Two boxes [0, 0.5] x [0, 0.5] x [0, 0.25] and [0.5, 1] x [0, 0.5] x [0, 0.25] side by
+    side, fragmented and meshed by gmsh into 2 x 3 x 2 hexahedra each (transfinite,
+    recombined), with physical groups "soft" (the box x < 0.5, tag 1), "stiff" (x > 0.5, tag 2)
+    and "clamp" (the face x = 0, tag 3): linear (8-node) and 27-node, MSH 4.1 ASCII. Gmsh
+    numbers the "stiff" box's elements first or last as it likes, so a scene selecting it by
+    its group must map its elements as a box of the same centroids does."""
+    for order, name in [(1, "two_blocks_hex8_v41.msh"), (2, "two_blocks_hex27_v41.msh")]:
+        gmsh.initialize()
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.model.add("two_blocks_hex")
+        left = gmsh.model.occ.addBox(0, 0, 0, 0.5, 0.5, 0.25)
+        right = gmsh.model.occ.addBox(0.5, 0, 0, 0.5, 0.5, 0.25)
+        gmsh.model.occ.fragment([(3, left)], [(3, right)])
+        gmsh.model.occ.synchronize()
+        for _, curve in gmsh.model.getEntities(1):
+            x0, y0, z0, x1, y1, z1 = gmsh.model.getBoundingBox(1, curve)
+            cells = 2 if x1 - x0 > 1e-3 else 3 if y1 - y0 > 1e-3 else 2
+            gmsh.model.mesh.setTransfiniteCurve(curve, cells + 1)
+        for _, surface in gmsh.model.getEntities(2):
+            gmsh.model.mesh.setTransfiniteSurface(surface)
+            gmsh.model.mesh.setRecombine(2, surface)
+        for _, volume in gmsh.model.getEntities(3):
+            gmsh.model.mesh.setTransfiniteVolume(volume)
+
+        def volume_at(x):
+            return [t for _, t in gmsh.model.getEntitiesInBoundingBox(
+                x - 0.3, -0.1, -0.1, x + 0.3, 0.6, 0.35, 3)]
+
+        clamp = [t for _, t in gmsh.model.getEntitiesInBoundingBox(
+            -1e-6, -1e-6, -1e-6, 1e-6, 0.51, 0.26, 2)]
+        gmsh.model.addPhysicalGroup(3, volume_at(0.25), 1, name="soft")
+        gmsh.model.addPhysicalGroup(3, volume_at(0.75), 2, name="stiff")
+        gmsh.model.addPhysicalGroup(2, clamp, 3, name="clamp")
+        gmsh.model.mesh.generate(3)
+        if order == 2:
+            gmsh.option.setNumber("Mesh.SecondOrderIncomplete", 0)
+            gmsh.model.mesh.setOrder(2)
+        gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
+        gmsh.option.setNumber("Mesh.Binary", 0)
+        gmsh.write(os.path.join(OUT, name))
+        gmsh.finalize()
+
+
 STEPS = [cube_msh, cube_others, surfaces, cube_meshio_compressed, cube_vtk_library,
          multi_solid_stl, cube_msh_other_forms, cube_regions, two_volumes, pneumatic_finger,
-         two_volumes_vtu, hexahedra, hollow_sphere]
+         two_volumes_vtu, hexahedra, hollow_sphere, two_blocks_hex]
 
 if __name__ == "__main__":
     import sys

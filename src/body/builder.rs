@@ -7,7 +7,7 @@ use crate::damping::RayleighDamping;
 use crate::element::{ElementShape, Elements, PressureBasis, QuadraticElements};
 use crate::embedding::Embedding;
 use crate::fvm::{FvmMesh, NodalAveraging, VolumetricTreatment};
-use crate::material::Material;
+use crate::material::{ElementMaterials, Material};
 use crate::mesh::{QuadraticHexMesh, QuadraticTetMesh, SUB_TETS, TetMesh, check_position};
 use rapier3d::dynamics::CoefficientCombineRule;
 use rapier3d::geometry::InteractionGroups;
@@ -57,6 +57,8 @@ pub struct DeformableBodyBuilder {
     restitution_combine_rule: CoefficientCombineRule,
     self_contact: bool,
     embedded: Option<TetMesh>,
+    /// Elements given their own material, in the order given.
+    region_materials: Vec<(Vec<u32>, Material)>,
 }
 
 /// The quadratic elements a builder was given.
@@ -101,6 +103,7 @@ impl DeformableBodyBuilder {
             restitution_combine_rule: CoefficientCombineRule::Average,
             self_contact: false,
             embedded: None,
+            region_materials: Vec::new(),
         }
     }
 
@@ -214,6 +217,46 @@ impl DeformableBodyBuilder {
     /// Rayleigh damping on the strain rate.
     pub fn damping(mut self, damping: RayleighDamping) -> Self {
         self.damping = Some(damping);
+        self
+    }
+
+    /// Gives the elements `elements` the material `material`: a region of another Young's
+    /// modulus and density (a stiff wall inside a soft finger). The indices are the body's
+    /// elements: the tetrahedra of a linear body, the quadratic elements of a quadratic one, as
+    /// a volume region of a file lists them (`MeshRegion::tets` of `mesh::import`), the
+    /// hexahedra of a cage (for a file's region, `MeshRegion::cage_elements`).
+    /// The material must have the body's model and Poisson's ratio. A later call takes
+    /// precedence for the elements it shares with an earlier one; materials that change no
+    /// element's modulus or density leave the body of one material. The elements' Rayleigh damping
+    /// is the body's times `E_e / E`: stiffness-proportional damping keeps its time constant.
+    /// Not with [`VolumetricTreatment::NodalAverage`] (its patches mix elements) nor an
+    /// [embedded](DeformableBodyBuilder::embedded) mesh.
+    ///
+    /// # Example
+    /// ```
+    /// use rapier_fvm::prelude::*;
+    ///
+    /// // A 1 m bar of ten cells, its right half ten times as stiff and twice as dense.
+    /// let mesh = mesh::cuboid(DVec3::new(0.5, 0.05, 0.05), [10, 1, 1])?;
+    /// let right: Vec<u32> = (0..mesh.tet_count() as u32)
+    ///     .filter(|&t| mesh.tets()[t as usize].iter().all(|&n| mesh.positions()[n as usize].x >= 0.0))
+    ///     .collect();
+    /// let soft = Material::new(MaterialModel::Linear, 1e6, 0.3, 1000.0)?;
+    /// let stiff = Material::new(MaterialModel::Linear, 1e7, 0.3, 2000.0)?;
+    /// let bar = DeformableBodyBuilder::new(mesh, soft)
+    ///     .region_material(right, stiff)
+    ///     .build()?;
+    /// assert!((bar.total_mass() - 15.0).abs() < 1e-9);
+    /// assert_eq!(bar.element_material(0), Some(soft));
+    /// # Ok::<(), rapier_fvm::Error>(())
+    /// ```
+    pub fn region_material(
+        mut self,
+        elements: impl IntoIterator<Item = u32>,
+        material: Material,
+    ) -> Self {
+        self.region_materials
+            .push((elements.into_iter().collect(), material));
         self
     }
 
@@ -412,7 +455,10 @@ impl DeformableBodyBuilder {
     /// ±[`MAX_COORDINATE`](crate::mesh::MAX_COORDINATE);
     /// [`Error::SliverTet`] for a tetrahedron below the minimum quality (of the subdivision, for
     /// quadratic elements); [`Error::InvertedTet`] for a quadratic element whose rest map folds;
-    /// [`Error::UnsupportedOption`] for nodal averaging on quadratic elements;
+    /// [`Error::UnsupportedOption`] for nodal averaging on quadratic elements, or with region
+    /// materials, and for region materials with an embedded mesh; [`Error::ElementOutOfRange`]
+    /// and [`Error::RegionMaterialMismatch`] for a [region material](DeformableBodyBuilder::region_material)
+    /// on an element that does not exist or of another model or Poisson's ratio;
     /// [`Error::OutsideSimulationMesh`] naming a vertex of the embedded mesh that no element
     /// carries;
     /// [`Error::InvalidSetting`] for a minimum quality outside `[0, 1)`, a negative or
@@ -428,7 +474,12 @@ impl DeformableBodyBuilder {
             .quadratic
             .as_ref()
             .map_or_else(Vec::new, |quadratic| quadratic.parents.clone());
-        let (elements, masses) = self.elements_and_masses()?;
+        let mut materials = self.element_materials()?;
+        let (elements, masses) = self.elements_and_masses(materials.as_ref())?;
+        if let Some(materials) = &mut materials {
+            let stiffness_volume = elements.sum_over_points(|_, _, _, weight| weight);
+            materials.set_geometry(elements.lumped_volumes().into_owned(), stiffness_volume);
+        }
         let velocities = self.initial_velocities(&positions, &masses, &pinned)?;
         let embedding = match self.embedded {
             Some(fine) => Some(Embedding::new(
@@ -447,6 +498,7 @@ impl DeformableBodyBuilder {
             mesh: self.mesh,
             subdivision_parents,
             material: self.material,
+            element_materials: materials,
             damping: self.damping,
             positions,
             velocities,
@@ -596,11 +648,53 @@ impl DeformableBodyBuilder {
         Ok(velocities)
     }
 
+    /// The materials of the elements given their own ([`DeformableBodyBuilder::region_material`]);
+    /// `None` if none is.
+    fn element_materials(&self) -> Result<Option<ElementMaterials>, Error> {
+        if self.region_materials.is_empty() {
+            return Ok(None);
+        }
+        let element_count = match &self.quadratic {
+            Some(quadratic) => quadratic.nodes.len() / quadratic.shape.node_count(),
+            None => self.mesh.tet_count(),
+        };
+        let materials =
+            ElementMaterials::new(&self.material, self.region_materials.clone(), element_count)?;
+        let unsupported = if self.volumetric == VolumetricTreatment::NodalAverage {
+            Some((
+                "VolumetricTreatment::NodalAverage with region materials",
+                "its patches of elements would mix materials",
+            ))
+        } else if self.embedded.is_some() {
+            Some((
+                "an embedded mesh with region materials",
+                "its stresses would take the body's material",
+            ))
+        } else {
+            None
+        };
+        match unsupported {
+            Some((option, reason)) if materials.is_some() => {
+                Err(Error::UnsupportedOption { option, reason })
+            }
+            _ => Ok(materials),
+        }
+    }
+
     /// The elements (linear, with nodal averaging if asked; or quadratic, with the projected
-    /// pressure if asked) and the nodes' lumped masses (kg).
-    fn elements_and_masses(&self) -> Result<(Elements, Vec<f64>), Error> {
+    /// pressure if asked) and the nodes' lumped masses (kg), each element weighted by its
+    /// stiffness and lumped with its density when `materials` differ by element.
+    fn elements_and_masses(
+        &self,
+        materials: Option<&ElementMaterials>,
+    ) -> Result<(Elements, Vec<f64>), Error> {
+        let density =
+            |element: usize| materials.map_or(self.material.density(), |m| m.densities()[element]);
         let Some(quadratic) = &self.quadratic else {
-            let fvm = FvmMesh::new(&self.mesh);
+            let mut fvm = FvmMesh::new(&self.mesh);
+            if let Some(materials) = materials {
+                fvm.scale_stiffness(materials.stiffness_factors());
+            }
             let nodal_averaging = (self.volumetric == VolumetricTreatment::NodalAverage)
                 .then(|| NodalAveraging::new(&fvm));
             return Ok((
@@ -608,7 +702,7 @@ impl DeformableBodyBuilder {
                     fvm,
                     nodal_averaging,
                 },
-                lumped_masses(&self.mesh, self.material.density()),
+                lumped_masses(&self.mesh, density),
             ));
         };
         if self.volumetric == VolumetricTreatment::NodalAverage {
@@ -618,13 +712,17 @@ impl DeformableBodyBuilder {
                          average per element (VolumetricTreatment::ElementAverage)",
             });
         }
-        let elements =
+        let mut elements =
             QuadraticElements::new(quadratic.shape, self.mesh.positions(), &quadratic.nodes)?;
-        let masses = elements
-            .lumped_volumes()
-            .iter()
-            .map(|volume| volume * self.material.density())
-            .collect();
+        let masses = match materials {
+            Some(materials) => {
+                elements.scale_stiffness(materials.stiffness_factors());
+                elements.lumped(density)
+            }
+            None => (elements.lumped_volumes().iter())
+                .map(|volume| volume * self.material.density())
+                .collect(),
+        };
         let pressure = (self.volumetric == VolumetricTreatment::ElementAverage)
             .then(|| PressureBasis::new(&elements));
         Ok((Elements::Quadratic { elements, pressure }, masses))

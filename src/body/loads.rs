@@ -90,13 +90,20 @@ impl DeformableBody {
 
     /// `load`'s potential energy (J) at the body's current positions.
     fn potential_of(&self, load: &Load) -> f64 {
+        let volumes = self.control_volumes();
+        load.potential(self.mesh.positions(), volumes, &self.positions)
+    }
+
+    /// Each node's rest control volume (m³), by node index: its mass over the density, or with
+    /// [region materials](super::DeformableBodyBuilder::region_material) its lumped share of
+    /// the elements' volumes.
+    fn control_volumes(&self) -> impl Fn(usize) -> f64 + '_ {
         let density = self.material.density();
-        load.potential(
-            self.mesh.positions(),
-            &self.masses,
-            density,
-            &self.positions,
-        )
+        let mixed = (self.element_materials.as_ref()).map(|m| m.control_volumes());
+        move |n| match mixed {
+            Some(volumes) => volumes[n],
+            None => self.masses[n] / density,
+        }
     }
 
     /// A bound (rad²/s²) on the squared highest angular frequency the follower loads' stiffness
@@ -137,9 +144,9 @@ impl DeformableBody {
 
     /// Adds the dead loads' forces (traction, body force; N per node) to `forces`.
     fn add_dead_forces(&self, forces: &mut [DVec3]) {
-        let density = self.material.density();
+        let volumes = self.control_volumes();
         for load in &self.loads {
-            load.add_dead_forces(self.mesh.positions(), &self.masses, density, forces);
+            load.add_dead_forces(self.mesh.positions(), &volumes, forces);
         }
     }
 

@@ -21,7 +21,7 @@ use crate::damping::RayleighDamping;
 use crate::element::{ElementOrder, ElementShape, Elements};
 use crate::embedding::Embedding;
 use crate::fvm::VolumetricTreatment;
-use crate::material::{Material, with_hyperelastic_model};
+use crate::material::{ElementMaterials, Material, with_hyperelastic_model};
 use crate::mesh::TetMesh;
 use rapier3d::dynamics::CoefficientCombineRule;
 use rapier3d::geometry::InteractionGroups;
@@ -31,13 +31,16 @@ use rapier3d::glamx::DVec3;
 /// quadratic.
 ///
 /// Built with [`DeformableBodyBuilder`]. Mass is lumped on the nodes from their control volumes (a
-/// quarter of each incident linear tetrahedron's rest volume times the density; HRZ fractions
-/// for quadratic ones), so the nodal masses sum to density times rest volume.
+/// quarter of each incident linear tetrahedron's rest volume times its density; HRZ fractions
+/// for quadratic ones), so the nodal masses sum to the elements' densities times their rest
+/// volumes.
 #[derive(Debug, Clone)]
 pub struct DeformableBody {
     /// The linear tetrahedra: the elements, or the subdivision of the quadratic ones.
     pub(crate) mesh: TetMesh,
     pub(crate) elements: Elements,
+    /// The elements' own materials, when not all have the body's.
+    pub(crate) element_materials: Option<ElementMaterials>,
     /// For quadratic elements, the element each tetrahedron of `mesh` lies in.
     pub(crate) subdivision_parents: Vec<u32>,
     pub(crate) material: Material,
@@ -129,9 +132,27 @@ impl DeformableBody {
         }
     }
 
-    /// The material.
+    /// The body's material: every element's but those given their own by
+    /// [`DeformableBodyBuilder::region_material`] (see [`DeformableBody::element_material`]).
     pub fn material(&self) -> &Material {
         &self.material
+    }
+
+    /// The material of element `element` (a tetrahedron of a linear body, a quadratic element of
+    /// a quadratic one); `None` if the body has no such element.
+    pub fn element_material(&self, element: usize) -> Option<Material> {
+        if element >= self.element_count() {
+            return None;
+        }
+        Some(match &self.element_materials {
+            Some(materials) => materials.material_of(&self.material, element),
+            None => self.material,
+        })
+    }
+
+    /// Whether the elements' materials differ (see [`DeformableBodyBuilder::region_material`]).
+    pub fn has_region_materials(&self) -> bool {
+        self.element_materials.is_some()
     }
 
     /// The Rayleigh damping, if any.
@@ -201,8 +222,29 @@ impl DeformableBody {
     /// [`FvmMesh::wave_length_scale`](crate::fvm::FvmMesh::wave_length_scale): the explicit
     /// critical step is about [`COURANT_NUMBER`](crate::integrate::COURANT_NUMBER) times this over
     /// the pressure wave speed.
+    ///
+    /// With [region materials](DeformableBodyBuilder::region_material) it counts each element's
+    /// stiffness and each node's mass, for the wave speed of the body's
+    /// [material](DeformableBody::material).
     pub fn wave_length_scale(&self) -> f64 {
-        self.elements.wave_length_scale(&self.positions)
+        let mass_volumes: Option<Vec<f64>> = self.element_materials.as_ref().map(|_| {
+            let density = self.material.density();
+            self.masses.iter().map(|m| m / density).collect()
+        });
+        (self.elements).wave_length_scale(&self.positions, mass_volumes.as_deref())
+    }
+
+    /// The speed (m/s) of pressure waves through the body as a whole: its material's
+    /// [`dilatational_wave_speed`](Material::dilatational_wave_speed), or with region materials
+    /// `sqrt((λ + 2μ) Σ s_e V_e / M)`, the elements' mean stiffness over their mean density.
+    pub(crate) fn mean_wave_speed(&self) -> f64 {
+        match &self.element_materials {
+            Some(materials) => {
+                let modulus = self.material.lame().p_wave_modulus();
+                (modulus * materials.stiffness_volume() / self.total_mass()).sqrt()
+            }
+            None => self.material.dilatational_wave_speed(),
+        }
     }
 
     /// Internal forces (N per node): elastic plus damping, at the current positions and velocities.
@@ -328,11 +370,11 @@ impl DeformableBody {
 }
 
 /// Lumped nodal masses (kg): each node receives a quarter of the mass of every tetrahedron it
-/// belongs to (its median-dual control volume times `density`, kg/m³).
-pub(crate) fn lumped_masses(mesh: &TetMesh, density: f64) -> Vec<f64> {
+/// belongs to (its median-dual control volume times the tetrahedron's `density(t)`, kg/m³).
+pub(crate) fn lumped_masses(mesh: &TetMesh, density: impl Fn(usize) -> f64) -> Vec<f64> {
     let mut masses = vec![0.0; mesh.node_count()];
     for (t, tet) in mesh.tets().iter().enumerate() {
-        let quarter = 0.25 * density * mesh.tet_volume(t);
+        let quarter = 0.25 * density(t) * mesh.tet_volume(t);
         for &n in tet {
             masses[n as usize] += quarter;
         }

@@ -1,7 +1,7 @@
 //! What a [`DeformableBody`] is written as with the feature `serde-serialize`: what it was built
-//! from (rest mesh, elements, material, damping, volumetric treatment, embedded mesh, pins,
-//! contact coefficients, user data, loads) and its nodal state. Read back, the body is built again by
-//! [`DeformableBodyBuilder`], so every check of a new body applies to a file (a typed error,
+//! from (rest mesh, elements, material and region materials, damping, volumetric treatment,
+//! embedded mesh, pins, contact coefficients, user data, loads) and its nodal state. Read back,
+//! the body is built again by [`DeformableBodyBuilder`], so every check of a new body applies to a file (a typed error,
 //! never a panic), and the rest data comes out as it was: the build is deterministic.
 
 use super::{DeformableBody, DeformableBodyBuilder};
@@ -25,6 +25,10 @@ pub(super) struct BodyRecord {
     /// The quadratic elements' shape, nodes and the element of each subdivision tetrahedron.
     quadratic: Option<(ElementShape, Vec<u32>, Vec<u32>)>,
     material: Material,
+    /// Elements given their own material (none in files written before region materials, and
+    /// not written for a body of one material).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    region_materials: Vec<(Vec<u32>, Material)>,
     damping: Option<RayleighDamping>,
     volumetric: VolumetricTreatment,
     embedded: Option<TetMesh>,
@@ -59,6 +63,8 @@ impl From<&DeformableBody> for BodyRecord {
             mesh: body.mesh.clone(),
             quadratic,
             material: body.material,
+            region_materials: (body.element_materials.as_ref())
+                .map_or_else(Vec::new, |m| m.assignments().to_vec()),
             damping: body.damping,
             volumetric: body.volumetric_treatment(),
             embedded: body.embedding.as_ref().map(|e| e.mesh().clone()),
@@ -97,6 +103,9 @@ impl TryFrom<BodyRecord> for DeformableBody {
         }
         if let Some(embedded) = record.embedded {
             builder = builder.embedded(embedded);
+        }
+        for (elements, material) in record.region_materials {
+            builder = builder.region_material(elements, material);
         }
         let mut body = builder
             .volumetric(record.volumetric)

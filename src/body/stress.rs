@@ -1,6 +1,6 @@
 //! Per-tetrahedron stress at the current positions, for output and post-processing: the Cauchy
 //! (true) stress `σ = P Fᵀ / det F` (Pa), force per unit deformed area in world axes, from the
-//! first Piola–Kirchhoff stress `P` of the body's material, and its von Mises equivalent
+//! first Piola–Kirchhoff stress `P` of the element's material, and its von Mises equivalent
 //! `σ_vm = sqrt(3/2 s:s)`, `s = σ - tr(σ)/3 I`.
 
 use super::DeformableBody;
@@ -57,7 +57,7 @@ impl DeformableBody {
                                 piola += model.volume_measure_gradient(&f)
                                     * (bulk * measures.excess(tet, t));
                             }
-                            cauchy_from_piola(&f, piola)
+                            cauchy_from_piola(&f, piola * self.stiffness_factor(t))
                         })
                         .collect()
                 }
@@ -99,7 +99,7 @@ impl DeformableBody {
                                 piola += model.volume_measure_gradient(&f)
                                     * (bulk * (projected - model.volume_measure(&f)));
                             }
-                            cauchy_from_piola(&f, piola)
+                            cauchy_from_piola(&f, piola * self.stiffness_factor(element))
                         })
                         .collect()
                 }
@@ -130,6 +130,12 @@ impl DeformableBody {
                 })
                 .collect()
         }))
+    }
+
+    /// Element `element`'s Young's modulus over the body's material's (1 unless materials differ
+    /// by region): the factor of its stress.
+    fn stiffness_factor(&self, element: usize) -> f64 {
+        (self.element_materials.as_ref()).map_or(1.0, |m| m.stiffness_factors()[element])
     }
 
     /// The von Mises equivalent stress `sqrt(3/2 s:s)` (Pa) of a stress tensor `stress` (Pa),

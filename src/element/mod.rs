@@ -3,8 +3,9 @@
 //! ([`hex27`], the element of a coarse cage).
 //!
 //! Both are seen by the rest of the crate as integration points: a point has the nodes of its
-//! element, the rest gradients `∇N_a` (1/m) of their shape functions there, and the rest volume
-//! it stands for. The deformation gradient at a point is `F = Σ_a x_a ⊗ ∇N_a`, the force on node
+//! element, the rest gradients `∇N_a` (1/m) of their shape functions there, and its weight `w`:
+//! the rest volume it stands for (times its element's `E_e/E` where the body's materials differ
+//! by region). The deformation gradient at a point is `F = Σ_a x_a ⊗ ∇N_a`, the force on node
 //! `a` is `−w P ∇N_a`, the energy `Σ w Ψ(F)` and the tangent `Σ w ∇N_aᵀ (∂P/∂F) ∇N_b`. A linear
 //! tetrahedron is one point with its whole volume, and `−V P ∇N_a` is exactly the finite-volume
 //! traction `P b_a` on node `a`'s control-volume boundary; a quadratic tetrahedron has four points
@@ -145,8 +146,9 @@ impl Elements {
     }
 
     /// Calls `visit(point, nodes, gradients, weight)` for every integration point in order: its
-    /// index, its element's nodes, their rest shape-function gradients there (1/m) and the rest
-    /// volume it stands for (m³).
+    /// index, its element's nodes, their rest shape-function gradients there (1/m) and its
+    /// stiffness weight (m³): the rest volume it stands for, times its element's stiffness factor
+    /// (1 unless materials differ by region).
     pub(crate) fn for_each_point(&self, visit: impl FnMut(usize, &[u32], &[DVec3], f64)) {
         self.for_each_point_in(0..self.element_count(), visit);
     }
@@ -161,7 +163,12 @@ impl Elements {
             Self::Linear { fvm, .. } => {
                 for t in elements {
                     let rest = fvm.tet_rest(t);
-                    visit(t, &fvm.tets()[t], &rest.shape_gradients(), rest.volume);
+                    visit(
+                        t,
+                        &fvm.tets()[t],
+                        &rest.shape_gradients(),
+                        fvm.tet_weight(t),
+                    );
                 }
             }
             Self::Quadratic {
@@ -352,13 +359,34 @@ impl Elements {
         }
     }
 
-    /// The wave length scale (m) at positions `x`, see [`FvmMesh::wave_length_scale`]; for
-    /// quadratic elements the same Gershgorin bound with the sums over quadrature points and
-    /// each node's lumped volume in place of a quarter of each tetrahedron.
-    pub(crate) fn wave_length_scale(&self, x: &[DVec3]) -> f64 {
+    /// Each node's rest control volume (m³): a quarter of each linear tetrahedron at the node,
+    /// or the HRZ share of each quadratic element's (the nodal masses over the density of a
+    /// body of one material).
+    pub(crate) fn lumped_volumes(&self) -> std::borrow::Cow<'_, [f64]> {
+        match self {
+            Self::Linear { fvm, .. } => {
+                let mut volumes = vec![0.0; fvm.node_count()];
+                for (t, tet) in fvm.tets().iter().enumerate() {
+                    let quarter = 0.25 * fvm.tet_rest(t).volume;
+                    for &n in tet {
+                        volumes[n as usize] += quarter;
+                    }
+                }
+                volumes.into()
+            }
+            Self::Quadratic { elements, .. } => elements.lumped_volumes().into(),
+        }
+    }
+
+    /// The wave length scale (m) at positions `x`, see [`FvmMesh::wave_length_scale`] (and for
+    /// `mass_volumes`); for quadratic elements the same Gershgorin bound with the sums over
+    /// quadrature points and each node's lumped volume in place of a quarter of each tetrahedron.
+    pub(crate) fn wave_length_scale(&self, x: &[DVec3], mass_volumes: Option<&[f64]>) -> f64 {
         let control_volumes = match self {
-            Self::Linear { fvm, .. } => return fvm.wave_length_scale(x),
-            Self::Quadratic { elements, .. } => elements.lumped_volumes(),
+            Self::Linear { fvm, .. } => return fvm.mixed_wave_length_scale(x, mass_volumes),
+            Self::Quadratic { elements, .. } => {
+                mass_volumes.unwrap_or_else(|| elements.lumped_volumes())
+            }
         };
         let mut row_sum = vec![0.0; control_volumes.len()];
         let mut flattened = false;

@@ -142,8 +142,12 @@ pub struct QuadraticElements {
     nodes: Vec<u32>,
     /// Per quadrature point, `∇N_a` (1/m) of its element's shape functions in rest coordinates.
     gradients: Vec<DVec3>,
-    /// Per quadrature point, the rest volume it stands for (m³).
+    /// Per quadrature point, its stiffness weight (m³): the rest volume it stands for, times its
+    /// element's stiffness factor.
     weights: Vec<f64>,
+    /// Per element, its rest volume (m³).
+    volumes: Vec<f64>,
+    node_count: usize,
     points_per_element: usize,
     lumped_volumes: Vec<f64>,
 }
@@ -181,21 +185,58 @@ impl QuadraticElements {
                 weights.push(weight * determinant);
             }
         }
-        let mut lumped_volumes = vec![0.0; positions.len()];
-        for (element, element_nodes) in nodes.chunks_exact(per_element).enumerate() {
-            let volume: f64 = weights[rule.len() * element..][..rule.len()].iter().sum();
-            for (&n, fraction) in element_nodes.iter().zip(shape.lumped_mass_fractions()) {
-                lumped_volumes[n as usize] += fraction * volume;
-            }
-        }
-        Ok(Self {
+        let volumes: Vec<f64> = weights
+            .chunks_exact(rule.len())
+            .map(|w| w.iter().sum())
+            .collect();
+        let mut elements = Self {
             shape,
             nodes: nodes.to_vec(),
             gradients,
             weights,
+            volumes,
+            node_count: positions.len(),
             points_per_element: rule.len(),
-            lumped_volumes,
-        })
+            lumped_volumes: Vec::new(),
+        };
+        elements.lumped_volumes = elements.lumped(|_| 1.0);
+        Ok(elements)
+    }
+
+    /// Per node, `Σ_e h_a V_e value(e)` over the elements `e` at the node, with `h_a` the node's
+    /// HRZ fraction in `e` and `V_e` its rest volume (m³): the lumped volumes for `value = 1`,
+    /// the lumped masses (kg) for `value` the elements' densities (kg/m³).
+    pub(crate) fn lumped(&self, value: impl Fn(usize) -> f64) -> Vec<f64> {
+        let mut lumped = vec![0.0; self.node_count];
+        let fractions = self.shape.lumped_mass_fractions();
+        for (element, element_nodes) in self.elements().enumerate() {
+            let share = self.volumes[element] * value(element);
+            for (&n, fraction) in element_nodes.iter().zip(fractions) {
+                lumped[n as usize] += fraction * share;
+            }
+        }
+        lumped
+    }
+
+    /// Multiplies each element's quadrature weights by its factor in `factors` (one per element,
+    /// applied once, when the body is built):
+    /// its Young's modulus over the modulus of the model the forces are computed with. Stress,
+    /// energy and tangent of the element scale alike; its volume and lumped volumes do not.
+    ///
+    /// # Panics
+    /// If `factors` does not have one entry per element.
+    pub(crate) fn scale_stiffness(&mut self, factors: &[f64]) {
+        assert_eq!(
+            factors.len(),
+            self.element_count(),
+            "one factor per element"
+        );
+        let q = self.points_per_element;
+        for (weights, factor) in self.weights.chunks_exact_mut(q).zip(factors) {
+            for w in weights {
+                *w *= factor;
+            }
+        }
     }
 
     /// The elements' shape.
@@ -246,17 +287,18 @@ impl QuadraticElements {
         &self.gradients[n * point..n * (point + 1)]
     }
 
-    /// The rest volume quadrature point `point` stands for (m³).
+    /// The stiffness weight (m³) of quadrature point `point`: the rest volume it stands for,
+    /// times its element's stiffness factor (1 unless the body's materials differ by region).
     pub fn point_weight(&self, point: usize) -> f64 {
         self.weights[point]
     }
 
-    /// Rest volume of element `element` (m³), the sum of its quadrature weights.
+    /// Rest volume of element `element` (m³), the sum of its quadrature points' rest volumes.
     ///
     /// # Panics
     /// If the element does not exist.
     pub fn volume(&self, element: usize) -> f64 {
-        self.weights[self.element_points(element)].iter().sum()
+        self.volumes[element]
     }
 
     /// The rest volume (m³) lumped on each node: HRZ fractions of each element's volume; times

@@ -3,7 +3,9 @@
 //!
 //! [`tet_forces`] is the scalar reference. The mesh loop evaluates four tetrahedra at once, one
 //! per SIMD lane ([`crate::lanes`]), with the same formulas, and adds each tetrahedron's forces to
-//! its nodes in ascending tetrahedron order.
+//! its nodes in ascending tetrahedron order. Each tetrahedron's forces are weighted by its
+//! [stiffness weight](FvmMesh::tet_weight), its rest volume unless the body's materials differ
+//! by region (then the reference's forces times the tetrahedron's `E_e/E`).
 //!
 //! Large meshes are cut into fixed chunks of consecutive tetrahedra. Each chunk adds its forces
 //! into a window of its own covering the nodes it touches (small for meshes numbered in spatial
@@ -59,7 +61,8 @@ pub fn stress_forces(rest: &TetRest, stress: &DMat3) -> [DVec3; 4] {
 #[derive(Debug, Clone, Copy)]
 struct RestBlock {
     inverse_rest_edges: Mat3x4,
-    volume: f64x4,
+    /// The tetrahedra's [stiffness weights](FvmMesh::tet_weight) (m³).
+    weight: f64x4,
 }
 
 /// The mesh as the finite-volume method sees it: tetrahedra, their rest data, and reusable storage
@@ -70,6 +73,8 @@ pub struct FvmMesh {
     tets: Vec<[u32; 4]>,
     tet_count: usize,
     blocks: Vec<RestBlock>,
+    /// Rest volume (m³) of each tetrahedron.
+    volumes: Vec<f64>,
     node_count: usize,
     /// Per chunk of [`CHUNK_TETS`] tetrahedra: the first node it touches and its force window;
     /// empty for meshes of a single chunk.
@@ -91,7 +96,7 @@ impl FvmMesh {
                 let lanes: [TetRest; LANES] = std::array::from_fn(lane);
                 RestBlock {
                     inverse_rest_edges: Mat3x4::from_lanes(lanes.map(|r| r.inverse_rest_edges)),
-                    volume: f64x4::new(lanes.map(|r| r.volume)),
+                    weight: f64x4::new(lanes.map(|r| r.volume)),
                 }
             })
             .collect();
@@ -100,8 +105,26 @@ impl FvmMesh {
             tets,
             tet_count,
             blocks,
+            volumes: rest.iter().map(|r| r.volume).collect(),
             node_count,
             windows,
+        }
+    }
+
+    /// Sets each tetrahedron's [stiffness weight](FvmMesh::tet_weight) to its rest volume times
+    /// its factor in `factors` (one per tetrahedron): its Young's modulus over the modulus of the
+    /// model the forces are computed with. Stress, energy and tangent of the tetrahedron scale
+    /// alike.
+    ///
+    /// # Panics
+    /// If `factors` does not have one entry per tetrahedron.
+    pub(crate) fn scale_stiffness(&mut self, factors: &[f64]) {
+        assert_eq!(factors.len(), self.tet_count, "one factor per tetrahedron");
+        for (t, factor) in factors.iter().enumerate() {
+            let block = &mut self.blocks[t / LANES];
+            let mut weights = *block.weight.as_array();
+            weights[t % LANES] = self.volumes[t] * factor;
+            block.weight = f64x4::new(weights);
         }
     }
 
@@ -116,11 +139,24 @@ impl FvmMesh {
     /// If `tet` is not below the number of tetrahedra.
     pub fn tet_rest(&self, tet: usize) -> TetRest {
         assert!(tet < self.tet_count, "tetrahedron {tet} does not exist");
-        let block = &self.blocks[tet / LANES];
         TetRest {
-            inverse_rest_edges: block.inverse_rest_edges.lane(tet % LANES),
-            volume: block.volume.as_array()[tet % LANES],
+            inverse_rest_edges: self.blocks[tet / LANES]
+                .inverse_rest_edges
+                .lane(tet % LANES),
+            volume: self.volumes[tet],
         }
+    }
+
+    /// The stiffness weight (m³) of tetrahedron `tet`: the rest volume its stress acts over,
+    /// times its stiffness factor `E_e/E` (1 unless the body's materials differ by
+    /// [region](crate::body::DeformableBodyBuilder::region_material)). Its forces are
+    /// `−w P ∇N_a` and its energy `w Ψ(F)`.
+    ///
+    /// # Panics
+    /// If `tet` is not below the number of tetrahedra.
+    pub fn tet_weight(&self, tet: usize) -> f64 {
+        assert!(tet < self.tet_count, "tetrahedron {tet} does not exist");
+        self.blocks[tet / LANES].weight.as_array()[tet % LANES]
     }
 
     /// Number of nodes.
@@ -135,8 +171,30 @@ impl FvmMesh {
     /// deformed configuration (Gershgorin's bound on the lumped-mass wave operator, with the
     /// spatial stiffness of a compressed element). Unlike the smallest element altitude it counts
     /// how many elements share a node, and it shrinks as elements are crushed; zero if one is flat.
+    ///
+    ///
+    /// With materials that differ by region, `V_e` in the row sums is the tetrahedron's
+    /// [stiffness weight](FvmMesh::tet_weight), and the control volume a node's mass over the
+    /// density of the wave speed.
     pub fn wave_length_scale(&self, x: &[DVec3]) -> f64 {
-        let mut control_volume = vec![0.0; self.node_count];
+        self.mixed_wave_length_scale(x, None)
+    }
+
+    /// [`FvmMesh::wave_length_scale`] with each node's mass over the density `ρ` of the wave
+    /// speed `c` in `mass_volumes` (m³) in place of its control volume `V_i` (`None` takes
+    /// `V_i`): `2c/ℓ` then bounds the highest frequency of a mesh of materials that differ by
+    /// region.
+    ///
+    /// # Panics
+    /// If `mass_volumes` does not have one entry per node.
+    pub(crate) fn mixed_wave_length_scale(&self, x: &[DVec3], mass_volumes: Option<&[f64]>) -> f64 {
+        assert!(
+            mass_volumes.is_none_or(|v| v.len() == self.node_count),
+            "one mass volume per node"
+        );
+        let geometric = mass_volumes.is_none();
+        let mut control_volume =
+            mass_volumes.map_or_else(|| vec![0.0; self.node_count], <[_]>::to_vec);
         let mut row_sum = vec![0.0; self.node_count];
         for (t, tet) in self.tets().iter().enumerate() {
             let rest = self.tet_rest(t);
@@ -153,9 +211,12 @@ impl FvmMesh {
                 g.z_axis,
             ];
             let total: f64 = gradients.iter().map(|g| g.length()).sum();
+            let weight = self.tet_weight(t);
             for (corner, &n) in tet.iter().enumerate() {
-                control_volume[n as usize] += 0.25 * rest.volume;
-                row_sum[n as usize] += rest.volume * gradients[corner].length() * total;
+                if geometric {
+                    control_volume[n as usize] += 0.25 * rest.volume;
+                }
+                row_sum[n as usize] += weight * gradients[corner].length() * total;
             }
         }
         control_volume
@@ -226,14 +287,15 @@ impl FvmMesh {
         }
     }
 
-    /// Total elastic energy `Σ V Ψ(F)` (J) at positions `x` (m).
+    /// Total elastic energy `Σ w Ψ(F)` (J) at positions `x` (m), `w` the
+    /// [stiffness weights](FvmMesh::tet_weight).
     /// Summed in the force loop's chunks of tetrahedra (on rayon's threads with the `parallel`
     /// feature), the chunks' sums in order: the same whatever the number of threads.
     pub fn elastic_energy<M: HyperelasticModel>(&self, model: &M, x: &[DVec3]) -> f64 {
         crate::parallel::sum_ranges(self.tet_count, CHUNK_TETS, |tets| {
             tets.map(|t| {
-                let rest = self.tet_rest(t);
-                rest.volume * model.energy_density(&rest.gradient(&gather(&self.tets[t], x)))
+                let gradient = self.tet_rest(t).gradient(&gather(&self.tets[t], x));
+                self.tet_weight(t) * model.energy_density(&gradient)
             })
             .sum()
         })
@@ -301,8 +363,8 @@ fn block_forces<M: HyperelasticModel>(
         None => Mat3x4::splat(DMat3::ZERO),
     };
     let stress = model.first_piola_plus_lanes(&f, &extra);
-    // Forces on nodes 1..3 are the columns of P b = -V P Dm⁻ᵀ.
-    let forces = stress * rest.inverse_rest_edges.transpose() * -rest.volume;
+    // Forces on nodes 1..3 are the columns of P b = -V P Dm⁻ᵀ (V the stiffness weight).
+    let forces = stress * rest.inverse_rest_edges.transpose() * -rest.weight;
     let [f1, f2, f3] = forces.cols.map(Vec3x4::to_lanes);
     let f0 = (-(forces.cols[0] + forces.cols[1] + forces.cols[2])).to_lanes();
     std::array::from_fn(|l| [f0[l], f1[l], f2[l], f3[l]])

@@ -52,7 +52,9 @@ pub enum LinearSolver {
     ///   `κ = (1 + ω_max² w) / (1 + ω_min² w)`, `w = ĥ (ĥ + β)`: `ω_max = 2 c_p / ℓ` (rad/s) from
     ///   [`DeformableBody::wave_length_scale`] `ℓ` and the material's
     ///   [`dilatational_wave_speed`](crate::material::Material::dilatational_wave_speed) `c_p`,
-    ///   `ω_min = c_p / D` with `D` the diagonal of the body's bounding box, `ĥ` the substep (s),
+    ///   `ω_min = c̄ / D` with `D` the diagonal of the body's bounding box and `c̄` the body's
+    ///   mean wave speed (`c_p` but for region materials: the mean stiffness over the mean
+    ///   density), `ĥ` the substep (s),
     ///   `β = (φ + 2ψ)/(λ + 2μ)` the damping's stiffness-proportional time (s, zero undamped).
     ///   (Isolated lower modes, such as the bending of a slender part, cost a few iterations
     ///   each and are left out.)
@@ -184,15 +186,14 @@ pub struct SolverPrediction {
 /// current shape, for a conjugate gradient of relative tolerance `tolerance`.
 pub fn predict(body: &DeformableBody, h: f64, tolerance: f64) -> SolverPrediction {
     let material = body.material();
-    let speed = material.dilatational_wave_speed();
-    let highest = 2.0 * speed / body.wave_length_scale();
+    let highest = 2.0 * material.dilatational_wave_speed() / body.wave_length_scale();
     let (low, high) = body
         .positions()
         .iter()
         .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(low, high), x| {
             (low.min(*x), high.max(*x))
         });
-    let lowest = speed / (high - low).length();
+    let lowest = body.mean_wave_speed() / (high - low).length();
     let beta = body.damping().map_or(0.0, |d| {
         d.p_wave_viscosity() / material.lame().p_wave_modulus()
     });

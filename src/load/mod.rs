@@ -194,13 +194,12 @@ impl Load {
     }
 
     /// Adds the load's force (N per node) to `forces` if it is a dead load (traction, body
-    /// force), at the rest positions `rest` (m) with the nodal `masses` (kg) of a body of
-    /// `density` (kg/m³).
+    /// force), at the rest positions `rest` (m) with `control_volume(n)` the rest control volume
+    /// (m³) of node `n`.
     pub(crate) fn add_dead_forces(
         &self,
         rest: &[DVec3],
-        masses: &[f64],
-        density: f64,
+        control_volume: impl Fn(usize) -> f64,
         forces: &mut [DVec3],
     ) {
         match self {
@@ -217,8 +216,8 @@ impl Load {
                 }
             }
             Self::BodyForce { density: b } => {
-                for (f, m) in forces.iter_mut().zip(masses) {
-                    *f += *b * (m / density);
+                for (n, f) in forces.iter_mut().enumerate() {
+                    *f += *b * control_volume(n);
                 }
             }
             Self::Pressure { .. } | Self::Cable { .. } => {}
@@ -282,20 +281,19 @@ impl Load {
     }
 
     /// The load's potential energy `U` (J) at the positions `x` (m), measured from the origin
-    /// (rest positions `rest` (m), nodal `masses` (kg) and `density` (kg/m³) as for
+    /// (rest positions `rest` (m) and nodal `control_volume` (m³) as for
     /// [`Load::add_dead_forces`]): `−Σ f·x` for a dead load, `p V` (the cone from the world's
     /// origin) for a pressure, `T L` for a cable. Its changes are the work the load did not do.
     pub(crate) fn potential(
         &self,
         rest: &[DVec3],
-        masses: &[f64],
-        density: f64,
+        control_volume: impl Fn(usize) -> f64,
         x: &[DVec3],
     ) -> f64 {
         match self {
             Self::Traction { .. } | Self::BodyForce { .. } => {
                 let mut forces = vec![DVec3::ZERO; x.len()];
-                self.add_dead_forces(rest, masses, density, &mut forces);
+                self.add_dead_forces(rest, control_volume, &mut forces);
                 -forces.iter().zip(x).map(|(f, x)| f.dot(*x)).sum::<f64>()
             }
             Self::Pressure {

@@ -11,12 +11,14 @@ mod corotated;
 mod diagonal;
 mod linear;
 mod neo_hookean;
+mod per_element;
 mod stvk;
 mod volumetric;
 
 pub use corotated::Corotated;
 pub use linear::LinearElastic;
 pub use neo_hookean::StableNeoHookean;
+pub(crate) use per_element::ElementMaterials;
 pub use stvk::StVenantKirchhoff;
 pub(crate) use stvk::green_strain;
 pub use volumetric::VolumetricTerm;

@@ -4,9 +4,17 @@
 //! material = { model = "stable_neo_hookean", young = 1e5, poisson = 0.3, density = 1000.0 }
 //! damping = { stiffness_time = 2e-3 }    # s: phi = t λ and psi = t μ
 //! damping = { phi = 50.0, psi = 100.0 }  # Pa·s
+//! materials = [{ region = "wall", young = 4e5, density = 1200.0 }]
+//!                                        # elements of their own E (Pa) and density (kg/m³)
 //! ```
+//! A region's material keeps the body's model and Poisson's ratio; `young` and `density` default
+//! to the body's. It selects a mesh file's volume group (`region`, its elements) or the elements
+//! whose centroid lies in a box `min`..`max` (m, rest coordinates); a later entry wins where two
+//! overlap. The damping in a region is the body's times the region's `young` over the body's
+//! (stiffness-proportional damping keeps its time there; `phi` and `psi` are scaled alike).
 
 use super::check::Checker;
+use super::soft_body::{RegionName, Selection};
 use rapier_fvm::damping::RayleighDamping;
 use rapier_fvm::material::{Material, MaterialModel};
 use serde::Deserialize;
@@ -137,5 +145,59 @@ impl DampingSpec {
             Some(t) => RayleighDamping::stiffness_proportional(t, material.lame()),
             None => RayleighDamping::new(self.phi.unwrap_or(0.0), self.psi.unwrap_or(0.0)),
         }
+    }
+}
+
+/// Elements of a soft body with their own Young's modulus and density.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RegionMaterialSpec {
+    /// Lower corner of the box (m, rest coordinates) the elements' centroids lie in.
+    pub min: Option<[f64; 3]>,
+    /// Upper corner of the box (m, rest coordinates).
+    pub max: Option<[f64; 3]>,
+    /// The mesh file's volume group, in place of a box.
+    pub region: Option<RegionName>,
+    /// Young's modulus (Pa); default the body's.
+    pub young: Option<f64>,
+    /// Density (kg/m³); default the body's.
+    pub density: Option<f64>,
+}
+
+impl RegionMaterialSpec {
+    /// The elements it selects, as a box or a region.
+    pub fn selection(&self) -> Selection<'_> {
+        Selection {
+            min: self.min,
+            max: self.max,
+            region: self.region.as_ref(),
+        }
+    }
+
+    /// Checks the selection and the constants; `key` is its key path.
+    pub(crate) fn check(&self, key: &str, c: &mut Checker<'_>) {
+        self.selection().check(key, c);
+        if self.young.is_none() && self.density.is_none() {
+            c.fail(key, "give `young` (Pa), `density` (kg/m³) or both");
+        }
+        if let Some(young) = self.young {
+            c.positive(&format!("{key}.young"), young, "Pa");
+        }
+        if let Some(density) = self.density {
+            c.positive(&format!("{key}.density"), density, "kg/m³");
+        }
+    }
+
+    /// The region's material: `body`'s with this Young's modulus and density.
+    ///
+    /// # Errors
+    /// The library's message for constants it refuses (none once the scene is checked).
+    pub fn material(&self, body: &MaterialSpec) -> Result<Material, rapier_fvm::Error> {
+        Material::new(
+            body.model.model(),
+            self.young.unwrap_or(body.young),
+            body.poisson,
+            self.density.unwrap_or(body.density),
+        )
     }
 }

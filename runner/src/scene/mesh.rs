@@ -195,7 +195,7 @@ impl MeshSpec {
 
     /// Builds a cage of quadratic hexahedra over a cuboid mesh's cells, or of a file's
     /// hexahedra (with its regions; a linear file's [widened](MeshRegion::with_cage_nodes) to
-    /// the nodes its cage adds).
+    /// the nodes its cage adds; a volume group's `tets` become the cage's hexahedra).
     ///
     /// # Errors
     /// A [`SceneError`] at `key` for another mesh, the generator's problem or a file without
@@ -208,14 +208,20 @@ impl MeshSpec {
         if let Some(raw) = self.read_file(key, source)? {
             let (path, regions) = (raw.path.clone(), raw.regions_in_mesh());
             let linear = matches!(raw.hexahedra, import::Hexahedra::Linear(_));
+            let per_hexahedron = raw.hexahedra.tets_per_element();
             let mesh = raw
                 .into_cage()
                 .map_err(|e| source.error(&format!("{key}.file"), e.to_string()))?;
-            let regions = if linear {
-                regions.iter().map(|r| r.with_cage_nodes(&mesh)).collect()
-            } else {
-                regions
-            };
+            let regions = regions.into_iter().map(|region| {
+                let mut region = if linear {
+                    region.with_cage_nodes(&mesh)
+                } else {
+                    region
+                };
+                region.tets = region.cage_elements(per_hexahedron);
+                region
+            });
+            let regions = regions.collect();
             return Ok(BuiltMesh {
                 mesh,
                 regions,

@@ -8,6 +8,10 @@
 //! mesh = { cuboid = { half_extents = [0.5, 0.05, 0.05], cells = [20, 2, 2] } }
 //! material = { model = "st_venant_kirchhoff", young = 1e8, poisson = 0.3, density = 1000.0 }
 //! damping = { stiffness_time = 1e-3 }
+//! materials = [{ min = [0, -1, -1], max = [1, 1, 1], young = 4e8 }]
+//!                                 # elements (centroid in the box, or a file's volume `region`)
+//!                                 # of their own `young` (Pa) and `density` (kg/m³); see
+//!                                 # `material`
 //! translation = [0.5, 0.0, 0.0]   # m, default 0
 //! rotation = [0.0, 0.0, 0.0]      # scaled axis (rad), default 0
 //! linvel = [0.0, 0.0, 0.0]        # m/s, default 0
@@ -37,7 +41,7 @@
 
 use super::check::Checker;
 use super::load::LoadSpec;
-use super::material::{DampingSpec, MaterialSpec};
+use super::material::{DampingSpec, MaterialSpec, RegionMaterialSpec};
 use super::mesh::{CAGE_MESHES, MeshSpec};
 use rapier_fvm::glamx::DVec3;
 use rapier_fvm::mesh::TetMesh;
@@ -56,6 +60,10 @@ pub struct SoftBodySpec {
     pub material: MaterialSpec,
     /// Rayleigh damping; default none.
     pub damping: Option<DampingSpec>,
+    /// Elements of their own Young's modulus and density; a later entry wins where two
+    /// overlap.
+    #[serde(default)]
+    pub materials: Vec<RegionMaterialSpec>,
     /// Translation of the rest mesh (m); default 0.
     #[serde(default)]
     pub translation: [f64; 3],
@@ -287,7 +295,8 @@ impl SoftBodySpec {
         let selections = (self.pinned.iter().map(RegionSpec::selection))
             .chain(self.attach.iter().map(AttachmentSpec::selection))
             .chain(self.velocity.iter().map(RegionVelocitySpec::selection))
-            .chain(self.loads.iter().map(LoadSpec::selection));
+            .chain(self.loads.iter().map(LoadSpec::selection))
+            .chain(self.materials.iter().map(RegionMaterialSpec::selection));
         if self.mesh.file.is_none() && selections.into_iter().any(|s| s.region.is_some()) {
             c.fail(
                 &format!("{key}.mesh"),
@@ -315,6 +324,27 @@ impl SoftBodySpec {
         }
         for (i, load) in self.loads.iter().enumerate() {
             load.check(&format!("{key}.loads[{i}]"), c);
+        }
+        for (i, material) in self.materials.iter().enumerate() {
+            material.check(&format!("{key}.materials[{i}]"), c);
+        }
+        if !self.materials.is_empty() {
+            if self.volumetric == VolumetricSpec::NodalAverage {
+                c.fail(
+                    &format!("{key}.materials"),
+                    "region materials do not work with volumetric = \"nodal_average\" (its \
+                     patches of elements would mix materials)"
+                        .to_owned(),
+                );
+            }
+            if self.embedded.is_some() {
+                c.fail(
+                    &format!("{key}.materials"),
+                    "region materials do not work with an `embedded` mesh (its stresses would \
+                     take the body's material)"
+                        .to_owned(),
+                );
+            }
         }
     }
 }

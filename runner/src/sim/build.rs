@@ -2,6 +2,7 @@
 //! rigid bodies and their colliders inserted, probes bound to the bodies they read.
 
 use super::loads::{DrivenLoad, add_loads, build_loads};
+use super::materials::{element_centroids, region_materials};
 use super::meshes::BodyMeshes;
 use super::probe::Probe;
 use super::regions::BodyRegions;
@@ -255,6 +256,12 @@ fn insert_soft(
         attachments,
     } = BodyRegions::select(spec, (&mesh, &regions, &path), rigid, (key, source))?;
     let loads = build_loads(&spec.loads, (&mesh, &regions, &path), (key, source))?;
+    let centroids = match (&quadratic, &cage) {
+        (Some(q), _) => element_centroids(mesh.positions(), q.elements().iter().map(|e| &e[..])),
+        (_, Some(c)) => element_centroids(mesh.positions(), c.elements().iter().map(|e| &e[..])),
+        _ => element_centroids(mesh.positions(), mesh.tets().iter().map(|t| &t[..])),
+    };
+    let materials = region_materials(spec, &centroids, (&regions, &path), (key, source))?;
     let mut builder = match (quadratic, cage) {
         (Some(quadratic), _) => DeformableBodyBuilder::quadratic(quadratic, material),
         (_, Some(cage)) => DeformableBodyBuilder::quadratic_hex(cage, material),
@@ -278,6 +285,9 @@ fn insert_soft(
         });
     for (nodes, linvel) in velocities {
         builder = builder.nodes_linvel(nodes, linvel);
+    }
+    for (elements, material) in materials {
+        builder = builder.region_material(elements, material);
     }
     if let Some(damping) = &spec.damping {
         builder = builder.damping(

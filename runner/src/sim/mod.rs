@@ -11,6 +11,7 @@
 
 mod build;
 mod loads;
+mod materials;
 mod meshes;
 mod probe;
 mod regions;

@@ -312,8 +312,8 @@ impl MeshRegion {
     /// group selects its whole face of the cage. The region knows its nodes, not its faces: one
     /// whose nodes surround a boundary face it does not hold (the four sides of a beam one
     /// element across hold its end faces' corners) gains that face's nodes too. Its
-    /// tetrahedra stay the file's (six per hexahedron). A 27-node file's regions hold their
-    /// nodes already and need no widening.
+    /// tetrahedra stay the file's (six per hexahedron; [`MeshRegion::cage_elements`] gives its
+    /// hexahedra). A 27-node file's regions hold their nodes already and need no widening.
     #[must_use]
     pub fn with_cage_nodes(&self, cage: &QuadraticHexMesh) -> Self {
         const CORNER_LATTICE: [usize; 8] = [0, 2, 6, 8, 18, 20, 24, 26];
@@ -325,5 +325,21 @@ impl MeshRegion {
             })
         });
         self.widened_by(cage.subdivided(), middles)
+    }
+
+    /// The cage elements of a volume group of a file of hexahedra: the hexahedra its
+    /// tetrahedra were split from (each into `tets_per_hexahedron` consecutive ones,
+    /// [`Hexahedra::tets_per_element`]), which are the elements of the cage
+    /// [`RawMesh::into_cage`] builds, in order: the indices
+    /// [`region_material`](crate::body::DeformableBodyBuilder::region_material) takes for a
+    /// cage body.
+    ///
+    /// # Panics
+    /// If `tets_per_hexahedron` is zero.
+    pub fn cage_elements(&self, tets_per_hexahedron: usize) -> Vec<u32> {
+        let per = tets_per_hexahedron as u32;
+        let mut elements: Vec<u32> = self.tets.iter().map(|t| t / per).collect();
+        elements.dedup();
+        elements
     }
 }
