@@ -478,7 +478,11 @@ impl DeformableBodyBuilder {
         let (elements, masses) = self.elements_and_masses(materials.as_ref())?;
         if let Some(materials) = &mut materials {
             let stiffness_volume = elements.sum_over_points(|_, _, _, weight| weight);
-            materials.set_geometry(elements.lumped_volumes().into_owned(), stiffness_volume);
+            let control_volumes = match &elements {
+                Elements::Linear { .. } => lumped_masses(&self.mesh, |_| 1.0),
+                Elements::Quadratic { elements, .. } => elements.lumped_volumes().to_vec(),
+            };
+            materials.set_geometry(control_volumes, stiffness_volume);
         }
         let velocities = self.initial_velocities(&positions, &masses, &pinned)?;
         let embedding = match self.embedded {

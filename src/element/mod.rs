@@ -359,25 +359,6 @@ impl Elements {
         }
     }
 
-    /// Each node's rest control volume (m³): a quarter of each linear tetrahedron at the node,
-    /// or the HRZ share of each quadratic element's (the nodal masses over the density of a
-    /// body of one material).
-    pub(crate) fn lumped_volumes(&self) -> std::borrow::Cow<'_, [f64]> {
-        match self {
-            Self::Linear { fvm, .. } => {
-                let mut volumes = vec![0.0; fvm.node_count()];
-                for (t, tet) in fvm.tets().iter().enumerate() {
-                    let quarter = 0.25 * fvm.tet_rest(t).volume;
-                    for &n in tet {
-                        volumes[n as usize] += quarter;
-                    }
-                }
-                volumes.into()
-            }
-            Self::Quadratic { elements, .. } => elements.lumped_volumes().into(),
-        }
-    }
-
     /// The wave length scale (m) at positions `x`, see [`FvmMesh::wave_length_scale`] (and for
     /// `mass_volumes`); for quadratic elements the same Gershgorin bound with the sums over
     /// quadrature points and each node's lumped volume in place of a quarter of each tetrahedron.
