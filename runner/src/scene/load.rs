@@ -21,7 +21,7 @@
 //! the nearest nodes (consecutive repeats dropped).
 
 use super::check::Checker;
-use super::soft_body::{RegionName, Selection};
+use super::soft_body::RegionName;
 use serde::Deserialize;
 
 /// A load on a soft body: exactly one of `pressure`, `traction`, `body_force`, `tension`.
@@ -150,15 +150,6 @@ impl<T: Interpolated> Schedule<T> {
 }
 
 impl LoadSpec {
-    /// The boundary it acts on, for a pressure or traction.
-    pub fn selection(&self) -> Selection<'_> {
-        Selection {
-            min: self.min,
-            max: self.max,
-            region: self.region.as_ref(),
-        }
-    }
-
     /// Checks that it names one kind of load with what that kind needs, and the values;
     /// `key` is its key path.
     pub(crate) fn check(&self, key: &str, c: &mut Checker<'_>) {

@@ -14,7 +14,7 @@
 //! (stiffness-proportional damping keeps its time there; `phi` and `psi` are scaled alike).
 
 use super::check::Checker;
-use super::soft_body::{RegionName, Selection};
+use super::soft_body::RegionName;
 use rapier_fvm::damping::RayleighDamping;
 use rapier_fvm::material::{Material, MaterialModel};
 use serde::Deserialize;
@@ -165,15 +165,6 @@ pub struct RegionMaterialSpec {
 }
 
 impl RegionMaterialSpec {
-    /// The elements it selects, as a box or a region.
-    pub fn selection(&self) -> Selection<'_> {
-        Selection {
-            min: self.min,
-            max: self.max,
-            region: self.region.as_ref(),
-        }
-    }
-
     /// Checks the selection and the constants; `key` is its key path.
     pub(crate) fn check(&self, key: &str, c: &mut Checker<'_>) {
         self.selection().check(key, c);

@@ -207,11 +207,12 @@ pub struct Selection<'a> {
     pub region: Option<&'a RegionName>,
 }
 
-/// `selection()` for each spec that selects nodes by a box or a region.
+/// `selection()` for each spec that selects nodes (a load's boundary, a material's elements)
+/// by a box or a region.
 macro_rules! selects_nodes {
     ($($spec:ty),*) => {$(
         impl $spec {
-            /// The nodes it selects.
+            /// What it selects: a box of rest coordinates or a mesh file's region.
             pub fn selection(&self) -> Selection<'_> {
                 Selection {
                     min: self.min,
@@ -223,7 +224,13 @@ macro_rules! selects_nodes {
     )*};
 }
 
-selects_nodes!(RegionSpec, AttachmentSpec, RegionVelocitySpec);
+selects_nodes!(
+    RegionSpec,
+    AttachmentSpec,
+    RegionVelocitySpec,
+    LoadSpec,
+    RegionMaterialSpec
+);
 
 impl Selection<'_> {
     /// The nodes of `mesh` (rest coordinates) inside the box (bounds included), or those of the
