@@ -346,12 +346,14 @@ pub enum Error {
     /// [`integrate::COLLAPSE_RATIO`](crate::integrate::COLLAPSE_RATIO)): the load or impact is
     /// more than the material can hold at this mesh resolution. The step was refused.
     #[error(
-        "the step crushed tetrahedron {tet} to {volume_ratio:.2e} of its rest volume; the step was refused and the previous state kept: the load or impact is more than the material can hold at this resolution (a stiffer material, a finer mesh or a slower impact)"
+        "the step crushed element {element} to a volume ratio J = {volume_ratio:.2e}; the step was refused and the previous state kept: the load or impact is more than the material can hold at this resolution (a stiffer material, a finer mesh or a slower impact)"
     )]
     ElementCrushed {
-        /// The first tetrahedron found crushed.
-        tet: usize,
-        /// Its volume over its rest volume (dimensionless; negative when inverted).
+        /// The first element found crushed (a tetrahedron of a linear body, a quadratic element
+        /// of a quadratic one, in the body's element order).
+        element: usize,
+        /// Its volume ratio `J` (dimensionless; negative when inverted): `V / V₀` for a linear
+        /// tetrahedron, the smallest `det F` at the quadrature points of a quadratic element.
         volume_ratio: f64,
     },
     /// An implicit step's Newton solve did not meet its tolerance, even in the most substeps

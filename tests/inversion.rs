@@ -38,7 +38,7 @@ fn recover(body: &mut DeformableBody, frames: usize) -> Vec<usize> {
                     DVec3::ZERO,
                 )
                 .unwrap()
-                .inverted_tets
+                .inverted_elements
         })
         .collect()
 }
@@ -122,7 +122,7 @@ fn a_tetrahedron_turned_inside_out_recovers_with_the_explicit_integrator_too() {
                     DVec3::ZERO,
                 )
                 .unwrap()
-                .inverted_tets;
+                .inverted_elements;
         }
         let volume = body.deformed_volume() / body.mesh().volume();
         println!("{model:?}: single tet volume {volume:.4} of rest after 2 s");

@@ -187,7 +187,7 @@ fn run(
             body.implicit_frames,
             body.asleep_frames,
             body.failed_frames,
-            body.max_inverted_tets
+            body.max_inverted_elements
         );
         let c = &body.cost;
         println!(

@@ -18,7 +18,7 @@ pub use state::SPEED_OF_LIGHT;
 pub(crate) use surface::BodySurface;
 
 use crate::damping::RayleighDamping;
-use crate::element::{ElementOrder, ElementShape, Elements};
+use crate::element::{ElementOrder, ElementShape, Elements, deformation_gradient};
 use crate::embedding::Embedding;
 use crate::fvm::VolumetricTreatment;
 use crate::material::{ElementMaterials, Material, with_hyperelastic_model};
@@ -337,6 +337,38 @@ impl DeformableBody {
             .iter()
             .zip(&self.velocities)
             .position(|(x, v)| !(x.is_finite() && v.is_finite()))
+    }
+
+    /// Each element's volume ratio `J = det F` (dimensionless) at the current positions, in
+    /// element order: a linear tetrahedron's `V / V₀`; a quadratic element's smallest `det F` at
+    /// its quadrature points, where its stiffness is sampled (the straight-sided tetrahedra of
+    /// its subdivision, [`DeformableBody::mesh`], can fold where the curved element does not).
+    /// Negative for an inverted element, NaN for non-finite positions.
+    pub fn element_volume_ratios(&self) -> Vec<f64> {
+        match &self.elements {
+            Elements::Linear { .. } => (self.mesh.tets().iter().enumerate())
+                .map(|(t, tet)| {
+                    crate::mesh::signed_volume(&self.positions, tet) / self.mesh.tet_volume(t)
+                })
+                .collect(),
+            Elements::Quadratic { elements, .. } => (0..elements.element_count())
+                .map(|e| {
+                    let nodes = elements.element(e);
+                    (elements.element_points(e))
+                        .map(|point| {
+                            let gradients = elements.point_gradients(point);
+                            deformation_gradient(nodes, gradients, &self.positions).determinant()
+                        })
+                        .fold(f64::INFINITY, |smallest, ratio| {
+                            if smallest.is_nan() || ratio.is_nan() {
+                                f64::NAN
+                            } else {
+                                smallest.min(ratio)
+                            }
+                        })
+                })
+                .collect(),
+        }
     }
 
     /// Number of tetrahedra whose current volume is zero or negative (inverted elements).

@@ -1,5 +1,7 @@
-//! Crushed elements: a tetrahedron is *crushed* when its volume is below [`COLLAPSE_RATIO`] of its
-//! rest volume, `J = V / V₀ < J_min` (inverted at `J ≤ 0`, collapsed at `0 < J < J_min`).
+//! Crushed elements: an element is *crushed* when its volume ratio is below [`COLLAPSE_RATIO`],
+//! `J < J_min` (inverted at `J ≤ 0`, collapsed at `0 < J < J_min`), with `J = V / V₀` for a
+//! linear tetrahedron and the smallest `det F` at its quadrature points for a quadratic element
+//! ([`DeformableBody::element_volume_ratios`]).
 //! No solid is compressed so far; a step that leaves an element so has carried the body past what
 //! its material model describes (a soft body struck faster than its material can stop it: the
 //! stable Neo-Hookean energy is finite at zero volume, so such an impact flattens elements and
@@ -15,13 +17,10 @@ use crate::body::DeformableBody;
 /// volume.
 pub const COLLAPSE_RATIO: f64 = 1e-2;
 
-/// Each tetrahedron's volume over its rest volume, `J = V / V₀`, at the body's positions.
-fn volume_ratios(body: &DeformableBody) -> impl Iterator<Item = (usize, f64)> + '_ {
-    let mesh = body.mesh();
-    mesh.tets().iter().enumerate().map(move |(t, tet)| {
-        let ratio = crate::mesh::signed_volume(body.positions(), tet) / mesh.tet_volume(t);
-        (t, ratio)
-    })
+/// Each element's volume ratio `J` at the body's positions
+/// ([`DeformableBody::element_volume_ratios`]), with its index.
+fn volume_ratios(body: &DeformableBody) -> impl Iterator<Item = (usize, f64)> {
+    body.element_volume_ratios().into_iter().enumerate()
 }
 
 /// Whether the volume ratio `ratio` is crushed (a NaN is).
@@ -31,7 +30,7 @@ fn crushed(ratio: f64) -> bool {
 
 /// The elements crushed when a step began, to tell the step's own crushing from them.
 pub(crate) struct CrushWatch {
-    /// Indices of the tetrahedra crushed at the start, ascending.
+    /// Indices of the elements crushed at the start, ascending.
     crushed_at_start: Vec<usize>,
 }
 
@@ -46,17 +45,17 @@ impl CrushWatch {
         }
     }
 
-    /// After the step: the number of inverted tetrahedra (`J ≤ 0`) of `body`.
+    /// After the step: the number of inverted elements (`J ≤ 0`) of `body`.
     ///
     /// # Errors
-    /// [`Error::ElementCrushed`] for the first tetrahedron crushed now that was not at the start.
+    /// [`Error::ElementCrushed`] for the first element crushed now that was not at the start.
     pub(crate) fn check(&self, body: &DeformableBody) -> Result<usize, Error> {
         let mut inverted = 0;
         for (t, ratio) in volume_ratios(body) {
             inverted += usize::from(ratio.is_nan() || ratio <= 0.0);
             if crushed(ratio) && self.crushed_at_start.binary_search(&t).is_err() {
                 return Err(Error::ElementCrushed {
-                    tet: t,
+                    element: t,
                     volume_ratio: ratio,
                 });
             }

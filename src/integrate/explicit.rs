@@ -80,8 +80,9 @@ pub struct StepReport {
     /// Length of the shortest substep (s): automatic substeps shorten within a frame when the
     /// stability limit drops (elements crushed by an impact).
     pub substep_dt: f64,
-    /// Tetrahedra inverted (zero or negative volume) at the end of the frame.
-    pub inverted_tets: usize,
+    /// Elements inverted at the end of the frame (volume ratio `J ≤ 0`, see
+    /// [`DeformableBody::element_volume_ratios`](crate::body::DeformableBody::element_volume_ratios)).
+    pub inverted_elements: usize,
 }
 
 impl SymplecticEuler {
@@ -264,10 +265,10 @@ impl SymplecticEuler {
         match inverted {
             Ok(inverted) => Ok(inverted
                 .into_iter()
-                .map(|inverted_tets| StepReport {
+                .map(|inverted_elements| StepReport {
                     substeps: taken,
                     substep_dt: smallest,
-                    inverted_tets,
+                    inverted_elements,
                 })
                 .collect()),
             Err(error) => fail(bodies, histories, error),

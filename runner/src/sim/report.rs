@@ -106,8 +106,8 @@ pub struct SoftBodyReport {
     pub failed_frames: usize,
     /// The first failure's message.
     pub first_error: Option<String>,
-    /// Most inverted tetrahedra at the end of a frame.
-    pub max_inverted_tets: usize,
+    /// Most inverted elements at the end of a frame.
+    pub max_inverted_elements: usize,
     /// What the per-frame audit (`rapier_fvm::coupling::Audit`) found for this body.
     pub stability_flags: BodyFlags,
     /// Whether no flag was raised and no step failed.
@@ -380,13 +380,15 @@ impl SoftBodyReport {
                 if let Some(explicit) = report.explicit {
                     self.explicit_substeps_sum += u64::from(explicit.substeps);
                     self.max_explicit_substeps = self.max_explicit_substeps.max(explicit.substeps);
-                    self.max_inverted_tets = self.max_inverted_tets.max(explicit.inverted_tets);
+                    self.max_inverted_elements =
+                        self.max_inverted_elements.max(explicit.inverted_elements);
                 }
                 if let Some(implicit) = report.implicit {
                     self.unconverged_frames += usize::from(!implicit.converged);
-                    self.max_inverted_tets = self.max_inverted_tets.max(implicit.inverted_tets);
+                    self.max_inverted_elements =
+                        self.max_inverted_elements.max(implicit.inverted_elements);
                 }
-                stability.inverted_elements |= self.max_inverted_tets > 0;
+                stability.inverted_elements |= self.max_inverted_elements > 0;
                 if self.explicit_frames > 0 {
                     self.mean_explicit_substeps =
                         self.explicit_substeps_sum as f64 / self.explicit_frames as f64;

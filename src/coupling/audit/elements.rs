@@ -1,5 +1,6 @@
-//! The element side of the audit: each tetrahedron's volume after a frame over its rest volume,
-//! `J = V / V₀`. An element is *inverted* at `J ≤ 0` and *collapsed* at `0 < J < J_min`
+//! The element side of the audit: each element's volume ratio after a frame
+//! ([`DeformableBody::element_volume_ratios`]: `J = V / V₀` for a linear tetrahedron, the
+//! smallest `det F` at the quadrature points of a quadratic element). An element is *inverted* at `J ≤ 0` and *collapsed* at `0 < J < J_min`
 //! ([`AuditSettings::collapse_ratio`](super::AuditSettings::collapse_ratio)).
 
 use crate::body::DeformableBody;
@@ -15,14 +16,12 @@ pub(super) struct ElementState {
 /// The inverted and collapsed (`0 < J < collapse_ratio`) elements of `body`, and its smallest
 /// volume ratio `J`.
 pub(super) fn element_state(body: &DeformableBody, collapse_ratio: f64) -> ElementState {
-    let mesh = body.mesh();
     let mut state = ElementState {
         inverted: 0,
         collapsed: 0,
         smallest_ratio: f64::INFINITY,
     };
-    for (t, tet) in mesh.tets().iter().enumerate() {
-        let ratio = crate::mesh::signed_volume(body.positions(), tet) / mesh.tet_volume(t);
+    for ratio in body.element_volume_ratios() {
         state.smallest_ratio = state.smallest_ratio.min(ratio);
         if ratio <= 0.0 || ratio.is_nan() {
             state.inverted += 1;

@@ -346,10 +346,10 @@ impl ImplicitIntegrator {
                 .iter_mut()
                 .zip(last)
                 .zip(inverted)
-                .map(|((step, last), inverted_tets)| {
+                .map(|((step, last), inverted_elements)| {
                     step.workspace.previous_step = last;
                     ImplicitReport {
-                        inverted_tets,
+                        inverted_elements,
                         ..report
                     }
                 })

@@ -313,7 +313,7 @@ impl ImplicitIntegrator {
             Ok(inverted) => {
                 let last = solver.last_step.take();
                 solver.give_back(workspace, last);
-                report.inverted_tets = inverted;
+                report.inverted_elements = inverted;
                 Ok(report)
             }
             Err(error) => {

@@ -37,8 +37,9 @@ pub struct ImplicitReport {
     /// changes it by (very stiff or nearly incompressible material against a small load, a very
     /// stiff coupling). Not converged, not failed: the frame is taken.
     pub stalled_substeps: u32,
-    /// Tetrahedra inverted (zero or negative volume) at the end of the frame.
-    pub inverted_tets: usize,
+    /// Elements inverted at the end of the frame (volume ratio `J ≤ 0`, see
+    /// [`DeformableBody::element_volume_ratios`](crate::body::DeformableBody::element_volume_ratios)).
+    pub inverted_elements: usize,
 }
 
 /// How a substep's Newton solve ended.
@@ -85,7 +86,7 @@ impl ImplicitReport {
             relative_residual: 0.0,
             converged: true,
             stalled_substeps: 0,
-            inverted_tets: 0,
+            inverted_elements: 0,
         }
     }
 
