@@ -2,14 +2,11 @@
 //! runs as the same body pinned by the equivalent box, each volume of a file can be a body of
 //! its own, and a region the file does not have is refused at its key with the file's regions.
 
-use rapier_fvm_runner::scene::{Scene, SceneError};
-use rapier_fvm_runner::sim::{self, RunOptions, Simulation};
-use std::path::{Path, PathBuf};
+mod scenes;
 
-/// Where the scenes below pretend to live, so that `../meshes/` is the shipped meshes' folder.
-fn scene_path(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../assets/scenes/{name}.toml"))
-}
+use rapier_fvm_runner::scene::{Scene, SceneError};
+use rapier_fvm_runner::sim::{self, Simulation};
+use scenes::{run_scene, scene_path};
 
 /// A 10 cm cube read from gmsh's `cube_regions_v22.msh` (its face x = 0 the surface group
 /// "clamp", tag 1), hanging from that face under gravity and sagging; `pinned` selects the face.
@@ -38,19 +35,6 @@ component = "y"
     )
 }
 
-/// The report of running `text` (scene `name`) for its whole duration.
-fn run(name: &str, text: String) -> sim::Report {
-    let scene = Scene::parse(scene_path(name), text).unwrap_or_else(|e| panic!("{e}"));
-    let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
-    let _ = std::fs::remove_dir_all(&out);
-    let options = RunOptions {
-        out,
-        duration: None,
-        progress: false,
-    };
-    sim::run(&scene, &options).unwrap_or_else(|e| panic!("{e}"))
-}
-
 #[test]
 fn a_body_pinned_by_its_physical_surface_runs_as_one_pinned_by_the_same_box() {
     // The box around x = 0 (the cube spans [0, 0.1] m) holds exactly the clamp's nodes, so the
@@ -58,18 +42,24 @@ fn a_body_pinned_by_its_physical_surface_runs_as_one_pinned_by_the_same_box() {
     // takes the face's mid-edge nodes too). The cube sags by millimetres: the pins hold.
     let the_box = "{ min = [-0.001, -1.0, -1.0], max = [0.001, 1.0, 1.0] }";
     for elements in ["linear", "quadratic"] {
-        let by_region = run(
+        let by_region = run_scene(
             &format!("pinned_by_region_{elements}"),
-            hanging_cube(r#"{ region = "clamp" }"#, elements),
-        );
-        let by_tag = run(
+            &hanging_cube(r#"{ region = "clamp" }"#, elements),
+            None,
+        )
+        .0;
+        let by_tag = run_scene(
             &format!("pinned_by_tag_{elements}"),
-            hanging_cube("{ region = 1 }", elements),
-        );
-        let by_box = run(
+            &hanging_cube("{ region = 1 }", elements),
+            None,
+        )
+        .0;
+        let by_box = run_scene(
             &format!("pinned_by_box_{elements}"),
-            hanging_cube(the_box, elements),
-        );
+            &hanging_cube(the_box, elements),
+            None,
+        )
+        .0;
         let sag = |report: &sim::Report| report.probes[0].values.clone();
         assert_eq!(sag(&by_region), sag(&by_box), "{elements}");
         assert_eq!(sag(&by_tag), sag(&by_box), "{elements}");
@@ -100,7 +90,7 @@ mesh = { file = "../meshes/two_volumes_v41.msh", scale = 0.1, region = 2 }
 material = { model = "stable_neo_hookean", young = 1e5, poisson = 0.3, density = 1000.0 }
 velocity = [{ region = "load", linvel = [0.0, 0.0, 0.1] }]
 "#;
-    let scene = Scene::parse(scene_path("two_volumes"), text.to_owned()).unwrap();
+    let scene = Scene::parse(scene_path("two_volumes.toml"), text.to_owned()).unwrap();
     let simulation = Simulation::build(&scene).unwrap_or_else(|e| panic!("{e}"));
     let whole = rapier_fvm::mesh::import::load(
         scene_path("x").with_file_name("../meshes/two_volumes_v41.msh"),
@@ -131,7 +121,7 @@ velocity = [{ region = "load", linvel = [0.0, 0.0, 0.1] }]
 
 /// The error of building `text`.
 fn build_error(text: String) -> SceneError {
-    let scene = Scene::parse(scene_path("bad_region"), text).unwrap();
+    let scene = Scene::parse(scene_path("bad_region.toml"), text).unwrap();
     match Simulation::build(&scene) {
         Ok(_) => panic!("the scene should be refused"),
         Err(error) => error,
@@ -164,7 +154,7 @@ fn a_region_the_file_lacks_is_refused_at_its_key_with_the_file_s_regions() {
         r#"{ file = "../meshes/cube_regions_v22.msh", scale = 0.1 }"#,
         "{ cuboid = { half_extents = [0.05, 0.05, 0.05], cells = [2, 2, 2] } }",
     );
-    let error = Scene::parse(scene_path("generator"), text).unwrap_err();
+    let error = Scene::parse(scene_path("generator.toml"), text).unwrap_err();
     assert_eq!(error.key.as_deref(), Some("soft_body[0].mesh"));
     assert!(error.message.contains("this mesh is not a file"), "{error}");
     // A box and a region at once, or half a box.
@@ -172,7 +162,8 @@ fn a_region_the_file_lacks_is_refused_at_its_key_with_the_file_s_regions() {
         r#"{ region = "clamp", min = [0.0, 0.0, 0.0], max = [1.0, 1.0, 1.0] }"#,
         "{ min = [0.0, 0.0, 0.0] }",
     ] {
-        let error = Scene::parse(scene_path("both"), hanging_cube(pinned, "linear")).unwrap_err();
+        let error =
+            Scene::parse(scene_path("both.toml"), hanging_cube(pinned, "linear")).unwrap_err();
         assert_eq!(
             error.key.as_deref(),
             Some("soft_body[0].pinned[0]"),
@@ -203,7 +194,7 @@ mesh = { file = "../meshes/two_volumes_meshio.vtu", scale = 0.1, region = 2 }
 material = { model = "stable_neo_hookean", young = 1e5, poisson = 0.3, density = 1000.0 }
 velocity = [{ region = 4, linvel = [0.0, 0.0, 0.1] }]
 "#;
-    let scene = Scene::parse(scene_path("two_volumes_vtu"), text.to_owned()).unwrap();
+    let scene = Scene::parse(scene_path("two_volumes_vtu.toml"), text.to_owned()).unwrap();
     let simulation = Simulation::build(&scene).unwrap_or_else(|e| panic!("{e}"));
     let left = &simulation.world.soft_bodies[simulation.soft[0].handle];
     let right = &simulation.world.soft_bodies[simulation.soft[1].handle];
@@ -261,14 +252,18 @@ fn a_cage_read_from_a_file_hangs_from_its_physical_surface_as_the_generated_cage
     let mut read = Vec::new();
     for nodes in [27, 8] {
         let file = format!(r#"{{ file = "../meshes/box_hex{nodes}_v41.msh", scale = 0.1 }}"#);
-        let by_region = run(
+        let by_region = run_scene(
             &format!("cage{nodes}_by_region"),
-            hanging_cage(&file, clamp, end),
-        );
-        let by_box = run(
+            &hanging_cage(&file, clamp, end),
+            None,
+        )
+        .0;
+        let by_box = run_scene(
             &format!("cage{nodes}_by_box"),
-            hanging_cage(&file, the_box, end),
-        );
+            &hanging_cage(&file, the_box, end),
+            None,
+        )
+        .0;
         let sag = |report: &sim::Report| report.probes[0].values.clone();
         assert_eq!(sag(&by_region), sag(&by_box), "{nodes}-node hexahedra");
         assert!(by_region.stability.stable);
@@ -281,7 +276,7 @@ fn a_cage_read_from_a_file_hangs_from_its_physical_surface_as_the_generated_cage
         "elements = \"quadratic_hex\"",
         "elements = \"quadratic_hex\"\ntranslation = [0.05, 0.025, 0.0125]",
     );
-    let generated = run("cage_generated", generated);
+    let generated = run_scene("cage_generated", &generated, None).0;
     let made = generated.probes[0].final_value;
     for (read, nodes) in read.into_iter().zip([27, 8]) {
         println!("cage sag after 0.1 s: {nodes}-node file {read:.9e} m, generator {made:.9e} m");

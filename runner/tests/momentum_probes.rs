@@ -2,30 +2,17 @@
 //! the probes that check what follows: momentum, angular momentum and energy of a free body
 //! against their closed forms, and the force on a dropped cube against its change of momentum.
 
+mod scenes;
+
 use rapier_fvm_runner::scene::Scene;
-use rapier_fvm_runner::sim::{self, RunOptions};
+use scenes::{run_scene, scene_path};
 use serde_json::Value;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-/// The shipped scene `name`.
-fn scene_path(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../assets/scenes")
-        .join(name)
-}
-
-/// Runs `toml` (a scene file's text, read as if it were the shipped scene `name`) for its
-/// duration, or `duration` (s), into a scratch folder; returns `report.json` and the folder.
+/// Runs `toml` (read as the shipped scene `{name}.toml`) for its duration, or `duration` (s),
+/// into the fresh folder `name`; returns `report.json` and the folder.
 fn run(name: &str, toml: &str, duration: Option<f64>) -> (Value, PathBuf) {
-    let scene = Scene::parse(scene_path(name), toml.to_owned()).unwrap_or_else(|e| panic!("{e}"));
-    let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("momentum_probes_{name}"));
-    let _ = std::fs::remove_dir_all(&out);
-    let options = RunOptions {
-        out: out.clone(),
-        duration,
-        progress: false,
-    };
-    sim::run(&scene, &options).unwrap_or_else(|e| panic!("{e}"));
+    let (_, out) = run_scene(name, toml, duration);
     let report = std::fs::read_to_string(out.join("report.json")).unwrap();
     (serde_json::from_str(&report).unwrap(), out)
 }
@@ -84,7 +71,7 @@ fn the_spinning_block_keeps_its_momenta_from_their_closed_forms() {
     // which keeps both momenta to round-off (3e-15 relative measured; 1e-12 allowed), while the
     // kinetic energy falls into elastic energy (the spin stretches the block) and the damping.
     let text = std::fs::read_to_string(scene_path("spinning_block.toml")).unwrap();
-    let (report, out) = run("spinning_block.toml", &text, None);
+    let (report, out) = run("momentum_probes_spinning_block", &text, None);
     assert_eq!(report["frames"], 180);
     let (mass, speed, omega) = (8.0, 0.1, 3.0);
     let trapezoidal = |half: f64, cells: f64| half * half * (1.0 + 2.0 / (cells * cells)) / 3.0;
@@ -147,7 +134,7 @@ name = "kinetic energy"
 kind = "energy"
 energy = "kinetic"
 "#;
-    let (report, _) = run("region_velocity.toml", text, None);
+    let (report, _) = run("momentum_probes_region_velocity", text, None);
     let momentum = probe(&report, "momentum y", "momentum", "kg m/s");
     assert!(
         largest_relative_change(&momentum, 0.625) < 1e-12,
@@ -178,7 +165,7 @@ body = "cube"
 component = "y"
 "#;
     let text = std::fs::read_to_string(scene_path("drop.toml")).unwrap() + probes;
-    let (report, _) = run("drop_momentum.toml", &text, Some(0.75));
+    let (report, _) = run("momentum_probes_drop_momentum", &text, Some(0.75));
     let momentum = probe(&report, "momentum y", "momentum", "kg m/s");
     let force = probe(&report, "force on the cube", "contact_force_on_soft", "N");
     let reaction = probe(&report, "ground reaction", "contact_force", "N");

@@ -2,27 +2,11 @@
 //! its own Young's modulus and density, the same elements by either selection running to the
 //! same bits, a cage file's volume group selecting its hexahedra, and the refusals at their keys.
 
+mod scenes;
+
 use rapier_fvm_runner::scene::Scene;
-use rapier_fvm_runner::sim::{self, RunOptions, Simulation};
-use std::path::{Path, PathBuf};
-
-/// Where the scenes below pretend to live, so that `../meshes/` is the shipped meshes' folder.
-fn scene_path(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../assets/scenes/{name}.toml"))
-}
-
-/// The report of running `text` (scene `name`) for its whole duration.
-fn run(name: &str, text: &str) -> sim::Report {
-    let scene = Scene::parse(scene_path(name), text.to_owned()).unwrap_or_else(|e| panic!("{e}"));
-    let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
-    let _ = std::fs::remove_dir_all(&out);
-    let options = RunOptions {
-        out,
-        duration: None,
-        progress: false,
-    };
-    sim::run(&scene, &options).unwrap_or_else(|e| panic!("{e}"))
-}
+use rapier_fvm_runner::sim::{self, Simulation};
+use scenes::{run_scene, scene_path};
 
 /// gmsh's two 10 cm boxes side by side (`two_volumes_v41.msh` scaled by 0.1: volumes "left",
 /// x in [0, 0.1] m, and "right") as one body hanging from its "clamp" face x = 0, the right box
@@ -63,13 +47,16 @@ fn a_file_s_volume_and_the_box_of_its_elements_give_the_same_material_run() {
     let by_box = two_boxes(&format!(
         "{{ min = [0.1, -1.0, -1.0], max = [1.0, 1.0, 1.0], {stiff} }}"
     ));
-    let scene = Scene::parse(scene_path("two_materials"), by_region.clone()).unwrap();
+    let scene = Scene::parse(scene_path("two_materials.toml"), by_region.clone()).unwrap();
     let simulation = Simulation::build(&scene).unwrap_or_else(|e| panic!("{e}"));
     let body = &simulation.world.soft_bodies[simulation.soft[0].handle];
     let mass = body.total_mass();
     assert!((mass / 3.5 - 1.0).abs() < 1e-12, "mass {mass} kg");
-    let (region, boxed) = (run("by_region", &by_region), run("by_box", &by_box));
-    let uniform = run("uniform", &two_boxes(""));
+    let (region, boxed) = (
+        run_scene("by_region", &by_region, None).0,
+        run_scene("by_box", &by_box, None).0,
+    );
+    let uniform = run_scene("uniform", &two_boxes(""), None).0;
     let sag = |report: &sim::Report| report.probes[0].values.clone();
     assert_eq!(sag(&region), sag(&boxed));
     let (mixed, plain) = (region.probes[0].final_value, uniform.probes[0].final_value);
@@ -117,11 +104,18 @@ fn a_cage_file_s_volume_group_selects_its_hexahedra() {
     // modulus: 1e-9 relative).
     for nodes in [27, 8] {
         let file = format!("box_hex{nodes}_v41.msh");
-        let given = run(
+        let given = run_scene(
             &format!("cage{nodes}_given"),
             &hanging_cage(&file, 1e5, r#"{ region = "block", young = 3e5 }"#),
-        );
-        let plain = run(&format!("cage{nodes}_plain"), &hanging_cage(&file, 3e5, ""));
+            None,
+        )
+        .0;
+        let plain = run_scene(
+            &format!("cage{nodes}_plain"),
+            &hanging_cage(&file, 3e5, ""),
+            None,
+        )
+        .0;
         let (a, b) = (given.probes[0].final_value, plain.probes[0].final_value);
         println!("{nodes}-node cage: sag {a:.9e} m given, {b:.9e} m plain");
         assert!(a < -1e-5 && (a / b - 1.0).abs() < 1e-9, "{a} against {b}");
@@ -139,18 +133,24 @@ fn a_cage_file_s_partial_volume_group_selects_its_own_hexahedra() {
         let file = format!("two_blocks_hex{nodes}_v41.msh");
         let region = format!(r#"{{ region = "stiff", {stiff} }}"#);
         let boxed = format!("{{ min = [0.05, -1.0, -1.0], max = [1.0, 1.0, 1.0], {stiff} }}");
-        let by_region = run(
+        let by_region = run_scene(
             &format!("blocks{nodes}_region"),
             &hanging_cage(&file, 1e5, &region),
-        );
-        let by_box = run(
+            None,
+        )
+        .0;
+        let by_box = run_scene(
             &format!("blocks{nodes}_box"),
             &hanging_cage(&file, 1e5, &boxed),
-        );
-        let uniform = run(
+            None,
+        )
+        .0;
+        let uniform = run_scene(
             &format!("blocks{nodes}_uniform"),
             &hanging_cage(&file, 1e5, ""),
-        );
+            None,
+        )
+        .0;
         let sag = |report: &sim::Report| report.probes[0].values.clone();
         assert_eq!(sag(&by_region), sag(&by_box), "{nodes}-node hexahedra");
         let (mixed, plain) = (
@@ -170,7 +170,7 @@ fn a_cage_file_s_partial_volume_group_selects_its_own_hexahedra() {
 #[test]
 fn a_material_region_that_selects_no_element_is_refused_at_its_key() {
     let build_error = |materials: &str| {
-        let scene = Scene::parse(scene_path("bad"), two_boxes(materials)).unwrap();
+        let scene = Scene::parse(scene_path("bad.toml"), two_boxes(materials)).unwrap();
         match Simulation::build(&scene) {
             Ok(_) => panic!("{materials}: the scene should be refused"),
             Err(error) => error,
@@ -198,13 +198,14 @@ fn a_material_region_that_selects_no_element_is_refused_at_its_key() {
         Some("soft_body[0].materials[0].region")
     );
     // Neither constant given: refused when the scene is read.
-    let error = Scene::parse(scene_path("bad"), two_boxes(r#"{ region = "right" }"#)).unwrap_err();
+    let error =
+        Scene::parse(scene_path("bad.toml"), two_boxes(r#"{ region = "right" }"#)).unwrap_err();
     assert_eq!(error.key.as_deref(), Some("soft_body[0].materials[0]"));
     assert!(error.message.contains("give `young`"), "{error}");
     // Nodal averaging mixes elements in its patches: refused when the scene is read.
     let averaged = two_boxes(r#"{ region = "right", young = 2e5 }"#)
         .replace("pinned =", "volumetric = \"nodal_average\"\npinned =");
-    let error = Scene::parse(scene_path("bad"), averaged).unwrap_err();
+    let error = Scene::parse(scene_path("bad.toml"), averaged).unwrap_err();
     assert_eq!(error.key.as_deref(), Some("soft_body[0].materials"));
     assert!(error.message.contains("nodal_average"), "{error}");
 }

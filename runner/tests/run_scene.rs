@@ -2,18 +2,14 @@
 //! ParaView series, the surfaces, the pictures and the plots; the `.vtu` read back matches the
 //! body's state.
 
+mod scenes;
+
 use rapier_fvm::glamx::DVec3;
 use rapier_fvm_runner::scene::Scene;
 use rapier_fvm_runner::sim::{self, RunOptions, Simulation};
+use scenes::{run_scene, scene_path};
 use std::path::{Path, PathBuf};
 use vtkio::model::{Attribute, DataSet, IOBuffer, Piece, Vtk};
-
-/// The shipped scene `name`.
-fn scene_path(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../assets/scenes")
-        .join(name)
-}
 
 /// A fresh output folder for `test`.
 fn out_dir(test: &str) -> PathBuf {
@@ -163,18 +159,10 @@ fn a_cage_reports_its_hexahedra_and_the_fine_mesh_it_carries() {
     assert!(!report.stability.any_error && report.stability.final_state_finite);
 }
 
-/// Runs `toml` (a scene file's text) for `duration` (s) into the scratch folder `name`; returns
-/// the report as `report.json` holds it.
+/// Runs `toml` (read as the shipped scene `{name}.toml`) for `duration` (s) into the fresh
+/// folder `name`; returns the report as `report.json` holds it.
 fn run_text(name: &str, toml: &str, duration: f64) -> serde_json::Value {
-    let path = scene_path("drop.toml").with_file_name(format!("{name}.toml"));
-    let scene = Scene::parse(&path, toml.to_owned()).unwrap();
-    let out = out_dir(name);
-    let options = RunOptions {
-        out: out.clone(),
-        duration: Some(duration),
-        progress: false,
-    };
-    sim::run(&scene, &options).unwrap();
+    let (_, out) = run_scene(name, toml, Some(duration));
     serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap()
 }
 
