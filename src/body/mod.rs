@@ -18,7 +18,7 @@ pub use state::SPEED_OF_LIGHT;
 pub(crate) use surface::BodySurface;
 
 use crate::damping::RayleighDamping;
-use crate::element::{ElementOrder, ElementShape, Elements, deformation_gradient};
+use crate::element::{ElementOrder, ElementShape, Elements};
 use crate::embedding::Embedding;
 use crate::fvm::VolumetricTreatment;
 use crate::material::{ElementMaterials, Material, with_hyperelastic_model};
@@ -351,21 +351,17 @@ impl DeformableBody {
                     crate::mesh::signed_volume(&self.positions, tet) / self.mesh.tet_volume(t)
                 })
                 .collect(),
-            Elements::Quadratic { elements, .. } => (0..elements.element_count())
-                .map(|e| {
-                    let nodes = elements.element(e);
-                    (elements.element_points(e))
-                        .map(|point| {
-                            let gradients = elements.point_gradients(point);
-                            deformation_gradient(nodes, gradients, &self.positions).determinant()
-                        })
-                        .fold(f64::INFINITY, |smallest, ratio| {
-                            if smallest.is_nan() || ratio.is_nan() {
-                                f64::NAN
-                            } else {
-                                smallest.min(ratio)
-                            }
-                        })
+            Elements::Quadratic { elements, .. } => (self.elements.gradients(&self.positions))
+                .chunks(elements.shape().quadrature().len())
+                .map(|element| {
+                    (element.iter()).fold(f64::INFINITY, |smallest, f| {
+                        let ratio = f.determinant();
+                        if smallest.is_nan() || ratio.is_nan() {
+                            f64::NAN
+                        } else {
+                            smallest.min(ratio)
+                        }
+                    })
                 })
                 .collect(),
         }

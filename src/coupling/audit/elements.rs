@@ -1,6 +1,7 @@
 //! The element side of the audit: each element's volume ratio after a frame
 //! ([`DeformableBody::element_volume_ratios`]: `J = V / V₀` for a linear tetrahedron, the
-//! smallest `det F` at the quadrature points of a quadratic element). An element is *inverted* at `J ≤ 0` and *collapsed* at `0 < J < J_min`
+//! smallest `det F` at the quadrature points of a quadratic element). An element is *inverted*
+//! at `J ≤ 0` and *collapsed* at `0 < J < J_min`
 //! ([`AuditSettings::collapse_ratio`](super::AuditSettings::collapse_ratio)).
 
 use crate::body::DeformableBody;
