@@ -171,7 +171,8 @@ impl Stiffness {
     /// the elastic stress differential plus `extra(point, F, dF)` (a further stress differential,
     /// Pa), projected to be positive
     /// semi-definite if `project`; the coupling of nodal averaging if the body uses it; the
-    /// Hessians of its follower loads' potentials ([`crate::load`]); and `diagonal[n] I` on each
+    /// Hessians of its follower loads' potentials ([`crate::load`]; a chamber's pressure not
+    /// if `project`); and `diagonal[n] I` on each
     /// free node.
     pub(crate) fn assemble(
         &mut self,
@@ -216,7 +217,7 @@ impl Stiffness {
                     self.add_outer(gradient, weight, &body.pinned)
                 });
         });
-        crate::load::add_follower_tangents(body, self);
+        crate::load::add_follower_tangents(body, self, project);
         for (node, &pinned) in body.pinned.iter().enumerate() {
             for i in 0..3 {
                 let e = self.entry(node, i, node, i);

@@ -4,7 +4,7 @@
 
 use super::DeformableBody;
 use crate::Error;
-use crate::load::{Load, LoadHandle, LoadValue};
+use crate::load::{ChamberTerms, Load, LoadHandle, LoadValue};
 use rapier3d::glamx::DVec3;
 
 impl DeformableBody {
@@ -46,9 +46,9 @@ impl DeformableBody {
         self.loads.get(handle.0 as usize)
     }
 
-    /// Sets the magnitude of the load `handle` (a pressure in Pa, a tension in N, a traction in
-    /// Pa or a force density in N/m³), as a controller does between frames. A sleeping body
-    /// wakes when one of its loads changes.
+    /// Sets the magnitude of the load `handle` (a pressure in Pa, a tension in N, a chamber's
+    /// volume in m³, a traction in Pa or a force density in N/m³), as a controller does between
+    /// frames. A sleeping body wakes when one of its loads changes.
     ///
     /// # Errors
     /// [`Error::InvalidLoad`] for a handle the body does not have or a value [`Load::set`]
@@ -75,7 +75,7 @@ impl DeformableBody {
     /// The potential energy of the body's loads (J) at its current positions: `−Σ f·x` of the
     /// tractions and body forces, `p V` of each pressure (`V` the signed volume of the cone its
     /// triangles span from the world's origin, minus a cavity's volume), `T L` of each cable
-    /// (`L` its length). With the kinetic, elastic and gravitational energies it makes the
+    /// (`L` its length), the liquid's `K (V − V*)²/(2V*)` of each chamber. With the kinetic, elastic and gravitational energies it makes the
     /// energy the loads conserve while their values stay as they are.
     pub fn load_potential_energy(&self) -> f64 {
         self.loads.iter().map(|load| self.potential_of(load)).sum()
@@ -122,6 +122,30 @@ impl DeformableBody {
             .filter(|&((_, _), &pinned)| !pinned)
             .map(|((row, mass), _)| row / mass)
             .fold(0.0, f64::max)
+    }
+
+    /// Whether a load is a [chamber](Load::Chamber), whose liquid's tangent a Newton direction
+    /// takes in by the Woodbury identity (so its system is solved by factorization).
+    pub(crate) fn has_chambers(&self) -> bool {
+        (self.loads.iter()).any(|load| matches!(load, Load::Chamber { .. }))
+    }
+
+    /// The rank-one tangents of the body's chambers at its current positions, zero on pinned
+    /// nodes (see [`ChamberTerms`]).
+    pub(crate) fn chamber_terms(&self) -> ChamberTerms {
+        let mut terms = ChamberTerms::default();
+        for (mut column, weight) in
+            (self.loads.iter()).filter_map(|l| l.chamber_term(&self.positions))
+        {
+            for (g, &pinned) in column.iter_mut().zip(&self.pinned) {
+                if pinned {
+                    *g = DVec3::ZERO;
+                }
+            }
+            terms.columns.push(column);
+            terms.weights.push(weight);
+        }
+        terms
     }
 
     /// The node pairs the loads' tangents couple (`[a, b]`, `a > b`).

@@ -86,7 +86,8 @@ pub enum LinearSolver {
     /// The sparse Cholesky factorization: exact to round-off, cost independent of the
     /// conditioning.
     Direct,
-    /// The block-Jacobi preconditioned conjugate gradient, started from zero.
+    /// The block-Jacobi preconditioned conjugate gradient, started from zero. A body with a
+    /// [chamber](crate::load::Load::Chamber) is solved by factorization all the same.
     ConjugateGradient {
         /// Stop when the residual of the linear system is below this fraction of its
         /// right-hand side, `‖K u - r‖ <= tolerance ‖r‖` (dimensionless, positive).
@@ -142,8 +143,13 @@ impl LinearSolver {
         Ok(())
     }
 
-    /// The method for substeps of `h` (s) on `body` in its current shape.
+    /// The method for substeps of `h` (s) on `body` in its current shape: the direct one for a
+    /// body with a [chamber](crate::load::Load::Chamber), whatever is chosen (its liquid's
+    /// tangent is taken in with the factorization).
     pub(crate) fn method(&self, body: &DeformableBody, h: f64) -> Method {
+        if body.has_chambers() {
+            return Method::Direct;
+        }
         match *self {
             LinearSolver::Direct => Method::Direct,
             LinearSolver::ConjugateGradient {

@@ -111,15 +111,22 @@ fn cross_matrix(v: DVec3) -> DMat3 {
 }
 
 /// Adds the Hessians (N/m) of the potentials of `body`'s follower loads at its current
-/// positions to `stiffness` (see the module documentation), skipping pinned nodes.
-pub(crate) fn add_follower_tangents(body: &DeformableBody, stiffness: &mut Stiffness) {
+/// positions to `stiffness` (see the module documentation), skipping pinned nodes. A chamber
+/// adds its pressure's part (its liquid's rank-one part is taken in by the Newton direction,
+/// see `super::chamber`), but not to a tangent that is `projected` to be positive definite: the
+/// pressure's blocks are indefinite, and a liquid pumped beyond what the cavity holds pushes
+/// with a pressure of the order of its bulk modulus until the walls give way.
+pub(crate) fn add_follower_tangents(
+    body: &DeformableBody,
+    stiffness: &mut Stiffness,
+    projected: bool,
+) {
     let (x, pinned) = (body.positions(), &body.pinned);
     for load in body.loads() {
         match load {
-            super::Load::Pressure {
-                triangles,
-                pressure,
-            } => {
+            super::Load::Chamber { .. } if projected => {}
+            super::Load::Pressure { triangles, .. } | super::Load::Chamber { triangles, .. } => {
+                let pressure = load.pressure_at(x).unwrap_or(0.0);
                 let origin = centre(triangles, x);
                 for &[a, b, c] in triangles {
                     let [ya, yb, yc] = [a, b, c].map(|n| x[n as usize] - origin);
@@ -223,7 +230,7 @@ mod tests {
         );
         let mut stiffness = Stiffness::new(&body);
         stiffness.values.fill(0.0);
-        super::add_follower_tangents(&body, &mut stiffness);
+        super::add_follower_tangents(&body, &mut stiffness, false);
         let k_d = stiffness.multiply(&direction);
         let scale = k_d.iter().map(|v| v.length()).fold(0.0, f64::max);
         for node in 0..n {

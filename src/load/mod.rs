@@ -13,7 +13,11 @@
 //!   pressure that fills it to a given volume at equilibrium);
 //! - **cable** of tension `T` (N) running through a path of nodes (eyelets), anchored at both
 //!   ends in the body: node `i` is pulled toward its neighbours on the path,
-//!   `T (ê_{i→i−1} + ê_{i→i+1})`, as a tendon pulled by an actuator in the body is.
+//!   `T (ê_{i→i−1} + ê_{i→i+1})`, as a tendon pulled by an actuator in the body is;
+//! - **chamber**: a cavity filled with a liquid of bulk modulus `K` (Pa) that a pump holds at a
+//!   volume `V*` (m³), a cavity inflated to a volume rather than a pressure: its walls carry the
+//!   liquid's pressure `p = K (V* − V)/V*`, a follower pressure, with the potential
+//!   `U = K (V − V*)²/(2V*)` (see [`Load::Chamber`]).
 //!
 //! Traction and body force are constant over a step. Pressure and cable derive from the
 //! potentials `U = p V(x)`, `V = Σ (x_a − o)·((x_b − o) × (x_c − o)) / 6` over the triangles
@@ -27,14 +31,18 @@
 //! its Newton solve descends an energy (exact on a closed surface or a pinned rim, first order
 //! in the step at a free rim); a static solve takes `R` afresh at every Newton iteration and
 //! meets the exact follower load at equilibrium; explicit steps use the exact force.
-//! Every load is internal in the sense of momentum where it should be: a cavity's pressure and
-//! a cable exert no net force or torque on the body.
+//! A chamber derives from its potential alike (its closed surface has no rim). Every load is
+//! internal in the sense of momentum where it should be: a cavity's pressure, a chamber and a
+//! cable exert no net force or torque on the body.
 
+mod chamber;
 mod follower;
+mod value;
 
+pub use chamber::WATER_BULK_MODULUS;
+pub(crate) use chamber::{ChamberTerms, take_in as take_in_chambers};
 pub(crate) use follower::add_follower_tangents;
 
-use crate::Error;
 use rapier3d::glamx::DVec3;
 
 /// A load on a deformable body (see the module documentation).
@@ -72,6 +80,48 @@ pub enum Load {
         /// The tension (N), not negative: a cable pulls, it cannot push.
         tension: f64,
     },
+    /// A cavity filled with a liquid of bulk modulus `K` (Pa) that a pump holds at the volume
+    /// `V*` (m³), as a hydraulic actuator is driven by volume. At the cavity's volume `V` the
+    /// liquid stores `U = K (V − V*)²/(2V*)` (J) and pushes on the walls with the pressure
+    /// `p = K (V* − V)/V*` (Pa, [`Load::pressure_at`]), so the cavity gives way by `p/K` of its
+    /// volume. Its tangent is the follower pressure's at `p` plus `(K/V*) g gᵀ` (`g = ∂V/∂x`),
+    /// a rank-one term coupling every node of the walls that Newton solves take in by the
+    /// Woodbury identity with the factorization of the rest: a body with a chamber is solved by
+    /// factorization whatever [`LinearSolver`](crate::linear_solver::LinearSolver) says. Its
+    /// value ([`Load::set`]) is the volume `V*`.
+    ///
+    /// ```
+    /// # #[cfg(feature = "import")] {
+    /// use rapier_fvm::load::WATER_BULK_MODULUS;
+    /// use rapier_fvm::mesh::import::{self, SurfaceOptions};
+    /// use rapier_fvm::prelude::*;
+    ///
+    /// // gmsh's hollow sphere (radii 50 and 25 mm), its cavity filled with water.
+    /// let file = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/meshes/hollow_sphere_v41.msh");
+    /// let shell = import::load_raw(file, 0.001, &SurfaceOptions::default())?.into_mesh()?;
+    /// let walls = shell.surface_triangles_where(|p| p.length() < 0.026);
+    /// let rubber = Material::new(MaterialModel::StableNeoHookean, 1e6, 0.45, 1100.0)?;
+    /// let mut body = DeformableBodyBuilder::new(shell, rubber).build()?;
+    /// let rest = Load::enclosed_volume_of(&walls, body.positions()).expect("a closed surface");
+    /// let chamber = Load::Chamber { triangles: walls, volume: rest, bulk_modulus: WATER_BULK_MODULUS };
+    /// let pump = body.add_load(chamber)?;
+    /// // A controller pumps in 1 % more; the walls, not moved yet, feel K (V* − V)/V*.
+    /// body.set_load(pump, LoadValue::Scalar(1.01 * rest))?;
+    /// let pressure = body.load(pump).unwrap().pressure_at(body.positions()).unwrap();
+    /// assert!((pressure / (WATER_BULK_MODULUS * 0.01 / 1.01) - 1.0).abs() < 1e-9);
+    /// # }
+    /// # Ok::<(), rapier_fvm::Error>(())
+    /// ```
+    Chamber {
+        /// The cavity's walls: a closed, consistently oriented surface, node indices oriented
+        /// out of the body (into the cavity).
+        triangles: Vec<[u32; 3]>,
+        /// The volume (m³) the pump holds the liquid at, positive: what the cavity encloses
+        /// when the liquid is at zero pressure.
+        volume: f64,
+        /// The liquid's bulk modulus (Pa), positive ([`WATER_BULK_MODULUS`] for water).
+        bulk_modulus: f64,
+    },
 }
 
 /// A load's index on its body, given by
@@ -88,111 +138,12 @@ pub struct LoadHandle(pub u32);
 pub enum LoadValue {
     /// A traction (Pa) or force density (N/m³), for [`Load::Traction`] and [`Load::BodyForce`].
     Vector(DVec3),
-    /// A pressure (Pa) or tension (N), for [`Load::Pressure`] and [`Load::Cable`].
+    /// A pressure (Pa), tension (N) or volume (m³), for [`Load::Pressure`], [`Load::Cable`]
+    /// and [`Load::Chamber`].
     Scalar(f64),
 }
 
-/// What [`Load::set`] says of a value of the other kind.
-const VALUE_KINDS: &str =
-    "a vector is the value of a traction or body force, a number that of a pressure or cable";
-
 impl Load {
-    /// The load's name, for messages.
-    pub fn kind(&self) -> &'static str {
-        match self {
-            Self::Traction { .. } => "traction",
-            Self::Pressure { .. } => "pressure",
-            Self::BodyForce { .. } => "body force",
-            Self::Cable { .. } => "cable",
-        }
-    }
-
-    /// The load's current magnitude.
-    pub fn value(&self) -> LoadValue {
-        match self {
-            Self::Traction { traction, .. } => LoadValue::Vector(*traction),
-            Self::BodyForce { density } => LoadValue::Vector(*density),
-            Self::Pressure { pressure, .. } => LoadValue::Scalar(*pressure),
-            Self::Cable { tension, .. } => LoadValue::Scalar(*tension),
-        }
-    }
-
-    /// Sets the load's magnitude, checked as [`Load::check`] does.
-    ///
-    /// # Errors
-    /// [`Error::InvalidLoad`] for a value of the other kind (a vector for a pressure), a
-    /// non-finite value or a negative tension; the load is then unchanged.
-    pub fn set(&mut self, value: LoadValue) -> Result<(), Error> {
-        let mut changed = self.clone();
-        match (&mut changed, value) {
-            (Self::Traction { traction: v, .. }, LoadValue::Vector(new))
-            | (Self::BodyForce { density: v }, LoadValue::Vector(new)) => *v = new,
-            (Self::Pressure { pressure: v, .. }, LoadValue::Scalar(new))
-            | (Self::Cable { tension: v, .. }, LoadValue::Scalar(new)) => *v = new,
-            _ => return Err(self.invalid(VALUE_KINDS)),
-        }
-        changed.check_value()?;
-        *self = changed;
-        Ok(())
-    }
-
-    /// Checks that the load's nodes exist among `node_count` and that its value is finite (and
-    /// a tension not negative).
-    ///
-    /// # Errors
-    /// [`Error::InvalidLoad`] saying what is wrong.
-    pub fn check(&self, node_count: usize) -> Result<(), Error> {
-        let in_range =
-            |mut nodes: std::slice::Iter<'_, u32>| nodes.all(|&n| (n as usize) < node_count);
-        match self {
-            Self::Traction { triangles, .. } | Self::Pressure { triangles, .. } => {
-                if !in_range(triangles.as_flattened().iter()) {
-                    return Err(self.invalid("a triangle names a node the body does not have"));
-                }
-                if triangles.iter().any(|[a, b, c]| a == b || b == c || c == a) {
-                    return Err(self.invalid("a triangle names a node twice"));
-                }
-            }
-            Self::Cable { path, .. } => {
-                if path.len() < 2 {
-                    return Err(self.invalid("a cable's path needs at least two nodes"));
-                }
-                if !in_range(path.iter()) {
-                    return Err(self.invalid("the path names a node the body does not have"));
-                }
-                if path.windows(2).any(|w| w[0] == w[1]) {
-                    return Err(self.invalid("the path names a node twice in a row"));
-                }
-            }
-            Self::BodyForce { .. } => {}
-        }
-        self.check_value()
-    }
-
-    /// [`Error::InvalidLoad`] for a non-finite value or a negative tension.
-    fn check_value(&self) -> Result<(), Error> {
-        let finite = match self.value() {
-            LoadValue::Vector(v) => v.is_finite(),
-            LoadValue::Scalar(s) => s.is_finite(),
-        };
-        if !finite {
-            return Err(self.invalid("its value must be finite"));
-        }
-        if let Self::Cable { tension, .. } = self
-            && *tension < 0.0
-        {
-            return Err(self.invalid("a cable's tension cannot be negative (a cable only pulls)"));
-        }
-        Ok(())
-    }
-
-    fn invalid(&self, reason: &str) -> Error {
-        Error::InvalidLoad {
-            load: self.kind(),
-            reason: reason.to_owned(),
-        }
-    }
-
     /// Adds the load's force (N per node) to `forces` if it is a dead load (traction, body
     /// force), at the rest positions `rest` (m) with `control_volume(n)` the rest control volume
     /// (m³) of node `n`.
@@ -220,7 +171,7 @@ impl Load {
                     *f += *b * control_volume(n);
                 }
             }
-            Self::Pressure { .. } | Self::Cable { .. } => {}
+            Self::Pressure { .. } | Self::Cable { .. } | Self::Chamber { .. } => {}
         }
     }
 
@@ -233,15 +184,46 @@ impl Load {
                 pressure,
             } => follower::add_pressure_forces(triangles, *pressure, x, forces),
             Self::Cable { path, tension } => follower::add_cable_forces(path, *tension, x, forces),
+            Self::Chamber { triangles, .. } => {
+                let pressure = self.pressure_at(x).unwrap_or(0.0);
+                follower::add_pressure_forces(triangles, pressure, x, forces);
+            }
             Self::Traction { .. } | Self::BodyForce { .. } => {}
         }
+    }
+
+    /// The pressure (Pa) the load pushes its triangles with at the positions `x` (m): a
+    /// pressure's value, a chamber's liquid's `K (V* − V)/V*`; `None` for other loads.
+    pub fn pressure_at(&self, x: &[DVec3]) -> Option<f64> {
+        match self {
+            Self::Pressure { pressure, .. } => Some(*pressure),
+            Self::Chamber {
+                triangles,
+                volume,
+                bulk_modulus,
+            } => Some(chamber::pressure(
+                chamber::volume(triangles, x),
+                (*volume, *bulk_modulus),
+            )),
+            _ => None,
+        }
+    }
+
+    /// The volume (m³) the closed surface `triangles` (oriented out of the body, so into the
+    /// cavity they close) encloses at the positions `x` (m): a chamber's volume at rest when `x`
+    /// are the rest positions. `None` if the triangles are not a closed, consistently oriented
+    /// surface; negative if they face out of what they close (a body's outer surface).
+    pub fn enclosed_volume_of(triangles: &[[u32; 3]], x: &[DVec3]) -> Option<f64> {
+        follower::is_closed(triangles).then(|| chamber::volume(triangles, x))
     }
 
     /// The point (m) a pressure's potential measures its cone from at the positions `x` (m):
     /// its triangles' centre (the world's origin for other loads, which do not use it).
     pub(crate) fn cone_origin(&self, x: &[DVec3]) -> DVec3 {
         match self {
-            Self::Pressure { triangles, .. } => follower::centre(triangles, x),
+            Self::Pressure { triangles, .. } | Self::Chamber { triangles, .. } => {
+                follower::centre(triangles, x)
+            }
             _ => DVec3::ZERO,
         }
     }
@@ -256,6 +238,11 @@ impl Load {
                 pressure,
             } => follower::add_cone_forces(triangles, *pressure, x, origin, forces),
             Self::Cable { path, tension } => follower::add_cable_forces(path, *tension, x, forces),
+            Self::Chamber { triangles, .. } => {
+                // A closed surface's cone does not depend on its origin: the exact force.
+                let pressure = self.pressure_at(x).unwrap_or(0.0);
+                follower::add_cone_forces(triangles, pressure, x, origin, forces);
+            }
             Self::Traction { .. } | Self::BodyForce { .. } => {}
         }
     }
@@ -276,6 +263,7 @@ impl Load {
             Self::Cable { path, tension } => {
                 tension * (follower::path_length(path, x) - follower::path_length(path, start))
             }
+            Self::Chamber { .. } => self.chamber_energy(x) - self.chamber_energy(start),
             Self::Traction { .. } | Self::BodyForce { .. } => 0.0,
         }
     }
@@ -283,7 +271,8 @@ impl Load {
     /// The load's potential energy `U` (J) at the positions `x` (m), measured from the origin
     /// (rest positions `rest` (m) and nodal `control_volume` (m³) as for
     /// [`Load::add_dead_forces`]): `−Σ f·x` for a dead load, `p V` (the cone from the world's
-    /// origin) for a pressure, `T L` for a cable. Its changes are the work the load did not do.
+    /// origin) for a pressure, `T L` for a cable, the liquid's `K (V − V*)²/(2V*)` for a
+    /// chamber. Its changes are the work the load did not do.
     pub(crate) fn potential(
         &self,
         rest: &[DVec3],
@@ -301,18 +290,30 @@ impl Load {
                 pressure,
             } => pressure * follower::cone_volume(triangles, x, DVec3::ZERO),
             Self::Cable { path, tension } => tension * follower::path_length(path, x),
+            Self::Chamber { .. } => self.chamber_energy(x),
         }
     }
 
-    /// For a pressure on a closed surface, the volume (m³) it encloses at the positions `x`
-    /// (m): a cavity's volume, whose faces are oriented out of the body and so into the cavity.
-    /// `None` for other loads; for an open surface the volume of the cone its triangles span
-    /// from their centre.
+    /// A chamber's liquid's energy (J) at the positions `x` (m); zero for other loads.
+    fn chamber_energy(&self, x: &[DVec3]) -> f64 {
+        match self {
+            Self::Chamber {
+                triangles,
+                volume,
+                bulk_modulus,
+            } => chamber::energy(chamber::volume(triangles, x), (*volume, *bulk_modulus)),
+            _ => 0.0,
+        }
+    }
+
+    /// For a pressure on a closed surface or a chamber, the volume (m³) it encloses at the
+    /// positions `x` (m): a cavity's volume, whose faces are oriented out of the body and so
+    /// into the cavity. `None` for other loads; for an open surface the volume of the cone its
+    /// triangles span from their centre.
     pub fn enclosed_volume(&self, x: &[DVec3]) -> Option<f64> {
         match self {
-            Self::Pressure { triangles, .. } => {
-                let origin = follower::centre(triangles, x);
-                Some(-follower::cone_volume(triangles, x, origin))
+            Self::Pressure { triangles, .. } | Self::Chamber { triangles, .. } => {
+                Some(chamber::volume(triangles, x))
             }
             _ => None,
         }
@@ -323,19 +324,26 @@ impl Load {
     /// the highest frequency it adds: `2T/d` at each end of a cable segment of length `d` (its
     /// blocks `±T (I − d̂ d̂ᵀ)/d`), `|p| s/6` at each corner of a pressurized triangle of
     /// perimeter `s` (its blocks `(p/6) [x_c − x_b]ₓ`, `(p/6) [x_c − x_a]ₓ`, `(p/6) [x_b − x_a]ₓ`
-    /// at corner `a`); dead loads add nothing.
+    /// at corner `a`), and for a chamber that of its pressure and its liquid's rank-one term
+    /// ([`chamber::add_stiffness_bounds`]); dead loads add nothing.
     pub(crate) fn add_stiffness_bounds(&self, x: &[DVec3], rows: &mut [f64]) {
         match self {
-            Self::Pressure {
-                triangles,
-                pressure,
-            } => {
+            Self::Pressure { triangles, .. } | Self::Chamber { triangles, .. } => {
+                let pressure = self.pressure_at(x).unwrap_or(0.0);
                 for &[a, b, c] in triangles {
                     let [xa, xb, xc] = [a, b, c].map(|n| x[n as usize]);
                     let perimeter = xa.distance(xb) + xb.distance(xc) + xc.distance(xa);
                     for n in [a, b, c] {
                         rows[n as usize] += pressure.abs() * perimeter / 6.0;
                     }
+                }
+                if let Self::Chamber {
+                    volume,
+                    bulk_modulus,
+                    ..
+                } = self
+                {
+                    chamber::add_stiffness_bounds(triangles, (*volume, *bulk_modulus), x, rows);
                 }
             }
             Self::Cable { path, tension } => {
@@ -357,21 +365,31 @@ impl Load {
         let Self::Pressure { triangles, .. } = self else {
             return None;
         };
-        if !follower::is_closed(triangles) {
-            return None;
+        follower::is_closed(triangles).then(|| chamber::volume_gradient(triangles, x))
+    }
+
+    /// For a chamber, its liquid's rank-one tangent `w g gᵀ` at the positions `x` (m): the
+    /// gradient `g = ∇V` (m² per node) of its volume and `w = K/V*` (Pa/m³). `None` for other
+    /// loads.
+    pub(crate) fn chamber_term(&self, x: &[DVec3]) -> Option<(Vec<DVec3>, f64)> {
+        match self {
+            Self::Chamber {
+                triangles,
+                volume,
+                bulk_modulus,
+            } => Some((
+                chamber::volume_gradient(triangles, x),
+                bulk_modulus / volume,
+            )),
+            _ => None,
         }
-        let mut gradient = vec![DVec3::ZERO; x.len()];
-        let origin = follower::centre(triangles, x);
-        // Minus the cone's gradient, as a cavity's faces point into it.
-        follower::add_cone_forces(triangles, 1.0, x, origin, &mut gradient);
-        Some(gradient)
     }
 
     /// The node pairs the load's tangent couples (`[a, b]`, `a > b`).
     pub(crate) fn coupled_pairs(&self) -> Vec<[u32; 2]> {
         let ordered = |a: u32, b: u32| if a > b { [a, b] } else { [b, a] };
         match self {
-            Self::Pressure { triangles, .. } => triangles
+            Self::Pressure { triangles, .. } | Self::Chamber { triangles, .. } => triangles
                 .iter()
                 .flat_map(|&[a, b, c]| [ordered(a, b), ordered(b, c), ordered(c, a)])
                 .collect(),

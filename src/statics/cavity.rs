@@ -13,6 +13,7 @@ use super::{StaticReport, StaticSettings, assemble_elastic, solve_equilibrium};
 use crate::Error;
 use crate::assembly::{Stiffness, factorize, solve};
 use crate::body::DeformableBody;
+use crate::load::take_in_chambers;
 use crate::load::{LoadHandle, LoadValue};
 use rapier3d::glamx::DVec3;
 
@@ -189,7 +190,7 @@ fn enclosed_volume(body: &DeformableBody, cavity: LoadHandle) -> f64 {
 }
 
 /// `dV/dp = gᵀ K⁻¹ g` (m³/Pa) at the current equilibrium: how much the enclosed volume grows
-/// per pascal, through the tangent stiffness with the pressure's own.
+/// per pascal, through the tangent stiffness with the pressure's own (and any chamber's).
 fn volume_compliance(body: &DeformableBody, cavity: LoadHandle) -> Result<f64, Error> {
     let mut gradient = cavity_gradient(body, cavity)?;
     for (g, &pinned) in gradient.iter_mut().zip(&body.pinned) {
@@ -201,5 +202,6 @@ fn volume_compliance(body: &DeformableBody, cavity: LoadHandle) -> Result<f64, E
     assemble_elastic(&mut stiffness, body, false);
     let factor = factorize(&mut stiffness, 0)?;
     let response = solve(&factor, &gradient);
+    let response = take_in_chambers(&body.chamber_terms(), &factor, &gradient, response);
     Ok(gradient.iter().zip(&response).map(|(g, u)| g.dot(*u)).sum())
 }

@@ -17,6 +17,7 @@ use crate::assembly::{Stiffness, factorize, solve};
 use crate::body::DeformableBody;
 use crate::integrate::SolverWorkspace;
 use crate::linear_solver::{Method, solve_newton_system};
+use crate::load::take_in_chambers;
 use crate::newton::{Search, check_tolerance, descend, norm, round_off_floor};
 use rapier3d::glamx::{DMat3, DVec3};
 
@@ -123,17 +124,7 @@ fn newton(
             });
         }
         history.push(relative);
-        // The exact tangent converges quadratically; where the body is in an unstable (buckling)
-        // state it is indefinite, and the projected tangent still gives a descent direction.
-        let step = solve_newton_system(
-            Method::Direct,
-            1.0,
-            stiffness,
-            &residual,
-            iteration,
-            |stiffness, project| assemble_elastic(stiffness, body, project),
-        )?
-        .direction;
+        let step = newton_direction(body, stiffness, &residual, iteration)?;
         // This iteration's energy holds the follower loads' part no potential gives (a free
         // rim's, see `crate::load`) at its value here: its gradient is the residual here.
         let origins = body.cone_origins();
@@ -180,8 +171,35 @@ fn newton(
     }
 }
 
+/// The Newton direction (m per node) for the out-of-balance force `residual` (N) at Newton's
+/// `iteration`, the chambers' liquids' stiffness taken in. The exact tangent converges
+/// quadratically; where the body is in an unstable (buckling) state it is indefinite, and the
+/// projected tangent still gives a descent direction.
+fn newton_direction(
+    body: &DeformableBody,
+    stiffness: &mut Stiffness,
+    residual: &[DVec3],
+    iteration: usize,
+) -> Result<Vec<DVec3>, Error> {
+    let solution = solve_newton_system(
+        Method::Direct,
+        1.0,
+        stiffness,
+        residual,
+        iteration,
+        |stiffness, project| assemble_elastic(stiffness, body, project),
+    )?;
+    Ok(match &solution.factor {
+        Some(factor) => {
+            take_in_chambers(&body.chamber_terms(), factor, residual, solution.direction)
+        }
+        None => solution.direction,
+    })
+}
+
 /// The lowest natural frequency (Hz) of small undamped vibrations about the current positions,
-/// with pinned nodes held: `K φ = ω² M φ` solved by inverse iteration with the lumped mass until
+/// with pinned nodes held: `K φ = ω² M φ` (`K` the tangent stiffness, the loads' and the
+/// chambers' liquids' included) solved by inverse iteration with the lumped mass until
 /// the Rayleigh quotient changes by less than 1e-13 (relative), or 500 iterations, after which
 /// the current estimate is returned (convergence is geometric in the ratio of the two lowest
 /// distinct frequencies, so 500 iterations are only reached for nearly equal ones).
@@ -198,6 +216,7 @@ pub fn fundamental_frequency(body: &DeformableBody) -> Result<f64, Error> {
     let mut stiffness = Stiffness::new(body);
     assemble_elastic(&mut stiffness, body, false);
     let factor = factorize(&mut stiffness, 0)?;
+    let chambers = body.chamber_terms();
     let masses = &body.masses;
     let free = |n: usize| !body.pinned[n];
     // Start from a fixed pseudo-random motion of the free nodes, which has a component on every
@@ -215,6 +234,7 @@ pub fn fundamental_frequency(body: &DeformableBody) -> Result<f64, Error> {
     for _ in 0..MAX_ITERATIONS {
         let mass_times_mode: Vec<DVec3> = mode.iter().zip(masses).map(|(x, m)| *x * *m).collect();
         let next = solve(&factor, &mass_times_mode);
+        let next = take_in_chambers(&chambers, &factor, &mass_times_mode, next);
         // Rayleigh quotient of the previous iterate: xᵀ M x / xᵀ M K⁻¹ M x.
         let x_m_x: f64 = mode
             .iter()

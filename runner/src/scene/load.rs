@@ -13,18 +13,25 @@
 //!   { tension = 20.0, path = [[-0.5, 0.03, 0.0], [0.5, 0.03, 0.0]] },
 //!                                                       # N: a cable through the nodes nearest
 //!                                                       # the points, in order
+//!   { volume_ratio = [{ time = 0.0, value = 1.0 }, { time = 1.0, value = 1.5 }],
+//!     region = "chamber", bulk_modulus = 2.2e9 },       # a chamber: a cavity filled with a
+//!                                                       # liquid (Pa, default water's) pumped
+//!                                                       # to this many times its rest volume
 //! ]
 //! ```
 //! A pressure or traction acts on the boundary triangles whose three corners the box or region
 //! selects; a region's triangles pointing out of the body (a closed inner surface is a
-//! cavity). A cable's path is given as points in the mesh's rest coordinates; its eyelets are
+//! cavity). A chamber's triangles must close its cavity
+//! ([`Load::Chamber`](rapier_fvm::load::Load::Chamber)): it holds a volume where a pressure
+//! holds a force. A cable's path is given as points in the mesh's rest coordinates; its eyelets are
 //! the nearest nodes (consecutive repeats dropped).
 
 use super::check::Checker;
 use super::soft_body::RegionName;
 use serde::Deserialize;
 
-/// A load on a soft body: exactly one of `pressure`, `traction`, `body_force`, `tension`.
+/// A load on a soft body: exactly one of `pressure`, `traction`, `body_force`, `tension`,
+/// `volume_ratio`.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LoadSpec {
@@ -38,6 +45,10 @@ pub struct LoadSpec {
     pub tension: Option<Schedule<f64>>,
     /// The cable's path: points (m, rest coordinates) whose nearest nodes are its eyelets.
     pub path: Option<Vec<[f64; 3]>>,
+    /// A chamber's volume, as a multiple of its cavity's rest volume (positive).
+    pub volume_ratio: Option<Schedule<f64>>,
+    /// A chamber's liquid's bulk modulus (Pa, positive); default water's, 2.2e9.
+    pub bulk_modulus: Option<f64>,
     /// Lower corner of the box (m, rest coordinates) selecting a pressure's or traction's
     /// boundary.
     pub min: Option<[f64; 3]>,
@@ -63,7 +74,7 @@ pub enum Schedule<T> {
 pub struct LoadKeyframe<T> {
     /// Simulated time (s).
     pub time: f64,
-    /// The value (Pa, N/m³ or N).
+    /// The value (Pa, N/m³, N, or a volume ratio).
     pub value: T,
 }
 
@@ -149,7 +160,40 @@ impl<T: Interpolated> Schedule<T> {
     }
 }
 
+/// What a load must name, one of.
+pub(crate) const KINDS: &str =
+    "give one of `pressure`, `traction`, `body_force`, `tension` or `volume_ratio`";
+
 impl LoadSpec {
+    /// Checks a chamber's volume ratio (positive) and bulk modulus (positive, with a volume
+    /// ratio only); `key` is the load's key path.
+    fn check_chamber(&self, key: &str, c: &mut Checker<'_>) {
+        if let Some(s) = &self.volume_ratio {
+            s.check(&format!("{key}.volume_ratio"), c);
+            let positive = match s {
+                Schedule::Constant(r) => *r > 0.0,
+                Schedule::Keyframes(frames) => frames.iter().all(|f| f.value > 0.0),
+            };
+            if !positive {
+                c.fail(
+                    &format!("{key}.volume_ratio"),
+                    "a chamber's volume must be positive",
+                );
+            }
+        }
+        match (self.bulk_modulus, self.volume_ratio.is_some()) {
+            (Some(_), false) => c.fail(
+                &format!("{key}.bulk_modulus"),
+                "a bulk modulus is a chamber's (with `volume_ratio`)",
+            ),
+            (Some(k), true) if !(k.is_finite() && k > 0.0) => c.fail(
+                &format!("{key}.bulk_modulus"),
+                "a liquid's bulk modulus must be positive and finite",
+            ),
+            _ => {}
+        }
+    }
+
     /// Checks that it names one kind of load with what that kind needs, and the values;
     /// `key` is its key path.
     pub(crate) fn check(&self, key: &str, c: &mut Checker<'_>) {
@@ -158,23 +202,23 @@ impl LoadSpec {
             self.traction.is_some(),
             self.body_force.is_some(),
             self.tension.is_some(),
+            self.volume_ratio.is_some(),
         ];
         if kinds.iter().filter(|&&k| k).count() != 1 {
-            c.fail(
-                key,
-                "give one of `pressure`, `traction`, `body_force` or `tension`",
-            );
+            c.fail(key, KINDS);
             return;
         }
-        let on_surface = self.pressure.is_some() || self.traction.is_some();
+        let on_surface =
+            self.pressure.is_some() || self.traction.is_some() || self.volume_ratio.is_some();
         if on_surface {
             self.selection().check(key, c);
         } else if self.min.is_some() || self.max.is_some() || self.region.is_some() {
             c.fail(
                 key,
-                "only a `pressure` or a `traction` acts on a box or region",
+                "only a `pressure`, a `traction` or a `volume_ratio` acts on a box or region",
             );
         }
+        self.check_chamber(key, c);
         if self.tension.is_some() != self.path.is_some() {
             c.fail(
                 &format!("{key}.path"),

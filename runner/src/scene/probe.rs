@@ -44,6 +44,12 @@
 //! kind = "angular_momentum" # Σ m (x - c) × v of soft `body` about its centre of mass c, or of
 //! body = "block"            # all about theirs (N m s)
 //! component = "z"
+//!
+//! [[probe]]
+//! name = "chamber pressure"
+//! kind = "cavity_pressure"  # or "cavity_volume": the pressure (Pa) or enclosed volume (m³) of
+//! body = "finger"           # soft `body`'s load number `load` (from 0, in the order of its
+//! load = 0                  # `loads`), a pressure or a chamber
 //! ```
 //! The contact force is the frame's mean force the soft bodies' contacts and attachments
 //! exerted on the rigid body (`FvmWorld::load_on`); the force on a soft body is its opposite.
@@ -73,6 +79,8 @@ pub struct ProbeSpec {
     pub component: Component,
     /// Which energy (energy probes).
     pub energy: Option<EnergyKind>,
+    /// The soft body's load, by its index in the body's `loads` (cavity probes).
+    pub load: Option<usize>,
 }
 
 /// What a probe measures.
@@ -95,6 +103,10 @@ pub enum ProbeKind {
     Momentum,
     /// The angular momentum of soft bodies about their centre of mass (N m s).
     AngularMomentum,
+    /// The pressure a soft body's pressure or chamber load pushes with (Pa).
+    CavityPressure,
+    /// The volume a soft body's pressure or chamber load encloses (m³).
+    CavityVolume,
 }
 
 /// A component of a vector quantity.
@@ -138,6 +150,8 @@ impl ProbeKind {
             Self::Energy => "energy",
             Self::Momentum => "momentum",
             Self::AngularMomentum => "angular_momentum",
+            Self::CavityPressure => "cavity_pressure",
+            Self::CavityVolume => "cavity_volume",
         }
     }
 
@@ -150,6 +164,8 @@ impl ProbeKind {
             Self::Energy => "J",
             Self::Momentum => "kg m/s",
             Self::AngularMomentum => "N m s",
+            Self::CavityPressure => "Pa",
+            Self::CavityVolume => "m³",
         }
     }
 }
@@ -160,8 +176,8 @@ impl ProbeSpec {
     pub(crate) fn check(&self, key: &str, soft: &[&str], rigid: &[&str], c: &mut Checker<'_>) {
         use Need::{Forbidden, Optional, Required};
         use ProbeKind::{
-            AngularMomentum, ContactForce, ContactForceOnSoft, Displacement, Energy, Momentum,
-            Position, Velocity,
+            AngularMomentum, CavityPressure, CavityVolume, ContactForce, ContactForceOnSoft,
+            Displacement, Energy, Momentum, Position, Velocity,
         };
         let (body, rigid_body, point, energy) = match self.kind {
             Displacement => (Required, Forbidden, Required, Forbidden),
@@ -170,6 +186,11 @@ impl ProbeSpec {
             ContactForceOnSoft => (Required, Optional, Forbidden, Forbidden),
             Energy => (Optional, Forbidden, Forbidden, Required),
             Momentum | AngularMomentum => (Optional, Forbidden, Forbidden, Forbidden),
+            CavityPressure | CavityVolume => (Required, Forbidden, Forbidden, Forbidden),
+        };
+        let load = match self.kind {
+            CavityPressure | CavityVolume => Required,
+            _ => Forbidden,
         };
         let kind = self.kind.name();
         let presence = [
@@ -177,6 +198,7 @@ impl ProbeSpec {
             ("rigid", self.rigid.is_some(), rigid_body),
             ("point", self.point.is_some(), point),
             ("energy", self.energy.is_some(), energy),
+            ("load", self.load.is_some(), load),
         ];
         for (name, given, need) in presence {
             match (given, need) {
@@ -192,8 +214,10 @@ impl ProbeSpec {
                 _ => {}
             }
         }
-        if self.kind == Energy && self.component != Component::Norm {
-            c.fail(&format!("{key}.component"), "an energy has no component");
+        if matches!(self.kind, Energy | CavityPressure | CavityVolume)
+            && self.component != Component::Norm
+        {
+            c.fail(&format!("{key}.component"), "a scalar has no component");
         }
         if let Some(body) = &self.body
             && !soft.contains(&body.as_str())

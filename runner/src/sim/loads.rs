@@ -2,11 +2,11 @@
 //! region selects, a cable's eyelets, each load's value at the start, and what drives it over
 //! time.
 
-use crate::scene::load::{LoadSpec, Schedule};
+use crate::scene::load::{KINDS, LoadSpec, Schedule};
 use crate::scene::{SceneError, SceneSource};
 use rapier_fvm::body::DeformableBody;
 use rapier_fvm::glamx::DVec3;
-use rapier_fvm::load::{Load, LoadHandle, LoadValue};
+use rapier_fvm::load::{Load, LoadHandle, LoadValue, WATER_BULK_MODULUS};
 use rapier_fvm::mesh::TetMesh;
 use rapier_fvm::mesh::import::MeshRegion;
 
@@ -17,6 +17,13 @@ pub enum LoadSchedule {
     Scalar(Schedule<f64>),
     /// A traction (Pa) or force density (N/m³).
     Vector(Schedule<[f64; 3]>),
+    /// A chamber's volume: ratios to its cavity's rest volume `rest` (m³).
+    Volume {
+        /// The ratios over time.
+        ratio: Schedule<f64>,
+        /// The cavity's rest volume (m³).
+        rest: f64,
+    },
 }
 
 impl LoadSchedule {
@@ -25,13 +32,14 @@ impl LoadSchedule {
         match self {
             Self::Scalar(s) => LoadValue::Scalar(s.at(t)),
             Self::Vector(s) => LoadValue::Vector(DVec3::from_array(s.at(t))),
+            Self::Volume { ratio, rest } => LoadValue::Scalar(ratio.at(t) * rest),
         }
     }
 
     /// Whether the value changes over time.
     fn varies(&self) -> bool {
         match self {
-            Self::Scalar(s) => s.varies(),
+            Self::Scalar(s) | Self::Volume { ratio: s, .. } => s.varies(),
             Self::Vector(s) => s.varies(),
         }
     }
@@ -133,13 +141,42 @@ pub(super) fn build_loads(
                     LoadSchedule::Scalar(s.clone()),
                 )
             }
-            // The scene's check asks for exactly one kind, a cable with its path.
-            _ => {
-                return Err(source.error(
-                    &key,
-                    "give one of `pressure`, `traction`, `body_force` or `tension`",
-                ));
+            LoadSpec {
+                volume_ratio: Some(s),
+                bulk_modulus,
+                ..
+            } => {
+                let triangles = triangles()?;
+                let rest = match Load::enclosed_volume_of(&triangles, mesh.positions()) {
+                    Some(rest) if rest > 0.0 => rest,
+                    Some(_) => {
+                        return Err(source.error(
+                            &key,
+                            "its boundary triangles enclose no cavity (a chamber's face into \
+                             its cavity: select an inner surface, not the body's outside)",
+                        ));
+                    }
+                    None => {
+                        return Err(source.error(
+                            &key,
+                            "a chamber's walls must be a closed surface: its boundary \
+                             triangles leave holes",
+                        ));
+                    }
+                };
+                let schedule = LoadSchedule::Volume {
+                    ratio: s.clone(),
+                    rest,
+                };
+                let load = Load::Chamber {
+                    triangles,
+                    volume: s.at(0.0) * rest,
+                    bulk_modulus: bulk_modulus.unwrap_or(WATER_BULK_MODULUS),
+                };
+                (load, schedule)
             }
+            // The scene's check asks for exactly one kind, a cable with its path.
+            _ => return Err(source.error(&key, KINDS)),
         };
         loads.push((load, schedule, key));
     }

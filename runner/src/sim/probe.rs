@@ -6,6 +6,7 @@ use crate::scene::probe::{Component, EnergyKind, ProbeKind, ProbeSpec};
 use crate::scene::{SceneError, SceneSource};
 use rapier_fvm::body::DeformableBody;
 use rapier_fvm::glamx::DVec3;
+use rapier_fvm::load::LoadHandle;
 
 /// A probe and the samples taken so far.
 #[derive(Debug, Clone)]
@@ -55,6 +56,11 @@ enum Target {
     AngularMomentum {
         soft: Option<usize>,
         component: Component,
+    },
+    Cavity {
+        soft: usize,
+        load: LoadHandle,
+        pressure: bool,
     },
 }
 
@@ -133,6 +139,23 @@ impl Probe {
                 soft: soft(&spec.body)?,
                 component,
             },
+            ProbeKind::CavityPressure | ProbeKind::CavityVolume => {
+                let soft = soft(&spec.body)?.ok_or_else(|| missing("body"))?;
+                let load = LoadHandle(spec.load.ok_or_else(|| missing("load"))? as u32);
+                let body = &simulation.world.soft_bodies[simulation.soft[soft].handle];
+                let encloses = (body.load(load)).and_then(|l| l.enclosed_volume(body.positions()));
+                if encloses.is_none() {
+                    return Err(source.error(
+                        &format!("{key}.load"),
+                        "the body has no pressure or chamber load of that number",
+                    ));
+                }
+                Target::Cavity {
+                    soft,
+                    load,
+                    pressure: spec.kind == ProbeKind::CavityPressure,
+                }
+            }
         };
         Ok(Self {
             target,
@@ -182,6 +205,19 @@ impl Probe {
             }
             Target::AngularMomentum { soft, component } => {
                 pick(angular_momentum(simulation, soft), component)
+            }
+            Target::Cavity {
+                soft,
+                load,
+                pressure,
+            } => {
+                let body = &world.soft_bodies[simulation.soft[soft].handle];
+                let (load, x) = (body.load(load), body.positions());
+                let value = match pressure {
+                    true => load.and_then(|l| l.pressure_at(x)),
+                    false => load.and_then(|l| l.enclosed_volume(x)),
+                };
+                value.unwrap_or(f64::NAN)
             }
         }
     }

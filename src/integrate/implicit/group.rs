@@ -25,6 +25,7 @@ use crate::constraint::{self, BodyConstraints};
 use crate::contact::{self, BetweenContact, ContactSettings, JointContacts, NodeSlices};
 use crate::integrate::{BodyInStep, PreviousStep};
 use crate::linear_solver::{Method, solve_newton_system};
+use crate::load::{ChamberTerms, take_in_chambers};
 use crate::newton::{Configuration, Search, descend, norm, round_off_floor};
 use rapier3d::glamx::DVec3;
 use std::cell::RefCell;
@@ -554,7 +555,8 @@ impl ImplicitIntegrator {
     }
 
     /// The Newton direction (m per node of the group) of the group's exact tangent (projected
-    /// where it is not positive definite), with each body's rigid partners' response taken in.
+    /// where it is not positive definite), with the members' chambers' liquids taken in, then
+    /// each body's rigid partners' response.
     fn group_direction(
         &self,
         group: &Group,
@@ -575,6 +577,11 @@ impl ImplicitIntegrator {
         outcome.projected_tangents += usize::from(solution.projected);
         let mut direction = solution.direction;
         if let Some(factor) = &solution.factor {
+            let mut chambers = ChamberTerms::default();
+            for (k, body) in group.bodies.iter().enumerate() {
+                chambers.append_placed(body.chamber_terms(), group.offsets[k], group.node_count());
+            }
+            direction = take_in_chambers(&chambers, factor, residual, direction);
             for (k, member) in potential.members.iter().enumerate() {
                 let placement = Placement {
                     offset: group.offsets[k],

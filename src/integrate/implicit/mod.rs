@@ -638,8 +638,7 @@ impl ImplicitIntegrator {
         }
         let mut direction = solution.direction;
         if let Some(factor) = &solution.factor {
-            direction =
-                incremental.take_in_rigid_response(body, (factor, false), residual, direction);
+            direction = incremental.take_in_unassembled(body, (factor, false), residual, direction);
         }
         if let Some(factor) = solution.factor
             && self.reuse_factorization

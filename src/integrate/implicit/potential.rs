@@ -16,6 +16,7 @@ use crate::constraint::{self, BodyConstraints};
 use crate::damping::RayleighDamping;
 use crate::element::deformation_gradient;
 use crate::integrate::PreviousStep;
+use crate::load::take_in_chambers;
 use crate::material::green_strain;
 use crate::newton::norm;
 use rapier3d::glamx::{DMat3, DVec3};
@@ -244,7 +245,7 @@ impl Potential<'_> {
     }
 
     /// The Newton direction (m per node) for `residual` (N) solved with `factor`, an earlier
-    /// iteration's, with the rigid bodies' response taken in.
+    /// iteration's, with the unassembled terms taken in.
     pub(super) fn reused_direction(
         &self,
         body: &DeformableBody,
@@ -252,13 +253,14 @@ impl Potential<'_> {
         residual: &[DVec3],
     ) -> Vec<DVec3> {
         let direction = solve(factor, residual);
-        self.take_in_rigid_response(body, (factor, true), residual, direction)
+        self.take_in_unassembled(body, (factor, true), residual, direction)
     }
 
     /// The Newton direction `direction` (m per node), solved with `factor` (the one of the last
-    /// call if `true`), with the rigid bodies' response taken in (see
+    /// call if `true`), with the tangent's terms that are not assembled taken in: the chambers'
+    /// liquids' ([`crate::load::take_in_chambers`]), then the rigid bodies' response (see
     /// [`RigidResponse::take_in`]).
-    pub(super) fn take_in_rigid_response(
+    pub(super) fn take_in_unassembled(
         &self,
         body: &DeformableBody,
         factor: (&Factor, bool),
@@ -269,6 +271,7 @@ impl Potential<'_> {
             offset: 0,
             total: body.positions.len(),
         };
+        let direction = take_in_chambers(&body.chamber_terms(), factor.0, residual, direction);
         self.take_in_placed(body, factor, placement, residual, direction)
     }
 

@@ -1,0 +1,266 @@
+//! A liquid-filled chamber ([`Load::Chamber`](super::Load::Chamber)): a closed inner surface of
+//! the body (a cavity; its triangles oriented out of the body, so into the cavity) filled with a
+//! liquid of bulk modulus `K` (Pa) that a pump holds at the volume `V*` (m³), as a hydraulic
+//! actuator is driven by volume. At the cavity's volume `V(x)` the liquid stores
+//! `U = K (V − V*)² / (2 V*)` (J) and pushes on the walls with the pressure
+//! `p = −dU/dV = K (V* − V)/V*` (Pa): the walls carry the follower pressure `p` (see
+//! [`crate::load`]), and the Newton tangent is `∇²U = −p ∇²V + (K/V*) g gᵀ` with `g = ∇V` (m² per
+//! node): the follower pressure's tangent at `p` plus a rank-one term that couples every node
+//! of the walls. That term is not assembled (it would fill the factorization among the walls'
+//! nodes); a Newton direction takes it in by the Woodbury identity with the factorization of the
+//! rest ([`take_in`]), one more solve per chamber.
+//!
+//! The volume is held to `p/K` of itself (water, 2.2e9 Pa: 1e-6 at 2.2 kPa): a stiffer liquid
+//! holds it closer and stiffens the explicit step, which the stable step counts
+//! ([`add_stiffness_bounds`]). The liquid is internal: it exerts no net force or torque.
+
+use super::follower;
+use crate::assembly::{Factor, solve_columns};
+use rapier3d::glamx::DVec3;
+use rapier3d::na::{DMatrix, DVector};
+
+/// The bulk modulus of water (Pa) at 20 °C, the default liquid.
+pub const WATER_BULK_MODULUS: f64 = 2.2e9;
+
+/// The volume (m³) the closed surface `triangles` encloses at the positions `x` (m), its
+/// triangles pointing into it.
+pub(super) fn volume(triangles: &[[u32; 3]], x: &[DVec3]) -> f64 {
+    -follower::cone_volume(triangles, x, follower::centre(triangles, x))
+}
+
+/// The liquid's pressure (Pa) at the cavity's volume `volume` (m³): `K (V* − V)/V*`.
+pub(super) fn pressure(volume: f64, (target, bulk_modulus): (f64, f64)) -> f64 {
+    bulk_modulus * (target - volume) / target
+}
+
+/// The liquid's energy (J) at the cavity's volume `volume` (m³): `K (V − V*)² / (2 V*)`.
+pub(super) fn energy(volume: f64, (target, bulk_modulus): (f64, f64)) -> f64 {
+    0.5 * bulk_modulus * (volume - target).powi(2) / target
+}
+
+/// `g = ∇V` (m² per node) of the volume the closed surface `triangles` encloses at `x` (m).
+pub(super) fn volume_gradient(triangles: &[[u32; 3]], x: &[DVec3]) -> Vec<DVec3> {
+    let mut gradient = vec![DVec3::ZERO; x.len()];
+    // Minus the cone's gradient, as the faces point into the cavity.
+    follower::add_cone_forces(
+        triangles,
+        1.0,
+        x,
+        follower::centre(triangles, x),
+        &mut gradient,
+    );
+    gradient
+}
+
+/// Adds to `rows[n]` the row sums `(K/V*) |g_n| Σ_m |g_m|` (N/m) of the norms of the blocks of
+/// the rank-one term `(K/V*) g gᵀ`, for Gershgorin's bound on the highest frequency (the
+/// follower pressure's part is the caller's).
+pub(super) fn add_stiffness_bounds(
+    triangles: &[[u32; 3]],
+    (target, bulk_modulus): (f64, f64),
+    x: &[DVec3],
+    rows: &mut [f64],
+) {
+    let gradient = volume_gradient(triangles, x);
+    let total: f64 = gradient.iter().map(|g| g.length()).sum();
+    let weight = bulk_modulus / target;
+    for (row, g) in rows.iter_mut().zip(&gradient) {
+        *row += weight * g.length() * total;
+    }
+}
+
+/// The rank-one terms `w g gᵀ` of a body's (or a group's) chambers: per chamber its column `g`
+/// (m² per node of the system, zero on pinned nodes) and weight `w = K/V*` (Pa/m³).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct ChamberTerms {
+    pub(crate) columns: Vec<Vec<DVec3>>,
+    pub(crate) weights: Vec<f64>,
+}
+
+impl ChamberTerms {
+    /// Whether there is no chamber.
+    pub(crate) fn is_empty(&self) -> bool {
+        self.columns.is_empty()
+    }
+
+    /// Appends `other`, whose columns are over `other_nodes` nodes placed from node `offset` on
+    /// of a system of `total` nodes (this one's columns already over the system's nodes).
+    pub(crate) fn append_placed(&mut self, other: ChamberTerms, offset: usize, total: usize) {
+        for column in other.columns {
+            let mut placed = vec![DVec3::ZERO; total];
+            placed[offset..offset + column.len()].copy_from_slice(&column);
+            self.columns.push(placed);
+        }
+        self.weights.extend(other.weights);
+    }
+}
+
+/// `direction` solves `K d = r` (`r` the `residual`, N) with `factor`, the tangent without the
+/// chambers' rank-one terms `G W Gᵀ`; this returns `(K + G W Gᵀ)⁻¹ r` by the Woodbury identity,
+/// `d − Z (W⁻¹ + Gᵀ Z)⁻¹ Gᵀ d` with `Z = K⁻¹ G`, or `direction` itself when there is no chamber
+/// or the result would not descend (round-off on a nearly singular system).
+pub(crate) fn take_in(
+    terms: &ChamberTerms,
+    factor: &Factor,
+    residual: &[DVec3],
+    direction: Vec<DVec3>,
+) -> Vec<DVec3> {
+    if terms.is_empty() {
+        return direction;
+    }
+    let dot = |a: &[DVec3], b: &[DVec3]| -> f64 { a.iter().zip(b).map(|(x, y)| x.dot(*y)).sum() };
+    let solved = solve_columns(factor, &terms.columns);
+    let k = terms.columns.len();
+    let system = DMatrix::from_fn(k, k, |i, j| {
+        let inverse_weight = if i == j { 1.0 / terms.weights[i] } else { 0.0 };
+        inverse_weight + dot(&terms.columns[i], &solved[j])
+    });
+    let projection = DVector::from_fn(k, |i, _| dot(&terms.columns[i], &direction));
+    let Some(weights) = system.lu().solve(&projection) else {
+        return direction;
+    };
+    let mut taken = direction.clone();
+    for (z, weight) in solved.iter().zip(weights.iter()) {
+        for (d, z) in taken.iter_mut().zip(z) {
+            *d -= *z * *weight;
+        }
+    }
+    let finite = taken.iter().all(|d| d.is_finite());
+    if finite && dot(residual, &taken) > 0.0 {
+        taken
+    } else {
+        direction
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::assembly::{Stiffness, factorize, perturb_positions, solve};
+    use crate::body::{DeformableBody, DeformableBodyBuilder};
+    use crate::load::Load;
+    use crate::material::{Material, MaterialModel};
+    use crate::mesh;
+    use rapier3d::glamx::{DMat3, DVec3};
+
+    /// A 0.2 m cube, deformed, its bottom face pinned, whose whole surface turned inside out is
+    /// a chamber (a closed surface) of a liquid of 1e6 Pa pumped 2 % beyond what it encloses:
+    /// the liquid pushes at 20 kPa, and its rank-one stiffness is of the elements' order.
+    fn cube_with_chamber() -> DeformableBody {
+        let mesh = mesh::cuboid(DVec3::splat(0.1), [2, 2, 2]).unwrap();
+        let walls: Vec<[u32; 3]> = (mesh.surface_triangles().iter())
+            .map(|&[a, b, c]| [a, c, b])
+            .collect();
+        let base = mesh.nodes_where(|p| p.y < -0.1 + 1e-9);
+        let material = Material::new(MaterialModel::Linear, 1e6, 0.3, 1000.0).unwrap();
+        let builder = DeformableBodyBuilder::new(mesh, material).pinned_nodes(base);
+        let mut body = builder.build().unwrap();
+        perturb_positions(&mut body, 7, 0.01);
+        let volume = Load::enclosed_volume_of(&walls, body.positions()).unwrap();
+        let chamber = Load::Chamber {
+            triangles: walls,
+            volume: 1.02 * volume,
+            bulk_modulus: 1e6,
+        };
+        body.add_load(chamber).unwrap();
+        body
+    }
+
+    fn direction(n: usize) -> Vec<DVec3> {
+        (0..n)
+            .map(|i| DVec3::new((i % 3) as f64 - 1.0, (i % 5) as f64 * 0.5 - 1.0, 0.7))
+            .collect()
+    }
+
+    /// The liquid's forces are minus the gradient of its energy (to 1e-7 relative) and its
+    /// tangent, the pressure's assembled part plus the rank-one `w g gᵀ`, minus the gradient of
+    /// its forces (to 1e-6 of the largest `K d`), by central differences of 1e-7 m on the 0.2 m
+    /// cube (truncation about 1e-12, round-off about 1e-9 relative).
+    #[test]
+    fn forces_and_tangent_derive_from_the_liquid_s_energy() {
+        let mut body = cube_with_chamber();
+        let n = body.node_count();
+        let (start, mut d) = (body.positions().to_vec(), direction(n));
+        // The tangent leaves out pinned nodes, which do not move.
+        for (d, &pinned) in d.iter_mut().zip(&body.pinned) {
+            if pinned {
+                *d = DVec3::ZERO;
+            }
+        }
+        let origins = body.cone_origins();
+        let h = 1e-7;
+        let at = |body: &mut DeformableBody, step: f64| {
+            for ((x, x0), d) in body.positions_mut().iter_mut().zip(&start).zip(&d) {
+                *x = *x0 + *d * step;
+            }
+            let mut forces = vec![DVec3::ZERO; n];
+            body.add_follower_forces(&mut forces);
+            (body.follower_potential(&origins, &start), forces)
+        };
+        let (_, forces) = at(&mut body, 0.0);
+        let (u_plus, f_plus) = at(&mut body, h);
+        let (u_minus, f_minus) = at(&mut body, -h);
+        at(&mut body, 0.0);
+        let pressure = body.loads()[0].pressure_at(body.positions()).unwrap();
+        // `K (V* − V)/V*` with `V* = 1.02 V`.
+        assert!((pressure * 1.02 / 2e4 - 1.0).abs() < 1e-12, "{pressure}");
+        let slope = (u_plus - u_minus) / (2.0 * h);
+        let work: f64 = forces.iter().zip(&d).map(|(f, d)| f.dot(*d)).sum();
+        assert!(
+            (slope + work).abs() <= 1e-7 * work.abs(),
+            "{slope} vs {work}"
+        );
+        let mut stiffness = Stiffness::new(&body);
+        stiffness.values.fill(0.0);
+        crate::load::add_follower_tangents(&body, &mut stiffness, false);
+        let mut k_d = stiffness.multiply(&d);
+        let (g, w) = body.loads()[0].chamber_term(body.positions()).unwrap();
+        let g_d: f64 = g.iter().zip(&d).map(|(g, d)| g.dot(*d)).sum();
+        for (k_d, g) in k_d.iter_mut().zip(&g) {
+            *k_d += *g * (w * g_d);
+        }
+        let scale = k_d.iter().map(|v| v.length()).fold(0.0, f64::max);
+        for node in (0..n).filter(|&node| !body.pinned[node]) {
+            let difference = -(f_plus[node] - f_minus[node]) / (2.0 * h);
+            assert!(
+                (difference - k_d[node]).length() <= 1e-6 * scale,
+                "node {node}: K d {} vs -df/ds {difference}",
+                k_d[node]
+            );
+        }
+    }
+
+    /// The Woodbury direction solves the system with the rank-one term: `(K + w g gᵀ) d = r` to
+    /// 1e-10 of `|r|` (the factorization's round-off), while the direction of `K` alone is off
+    /// by more than the tolerance.
+    #[test]
+    fn the_taken_in_direction_solves_the_system_with_the_liquid() {
+        let body = cube_with_chamber();
+        let n = body.node_count();
+        let mut stiffness = Stiffness::new(&body);
+        stiffness.assemble(&body, None, false, |_, _, _| DMat3::ZERO);
+        let factor = factorize(&mut stiffness, 0).unwrap();
+        let mut residual = direction(n);
+        for (r, &pinned) in residual.iter_mut().zip(&body.pinned) {
+            if pinned {
+                *r = DVec3::ZERO;
+            }
+        }
+        let terms = body.chamber_terms();
+        let plain = solve(&factor, &residual);
+        let taken = super::take_in(&terms, &factor, &residual, plain.clone());
+        let error = |d: &[DVec3]| -> f64 {
+            let mut k_d = stiffness.multiply(d);
+            let g_d: f64 = terms.columns[0].iter().zip(d).map(|(g, d)| g.dot(*d)).sum();
+            for (k_d, g) in k_d.iter_mut().zip(&terms.columns[0]) {
+                *k_d += *g * (terms.weights[0] * g_d);
+            }
+            let off: f64 = (k_d.iter().zip(&residual))
+                .map(|(a, b)| (*a - *b).length_squared())
+                .sum();
+            let size: f64 = residual.iter().map(|r| r.length_squared()).sum();
+            (off / size).sqrt()
+        };
+        assert!(error(&taken) < 1e-10, "{}", error(&taken));
+        assert!(error(&plain) > 1e-2, "{}", error(&plain));
+    }
+}
