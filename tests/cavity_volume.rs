@@ -7,6 +7,7 @@ use rapier_fvm::load::WATER_BULK_MODULUS;
 use rapier_fvm::mesh::import::{self, SurfaceOptions};
 use rapier_fvm::prelude::*;
 use rapier_fvm::statics::{self, StaticSettings};
+use rapier_fvm::world::FvmWorld;
 
 const INNER: f64 = 0.025;
 const OUTER: f64 = 0.05;
@@ -333,4 +334,90 @@ fn a_free_body_pumped_up_keeps_its_momentum() {
         };
         assert!(worst < bound, "{kind:?}: {worst:e}");
     }
+}
+
+/// The Newton iterations, summed over 12 frames, of the pinned hollow sphere (quadratic, stable
+/// Neo-Hookean) whose water chamber a pump fills 1 % over 0.2 s, in a world under gravity, with
+/// a 0.5 kg box glued under its bottom cap if `with_box`.
+fn newton_iterations_pumping(with_box: bool) -> usize {
+    use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder};
+    let model = MaterialModel::StableNeoHookean;
+    let (body, chamber, rest) = hollow_sphere_with_chamber((model, true), 0.0, WATER_BULK_MODULUS);
+    let bottom = body.mesh().nodes_where(|p| p.y < -0.045);
+    let mut world = FvmWorld::default();
+    let soft = world.soft_bodies.insert(body);
+    if with_box {
+        let (rigid, _) = world.physics.insert(
+            RigidBodyBuilder::dynamic().translation(rapier_fvm::glamx::Vec3::new(0.0, -0.06, 0.0)),
+            ColliderBuilder::cuboid(0.02, 0.01, 0.02).mass(0.5),
+        );
+        world.attach(soft, bottom, rigid).unwrap();
+    }
+    let frame = f64::from(world.physics.integration_parameters.dt);
+    let mut iterations = 0;
+    for k in 1..=12 {
+        let volume = rest * (1.0 + 0.01 * (k as f64 * frame / 0.2).min(1.0));
+        world.soft_bodies[soft]
+            .set_load(chamber, LoadValue::Scalar(volume))
+            .unwrap();
+        for (_, outcome) in world.step() {
+            let report = outcome.unwrap();
+            // Water makes the step implicit; a Newton solve that fails falls back to explicit.
+            let implicit = (report.implicit)
+                .unwrap_or_else(|| panic!("frame {k}: the implicit step failed ({report:?})"));
+            iterations += implicit.newton_iterations;
+        }
+    }
+    iterations
+}
+
+/// A chamber glued to a dynamic rigid body: the Newton direction takes the liquid in, then the
+/// rigid body's response with solves that take the liquid in too (the two rank-one and
+/// six-column Woodbury corrections composed), so the coupled step converges about as fast as
+/// the sphere alone: at most 1.5 times its Newton iterations (measured 29 against 33). With the
+/// rigid response solved without the liquid, the implicit step failed and fell back to
+/// explicit steps.
+#[test]
+fn a_chamber_glued_to_a_rigid_body_converges_as_fast_as_alone() {
+    let alone = newton_iterations_pumping(false);
+    let glued = newton_iterations_pumping(true);
+    println!("Newton iterations over 12 frames: alone {alone}, a box glued under it {glued}");
+    assert!(2 * glued <= 3 * alone, "{glued} vs {alone}");
+}
+
+/// A chamber's walls must close its cavity and face into it, and its volume and bulk modulus be
+/// positive: half the walls, the walls reversed (they then enclose a negative volume), a volume
+/// of zero and a bulk modulus of zero are refused as invalid loads, and so is a volume set to
+/// zero later; the body keeps its one good chamber.
+#[test]
+fn a_chamber_that_encloses_no_cavity_is_refused() {
+    let (mut body, walls) = hollow_sphere_and_walls((MaterialModel::Linear, 0.3), false, true);
+    let rest = Load::enclosed_volume_of(&walls, body.positions()).unwrap();
+    let chamber = |triangles: Vec<[u32; 3]>, volume: f64, bulk_modulus: f64| Load::Chamber {
+        triangles,
+        volume,
+        bulk_modulus,
+    };
+    let reversed: Vec<[u32; 3]> = walls.iter().map(|&[a, b, c]| [a, c, b]).collect();
+    let half = walls[..walls.len() / 2].to_vec();
+    for (load, words) in [
+        (chamber(half, rest, 1e9), "closed"),
+        (chamber(reversed, rest, 1e9), "enclose no cavity"),
+        (chamber(walls.clone(), 0.0, 1e9), "volume must be positive"),
+        (
+            chamber(walls.clone(), rest, 0.0),
+            "bulk modulus must be positive",
+        ),
+    ] {
+        let error = body.add_load(load).unwrap_err();
+        assert!(
+            matches!(&error, Error::InvalidLoad { reason, .. } if reason.contains(words)),
+            "{error}"
+        );
+    }
+    let good = body.add_load(chamber(walls, rest, 1e9)).unwrap();
+    let error = body.set_load(good, LoadValue::Scalar(0.0)).unwrap_err();
+    assert!(matches!(error, Error::InvalidLoad { .. }), "{error}");
+    assert_eq!(body.loads().len(), 1);
+    assert_eq!(body.load(good).unwrap().value(), LoadValue::Scalar(rest));
 }

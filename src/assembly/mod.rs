@@ -169,11 +169,9 @@ impl Stiffness {
     /// Fills the values with the body's tangent stiffness at its current positions: for every
     /// integration point (see [`crate::element`]) `w ∇N_aᵀ A ∇N_b` with `A` the stress tangent of
     /// the elastic stress differential plus `extra(point, F, dF)` (a further stress differential,
-    /// Pa), projected to be positive
-    /// semi-definite if `project`; the coupling of nodal averaging if the body uses it; the
-    /// Hessians of its follower loads' potentials ([`crate::load`]; a chamber's pressure not
-    /// if `project`); and `diagonal[n] I` on each
-    /// free node.
+    /// Pa), projected to be positive semi-definite if `project`; the coupling of nodal averaging
+    /// if the body uses it; the Hessians of its follower loads' potentials ([`crate::load`]; a
+    /// chamber's pressure not if `project`); and `diagonal[n] I` on each free node.
     pub(crate) fn assemble(
         &mut self,
         body: &DeformableBody,

@@ -12,7 +12,9 @@ impl DeformableBody {
     ///
     /// # Errors
     /// [`Error::InvalidLoad`] for a load naming a node the body does not have, a degenerate
-    /// triangle or path, or a non-finite value (see [`Load::check`]).
+    /// triangle or path, or a non-finite value (see [`Load::check`]), and for a chamber whose
+    /// walls enclose no volume at the body's positions (they face out of the cavity: a body's
+    /// outer surface, or a cavity's triangles reversed).
     ///
     /// ```
     /// use rapier_fvm::prelude::*;
@@ -30,6 +32,16 @@ impl DeformableBody {
     /// ```
     pub fn add_load(&mut self, load: Load) -> Result<LoadHandle, Error> {
         load.check(self.node_count())?;
+        if let Load::Chamber { triangles, .. } = &load
+            && Load::enclosed_volume_of(triangles, &self.positions).is_some_and(|v| v <= 0.0)
+        {
+            return Err(Error::InvalidLoad {
+                load: load.kind(),
+                reason: "its walls enclose no cavity: they face out of it (a chamber's triangles \
+                         are oriented out of the body, into the cavity)"
+                    .into(),
+            });
+        }
         self.load_change_work += self.potential_of(&load);
         self.loads.push(load);
         self.load_edits += 1;
@@ -75,8 +87,9 @@ impl DeformableBody {
     /// The potential energy of the body's loads (J) at its current positions: `−Σ f·x` of the
     /// tractions and body forces, `p V` of each pressure (`V` the signed volume of the cone its
     /// triangles span from the world's origin, minus a cavity's volume), `T L` of each cable
-    /// (`L` its length), the liquid's `K (V − V*)²/(2V*)` of each chamber. With the kinetic, elastic and gravitational energies it makes the
-    /// energy the loads conserve while their values stay as they are.
+    /// (`L` its length), the liquid's `K (V − V*)²/(2V*)` of each chamber. With the kinetic,
+    /// elastic and gravitational energies it makes the energy the loads conserve while their
+    /// values stay as they are.
     pub fn load_potential_energy(&self) -> f64 {
         self.loads.iter().map(|load| self.potential_of(load)).sum()
     }
@@ -174,7 +187,7 @@ impl DeformableBody {
         }
     }
 
-    /// Adds the follower loads' exact forces (pressure, cable; N per node) at the current
+    /// Adds the follower loads' exact forces (pressure, cable, chamber; N per node) at the current
     /// positions to `forces`.
     pub(crate) fn add_follower_forces(&self, forces: &mut [DVec3]) {
         for load in &self.loads {

@@ -90,8 +90,9 @@ impl SymplecticEuler {
     /// steps above it make the highest modes grow. Zero if an element is flat. The elements'
     /// highest frequency `ω_e = 2c/ℓ` (`c` the pressure wave speed, `ℓ` the
     /// [wave length scale](DeformableBody::wave_length_scale)) is raised by the follower loads'
-    /// stiffness to `sqrt(ω_e² + ω_l²)` (Gershgorin's bound, `ω_l` from the cables' `2T/d` and
-    /// the pressures' `|p| s/6` over the nodal masses), the step scaled alike.
+    /// stiffness to `sqrt(ω_e² + ω_l²)` (Gershgorin's bound, `ω_l` from the cables' `2T/d`, the
+    /// pressures' `|p| s/6` and the chambers' liquids' rank-one stiffness over the nodal
+    /// masses), the step scaled alike.
     pub fn critical_time_step(body: &DeformableBody) -> f64 {
         let mut undamped =
             COURANT_NUMBER * body.wave_length_scale() / body.material().dilatational_wave_speed();

@@ -8,7 +8,7 @@
 //! node): the follower pressure's tangent at `p` plus a rank-one term that couples every node
 //! of the walls. That term is not assembled (it would fill the factorization among the walls'
 //! nodes); a Newton direction takes it in by the Woodbury identity with the factorization of the
-//! rest ([`take_in`]), one more solve per chamber.
+//! rest ([`ChamberSolve`]), one more solve per chamber.
 //!
 //! The volume is held to `p/K` of itself (water, 2.2e9 Pa: 1e-6 at 2.2 kPa): a stiffer liquid
 //! holds it closer and stiffens the explicit step, which the stable step counts
@@ -17,7 +17,7 @@
 use super::follower;
 use crate::assembly::{Factor, solve_columns};
 use rapier3d::glamx::DVec3;
-use rapier3d::na::{DMatrix, DVector};
+use rapier3d::na::{DMatrix, DVector, Dyn, LU};
 
 /// The bulk modulus of water (Pa) at 20 °C, the default liquid.
 pub const WATER_BULK_MODULUS: f64 = 2.2e9;
@@ -83,8 +83,8 @@ impl ChamberTerms {
         self.columns.is_empty()
     }
 
-    /// Appends `other`, whose columns are over `other_nodes` nodes placed from node `offset` on
-    /// of a system of `total` nodes (this one's columns already over the system's nodes).
+    /// Appends `other`, a body's terms (columns over its own nodes), the body's nodes placed from
+    /// node `offset` on of a system of `total` nodes (this one's columns are over the system's).
     pub(crate) fn append_placed(&mut self, other: ChamberTerms, offset: usize, total: usize) {
         for column in other.columns {
             let mut placed = vec![DVec3::ZERO; total];
@@ -95,41 +95,87 @@ impl ChamberTerms {
     }
 }
 
-/// `direction` solves `K d = r` (`r` the `residual`, N) with `factor`, the tangent without the
-/// chambers' rank-one terms `G W Gᵀ`; this returns `(K + G W Gᵀ)⁻¹ r` by the Woodbury identity,
-/// `d − Z (W⁻¹ + Gᵀ Z)⁻¹ Gᵀ d` with `Z = K⁻¹ G`, or `direction` itself when there is no chamber
-/// or the result would not descend (round-off on a nearly singular system).
-pub(crate) fn take_in(
-    terms: &ChamberTerms,
-    factor: &Factor,
-    residual: &[DVec3],
-    direction: Vec<DVec3>,
-) -> Vec<DVec3> {
-    if terms.is_empty() {
-        return direction;
-    }
-    let dot = |a: &[DVec3], b: &[DVec3]| -> f64 { a.iter().zip(b).map(|(x, y)| x.dot(*y)).sum() };
-    let solved = solve_columns(factor, &terms.columns);
-    let k = terms.columns.len();
-    let system = DMatrix::from_fn(k, k, |i, j| {
-        let inverse_weight = if i == j { 1.0 / terms.weights[i] } else { 0.0 };
-        inverse_weight + dot(&terms.columns[i], &solved[j])
-    });
-    let projection = DVector::from_fn(k, |i, _| dot(&terms.columns[i], &direction));
-    let Some(weights) = system.lu().solve(&projection) else {
-        return direction;
-    };
-    let mut taken = direction.clone();
-    for (z, weight) in solved.iter().zip(weights.iter()) {
-        for (d, z) in taken.iter_mut().zip(z) {
-            *d -= *z * *weight;
+/// Solves with the factorization of a tangent `K` assembled without the chambers' rank-one
+/// terms `G W Gᵀ` as with `K + G W Gᵀ`, by the Woodbury identity:
+/// `(K + G W Gᵀ)⁻¹ b = K⁻¹ b − Z (W⁻¹ + Gᵀ Z)⁻¹ Gᵀ K⁻¹ b` with `Z = K⁻¹ G`, one solve per
+/// chamber made once. Without chambers it solves with the factorization alone.
+pub(crate) struct ChamberSolve<'a> {
+    factor: &'a Factor,
+    terms: &'a ChamberTerms,
+    /// `Z = K⁻¹ G`, and the LU factors of `W⁻¹ + Gᵀ Z` (`None` when singular to round-off,
+    /// where the chambers are left out).
+    solved: Vec<Vec<DVec3>>,
+    system: Option<LU<f64, Dyn, Dyn>>,
+}
+
+fn dot(a: &[DVec3], b: &[DVec3]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x.dot(*y)).sum()
+}
+
+impl<'a> ChamberSolve<'a> {
+    /// The solves with `factor` (of `K`) that take `terms` in.
+    pub(crate) fn new(factor: &'a Factor, terms: &'a ChamberTerms) -> Self {
+        let solved = solve_columns(factor, &terms.columns);
+        let k = terms.columns.len();
+        let system = DMatrix::from_fn(k, k, |i, j| {
+            let inverse_weight = if i == j { 1.0 / terms.weights[i] } else { 0.0 };
+            inverse_weight + dot(&terms.columns[i], &solved[j])
+        });
+        let system = Some(system.lu()).filter(|lu| lu.is_invertible());
+        Self {
+            factor,
+            terms,
+            solved,
+            system,
         }
     }
-    let finite = taken.iter().all(|d| d.is_finite());
-    if finite && dot(residual, &taken) > 0.0 {
-        taken
-    } else {
-        direction
+
+    /// Whether there is no chamber to take in: the solves are the factorization's.
+    pub(crate) fn is_plain(&self) -> bool {
+        self.terms.is_empty()
+    }
+
+    /// `(K + G W Gᵀ)⁻¹ b` from `solved = K⁻¹ b` (per node).
+    fn correct(&self, mut solved: Vec<DVec3>) -> Vec<DVec3> {
+        let Some(system) = &self.system else {
+            return solved;
+        };
+        let k = self.terms.columns.len();
+        let projection = DVector::from_fn(k, |i, _| dot(&self.terms.columns[i], &solved));
+        let Some(weights) = system.solve(&projection) else {
+            return solved;
+        };
+        for (z, weight) in self.solved.iter().zip(weights.iter()) {
+            for (d, z) in solved.iter_mut().zip(z) {
+                *d -= *z * *weight;
+            }
+        }
+        solved
+    }
+
+    /// `(K + G W Gᵀ)⁻¹` applied to each of `columns` (per node).
+    pub(crate) fn solve_columns(&self, columns: &[Vec<DVec3>]) -> Vec<Vec<DVec3>> {
+        let solved = solve_columns(self.factor, columns);
+        if self.is_plain() {
+            return solved;
+        }
+        solved.into_iter().map(|z| self.correct(z)).collect()
+    }
+
+    /// `direction` solves `K d = r` (`r` the `residual`, N); this returns `(K + G W Gᵀ)⁻¹ r`,
+    /// or `direction` itself when there is no chamber or the result would not descend (round-off
+    /// on a nearly singular system).
+    pub(crate) fn take_in(&self, residual: &[DVec3], direction: Vec<DVec3>) -> Vec<DVec3> {
+        if self.is_plain() {
+            return direction;
+        }
+        let taken = self.correct(direction.clone());
+        let finite = taken.iter().all(|d| d.is_finite());
+        if finite && dot(residual, &taken) > 0.0 {
+            taken
+        } else {
+            direction
+        }
     }
 }
 
@@ -247,7 +293,7 @@ mod tests {
         }
         let terms = body.chamber_terms();
         let plain = solve(&factor, &residual);
-        let taken = super::take_in(&terms, &factor, &residual, plain.clone());
+        let taken = super::ChamberSolve::new(&factor, &terms).take_in(&residual, plain.clone());
         let error = |d: &[DVec3]| -> f64 {
             let mut k_d = stiffness.multiply(d);
             let g_d: f64 = terms.columns[0].iter().zip(d).map(|(g, d)| g.dot(*d)).sum();

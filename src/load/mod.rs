@@ -40,7 +40,7 @@ mod follower;
 mod value;
 
 pub use chamber::WATER_BULK_MODULUS;
-pub(crate) use chamber::{ChamberTerms, take_in as take_in_chambers};
+pub(crate) use chamber::{ChamberSolve, ChamberTerms};
 pub(crate) use follower::add_follower_tangents;
 
 use rapier3d::glamx::DVec3;
@@ -88,7 +88,8 @@ pub enum Load {
     /// a rank-one term coupling every node of the walls that Newton solves take in by the
     /// Woodbury identity with the factorization of the rest: a body with a chamber is solved by
     /// factorization whatever [`LinearSolver`](crate::linear_solver::LinearSolver) says. Its
-    /// value ([`Load::set`]) is the volume `V*`.
+    /// value ([`Load::set`]) is the volume `V*`. Pulled beyond `V*`, the liquid pulls the walls
+    /// in (a negative pressure: it is not let to boil).
     ///
     /// ```
     /// # #[cfg(feature = "import")] {
@@ -176,7 +177,7 @@ impl Load {
     }
 
     /// Adds the load's force (N per node) at the positions `x` (m) to `forces` if it is a
-    /// follower load (pressure, cable): the exact follower force.
+    /// follower load (pressure, cable, chamber): the exact follower force.
     pub(crate) fn add_follower_forces(&self, x: &[DVec3], forces: &mut [DVec3]) {
         match self {
             Self::Pressure {

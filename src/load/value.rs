@@ -35,7 +35,8 @@ impl Load {
     ///
     /// # Errors
     /// [`Error::InvalidLoad`] for a value of the other kind (a vector for a pressure), a
-    /// non-finite value or a negative tension; the load is then unchanged.
+    /// non-finite value, a negative tension or a chamber's volume not positive; the load is then
+    /// unchanged.
     pub fn set(&mut self, value: LoadValue) -> Result<(), Error> {
         let mut changed = self.clone();
         match (&mut changed, value) {
@@ -96,7 +97,8 @@ impl Load {
         self.check_value()
     }
 
-    /// [`Error::InvalidLoad`] for a non-finite value or a negative tension.
+    /// [`Error::InvalidLoad`] for a non-finite value, a negative tension or a chamber's volume
+    /// not positive.
     fn check_value(&self) -> Result<(), Error> {
         let finite = match self.value() {
             LoadValue::Vector(v) => v.is_finite(),

@@ -13,7 +13,7 @@ use super::{StaticReport, StaticSettings, assemble_elastic, solve_equilibrium};
 use crate::Error;
 use crate::assembly::{Stiffness, factorize, solve};
 use crate::body::DeformableBody;
-use crate::load::take_in_chambers;
+use crate::load::ChamberSolve;
 use crate::load::{LoadHandle, LoadValue};
 use rapier3d::glamx::DVec3;
 
@@ -202,6 +202,7 @@ fn volume_compliance(body: &DeformableBody, cavity: LoadHandle) -> Result<f64, E
     assemble_elastic(&mut stiffness, body, false);
     let factor = factorize(&mut stiffness, 0)?;
     let response = solve(&factor, &gradient);
-    let response = take_in_chambers(&body.chamber_terms(), &factor, &gradient, response);
+    let chambers = body.chamber_terms();
+    let response = ChamberSolve::new(&factor, &chambers).take_in(&gradient, response);
     Ok(gradient.iter().zip(&response).map(|(g, u)| g.dot(*u)).sum())
 }

@@ -17,7 +17,7 @@ use crate::assembly::{Stiffness, factorize, solve};
 use crate::body::DeformableBody;
 use crate::integrate::SolverWorkspace;
 use crate::linear_solver::{Method, solve_newton_system};
-use crate::load::take_in_chambers;
+use crate::load::ChamberSolve;
 use crate::newton::{Search, check_tolerance, descend, norm, round_off_floor};
 use rapier3d::glamx::{DMat3, DVec3};
 
@@ -191,7 +191,8 @@ fn newton_direction(
     )?;
     Ok(match &solution.factor {
         Some(factor) => {
-            take_in_chambers(&body.chamber_terms(), factor, residual, solution.direction)
+            let chambers = body.chamber_terms();
+            ChamberSolve::new(factor, &chambers).take_in(residual, solution.direction)
         }
         None => solution.direction,
     })
@@ -217,6 +218,7 @@ pub fn fundamental_frequency(body: &DeformableBody) -> Result<f64, Error> {
     assemble_elastic(&mut stiffness, body, false);
     let factor = factorize(&mut stiffness, 0)?;
     let chambers = body.chamber_terms();
+    let solver = ChamberSolve::new(&factor, &chambers);
     let masses = &body.masses;
     let free = |n: usize| !body.pinned[n];
     // Start from a fixed pseudo-random motion of the free nodes, which has a component on every
@@ -233,8 +235,7 @@ pub fn fundamental_frequency(body: &DeformableBody) -> Result<f64, Error> {
     let mut eigenvalue = f64::INFINITY;
     for _ in 0..MAX_ITERATIONS {
         let mass_times_mode: Vec<DVec3> = mode.iter().zip(masses).map(|(x, m)| *x * *m).collect();
-        let next = solve(&factor, &mass_times_mode);
-        let next = take_in_chambers(&chambers, &factor, &mass_times_mode, next);
+        let next = solver.take_in(&mass_times_mode, solve(&factor, &mass_times_mode));
         // Rayleigh quotient of the previous iterate: xᵀ M x / xᵀ M K⁻¹ M x.
         let x_m_x: f64 = mode
             .iter()

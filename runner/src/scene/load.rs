@@ -49,8 +49,8 @@ pub struct LoadSpec {
     pub volume_ratio: Option<Schedule<f64>>,
     /// A chamber's liquid's bulk modulus (Pa, positive); default water's, 2.2e9.
     pub bulk_modulus: Option<f64>,
-    /// Lower corner of the box (m, rest coordinates) selecting a pressure's or traction's
-    /// boundary.
+    /// Lower corner of the box (m, rest coordinates) selecting a pressure's, traction's or
+    /// chamber's boundary.
     pub min: Option<[f64; 3]>,
     /// Upper corner of the box (m, rest coordinates).
     pub max: Option<[f64; 3]>,

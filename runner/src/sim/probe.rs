@@ -141,7 +141,8 @@ impl Probe {
             },
             ProbeKind::CavityPressure | ProbeKind::CavityVolume => {
                 let soft = soft(&spec.body)?.ok_or_else(|| missing("body"))?;
-                let load = LoadHandle(spec.load.ok_or_else(|| missing("load"))? as u32);
+                let index = spec.load.ok_or_else(|| missing("load"))?;
+                let load = LoadHandle(u32::try_from(index).unwrap_or(u32::MAX));
                 let body = &simulation.world.soft_bodies[simulation.soft[soft].handle];
                 let encloses = (body.load(load)).and_then(|l| l.enclosed_volume(body.positions()));
                 if encloses.is_none() {
@@ -213,9 +214,10 @@ impl Probe {
             } => {
                 let body = &world.soft_bodies[simulation.soft[soft].handle];
                 let (load, x) = (body.load(load), body.positions());
-                let value = match pressure {
-                    true => load.and_then(|l| l.pressure_at(x)),
-                    false => load.and_then(|l| l.enclosed_volume(x)),
+                let value = if pressure {
+                    load.and_then(|l| l.pressure_at(x))
+                } else {
+                    load.and_then(|l| l.enclosed_volume(x))
                 };
                 value.unwrap_or(f64::NAN)
             }

@@ -25,7 +25,7 @@ use crate::constraint::{self, BodyConstraints};
 use crate::contact::{self, BetweenContact, ContactSettings, JointContacts, NodeSlices};
 use crate::integrate::{BodyInStep, PreviousStep};
 use crate::linear_solver::{Method, solve_newton_system};
-use crate::load::{ChamberTerms, take_in_chambers};
+use crate::load::{ChamberSolve, ChamberTerms};
 use crate::newton::{Configuration, Search, descend, norm, round_off_floor};
 use rapier3d::glamx::DVec3;
 use std::cell::RefCell;
@@ -581,7 +581,8 @@ impl ImplicitIntegrator {
             for (k, body) in group.bodies.iter().enumerate() {
                 chambers.append_placed(body.chamber_terms(), group.offsets[k], group.node_count());
             }
-            direction = take_in_chambers(&chambers, factor, residual, direction);
+            let solver = ChamberSolve::new(factor, &chambers);
+            direction = solver.take_in(residual, direction);
             for (k, member) in potential.members.iter().enumerate() {
                 let placement = Placement {
                     offset: group.offsets[k],
@@ -589,7 +590,7 @@ impl ImplicitIntegrator {
                 };
                 direction = member.take_in_placed(
                     group.bodies[k],
-                    (factor, false),
+                    (&solver, false),
                     placement,
                     residual,
                     direction,

@@ -16,7 +16,7 @@ use crate::constraint::{self, BodyConstraints};
 use crate::damping::RayleighDamping;
 use crate::element::deformation_gradient;
 use crate::integrate::PreviousStep;
-use crate::load::take_in_chambers;
+use crate::load::ChamberSolve;
 use crate::material::green_strain;
 use crate::newton::norm;
 use rapier3d::glamx::{DMat3, DVec3};
@@ -258,12 +258,12 @@ impl Potential<'_> {
 
     /// The Newton direction `direction` (m per node), solved with `factor` (the one of the last
     /// call if `true`), with the tangent's terms that are not assembled taken in: the chambers'
-    /// liquids' ([`crate::load::take_in_chambers`]), then the rigid bodies' response (see
-    /// [`RigidResponse::take_in`]).
+    /// liquids' ([`ChamberSolve`]), then the rigid bodies' response (see
+    /// [`RigidResponse::take_in`]) with solves that take the chambers in.
     pub(super) fn take_in_unassembled(
         &self,
         body: &DeformableBody,
-        factor: (&Factor, bool),
+        (factor, same_factor): (&Factor, bool),
         residual: &[DVec3],
         direction: Vec<DVec3>,
     ) -> Vec<DVec3> {
@@ -271,16 +271,20 @@ impl Potential<'_> {
             offset: 0,
             total: body.positions.len(),
         };
-        let direction = take_in_chambers(&body.chamber_terms(), factor.0, residual, direction);
-        self.take_in_placed(body, factor, placement, residual, direction)
+        let chambers = body.chamber_terms();
+        let solver = ChamberSolve::new(factor, &chambers);
+        let direction = solver.take_in(residual, direction);
+        self.take_in_placed(body, (&solver, same_factor), placement, residual, direction)
     }
 
-    /// [`Potential::take_in_rigid_response`] for a body placed among the nodes of a group solved
-    /// as one system: `residual`, `direction` and `factor` are the system's.
+    /// The rigid bodies' response taken into `direction` for a body placed among the nodes of a
+    /// system (a group of bodies solved as one, or the body alone): `residual`, `direction` and
+    /// `solver` (the chambers taken in, the factorization the last call's if `true`) are the
+    /// system's.
     pub(super) fn take_in_placed(
         &self,
         body: &DeformableBody,
-        factor: (&Factor, bool),
+        factor: (&ChamberSolve, bool),
         placement: Placement,
         residual: &[DVec3],
         direction: Vec<DVec3>,

@@ -22,11 +22,10 @@
 //! `ι = −h Σ J_cᵀ f_c`: exactly the opposite of the impulses the terms give the soft body, which
 //! is what the bodies receive when the step's impulses are recorded.
 
-use crate::assembly::Factor;
-use crate::assembly::solve_columns;
 use crate::body::DeformableBody;
 use crate::constraint::{self, BodyConstraints, ImplicitTerm};
 use crate::contact::ImplicitStep;
+use crate::load::ChamberSolve;
 use crate::rigid::RigidProxy;
 use rapier3d::glamx::{DMat3, DVec3};
 use rapier3d::na::{DMatrix, DVector, Matrix3, Matrix6, Vector6};
@@ -397,13 +396,15 @@ impl RigidResponse {
 
 impl RigidResponse {
     /// The soft body's Newton direction (m per node) with the bodies' response taken in:
-    /// `direction` solves `K d = r` (`r` the `residual`, `N`) with `factor`, the tangent `K` with
-    /// the bodies held; this returns `(K − U Q Uᵀ)⁻¹ r` by the Woodbury identity,
-    /// `d + Z (I − Q Uᵀ Z)⁻¹ Q Uᵀ d` with `Z = K⁻¹ U`, or `direction` itself when no term acts
-    /// against a dynamic body or the result would not descend.
+    /// `direction` solves `K d = r` (`r` the `residual`, `N`) with `solver`, the tangent `K` with
+    /// the bodies held (the chambers' liquids taken in); this returns `(K − U Q Uᵀ)⁻¹ r` by the
+    /// Woodbury identity, `d + Z (I − Q Uᵀ Z)⁻¹ Q Uᵀ d` with `Z = K⁻¹ U` solved by the same
+    /// `solver`, or `direction` itself when no term acts against a dynamic body or the result
+    /// would not descend.
     ///
     /// `Z` is kept for the next call: when that one solves with the same factorization
-    /// (`same_factor`, a reused one) and finds the same `U`, it skips the solves.
+    /// (`same_factor`, a reused one) and no chamber, and finds the same `U`, it skips the
+    /// solves.
     ///
     /// In a group of bodies solved as one system, `residual`, `direction` and the factorization
     /// are the system's, and `placement` says where the body's nodes sit among its nodes: the
@@ -411,7 +412,7 @@ impl RigidResponse {
     pub(super) fn take_in(
         &mut self,
         (body, constraints): (&DeformableBody, &BodyConstraints),
-        (factor, same_factor): (&Factor, bool),
+        (solver, same_factor): (&ChamberSolve, bool),
         placement: Placement,
         residual: &[DVec3],
         direction: Vec<DVec3>,
@@ -425,9 +426,14 @@ impl RigidResponse {
         }
         let dot =
             |a: &[DVec3], b: &[DVec3]| -> f64 { a.iter().zip(b).map(|(x, y)| x.dot(*y)).sum() };
+        // With chambers `Z` depends on their gradients, which move with the body.
         let solved = match self.solved_columns.take() {
-            Some((columns, solved)) if same_factor && columns == coupling.columns => solved,
-            _ => solve_columns(factor, &placement.embed(&coupling.columns)),
+            Some((columns, solved))
+                if same_factor && solver.is_plain() && columns == coupling.columns =>
+            {
+                solved
+            }
+            _ => solver.solve_columns(&placement.embed(&coupling.columns)),
         };
         let m = coupling.columns.len();
         let q = self.compliance(&coupling);
