@@ -40,7 +40,7 @@ pub(crate) struct RigidPoint {
 }
 
 /// A rigid body in contact with a soft body during one soft step.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub(crate) struct RigidProxy {
     /// The body in rapier's set.
     pub(crate) handle: RigidBodyHandle,

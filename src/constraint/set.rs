@@ -114,6 +114,14 @@ impl BodyConstraints {
         Ok(&self.contacts.nodes)
     }
 
+    /// Whether `other` holds the same contacts, attachments and rigid bodies' proxies, bit for
+    /// bit: what a step reads of them (the state saved for a refused step's restart is not).
+    pub(crate) fn same_as(&self, other: &Self) -> bool {
+        self.contacts == other.contacts
+            && self.attachments == other.attachments
+            && self.rigid_proxies == other.rigid_proxies
+    }
+
     /// The contacts found by the last [`BodyConstraints::detect_contacts`].
     pub fn contacts(&self) -> &[NodeContact] {
         &self.contacts.nodes

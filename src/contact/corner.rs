@@ -35,7 +35,7 @@ use rapier3d::math::Pose;
 use rapier3d::parry::bounding_volume::BoundingVolume;
 
 /// A collider's vertex touching one of the soft body's boundary triangles.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub(crate) struct CornerContact {
     /// The collider and its rigid body's index among the body's proxies, if it has one.
     pub(crate) collider: ColliderHandle,

@@ -60,7 +60,7 @@ impl BodyPoint {
 /// collider's shape every substep to update the plane, the shape where its rigid body has carried
 /// it since detection; against a triangle of the body's own surface the plane follows the
 /// triangle.
-#[derive(Clone)]
+#[derive(Clone, PartialEq)]
 pub struct NodeContact {
     /// The point of the soft body in contact.
     pub at: BodyPoint,
@@ -109,6 +109,29 @@ pub(super) enum Obstacle {
     },
     /// The contact point of a triangle of the body's own surface.
     OwnTriangle(SoftPoint),
+}
+
+/// Equal obstacles: the same shape (the same shared allocation: a collider whose shape was
+/// replaced is another obstacle) at the same pose, or the same triangle point.
+impl PartialEq for Obstacle {
+    fn eq(&self, other: &Self) -> bool {
+        match (self, other) {
+            (
+                Self::Collider { shape, pose, proxy },
+                Self::Collider {
+                    shape: other_shape,
+                    pose: other_pose,
+                    proxy: other_proxy,
+                },
+            ) => {
+                std::sync::Arc::ptr_eq(&shape.0, &other_shape.0)
+                    && pose == other_pose
+                    && proxy == other_proxy
+            }
+            (Self::OwnTriangle(a), Self::OwnTriangle(b)) => a == b,
+            _ => false,
+        }
+    }
 }
 
 impl std::fmt::Debug for NodeContact {

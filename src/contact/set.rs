@@ -7,7 +7,7 @@ use crate::body::DeformableBody;
 use rapier3d::glamx::DVec3;
 
 /// The contacts one detection found for a body.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Default, PartialEq)]
 pub(crate) struct ContactSet {
     /// Surface points against colliders and against the body's own triangles.
     pub(crate) nodes: Vec<NodeContact>,

@@ -5,11 +5,13 @@
 //! preferred at equal cost: it has no numerical damping.
 
 use super::cost::{CostModel, Workload};
+use super::refusal::FrameInputs;
 use super::{
     BodyInStep, ImplicitIntegrator, ImplicitReport, SolverWorkspace, StepReport, SymplecticEuler,
 };
 use crate::Error;
 use crate::body::DeformableBody;
+use crate::chord::Chord;
 use crate::constraint::BodyConstraints;
 use crate::contact::{BetweenContact, ContactSettings};
 use rapier3d::glamx::DVec3;
@@ -166,6 +168,10 @@ impl AutomaticIntegrator {
     /// while the body has self-contacts or corners of dynamic rigid bodies against its surface
     /// (the implicit step exchanges angular momentum through them only approximately).
     ///
+    /// A frame refused again from exactly what the last refused frame started from (the body's
+    /// state and loads, its constraints, the frame and the plan for it) is refused at once with
+    /// the same error, without redoing the work (see [`refusal`](super::refusal)).
+    ///
     /// # Errors
     /// [`Error::InvalidTimeStep`] for a non-positive or non-finite `frame_dt`, [`Error::NonFiniteInput`]
     /// for a non-finite gravity,
@@ -186,7 +192,6 @@ impl AutomaticIntegrator {
             &self.workload(body, Some(constraints), Some(workspace)),
             needed,
         );
-        let started = Instant::now();
         let choice = self.force.unwrap_or_else(|| {
             if constraints.needs_explicit_contacts() {
                 IntegratorKind::Explicit
@@ -194,11 +199,41 @@ impl AutomaticIntegrator {
                 prediction.cheaper()
             }
         });
-        let mut step = BodyInStep {
-            body,
-            constraints,
-            workspace,
-        };
+        let inputs = workspace.refusals.watching().then(|| {
+            let plan = (choice, needed, self.implicit_for(&prediction));
+            let previous = workspace.previous_step.as_ref();
+            FrameInputs::of((body, constraints), (frame_dt, gravity), plan, previous)
+        });
+        if let Some(error) = (inputs.as_ref()).and_then(|i| workspace.refusals.repeated(i)) {
+            return Err(error);
+        }
+        let outcome = self.frame(
+            BodyInStep {
+                body,
+                constraints,
+                workspace,
+            },
+            (frame_dt, gravity),
+            (choice, prediction, needed),
+        );
+        if outcome.is_err() {
+            // The factorization a refused frame kept is not reused: the next frame's outcome is
+            // then a function of its inputs alone.
+            workspace.chord = Chord::default();
+        }
+        workspace.refusals.record(&outcome, inputs);
+        outcome
+    }
+
+    /// A frame of `frame_dt` (s) under `gravity` (m/s²) of `step`'s body by the integrator
+    /// `choice`, predicted as `prediction`, the explicit frame taking `needed` substeps.
+    fn frame(
+        &self,
+        mut step: BodyInStep<'_>,
+        (frame_dt, gravity): (f64, DVec3),
+        (choice, prediction, needed): (IntegratorKind, CostPrediction, f64),
+    ) -> Result<AutomaticReport, Error> {
+        let started = Instant::now();
         let explicit_frame = |step: &mut BodyInStep<'_>| {
             crate::parallel::on_pool(|| self.explicit.advance(step, frame_dt, gravity, needed))
         };

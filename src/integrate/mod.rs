@@ -10,6 +10,7 @@ mod crush;
 mod explicit;
 mod implicit;
 mod mesh_time_step;
+mod refusal;
 mod workspace;
 
 pub use automatic::{AutomaticIntegrator, AutomaticReport, CostPrediction, IntegratorKind};

@@ -1,12 +1,14 @@
 //! What the integrators keep of a body between steps, beside the body itself: scratch forces,
 //! the nodal state saved before a step (restored if it fails), the state at the start of the
 //! last implicit step (for two-step schemes), the sparse tangent's pattern and symbolic
-//! factorization, the chord method's last numeric factorization, and the body's mean Newton
-//! iterations (for the automatic choice). None of it is the body's
+//! factorization, the chord method's last numeric factorization, the body's mean Newton
+//! iterations (for the automatic choice), and what its last refused frame started from. None of
+//! it is the body's
 //! state: an empty workspace steps a body to the same result, except that BDF2 restarts with a
 //! backward Euler step and the first Newton iteration refactors.
 
 use super::cost::NewtonHistory;
+use super::refusal::Refusals;
 use crate::assembly::Stiffness;
 use crate::body::DeformableBody;
 use crate::chord::Chord;
@@ -51,6 +53,8 @@ pub struct SolverWorkspace {
     pub(crate) chord: Chord,
     /// The body's Newton iterations per implicit substep, for the automatic choice's cost.
     pub(crate) newton: NewtonHistory,
+    /// The last frame's refusal, if it was refused (see [`super::refusal`]); not written.
+    pub(crate) refusals: Refusals,
     /// Read back: the node pairs the tangent coupled beyond the mesh's, for its next build.
     #[cfg(feature = "serde-serialize")]
     pending_pairs: Vec<[u32; 2]>,
@@ -101,7 +105,7 @@ impl From<WorkspaceRecord> for SolverWorkspace {
 }
 
 /// The state at the start of an implicit substep of length `h` (s), kept for the next one.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 #[cfg_attr(
     feature = "serde-serialize",
     derive(serde::Serialize, serde::Deserialize)
