@@ -14,6 +14,7 @@ import struct
 
 import gmsh
 import meshio
+import numpy as np
 
 OUT = os.path.join(os.path.dirname(__file__), "..", "assets", "meshes")
 
@@ -411,6 +412,26 @@ def two_volumes_vtu():
     meshio.write(os.path.join(OUT, "two_volumes_meshio.vtk"), mesh)
 
 
+def two_volumes_tetgen():
+    """two_volumes_v41.msh written by meshio as TetGen `.node`/`.ele`: its tetrahedra with their
+    physical and geometrical tags as two attributes (the first, the physical tag, is the region),
+    and its physical surfaces "clamp" (3) and "load" (4) as the points' boundary markers (0
+    elsewhere), as TetGen marks the points of its facets."""
+    mesh = meshio.read(os.path.join(OUT, "two_volumes_v41.msh"))
+    blocks = [i for i, c in enumerate(mesh.cells) if c.type == "tetra"]
+    tetra = np.concatenate([mesh.cells[i].data for i in blocks])
+    tags = {key: [np.concatenate([mesh.cell_data[key][i] for i in blocks])]
+            for key in ("gmsh:physical", "gmsh:geometrical")}
+    markers = np.zeros(len(mesh.points), dtype=int)
+    for i, cells in enumerate(mesh.cells):
+        if cells.type == "triangle":
+            for triangle, tag in zip(cells.data, mesh.cell_data["gmsh:physical"][i]):
+                markers[triangle] = tag
+    out = meshio.Mesh(mesh.points, [("tetra", tetra)], point_data={"tetgen:ref": markers},
+                      cell_data=tags)
+    meshio.write(os.path.join(OUT, "two_volumes_meshio.node"), out, file_format="tetgen")
+
+
 def hexahedra():
     """A 1 x 0.5 x 0.25 box [0, 1] x [0, 0.5] x [0, 0.25] meshed by gmsh into 4 x 3 x 2
     hexahedra (transfinite, recombined), with physical groups "block" (the volume, tag 1) and
@@ -534,7 +555,7 @@ def two_blocks_hex():
 
 STEPS = [cube_msh, cube_others, surfaces, cube_meshio_compressed, cube_vtk_library,
          multi_solid_stl, cube_msh_other_forms, cube_regions, two_volumes, pneumatic_finger,
-         two_volumes_vtu, hexahedra, hollow_sphere, two_blocks_hex]
+         two_volumes_vtu, two_volumes_tetgen, hexahedra, hollow_sphere, two_blocks_hex]
 
 if __name__ == "__main__":
     import sys

@@ -169,8 +169,11 @@ impl AutomaticIntegrator {
     /// (the implicit step exchanges angular momentum through them only approximately).
     ///
     /// A frame refused again from exactly what the last refused frame started from (the body's
-    /// state and loads, its constraints, the frame and the plan for it) is refused at once with
-    /// the same error, without redoing the work (see [`refusal`](super::refusal)).
+    /// positions, velocities and loads, its constraints, the frame's length and gravity, the
+    /// plan for it and the two-step history) is refused at once with the same error, without
+    /// redoing the work: a refused frame leaves the body as it was, and its kept factorization
+    /// is dropped, so the same inputs give the same refusal. The first refusal's inputs are not
+    /// kept (frames that succeed keep nothing); the frame after it is tried again.
     ///
     /// # Errors
     /// [`Error::InvalidTimeStep`] for a non-positive or non-finite `frame_dt`, [`Error::NonFiniteInput`]

@@ -121,7 +121,7 @@ fn bytes_cached_ele() -> Vec<u8> {
 }
 
 /// (reader, valid file) pairs mutated by the fuzz properties.
-const SEEDS: [(usize, &str); 32] = [
+const SEEDS: [(usize, &str); 37] = [
     (0, "cube_v22_ascii.msh"),
     (0, "cube_v22_binary.msh"),
     (0, "cube_v41_ascii.msh"),
@@ -136,6 +136,7 @@ const SEEDS: [(usize, &str); 32] = [
     (0, "box_hex8_v22_binary.msh"),
     (0, "box_hex27_v41.msh"),
     (1, "cube.node"),
+    (1, "two_volumes_meshio.node"),
     (2, "cube.ele"),
     (3, "cube_ascii.vtu"),
     (3, "cube_binary.vtu"),
@@ -146,14 +147,18 @@ const SEEDS: [(usize, &str); 32] = [
     (3, "cube_vtk_binary_uint32.vtu"),
     (3, "two_volumes_meshio.vtu"),
     (3, "box_hex27_meshio.vtu"),
+    (3, "cube_tet10_ascii.vtu"),
+    (3, "cube_vtk_appended_raw.vtu"),
     (4, "cube_ascii.vtk"),
     (4, "cube_binary.vtk"),
     (4, "cube_vtk9_legacy.vtk"),
     (4, "two_volumes_meshio.vtk"),
     (4, "box_hex27_vtk9.vtk"),
+    (4, "cube_vtk9_legacy_binary.vtk"),
     (5, "sphere.obj"),
     (6, "cube.stl"),
     (6, "sphere_ascii.stl"),
+    (6, "cube_multi_solid.stl"),
 ];
 
 /// The seeds the mutation properties draw from: all, or those of the reader numbered

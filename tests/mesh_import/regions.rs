@@ -1,10 +1,11 @@
-//! Regions (Gmsh physical groups): read from the file, found by name or tag, numbered as the
+//! Regions (Gmsh physical groups, VTU/VTK cell tags, `TetGen` region attributes and boundary
+//! markers): read from the file, found by name or tag, numbered as the
 //! validated mesh's nodes, one volume kept as a mesh of its own, and widened to a quadratic
 //! body's mid-edge nodes.
 
 use super::bytes;
 use rapier_fvm::mesh::QuadraticTetMesh;
-use rapier_fvm::mesh::import::{MeshRegion, RawMesh, RegionId, gmsh, vtk};
+use rapier_fvm::mesh::import::{MeshRegion, RawMesh, RegionId, gmsh, tetgen, vtk};
 use rapier_fvm::{Error, FileLocation};
 
 #[test]
@@ -364,4 +365,46 @@ fn legacy_cell_tags_as_scalars_are_the_same_regions_as_in_a_field() {
     let from_scalars = vtk::parse_legacy(scalars.as_bytes(), "scalars.vtk", 1.0).unwrap();
     assert_eq!(from_scalars.regions.len(), 2);
     assert_eq!(from_scalars.regions, from_field.regions);
+}
+
+#[test]
+fn a_tetgen_file_s_attributes_and_markers_are_the_gmsh_file_s_regions() {
+    // meshio's TetGen files of two_volumes_v41.msh: each tetrahedron's physical tag is its first
+    // attribute (its geometrical tag the second), and the physical surfaces' points carry their
+    // tags as boundary markers: the volumes "region 1" and "region 2" and the surfaces "marker 3"
+    // and "marker 4", with the Gmsh groups' nodes and tetrahedra (compared by position, to the
+    // bit: meshio writes 17 significant digits).
+    let msh = two_volumes();
+    let (node, ele) = ("two_volumes_meshio.node", "two_volumes_meshio.ele");
+    let tetgen = tetgen::parse(&bytes(node), node, &bytes(ele), ele, 1.0).unwrap();
+    assert_eq!(tetgen.regions.len(), msh.regions.len());
+    for region in &msh.regions {
+        let kind = if region.dimension == 3 {
+            "region"
+        } else {
+            "marker"
+        };
+        let id = RegionId::Name(format!("{kind} {}", region.tag));
+        let found = MeshRegion::find(&tetgen.regions, &id, ele).unwrap();
+        assert_eq!((found.dimension, found.tag), (region.dimension, region.tag));
+        assert_eq!(
+            region_geometry(&tetgen, found),
+            region_geometry(&msh, region),
+            "{region}"
+        );
+    }
+    let left = tetgen.keep_volume(&name("region 1")).unwrap();
+    assert!((left.into_mesh().unwrap().volume() - 1.0).abs() < 1e-12);
+}
+
+#[test]
+fn a_tetgen_region_attribute_that_is_not_a_whole_number_is_refused_at_its_line() {
+    let node = b"4 3 0 0\n0 0 0 0\n1 1 0 0\n2 0 1 0\n3 0 0 1\n";
+    let ele = b"1 4 1\n0 0 1 2 3 1.5\n";
+    let error = tetgen::parse(node, "tet.node", ele, "tet.ele", 1.0).unwrap_err();
+    let message = error.to_string();
+    assert!(
+        message.starts_with("tet.ele: line 2: ") && message.contains("not a whole number"),
+        "{message}"
+    );
 }

@@ -1,4 +1,5 @@
-//! Named parts of a mesh file (Gmsh physical groups; a `.vtu` file's cell tags, unnamed):
+//! Named parts of a mesh file (Gmsh physical groups; a `.vtu` or `.vtk` file's cell tags,
+//! unnamed; a `TetGen` file's region attributes and boundary markers):
 //! finding one by name or tag, numbering its nodes as the validated mesh does, and keeping one
 //! volume's tetrahedra as a mesh of its own.
 //!
@@ -36,7 +37,9 @@ use crate::shape::tet10::EDGES;
 use std::fmt;
 
 /// A named part of a mesh file: a Gmsh physical group of points, curves, surfaces or volumes,
-/// or the cells of a `.vtu` file that share a tag (unnamed).
+/// the cells of a `.vtu` or `.vtk` file that share a tag (unnamed), or a `TetGen` file's
+/// tetrahedra of one region attribute (`"region N"`) or points of one boundary marker
+/// (`"marker N"`).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct MeshRegion {
     /// Its name (`$PhysicalNames`), empty if the file gives none.

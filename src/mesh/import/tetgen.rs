@@ -1,19 +1,27 @@
 //! `TetGen`'s `.node` and `.ele` files.
 //!
 //! `.node`: a header `<points> 3 <attributes> <boundary markers 0|1>`, then one line per point,
-//! `<index> <x> <y> <z> [attributes] [marker]`. `.ele`: a header `<tetrahedra> <4|10> <region
-//! attribute 0|1>`, then `<index> <n1> <n2> <n3> <n4> [region]`. Points are numbered
+//! `<index> <x> <y> <z> [attributes] [marker]`. `.ele`: a header `<tetrahedra> <4|10>
+//! <attributes>`, then `<index> <n1> <n2> <n3> <n4> [attributes]`. Points are numbered
 //! consecutively from 0 or 1 (the first point says which), and the tetrahedra use the same
 //! numbering. `#` starts a comment; blank lines are ignored. Ten-node (quadratic) tetrahedra
 //! are an [`ImportErrorKind::UnsupportedElement`] error. A file must hold exactly the points or
 //! tetrahedra its header announces, and its last one must end with a line break (a file cut
 //! inside a number would read as another number).
+//!
+//! Regions ([`MeshRegion`]): the tetrahedra's first attribute is their region (`TetGen`'s `-A`
+//! numbers regions 1, 2, …; meshio writes a Gmsh file's physical tag there), a whole number: the
+//! tetrahedra of each value make the volume `"region N"` of tag `N`. The points' non-zero
+//! boundary markers (`TetGen`'s facet markers) make the surfaces `"marker N"` of tag `N`, their
+//! points. Point attributes and further tetrahedron attributes are read, checked finite, and
+//! not kept.
 
 use super::text::{Source, end_of_line, parse_finite, parse_point, parse_token, scaled};
-use super::{RawMesh, check_scale};
+use super::{MeshRegion, RawMesh, check_scale};
 use crate::Error;
 use crate::error::ImportErrorKind;
 use rapier3d::glamx::DVec3;
+use std::collections::BTreeMap;
 
 /// The error of a point or tetrahedron line holding more than its numbers.
 const TOO_MANY_NUMBERS: &str = "more numbers on the line than the header announces";
@@ -32,25 +40,24 @@ pub fn parse(
     scale: f64,
 ) -> Result<RawMesh, Error> {
     check_scale(scale)?;
-    let (positions, base) = parse_node(node, node_path, scale)?;
+    let (positions, base, markers) = parse_node(node, node_path, scale)?;
     let mut source = Source::new(ele_path, ele);
-    let (count, region) = parse_ele_header(&mut source)?;
+    let (count, attributes) = parse_ele_header(&mut source)?;
     let capacity = source.capacity(count, 10);
     let mut tets = Vec::with_capacity(capacity);
     let mut tet_locations = Vec::with_capacity(capacity);
+    let mut volumes: BTreeMap<i64, Vec<u32>> = BTreeMap::new();
     let points = Numbering {
         base,
         count: positions.len() as u64,
     };
     for i in 0..count {
         let line = source.content_line(Some('#'), "a tetrahedron line")?;
-        tets.push(parse_tet_line(
-            &source,
-            line,
-            base + i as u64,
-            points,
-            region,
-        )?);
+        let (tet, region) = parse_tet_line(&source, line, base + i as u64, points, attributes)?;
+        if let Some(region) = region {
+            volumes.entry(region).or_default().push(i as u32);
+        }
+        tets.push(tet);
         tet_locations.push(source.location());
     }
     source.check_line_ended("the last tetrahedron")?;
@@ -58,24 +65,63 @@ pub fn parse(
     Ok(RawMesh {
         path: ele_path.to_owned(),
         positions,
+        regions: regions(&tets, volumes, &markers),
         tets,
         mid_edge_nodes: Vec::new(),
         hexahedra: super::Hexahedra::None,
         tet_locations,
-        regions: Vec::new(),
     })
 }
 
-/// The header of an `.ele` file: the tetrahedron count (not zero) and whether each line ends
-/// with a region attribute; quadratic (10-node) tetrahedra are refused.
-fn parse_ele_header(source: &mut Source<'_>) -> Result<(usize, bool), Error> {
-    let header = source.content_line(Some('#'), "the header `<tetrahedra> <4|10> <0|1>`")?;
+/// The regions of the module documentation: a volume per region attribute, its tetrahedra
+/// (indices into `tets`) given, and a surface per non-zero boundary marker of `markers` (one per
+/// point, or none).
+fn regions(
+    tets: &[[u32; 4]],
+    volumes: BTreeMap<i64, Vec<u32>>,
+    markers: &[i64],
+) -> Vec<MeshRegion> {
+    let mut regions = Vec::new();
+    for (tag, members) in volumes {
+        let mut nodes: Vec<u32> = (members.iter()).flat_map(|&t| tets[t as usize]).collect();
+        nodes.sort_unstable();
+        nodes.dedup();
+        regions.push(MeshRegion {
+            name: format!("region {tag}"),
+            dimension: 3,
+            tag,
+            nodes,
+            tets: members,
+        });
+    }
+    let mut surfaces: BTreeMap<i64, Vec<u32>> = BTreeMap::new();
+    for (point, &marker) in markers.iter().enumerate() {
+        if marker != 0 {
+            surfaces.entry(marker).or_default().push(point as u32);
+        }
+    }
+    for (tag, nodes) in surfaces {
+        regions.push(MeshRegion {
+            name: format!("marker {tag}"),
+            dimension: 2,
+            tag,
+            nodes,
+            tets: Vec::new(),
+        });
+    }
+    regions
+}
+
+/// The header of an `.ele` file: the tetrahedron count (not zero) and the number of attributes
+/// each line ends with; quadratic (10-node) tetrahedra are refused.
+fn parse_ele_header(source: &mut Source<'_>) -> Result<(usize, usize), Error> {
+    let header = source.content_line(Some('#'), "the header `<tetrahedra> <4|10> <attributes>`")?;
     let mut tokens = header.split_ascii_whitespace();
     let count: usize = parse_token(source, tokens.next(), "tetrahedron count")?;
     let per_tet: usize = parse_token(source, tokens.next(), "nodes per tetrahedron")?;
-    let region: u32 = tokens
+    let attributes: usize = tokens
         .next()
-        .map_or(Ok(0), |t| parse_token(source, Some(t), "region flag"))?;
+        .map_or(Ok(0), |t| parse_token(source, Some(t), "attribute count"))?;
     match per_tet {
         4 => {}
         10 => {
@@ -91,19 +137,13 @@ fn parse_ele_header(source: &mut Source<'_>) -> Result<(usize, bool), Error> {
             ));
         }
     }
-    if region > 1 {
-        return Err(source.error(
-            ImportErrorKind::Syntax,
-            format!("region flag {region} is neither 0 nor 1"),
-        ));
-    }
     if count == 0 {
         return Err(source.error(
             ImportErrorKind::NoTetrahedra,
             "the file holds no tetrahedra",
         ));
     }
-    Ok((count, region == 1))
+    Ok((count, attributes))
 }
 
 /// How the points are numbered: `count` of them from `base` (0 or 1).
@@ -114,14 +154,15 @@ struct Numbering {
 }
 
 /// The corners (0-based) of the tetrahedron line `line` `<index> <n1> <n2> <n3> <n4>
-/// [region]`, whose index must be `index`; the nodes are numbered by `points`.
+/// [attributes]`, whose index must be `index`, and its region (its first attribute, a whole
+/// number) if it has `attributes`; the nodes are numbered by `points`.
 fn parse_tet_line(
     source: &Source<'_>,
     line: &str,
     expected: u64,
     points: Numbering,
-    region: bool,
-) -> Result<[u32; 4], Error> {
+    attributes: usize,
+) -> Result<([u32; 4], Option<i64>), Error> {
     let Numbering { base, count } = points;
     let mut tokens = line.split_ascii_whitespace();
     let index: u64 = parse_token(source, tokens.next(), "tetrahedron index")?;
@@ -148,15 +189,33 @@ fn parse_tet_line(
         };
         *corner = local as u32;
     }
-    if region {
-        parse_finite(source, tokens.next(), "region attribute")?;
+    let mut region = None;
+    for k in 0..attributes {
+        let value = parse_finite(source, tokens.next(), "tetrahedron attribute")?;
+        if k == 0 {
+            region = Some(whole_number(source, value, "region attribute")?);
+        }
     }
     end_of_line(source, tokens, ImportErrorKind::BadCount, TOO_MANY_NUMBERS)?;
-    Ok(tet)
+    Ok((tet, region))
 }
 
-/// The points of a `.node` file and the index of the first (0 or 1).
-fn parse_node(data: &[u8], path: &str, scale: f64) -> Result<(Vec<DVec3>, u64), Error> {
+/// `value` as a whole number, or an error naming it `what`.
+fn whole_number(source: &Source<'_>, value: f64, what: &str) -> Result<i64, Error> {
+    // Whole numbers up to 2^53 are exact in an f64.
+    if value.fract() == 0.0 && value.abs() <= 9_007_199_254_740_992.0 {
+        Ok(value as i64)
+    } else {
+        Err(source.error(
+            ImportErrorKind::Syntax,
+            format!("{what} {value} is not a whole number: regions are numbered 1, 2, …"),
+        ))
+    }
+}
+
+/// The points of a `.node` file, the index of the first (0 or 1), and the points' boundary
+/// markers (none if the file has none).
+fn parse_node(data: &[u8], path: &str, scale: f64) -> Result<(Vec<DVec3>, u64, Vec<i64>), Error> {
     let mut source = Source::new(path, data);
     let header = source.content_line(
         Some('#'),
@@ -190,6 +249,7 @@ fn parse_node(data: &[u8], path: &str, scale: f64) -> Result<(Vec<DVec3>, u64), 
         return Err(source.error(ImportErrorKind::BadCount, "more than 2^32 - 1 points"));
     }
     let mut positions = Vec::with_capacity(source.capacity(count, 8));
+    let mut point_markers = Vec::new();
     let mut base = 0;
     for i in 0..count {
         let line = source.content_line(Some('#'), "a point line")?;
@@ -217,12 +277,12 @@ fn parse_node(data: &[u8], path: &str, scale: f64) -> Result<(Vec<DVec3>, u64), 
             parse_finite(&source, tokens.next(), "point attribute")?;
         }
         if markers == 1 {
-            let _: i64 = parse_token(&source, tokens.next(), "boundary marker")?;
+            point_markers.push(parse_token(&source, tokens.next(), "boundary marker")?);
         }
         end_of_line(&source, tokens, ImportErrorKind::BadCount, TOO_MANY_NUMBERS)?;
         positions.push(scaled(&source, p, scale)?);
     }
     source.check_line_ended("the last point")?;
     source.check_nothing_follows('#', "points", count)?;
-    Ok((positions, base))
+    Ok((positions, base, point_markers))
 }
