@@ -3,6 +3,9 @@
 //! gmsh's thick-walled hollow sphere (radii a = 25 mm, b = 50 mm), the pressure found against
 //! Lamé's closed form for a thick sphere.
 
+mod common;
+
+use rapier_fvm::integrate::AutomaticReport;
 use rapier_fvm::load::WATER_BULK_MODULUS;
 use rapier_fvm::mesh::import::{self, SurfaceOptions};
 use rapier_fvm::prelude::*;
@@ -212,6 +215,35 @@ fn water_pumped_into_a_chamber_takes_the_pressure_that_fills_the_cavity() {
     assert!((pressure / lame - 1.0).abs() < 0.01);
 }
 
+/// A body's integrator and what it keeps between frames.
+struct Stepper {
+    integrator: AutomaticIntegrator,
+    constraints: BodyConstraints,
+    workspace: SolverWorkspace,
+}
+
+impl Stepper {
+    fn new(integrator: AutomaticIntegrator) -> Self {
+        Self {
+            integrator,
+            constraints: BodyConstraints::new(),
+            workspace: SolverWorkspace::new(),
+        }
+    }
+
+    /// Steps `body` one frame of [`FRAME`] without gravity.
+    fn frame(&mut self, body: &mut DeformableBody) -> AutomaticReport {
+        let (constraints, workspace) = (&mut self.constraints, &mut self.workspace);
+        (self
+            .integrator
+            .step(body, constraints, workspace, FRAME, DVec3::ZERO))
+        .unwrap()
+    }
+}
+
+/// The frame (s) of the dynamic tests.
+const FRAME: f64 = 1.0 / 60.0;
+
 /// The same chamber pumped 0.1 % at once and stepped for 0.5 s by the default integrator
 /// (undamped material): the liquid's stiffness shortens the explicit step so that the default
 /// steps implicitly (checked), and the sphere settles to the static state: its pressure within
@@ -222,19 +254,10 @@ fn water_pumped_into_a_chamber_takes_the_pressure_that_fills_the_cavity() {
 fn a_chamber_pumped_at_once_settles_at_the_static_pressure() {
     let (mut body, chamber, rest) =
         hollow_sphere_with_chamber((MaterialModel::Linear, true), 1e-3, WATER_BULK_MODULUS);
-    let integrator = AutomaticIntegrator::default();
-    let (mut constraints, mut workspace) = (BodyConstraints::new(), SolverWorkspace::new());
-    let frame = 1.0 / 60.0;
+    let mut stepper = Stepper::new(AutomaticIntegrator::default());
     let mut pressures = Vec::new();
     for _ in 0..30 {
-        let report = (integrator.step(
-            &mut body,
-            &mut constraints,
-            &mut workspace,
-            frame,
-            DVec3::ZERO,
-        ))
-        .unwrap();
+        let report = stepper.frame(&mut body);
         assert_eq!(report.choice, IntegratorKind::Implicit);
         pressures.push(
             body.load(chamber)
@@ -263,21 +286,6 @@ fn a_chamber_pumped_at_once_settles_at_the_static_pressure() {
     assert!((last / by_inflation - 1.0).abs() < 1e-3);
 }
 
-/// Linear momentum (kg m/s), angular momentum about the origin (kg m²/s) and the momentum scale
-/// `Σ m |v|` (kg m/s) of a body.
-fn momenta(body: &DeformableBody) -> (DVec3, DVec3, f64) {
-    let (mut linear, mut angular, mut scale) = (DVec3::ZERO, DVec3::ZERO, 0.0);
-    for ((x, v), m) in (body.positions().iter())
-        .zip(body.velocities())
-        .zip(body.masses())
-    {
-        linear += *v * *m;
-        angular += x.cross(*v) * *m;
-        scale += m * v.length();
-    }
-    (linear, angular, scale)
-}
-
 /// The free hollow sphere (stable Neo-Hookean, whose stress turns with the body: the linear
 /// model's does not, and its torque grows with the rotations of the wall), no pin, no gravity, a
 /// chamber pumped from its rest volume to 1 % more over 0.1 s and held, keeps zero momentum: the
@@ -289,32 +297,23 @@ fn momenta(body: &DeformableBody) -> (DVec3, DVec3, f64) {
 /// measured 4.7e-15).
 #[test]
 fn a_free_body_pumped_up_keeps_its_momentum() {
-    let frame = 1.0 / 60.0;
     for (kind, bulk_modulus, frames) in [
         (IntegratorKind::Implicit, WATER_BULK_MODULUS, 12),
         (IntegratorKind::Explicit, 1e6, 12),
     ] {
-        let integrator = AutomaticIntegrator {
+        let mut stepper = Stepper::new(AutomaticIntegrator {
             force: Some(kind),
             ..AutomaticIntegrator::default()
-        };
+        });
         let model = MaterialModel::StableNeoHookean;
         let (mut body, chamber, rest) =
             hollow_sphere_with_chamber((model, false), 0.0, bulk_modulus);
-        let (mut constraints, mut workspace) = (BodyConstraints::new(), SolverWorkspace::new());
         let (mut worst, mut largest): (f64, f64) = (0.0, 0.0);
         for k in 1..=frames {
-            let volume = rest * (1.0 + 0.01 * (k as f64 * frame / 0.1).min(1.0));
+            let volume = rest * (1.0 + 0.01 * (k as f64 * FRAME / 0.1).min(1.0));
             body.set_load(chamber, LoadValue::Scalar(volume)).unwrap();
-            (integrator.step(
-                &mut body,
-                &mut constraints,
-                &mut workspace,
-                frame,
-                DVec3::ZERO,
-            ))
-            .unwrap();
-            let (linear, angular, scale) = momenta(&body);
+            stepper.frame(&mut body);
+            let (linear, angular, scale) = common::momenta(&body);
             worst = worst.max(linear.length()).max(angular.length() / OUTER);
             largest = largest.max(scale);
         }

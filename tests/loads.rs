@@ -2,6 +2,8 @@
 //! under an end traction (Timoshenko), a pneumatic finger (the pressure's work against the
 //! elastic energy, momentum of a free finger), a cable, and the follower forces' consistency.
 
+mod common;
+
 use rapier_fvm::prelude::*;
 use rapier_fvm::statics::{self, StaticSettings};
 
@@ -295,23 +297,6 @@ fn pneumatic_finger_bends_and_the_pressure_work_is_the_elastic_energy() {
     assert!((work / elastic - 1.0).abs() < 1e-3);
 }
 
-/// Linear momentum (kg m/s), angular momentum about the origin (kg m²/s), and the momentum
-/// scale `Σ m |v|` (kg m/s) of a body.
-fn momenta(body: &DeformableBody) -> (DVec3, DVec3, f64) {
-    let (mut linear, mut angular, mut scale) = (DVec3::ZERO, DVec3::ZERO, 0.0);
-    for ((x, v), m) in body
-        .positions()
-        .iter()
-        .zip(body.velocities())
-        .zip(body.masses())
-    {
-        linear += *v * *m;
-        angular += x.cross(*v) * *m;
-        scale += m * v.length();
-    }
-    (linear, angular, scale)
-}
-
 /// The free finger (no pin, no gravity), inflated from rest to 5 kPa over 0.25 s and held,
 /// keeps zero linear and angular momentum while it writhes: the chamber's pressure is internal.
 /// Explicit steps keep both to round-off (bound 1e-12 of the largest `Σ m |v|` of the run, and
@@ -347,7 +332,7 @@ fn free_pneumatic_finger_keeps_its_momentum() {
                 DVec3::ZERO,
             ))
             .unwrap();
-            let (linear, angular, scale) = momenta(&finger);
+            let (linear, angular, scale) = common::momenta(&finger);
             worst = worst.max(linear.length()).max(angular.length() / FINGER.x);
             largest = largest.max(scale);
         }

@@ -82,17 +82,6 @@ impl ChamberTerms {
     pub(crate) fn is_empty(&self) -> bool {
         self.columns.is_empty()
     }
-
-    /// Appends `other`, a body's terms (columns over its own nodes), the body's nodes placed from
-    /// node `offset` on of a system of `total` nodes (this one's columns are over the system's).
-    pub(crate) fn append_placed(&mut self, other: ChamberTerms, offset: usize, total: usize) {
-        for column in other.columns {
-            let mut placed = vec![DVec3::ZERO; total];
-            placed[offset..offset + column.len()].copy_from_slice(&column);
-            self.columns.push(placed);
-        }
-        self.weights.extend(other.weights);
-    }
 }
 
 /// Solves with the factorization of a tangent `K` assembled without the chambers' rank-one
@@ -184,6 +173,9 @@ mod tests {
     use crate::assembly::{Stiffness, factorize, perturb_positions, solve};
     use crate::body::{DeformableBody, DeformableBodyBuilder};
     use crate::load::Load;
+    use crate::load::follower::tests::{
+        assert_forces_and_tangent_derive_from_the_potential, fixed_direction,
+    };
     use crate::material::{Material, MaterialModel};
     use crate::mesh;
     use rapier3d::glamx::{DMat3, DVec3};
@@ -211,68 +203,20 @@ mod tests {
         body
     }
 
-    fn direction(n: usize) -> Vec<DVec3> {
-        (0..n)
-            .map(|i| DVec3::new((i % 3) as f64 - 1.0, (i % 5) as f64 * 0.5 - 1.0, 0.7))
-            .collect()
-    }
-
-    /// The liquid's forces are minus the gradient of its energy (to 1e-7 relative) and its
-    /// tangent, the pressure's assembled part plus the rank-one `w g gᵀ`, minus the gradient of
-    /// its forces (to 1e-6 of the largest `K d`), by central differences of 1e-7 m on the 0.2 m
-    /// cube (truncation about 1e-12, round-off about 1e-9 relative).
+    /// The liquid's forces and tangent, the pressure's assembled part plus the rank-one
+    /// `w g gᵀ`, derive from its energy (see
+    /// [`assert_forces_and_tangent_derive_from_the_potential`]); it pushes with `K (V* − V)/V*`.
     #[test]
     fn forces_and_tangent_derive_from_the_liquid_s_energy() {
         let mut body = cube_with_chamber();
-        let n = body.node_count();
-        let (start, mut d) = (body.positions().to_vec(), direction(n));
-        // The tangent leaves out pinned nodes, which do not move.
-        for (d, &pinned) in d.iter_mut().zip(&body.pinned) {
-            if pinned {
-                *d = DVec3::ZERO;
-            }
-        }
-        let origins = body.cone_origins();
-        let h = 1e-7;
-        let at = |body: &mut DeformableBody, step: f64| {
-            for ((x, x0), d) in body.positions_mut().iter_mut().zip(&start).zip(&d) {
-                *x = *x0 + *d * step;
-            }
-            let mut forces = vec![DVec3::ZERO; n];
-            body.add_follower_forces(&mut forces);
-            (body.follower_potential(&origins, &start), forces)
-        };
-        let (_, forces) = at(&mut body, 0.0);
-        let (u_plus, f_plus) = at(&mut body, h);
-        let (u_minus, f_minus) = at(&mut body, -h);
-        at(&mut body, 0.0);
         let pressure = body.loads()[0].pressure_at(body.positions()).unwrap();
         // `K (V* − V)/V*` with `V* = 1.02 V`.
         assert!((pressure * 1.02 / 2e4 - 1.0).abs() < 1e-12, "{pressure}");
-        let slope = (u_plus - u_minus) / (2.0 * h);
-        let work: f64 = forces.iter().zip(&d).map(|(f, d)| f.dot(*d)).sum();
-        assert!(
-            (slope + work).abs() <= 1e-7 * work.abs(),
-            "{slope} vs {work}"
-        );
-        let mut stiffness = Stiffness::new(&body);
-        stiffness.values.fill(0.0);
-        crate::load::add_follower_tangents(&body, &mut stiffness, false);
-        let mut k_d = stiffness.multiply(&d);
-        let (g, w) = body.loads()[0].chamber_term(body.positions()).unwrap();
-        let g_d: f64 = g.iter().zip(&d).map(|(g, d)| g.dot(*d)).sum();
-        for (k_d, g) in k_d.iter_mut().zip(&g) {
-            *k_d += *g * (w * g_d);
-        }
-        let scale = k_d.iter().map(|v| v.length()).fold(0.0, f64::max);
-        for node in (0..n).filter(|&node| !body.pinned[node]) {
-            let difference = -(f_plus[node] - f_minus[node]) / (2.0 * h);
-            assert!(
-                (difference - k_d[node]).length() <= 1e-6 * scale,
-                "node {node}: K d {} vs -df/ds {difference}",
-                k_d[node]
-            );
-        }
+        assert_forces_and_tangent_derive_from_the_potential(&mut body, |body, d| {
+            let (g, w) = body.loads()[0].chamber_term(body.positions()).unwrap();
+            let g_d: f64 = g.iter().zip(d).map(|(g, d)| g.dot(*d)).sum();
+            g.iter().map(|g| *g * (w * g_d)).collect()
+        });
     }
 
     /// The Woodbury direction solves the system with the rank-one term: `(K + w g gᵀ) d = r` to
@@ -281,16 +225,11 @@ mod tests {
     #[test]
     fn the_taken_in_direction_solves_the_system_with_the_liquid() {
         let body = cube_with_chamber();
-        let n = body.node_count();
         let mut stiffness = Stiffness::new(&body);
         stiffness.assemble(&body, None, false, |_, _, _| DMat3::ZERO);
         let factor = factorize(&mut stiffness, 0).unwrap();
-        let mut residual = direction(n);
-        for (r, &pinned) in residual.iter_mut().zip(&body.pinned) {
-            if pinned {
-                *r = DVec3::ZERO;
-            }
-        }
+        // A fixed out-of-balance force on the free nodes.
+        let residual = fixed_direction(&body);
         let terms = body.chamber_terms();
         let plain = solve(&factor, &residual);
         let taken = super::ChamberSolve::new(&factor, &terms).take_in(&residual, plain.clone());

@@ -160,7 +160,7 @@ pub(crate) fn add_follower_tangents(
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use crate::assembly::{Stiffness, perturb_positions};
     use crate::body::{DeformableBody, DeformableBodyBuilder};
     use crate::load::Load;
@@ -195,16 +195,31 @@ mod tests {
         forces
     }
 
-    /// The forces are minus the gradient of the potential (to 1e-7 relative) and the tangent
-    /// minus the gradient of the forces (to 1e-6 of the largest `K d`), by central differences
-    /// of 1e-7 m on the 0.2 m cube (truncation about 1e-12, round-off about 1e-9 relative).
-    #[test]
-    fn forces_and_tangent_derive_from_the_potential_on_a_closed_surface() {
-        let mut body = loaded_cube();
+    /// A fixed vector per node (of order one), zero on pinned nodes: a direction of motion or
+    /// an out-of-balance force for the tests.
+    pub(in crate::load) fn fixed_direction(body: &DeformableBody) -> Vec<DVec3> {
+        (0..body.node_count())
+            .map(|i| {
+                if body.pinned[i] {
+                    DVec3::ZERO
+                } else {
+                    DVec3::new((i % 3) as f64 - 1.0, (i % 5) as f64 * 0.5 - 1.0, 0.7)
+                }
+            })
+            .collect()
+    }
+
+    /// Checks by central differences of 1e-7 m along a fixed direction (zero on pinned nodes),
+    /// on a body of about 0.1 m (truncation about 1e-12, round-off about 1e-9 relative), that
+    /// the follower loads' forces are minus the gradient of their potential (to 1e-7 relative)
+    /// and that their tangent, the assembled Hessians plus `unassembled(body, d)` (N per node),
+    /// is minus the gradient of the forces at the free nodes (to 1e-6 of the largest `K d`).
+    pub(in crate::load) fn assert_forces_and_tangent_derive_from_the_potential(
+        body: &mut DeformableBody,
+        unassembled: impl Fn(&DeformableBody, &[DVec3]) -> Vec<DVec3>,
+    ) {
         let n = body.node_count();
-        let direction: Vec<DVec3> = (0..n)
-            .map(|i| DVec3::new((i % 3) as f64 - 1.0, (i % 5) as f64 * 0.5 - 1.0, 0.7))
-            .collect();
+        let direction = fixed_direction(body);
         let start = body.positions().to_vec();
         let origins = body.cone_origins();
         let h = 1e-7;
@@ -217,10 +232,10 @@ mod tests {
                 follower_forces(body),
             )
         };
-        let (_, forces) = at(&mut body, 0.0);
-        let (u_plus, f_plus) = at(&mut body, h);
-        let (u_minus, f_minus) = at(&mut body, -h);
-        at(&mut body, 0.0);
+        let (_, forces) = at(body, 0.0);
+        let (u_plus, f_plus) = at(body, h);
+        let (u_minus, f_minus) = at(body, -h);
+        at(body, 0.0);
         let slope = (u_plus - u_minus) / (2.0 * h);
         let work: f64 = forces.iter().zip(&direction).map(|(f, d)| f.dot(*d)).sum();
         assert!(
@@ -228,12 +243,15 @@ mod tests {
             "dU/ds {slope} vs -f·d {}",
             -work
         );
-        let mut stiffness = Stiffness::new(&body);
+        let mut stiffness = Stiffness::new(body);
         stiffness.values.fill(0.0);
-        super::add_follower_tangents(&body, &mut stiffness, false);
-        let k_d = stiffness.multiply(&direction);
+        super::add_follower_tangents(body, &mut stiffness, false);
+        let mut k_d = stiffness.multiply(&direction);
+        for (k_d, extra) in k_d.iter_mut().zip(unassembled(body, &direction)) {
+            *k_d += extra;
+        }
         let scale = k_d.iter().map(|v| v.length()).fold(0.0, f64::max);
-        for node in 0..n {
+        for node in (0..n).filter(|&node| !body.pinned[node]) {
             let difference = -(f_plus[node] - f_minus[node]) / (2.0 * h);
             assert!(
                 (difference - k_d[node]).length() <= 1e-6 * scale,
@@ -241,6 +259,16 @@ mod tests {
                 k_d[node]
             );
         }
+    }
+
+    /// The pressure's and the cable's forces and tangents derive from their potentials on the
+    /// free cube (see [`assert_forces_and_tangent_derive_from_the_potential`]).
+    #[test]
+    fn forces_and_tangent_derive_from_the_potential_on_a_closed_surface() {
+        let mut body = loaded_cube();
+        assert_forces_and_tangent_derive_from_the_potential(&mut body, |body, _| {
+            vec![DVec3::ZERO; body.node_count()]
+        });
     }
 
     /// A pressure on a closed surface and a cable anchored in the body are internal: no net

@@ -534,3 +534,20 @@ pub fn settle_on_colliders(
     }
     support
 }
+
+/// Linear momentum (kg m/s), angular momentum about the origin (kg m²/s), and the momentum
+/// scale `Σ m |v|` (kg m/s) of a body.
+pub fn momenta(body: &DeformableBody) -> (DVec3, DVec3, f64) {
+    let (mut linear, mut angular, mut scale) = (DVec3::ZERO, DVec3::ZERO, 0.0);
+    for ((x, v), m) in body
+        .positions()
+        .iter()
+        .zip(body.velocities())
+        .zip(body.masses())
+    {
+        linear += *v * *m;
+        angular += x.cross(*v) * *m;
+        scale += m * v.length();
+    }
+    (linear, angular, scale)
+}

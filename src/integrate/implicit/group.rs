@@ -577,17 +577,23 @@ impl ImplicitIntegrator {
         outcome.projected_tangents += usize::from(solution.projected);
         let mut direction = solution.direction;
         if let Some(factor) = &solution.factor {
+            // The last offset is the group's node count.
+            let placements: Vec<Placement> = (group.offsets[..group.bodies.len()].iter())
+                .map(|&offset| Placement {
+                    offset,
+                    total: group.node_count(),
+                })
+                .collect();
             let mut chambers = ChamberTerms::default();
-            for (k, body) in group.bodies.iter().enumerate() {
-                chambers.append_placed(body.chamber_terms(), group.offsets[k], group.node_count());
+            for (body, placement) in group.bodies.iter().zip(&placements) {
+                let terms = body.chamber_terms();
+                (chambers.columns).extend(placement.embed(&terms.columns).into_owned());
+                chambers.weights.extend(terms.weights);
             }
             let solver = ChamberSolve::new(factor, &chambers);
             direction = solver.take_in(residual, direction);
             for (k, member) in potential.members.iter().enumerate() {
-                let placement = Placement {
-                    offset: group.offsets[k],
-                    total: group.node_count(),
-                };
+                let placement = placements[k];
                 direction = member.take_in_placed(
                     group.bodies[k],
                     (&solver, false),

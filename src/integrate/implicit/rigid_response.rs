@@ -533,7 +533,7 @@ pub(super) struct Placement {
 
 impl Placement {
     /// The body's `columns` (per node of the body) as columns of the system, zero elsewhere.
-    fn embed<'c>(&self, columns: &'c [Vec<DVec3>]) -> Cow<'c, [Vec<DVec3>]> {
+    pub(super) fn embed<'c>(&self, columns: &'c [Vec<DVec3>]) -> Cow<'c, [Vec<DVec3>]> {
         if columns.iter().all(|column| column.len() == self.total) {
             return Cow::Borrowed(columns);
         }
