@@ -19,6 +19,8 @@
 //! pinned point `c`, `I_c δω = δL`; about the line through collinear pinned nodes (a hinge),
 //! `δω = a (a·δL) / I_a`; none when the pins hold every rotation. The step's positions are kept;
 //! only the velocities it ends with change. The deformation's numerical damping is untouched.
+//! The same rotation ([`turn_by`]) gives a body the moment by which its exchange with dynamic
+//! rigid bodies falls short (see `constraint::partner_arm_moment`).
 
 use crate::body::DeformableBody;
 use rapier3d::glamx::{DMat3, DVec3};
@@ -66,7 +68,7 @@ fn momentum_about_centre(positions: &[DVec3], velocities: &[DVec3], masses: &[f6
 
 /// Adds to the free nodes of `body` the rotation the pins allow whose angular momentum is `lost`
 /// (N m s).
-fn turn_by(body: &mut DeformableBody, lost: DVec3) {
+pub(super) fn turn_by(body: &mut DeformableBody, lost: DVec3) {
     if lost == DVec3::ZERO || !lost.is_finite() {
         return;
     }

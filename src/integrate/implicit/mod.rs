@@ -655,8 +655,10 @@ impl ImplicitIntegrator {
 /// `response` is solved there, every constraint records its impulses, and the velocities become
 /// `(x − a)/ĥ`, with the angular momentum a backward Euler step drains given back
 /// ([`angular`]): to a body `alone` (not stepped with others it touches) that nothing pins, holds
-/// or pushes at the step's end, all it started with. Returns the substep's start, for the next
-/// one.
+/// or pushes at the step's end, all it started with; to others the drain, and to a body alone
+/// and unpinned that only dynamic rigid bodies push, what makes the angular impulses exchanged
+/// with them equal and opposite ([`constraint::partner_arm_moment`]). Returns the substep's
+/// start, for the next one.
 fn end_substep(
     body: &mut DeformableBody,
     constraints: &mut BodyConstraints,
@@ -669,6 +671,9 @@ fn end_substep(
         && !body.pinned.contains(&true)
         && constraints.attachments.is_empty()
         && constraint::implicit_energy(body, constraints, response.step()) == 0.0;
+    let arms = (alone && !body.pinned.contains(&true))
+        .then(|| constraint::partner_arm_moment(body, constraints, response.step()))
+        .flatten();
     for kind in constraint::IMPLICIT {
         kind.record_impulses(body, constraints, response.step());
     }
@@ -685,6 +690,9 @@ fn end_substep(
             angular::keep_free_spin(body, &start.positions, &start.velocities);
         } else {
             angular::give_back(body, &start.velocities, h);
+            if let Some(arms) = arms {
+                angular::turn_by(body, arms);
+            }
         }
     }
     PreviousStep {
