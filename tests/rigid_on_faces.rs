@@ -144,8 +144,9 @@ fn a_rigid_box_striking_a_soft_block_corner_first_exchanges_momentum() {
     // Angular momentum about the origin, to the same 1e-6 (times the block's 10 cm) under both:
     // the explicit sweeps apply both sides' impulses at the triangle's point; an implicit step
     // gives the rigid body its impulses where its contact points began the step and the soft
-    // body where they end it, and then gives the soft body the moment of the difference
-    // (`constraint::partner_arm_moment`). Without that it was off by 1.68e-4 N m s, bounded by how
+    // body where they end it, and then sets the soft body's angular momentum to what it started
+    // with plus what the cube gave it, counted at the cube's points
+    // (`constraint::partner_angular_impulse`). Without that it was off by 1.68e-4 N m s, bounded by how
     // far a point of the cube travels in a frame times the impulse the cube received (6.9e-3).
     // The cube's inertia is isotropic, m a²/6, whatever its orientation.
     for (name, mut world) in worlds() {

@@ -353,30 +353,27 @@ pub(crate) fn for_each_implicit_term(
     }
 }
 
-/// What the impulses of the implicit terms against dynamic rigid bodies lack, as moments about
-/// the origin (N m s), for the body's angular momentum to change by exactly the opposite of the
-/// rigid bodies': `Σ (a − p) × F h` over the terms in the implicit `step` of length `h`, with the
-/// body where the step ends; `None` when a term pushes it against something else (a fixed or
-/// kinematic collider or anchor, its own surface), which takes angular momentum anyway. The body
-/// receives `F h` at its point `p` as the step ends (where a backward Euler step, its drain
-/// given back, counts the forces' arms), the rigid body `−F h` at its point `a`, fixed over the
-/// step (the corner's vertex, the plane's point, the anchor); the two differ by the points'
-/// relative travel over the step.
-pub(crate) fn partner_arm_moment(
+/// The angular impulse (N m s, about the origin) the implicit terms in the implicit `step` of
+/// length `h` give the body, counted where the dynamic rigid bodies take the opposite: `Σ a × F h`
+/// over the terms, `F` each term's force on the body where the step ends and `a` its rigid
+/// body's point, fixed over the step (a corner's vertex, a contact plane's point, an anchor);
+/// `None` when a term pushes the body against something else (a fixed or kinematic collider or
+/// anchor, its own surface), which takes angular momentum anyway. The body receives `F h` at its
+/// own point, where its nodes end the step; the two differ by the points' relative travel.
+pub(crate) fn partner_angular_impulse(
     body: &DeformableBody,
     constraints: &BodyConstraints,
     step: ImplicitStep,
 ) -> Option<DVec3> {
-    let mut moment = Some(DVec3::ZERO);
+    let mut impulse = Some(DVec3::ZERO);
     for_each_implicit_term(body, constraints, step, &mut |term| match term.partner {
         Some(partner) => {
-            let at = term.at.interpolate(&body.positions);
-            moment = moment.map(|m| m + (partner.point - at).cross(term.force * step.length));
+            impulse = impulse.map(|sum| sum + partner.point.cross(term.force * step.length));
         }
-        None if term.force != DVec3::ZERO => moment = None,
+        None if term.force != DVec3::ZERO => impulse = None,
         None => {}
     });
-    moment
+    impulse
 }
 
 /// Adds every implicit term's force (N) into `residual` (per node), in the implicit `step`.

@@ -19,8 +19,10 @@
 //! pinned point `c`, `I_c δω = δL`; about the line through collinear pinned nodes (a hinge),
 //! `δω = a (a·δL) / I_a`; none when the pins hold every rotation. The step's positions are kept;
 //! only the velocities it ends with change. The deformation's numerical damping is untouched.
-//! The same rotation ([`turn_by`]) gives a body the moment by which its exchange with dynamic
-//! rigid bodies falls short (see `constraint::partner_arm_moment`).
+//! A body that only its weight and dynamic rigid bodies act on is given, the same way, what makes
+//! its angular momentum change by exactly the angular impulse they gave it, counted where the
+//! rigid bodies take the opposite ([`keep_exchanged`]): the exchange is then exact, the drain
+//! and the Newton tolerance's share included.
 
 use crate::body::DeformableBody;
 use rapier3d::glamx::{DMat3, DVec3};
@@ -50,6 +52,23 @@ pub(super) fn keep_free_spin(body: &mut DeformableBody, positions: &[DVec3], vel
     turn_by(body, start - now);
 }
 
+/// Gives `body` what makes its angular momentum about the origin the one it started the step
+/// with at `positions` (m) and `velocities` (m/s) plus `received` (N m s), the angular impulse
+/// about the origin of everything that acted on it over the step.
+pub(super) fn keep_exchanged(
+    body: &mut DeformableBody,
+    (positions, velocities): (&[DVec3], &[DVec3]),
+    received: DVec3,
+) {
+    let start = momentum_about(DVec3::ZERO, (positions, velocities), &body.masses);
+    let now = momentum_about(
+        DVec3::ZERO,
+        (&body.positions, &body.velocities),
+        &body.masses,
+    );
+    turn_by(body, start + received - now);
+}
+
 /// The angular momentum (N m s) of nodes at `positions` (m) moving at `velocities` (m/s) with
 /// `masses` (kg) about their centre of mass: [`DeformableBody::angular_momentum`] of a state the
 /// body had.
@@ -61,14 +80,24 @@ fn momentum_about_centre(positions: &[DVec3], velocities: &[DVec3], masses: &[f6
         .map(|(x, m)| *x * *m)
         .sum::<DVec3>()
         / total;
+    momentum_about(centre, (positions, velocities), masses)
+}
+
+/// The angular momentum (N m s) about `point` (m) of nodes at `positions` (m) moving at
+/// `velocities` (m/s) with `masses` (kg).
+fn momentum_about(
+    point: DVec3,
+    (positions, velocities): (&[DVec3], &[DVec3]),
+    masses: &[f64],
+) -> DVec3 {
     (positions.iter().zip(velocities).zip(masses))
-        .map(|((x, v), m)| (*x - centre).cross(*v) * *m)
+        .map(|((x, v), m)| (*x - point).cross(*v) * *m)
         .sum()
 }
 
 /// Adds to the free nodes of `body` the rotation the pins allow whose angular momentum is `lost`
 /// (N m s).
-pub(super) fn turn_by(body: &mut DeformableBody, lost: DVec3) {
+fn turn_by(body: &mut DeformableBody, lost: DVec3) {
     if lost == DVec3::ZERO || !lost.is_finite() {
         return;
     }

@@ -655,10 +655,10 @@ impl ImplicitIntegrator {
 /// `response` is solved there, every constraint records its impulses, and the velocities become
 /// `(x − a)/ĥ`, with the angular momentum a backward Euler step drains given back
 /// ([`angular`]): to a body `alone` (not stepped with others it touches) that nothing pins, holds
-/// or pushes at the step's end, all it started with; to others the drain, and to a body alone
-/// and unpinned that only dynamic rigid bodies push, what makes the angular impulses exchanged
-/// with them equal and opposite ([`constraint::partner_arm_moment`]). Returns the substep's
-/// start, for the next one.
+/// or pushes at the step's end, all it started with; to a body alone, unpinned and without loads
+/// but its weight that only dynamic rigid bodies push, exactly what they and its weight gave it
+/// ([`constraint::partner_angular_impulse`]: equal and opposite to what the rigid bodies take);
+/// to others the drain. Returns the substep's start, for the next one.
 fn end_substep(
     body: &mut DeformableBody,
     constraints: &mut BodyConstraints,
@@ -671,8 +671,8 @@ fn end_substep(
         && !body.pinned.contains(&true)
         && constraints.attachments.is_empty()
         && constraint::implicit_energy(body, constraints, response.step()) == 0.0;
-    let arms = (alone && !body.pinned.contains(&true))
-        .then(|| constraint::partner_arm_moment(body, constraints, response.step()))
+    let exchanged = (alone && !body.pinned.contains(&true) && body.loads.is_empty())
+        .then(|| constraint::partner_angular_impulse(body, constraints, response.step()))
         .flatten();
     for kind in constraint::IMPLICIT {
         kind.record_impulses(body, constraints, response.step());
@@ -688,11 +688,14 @@ fn end_substep(
     if start.h == h {
         if free {
             angular::keep_free_spin(body, &start.positions, &start.velocities);
+        } else if let Some(exchanged) = exchanged {
+            let weight_moment: DVec3 = (body.positions.iter().zip(&start.load))
+                .map(|(x, weight)| x.cross(*weight * h))
+                .sum();
+            let before = (start.positions.as_slice(), start.velocities.as_slice());
+            angular::keep_exchanged(body, before, exchanged + weight_moment);
         } else {
             angular::give_back(body, &start.velocities, h);
-            if let Some(arms) = arms {
-                angular::turn_by(body, arms);
-            }
         }
     }
     PreviousStep {
