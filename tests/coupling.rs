@@ -52,10 +52,10 @@ fn a_soft_cube_hitting_a_free_ball_conserves_momentum() {
         world.coupling.integrator.force = integrator;
         world.physics.gravity = Vec3::ZERO;
         let radius = 0.05f32;
-        let density = 0.5 / (4.0 / 3.0 * std::f32::consts::PI * radius.powi(3));
-        let (ball, _) = world.physics.insert(
+        let ball = common::insert_ball(
+            &mut world,
             RigidBodyBuilder::dynamic().translation(Vec3::new(0.2, 0.03, 0.0)),
-            ColliderBuilder::ball(radius).density(density).friction(0.5),
+            (0.5, radius),
         );
         let mut cube = soft_cube(0.1, 4, DVec3::ZERO, 1e5);
         for v in cube.velocities_mut() {
@@ -102,15 +102,15 @@ fn a_soft_bar_glued_to_a_free_ball_tumbles_with_its_momentum_kept() {
         world.coupling.integrator.force = integrator;
         world.physics.gravity = Vec3::ZERO;
         let radius = 0.03f32;
-        let density = 0.5 / (4.0 / 3.0 * std::f32::consts::PI * radius.powi(3));
         let spin = DVec3::new(0.0, 0.0, 5.0);
         let centre = DVec3::new(0.05 + f64::from(radius), 0.0, 0.0);
-        let (ball, _) = world.physics.insert(
+        let ball = common::insert_ball(
+            &mut world,
             RigidBodyBuilder::dynamic()
                 .translation(centre.as_vec3())
                 .linvel((DVec3::X + spin.cross(centre)).as_vec3())
                 .angvel(spin.as_vec3()),
-            ColliderBuilder::ball(radius).density(density),
+            (0.5, radius),
         );
         let mesh = mesh::cuboid(DVec3::new(0.05, 0.01, 0.01), [5, 1, 1]).unwrap();
         let end = mesh.nodes_where(|p| p.x >= 0.05 - 1e-9);

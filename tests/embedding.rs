@@ -176,10 +176,10 @@ fn an_embedded_surface_hitting_a_free_ball_conserves_momentum() {
     let mut world = FvmWorld::default();
     world.physics.gravity = Vec3::ZERO;
     let radius = 0.05f32;
-    let density = 0.5 / (4.0 / 3.0 * std::f32::consts::PI * radius.powi(3));
-    let (ball, _) = world.physics.insert(
+    let ball = common::insert_ball(
+        &mut world,
         RigidBodyBuilder::dynamic().translation(Vec3::new(0.2, 0.03, 0.0)),
-        ColliderBuilder::ball(radius).density(density).friction(0.5),
+        (0.5, radius),
     );
     let material = rubber();
     let mut sphere = DeformableBodyBuilder::quadratic(

@@ -243,6 +243,18 @@ pub fn homogeneous_deformation_rate() -> DMat3 {
     )
 }
 
+/// Inserts into `world` the dynamic rigid body `body` with a ball collider of `radius` (m)
+/// weighing `mass` (kg), friction 0.5; returns its handle.
+pub fn insert_ball(
+    world: &mut FvmWorld,
+    body: rapier3d::prelude::RigidBodyBuilder,
+    (mass, radius): (f32, f32),
+) -> rapier3d::prelude::RigidBodyHandle {
+    let density = mass / (4.0 / 3.0 * std::f32::consts::PI * radius.powi(3));
+    let collider = ColliderBuilder::ball(radius).density(density).friction(0.5);
+    world.physics.insert(body, collider).0
+}
+
 /// The total linear momentum (kg m/s) and angular momentum about the origin (kg m²/s) of the soft
 /// body `soft` and the rigid ball `ball` of radius `radius` (m) in `world`.
 pub fn soft_and_ball_momenta(
