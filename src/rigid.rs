@@ -196,12 +196,6 @@ impl RigidProxy {
         direction.dot(self.inv_mass * direction) + arm.dot(self.inv_inertia * arm)
     }
 
-    /// The effective mass (kg) of the body at `point` (m) along unit `direction`; infinite
-    /// for a body contact impulses do not move.
-    pub(crate) fn effective_mass_along(&self, point: DVec3, direction: DVec3) -> f64 {
-        self.inverse_mass_along(point, direction).recip()
-    }
-
     /// A lower bound (kg) of the body's effective mass at `point` (m) in every direction: one
     /// over the trace of its inverse effective mass there; infinite for a body contact impulses
     /// do not move.

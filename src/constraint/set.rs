@@ -92,7 +92,7 @@ impl BodyConstraints {
             self.attachments.iter().map(|a| (a.body, a.node)).collect();
         let found = contact::detect(
             body,
-            (&glued, (&self.contacts.nodes, &self.rigid_proxies)),
+            (&glued, (&self.contacts, &self.rigid_proxies)),
             colliders,
             frame_dt,
             gravity,

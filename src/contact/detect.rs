@@ -77,6 +77,9 @@ pub(crate) fn detect(
     let mut corners = Vec::new();
     let contact_points = contact_points(body);
     let last = last_contacts(previous);
+    let last_corners: HashMap<_, _> = (previous.0.corners.iter())
+        .map(|c| ((c.collider, c.feature), c.stiffening))
+        .collect();
     for view in colliders {
         if !body.collision_groups.test(view.groups) {
             continue;
@@ -100,6 +103,8 @@ pub(crate) fn detect(
                 let proxy = proxy.or_else(|| near.proxy_in(&mut proxies));
                 for contact in &mut found {
                     contact.proxy = proxy;
+                    let last = last_corners.get(&(contact.collider, contact.feature));
+                    contact.stiffening = last.copied().unwrap_or_default();
                 }
             }
             corners.extend(found);
@@ -173,7 +178,7 @@ fn node_contact_with(
             },
         );
         contact.detected_at = x;
-        contact.load_stiffness = last.map_or(0.0, |last| last.load_stiffness);
+        contact.stiffening = last.map_or_else(Default::default, |last| last.stiffening);
         contact.depth_limit = 0.5 * thickness(near.shape.as_ref(), near.pose, point, normal);
         contact
     })
@@ -192,7 +197,7 @@ fn thickness(shape: &dyn Shape, pose: &Pose, point: DVec3, normal: DVec3) -> f64
 
 /// The contacts of the last detection and the rigid proxies of its step (as the step left
 /// them).
-type LastDetection<'a> = (&'a [NodeContact], &'a [RigidProxy]);
+type LastDetection<'a> = (&'a ContactSet, &'a [RigidProxy]);
 
 /// What the `contacts` of the last detection saw of each point's contact with each collider
 /// (the stiffness its load called for kept), their planes taken back to the colliders' poses at
@@ -202,6 +207,7 @@ fn last_contacts(
     (contacts, proxies): LastDetection<'_>,
 ) -> HashMap<(BodyPoint, ColliderHandle), LastContact> {
     contacts
+        .nodes
         .iter()
         .filter_map(|c| match (&c.target, &c.obstacle) {
             (ContactTarget::Collider(handle), Obstacle::Collider { pose, proxy, .. }) => {
@@ -213,7 +219,7 @@ fn last_contacts(
                         pose: *pose,
                         point: motion.map_or(c.point, |m| m.carry_back(c.point)),
                         normal: motion.map_or(c.normal, |m| m.turn_back(c.normal)),
-                        load_stiffness: c.load_stiffness,
+                        stiffening: c.stiffening,
                     },
                 ))
             }

@@ -20,14 +20,14 @@ use rapier3d::math::Pose;
 
 /// What the last detection saw of a point's contact with a collider: where the point was (m),
 /// the collider's pose then, and the contact plane it was given (a point, m, and the outward
-/// unit normal), and the penalty stiffness its load called for (N/m).
+/// unit normal), and the stiffenings its load called for.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct LastContact {
     pub(super) at: DVec3,
     pub(super) pose: Pose,
     pub(super) point: DVec3,
     pub(super) normal: DVec3,
-    pub(super) load_stiffness: f64,
+    pub(super) stiffening: super::stiffening::Stiffening,
 }
 
 /// The contact plane of a point at `x` (m) against `shape` at `pose`: its surface point, the

@@ -16,12 +16,16 @@
 //!   contacts (sequential impulses, as rapier's own solver).
 //! - [`ImplicitIntegrator`](crate::integrate::ImplicitIntegrator), as a stiff penalty in the
 //!   incremental potential, `k/2 min(0, g)²` per contact with `g` the signed distance to the plane
-//!   and `k` at least [`ContactSettings::penalty_factor`] times the node's `m/h²`, whose resting
+//!   and `k` at least [`ContactSettings::penalty_factor`] times the node's `m/h²` (its own mass,
+//!   against a fixed collider as against a dynamic rigid body: the body's mass counted in would
+//!   make each contact switching on or off a jump of curvature hundreds of times the node's
+//!   inertia, and Newton wander between them), whose resting
 //!   penetration under a load `w` is `w h²/(factor m)`: micrometres at game steps for a node
 //!   carrying its own weight, millimetres for a light node under a heavy body. A step that
 //!   leaves a point deeper than [`ContactSettings::resting_depth`] behind a collider's plane
-//!   raises that contact's `k` so that its load holds it at half that depth, and is solved
-//!   again; the contact keeps its `k` for as long as it is detected. Friction is the lagged
+//!   stiffens that contact beyond the depth it started the step at, so that its load holds it
+//!   at half that depth, and is solved again; the contact keeps its stiffenings for as long as
+//!   it is detected. Friction is the lagged
 //!   dissipation potential of incremental potential contact (Li et al. 2020): the normal force
 //!   is taken from the penalty at the start of the step, and the node's slip relative to the
 //!   surface over the step, `u`, costs `μ λ f(|u|)`, with `f` quadratic below
@@ -59,6 +63,7 @@ mod penalty;
 mod self_contact;
 mod set;
 mod soft_point;
+mod stiffening;
 mod support;
 mod surface_tree;
 mod sweep;
@@ -66,8 +71,9 @@ mod velocity_constraint;
 
 pub(crate) use between::{BetweenContact, detect_between, prepare_between, solve_between};
 pub(crate) use corner::{
-    CornerContact, CornerPlace, advance_corners, for_each_corner_stencil, for_each_corner_term,
-    lag_corner_friction, prepare_corners, record_corner_impulses, solve_corners,
+    CornerContact, CornerPlace, advance_corners, corner_penalty_energy, for_each_corner_stencil,
+    for_each_corner_term, lag_corner_friction, prepare_corners, record_corner_impulses,
+    solve_corners,
 };
 use detect::nearest_surface_point;
 pub(crate) use detect::{
@@ -120,12 +126,13 @@ pub struct ContactSettings {
     /// stiffness of a contact, which its load raises (see [`ContactSettings::resting_depth`]).
     pub penalty_factor: f64,
     /// The deepest (m) an implicit step leaves a point behind its contact plane with a collider
-    /// before the contact's penalty stiffens: a contact whose load presses it deeper has its
-    /// stiffness raised so that the load holds it at half this depth, and the step is solved
-    /// again; the contact keeps that stiffness while it is detected in later frames. A point
-    /// that already lay behind its plane at the step's start holds more energy in the stiffer
-    /// penalty than it did: at most its load times this depth (0.04 J for a node carrying 40 N
-    /// at the default), given back as the step pushes it out.
+    /// (or a collider's corner behind a soft face) before the contact's penalty stiffens: a
+    /// contact whose load presses it deeper is stiffened beyond the depth the step started it
+    /// at, so that the load is held at half this depth (a point that started deeper is held
+    /// short of where it ended), and the step is solved again; the contact keeps its
+    /// stiffenings while it is detected in later frames. A stiffening acts only beyond the
+    /// step's start, so it never changes the energy a point holds there (see
+    /// `contact::stiffening`).
     pub resting_depth: f64,
     /// The most speed (m/s) at which explicit contacts push a node found inside a collider back
     /// out (it entered between detections, e.g. pushed by a rigid body that moved): an impulse,

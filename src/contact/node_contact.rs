@@ -4,6 +4,7 @@
 //! implicit side's terms on it: the penalty `k/2 min(0, g)²` on the gap `g` and the lagged
 //! friction dissipation `μ λ f(|u|)` on the slip `u` over the step.
 
+use super::stiffening::{Penalty, Stiffening};
 use super::{
     Coefficients, ContactSettings, SoftPoint, VelocityConstraint, nearest_surface_point,
     penalty_tangent,
@@ -92,9 +93,9 @@ pub struct NodeContact {
     /// collider: half the collider's thickness along the normal there (infinite for a
     /// half-space or an own triangle).
     pub(super) depth_limit: f64,
-    /// The penalty stiffness (N/m) the contact's load has called for (see
-    /// [`ContactSettings::resting_depth`]); zero until a load presses the point that deep.
-    pub(super) load_stiffness: f64,
+    /// The stiffenings of the implicit penalty the contact's load has called for (see
+    /// [`ContactSettings::resting_depth`]); none until a load presses the point that deep.
+    pub(super) stiffening: Stiffening,
 }
 
 /// The far side of a contact.
@@ -172,7 +173,7 @@ impl NodeContact {
             slip_origin: DVec3::ZERO,
             detected_at: point,
             depth_limit: f64::INFINITY,
-            load_stiffness: 0.0,
+            stiffening: Stiffening::default(),
         }
     }
 
@@ -197,44 +198,36 @@ impl NodeContact {
         (x - self.point).dot(self.normal)
     }
 
-    /// The penalty stiffness (N/m) and gap (m) of the contact's node at `x` (m), of mass `mass`
-    /// (kg), in an implicit step of effective length `h` (s); `None` outside its plane.
-    pub(super) fn penalty(
+    /// The implicit penalty of the contact's point at `x` (m), of effective mass `mass` (kg), in
+    /// an implicit step of effective length `h` (s): the penalty factor times `m/h²`, stiffened
+    /// by its load (see [`super::stiffening`]); `None` outside its plane.
+    pub(crate) fn penalty(
         &self,
         x: DVec3,
         mass: f64,
         settings: &ContactSettings,
         h: f64,
-    ) -> Option<(f64, f64)> {
-        let gap = self.gap(x);
-        (gap < 0.0).then(|| (self.penalty_stiffness(mass, settings, h), gap))
+    ) -> Option<Penalty> {
+        (self.stiffening).penalty(settings.penalty_stiffness(mass, h), -self.gap(x))
     }
 
-    /// The contact's penalty stiffness (N/m) on a point of effective mass `mass` (kg) in an
-    /// implicit step of effective length `h` (s): [`ContactSettings::penalty_factor`] times
-    /// `m/h²`, or what its load has called for if more.
-    pub(crate) fn penalty_stiffness(&self, mass: f64, settings: &ContactSettings, h: f64) -> f64 {
-        settings.penalty_stiffness(mass, h).max(self.load_stiffness)
-    }
-
-    /// Raises the penalty stiffness of the point at `x` (m), of effective mass `mass` (kg), in
-    /// an implicit step of effective length `h` (s), when it lies deeper than
-    /// [`ContactSettings::resting_depth`] behind its plane: to the stiffness at which its present
-    /// force would hold it at half that depth. Returns whether it did.
+    /// Stiffens the penalty of the point an implicit step of effective length `h` (s) took from
+    /// `start` to `end` (m), of effective mass `mass` (kg), when it left it deeper than
+    /// [`ContactSettings::resting_depth`] (see [`Stiffening::stiffen`]). Returns whether it
+    /// did.
     pub(super) fn stiffen_if_deep(
         &mut self,
-        x: DVec3,
+        (start, end): (DVec3, DVec3),
         mass: f64,
         settings: &ContactSettings,
         h: f64,
     ) -> bool {
-        let depth = -self.gap(x);
-        if depth <= settings.resting_depth {
-            return false;
-        }
-        let stiffness = self.penalty_stiffness(mass, settings, h);
-        self.load_stiffness = stiffness * depth / (0.5 * settings.resting_depth);
-        true
+        let depths = (-self.gap(start), -self.gap(end));
+        (self.stiffening).stiffen(
+            settings.penalty_stiffness(mass, h),
+            depths,
+            settings.resting_depth,
+        )
     }
 
     /// The lagged friction dissipation of the node at `x` (m) relative to the surface (its

@@ -13,7 +13,7 @@
 //! triangle take equal and opposite forces, and the body's momentum is kept.
 
 use super::{
-    BodyPoint, ContactSet, ContactSettings, ImplicitStep, NodeContact, Obstacle, partners,
+    BodyPoint, ContactSet, ContactSettings, ImplicitStep, NodeContact, Obstacle, corner, partners,
 };
 use crate::body::DeformableBody;
 use crate::embedding::Embedding;
@@ -78,8 +78,6 @@ struct Carried {
     travel: DVec3,
     /// The rigid point the contact acts against when that body is dynamic.
     partner: Option<RigidPoint>,
-    /// That body's effective mass (kg) at the point along the normal; zero otherwise.
-    mass: f64,
 }
 
 /// `contact`'s obstacle in the implicit `step`.
@@ -87,24 +85,17 @@ fn carried(contact: &NodeContact, step: &ImplicitStep) -> Carried {
     match contact.obstacle {
         Obstacle::Collider { proxy: Some(p), .. } => {
             let rigid = &step.rigid[p];
-            let dynamic = rigid.is_dynamic();
             Carried {
                 travel: rigid.velocity_at(contact.point) * step.length,
-                partner: dynamic.then_some(RigidPoint {
+                partner: rigid.is_dynamic().then_some(RigidPoint {
                     proxy: p,
                     point: contact.point,
                 }),
-                mass: if dynamic {
-                    rigid.effective_mass_along(contact.point, contact.normal)
-                } else {
-                    0.0
-                },
             }
         }
         _ => Carried {
             travel: DVec3::ZERO,
             partner: None,
-            mass: 0.0,
         },
     }
 }
@@ -124,9 +115,7 @@ fn implicit_force(
         .map_or(DVec3::ZERO, |(_, force, _)| force);
     let penalty = contact
         .penalty(x, mass, settings, h)
-        .map_or(DVec3::ZERO, |(stiffness, gap)| {
-            -contact.normal * (stiffness * gap)
-        });
+        .map_or(DVec3::ZERO, |penalty| contact.normal * penalty.push);
     friction + penalty
 }
 
@@ -148,7 +137,7 @@ pub(crate) fn record_penalty_impulses(
         let at = point.stencil();
         let obstacle = carried(contact, &step);
         let x = point.position(positions) - obstacle.travel;
-        let mass = effective_mass(&at, partners.masses, partners.pinned) + obstacle.mass;
+        let mass = effective_mass(&at, partners.masses, partners.pinned);
         let impulse = implicit_force(contact, x, mass, &settings, step.effective) * step.length;
         if !matches!(contact.obstacle, Obstacle::OwnTriangle(_)) {
             partners.apply(&contact.obstacle, -impulse, contact.point);
@@ -159,7 +148,8 @@ pub(crate) fn record_penalty_impulses(
 }
 
 /// Stiffens the penalty of every contact with a collider whose point the implicit `step` (its
-/// rigid bodies at the velocities the step's solve gave them) leaves deeper than
+/// rigid bodies at the velocities the step's solve gave them) took from where it was at
+/// `start` (the body's positions at the step's start, m) to deeper than
 /// [`ContactSettings::resting_depth`] behind its plane (see [`NodeContact::stiffen_if_deep`]):
 /// the load, not the point's own mass, then sets how deep it rests. Returns whether any was
 /// stiffened (the step must then be solved again).
@@ -167,6 +157,7 @@ pub(crate) fn stiffen_deep_contacts(
     body: &DeformableBody,
     contacts: &mut ContactSet,
     step: ImplicitStep,
+    start: &[DVec3],
 ) -> bool {
     let settings = contacts.settings;
     let nodes = NodeSlices::of(body);
@@ -177,11 +168,13 @@ pub(crate) fn stiffen_deep_contacts(
         }
         let point = contact_point(contact, body.embedding.as_ref());
         let obstacle = carried(contact, &step);
-        let mass = effective_mass(&point.stencil(), nodes.masses, nodes.pinned) + obstacle.mass;
-        let x = point.position(nodes.positions) - obstacle.travel;
-        stiffened |= contact.stiffen_if_deep(x, mass, &settings, step.effective);
+        let mass = effective_mass(&point.stencil(), nodes.masses, nodes.pinned);
+        let end = point.position(nodes.positions) - obstacle.travel;
+        let path = (point.position(start), end);
+        stiffened |= contact.stiffen_if_deep(path, mass, &settings, step.effective);
     }
-    stiffened
+    let corners = (&mut contacts.corners[..], &settings);
+    stiffened | corner::stiffen_deep_corners((body, start), corners, step)
 }
 
 /// Readies implicit friction for the implicit `step` from the body's positions: each contact's
@@ -210,11 +203,10 @@ pub(super) fn lag_friction_at(
     for contact in contacts {
         let point = contact_point(contact, embedding);
         let x = point.position(nodes.positions);
-        let mass = effective_mass(&point.stencil(), nodes.masses, nodes.pinned)
-            + carried(contact, &step).mass;
+        let mass = effective_mass(&point.stencil(), nodes.masses, nodes.pinned);
         contact.lagged_normal_force = contact
             .penalty(x, mass, settings, step.effective)
-            .map_or(0.0, |(stiffness, gap)| -stiffness * gap);
+            .map_or(0.0, |penalty| penalty.push);
         contact.slip_origin = x;
     }
 }
@@ -257,15 +249,15 @@ pub(super) fn for_each_term_at(
         let point = contact_point(contact, embedding);
         let at = point.stencil();
         let obstacle = carried(contact, &step);
-        let mass = effective_mass(&at, nodes.masses, nodes.pinned) + obstacle.mass;
+        let mass = effective_mass(&at, nodes.masses, nodes.pinned);
         let x = point.position(nodes.positions) - obstacle.travel;
-        if let Some((stiffness, gap)) = contact.penalty(x, mass, settings, step.effective) {
+        if let Some(penalty) = contact.penalty(x, mass, settings, step.effective) {
             each(
                 at,
                 obstacle.partner,
-                0.5 * stiffness * gap * gap,
-                -contact.normal * (stiffness * gap),
-                penalty_tangent(stiffness, contact.normal),
+                penalty.energy,
+                contact.normal * penalty.push,
+                penalty_tangent(penalty.stiffness, contact.normal),
             );
         }
     }

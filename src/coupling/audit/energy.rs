@@ -5,11 +5,11 @@
 //!
 //! - Soft bodies: kinetic `Σ m v²/2`, elastic `Ψ` (the material's strain energy), gravitational
 //!   `-Σ m g·x`, the potential `U` of their loads
-//!   ([`DeformableBody::load_potential_energy`]), and after an implicit step the energy its contact penalties hold, `k g²/2` for
-//!   each node inside its contact plane (`g < 0`), with `k = penalty_factor m / ĥ²` (the node's
-//!   own mass: a dynamic rigid partner's share is left out, so this is a lower bound) or the
-//!   stiffness the contact's load called for if more, and `ĥ` the substep's effective step.
-//!   Embedded contact points' penalties are not counted.
+//!   ([`DeformableBody::load_potential_energy`]), and after an implicit step the energy its
+//!   contact penalties hold: `k g²/2` for each node inside its contact plane (`g < 0`) and each
+//!   rigid corner behind its face, with `k = penalty_factor m / ĥ²` (`m` the node's or the
+//!   face point's mass, `ĥ` the substep's effective step) and the stiffenings the contact's load
+//!   called for (see `contact::stiffening`). Embedded contact points' penalties are not counted.
 //!   A sleeping body not stepped in the frame keeps the energy it had when it was last measured:
 //!   its state does not change, and the penalty energy its last implicit step held is still
 //!   there (measured afresh it would drop out, then count as a gain when the body wakes).
@@ -43,7 +43,7 @@
 
 use super::{AuditInput, EnergyCheck};
 use crate::body::{DeformableBody, DeformableBodyHandle};
-use crate::contact::BodyPoint;
+use crate::contact::{self, BodyPoint};
 use crate::coupling::{SoftStepResults, iterations_per_substep};
 use crate::integrate::{ImplicitScheme, IntegratorKind, SymplecticEuler};
 use rapier3d::dynamics::{RigidBody, RigidBodyHandle};
@@ -146,8 +146,9 @@ fn rigid_integration_step(input: &AuditInput<'_>) -> f64 {
     input.dt / (substeps as usize * iterations) as f64
 }
 
-/// The energy (J) the implicit contact penalties of the deformable body `handle` hold now, after
-/// an implicit step in substeps of `h` (s).
+/// The energy (J) the implicit contact penalties of the deformable body `handle` hold now (its
+/// points' and the rigid corners' against its faces), after an implicit step in substeps of
+/// `h` (s).
 fn penalty_energy(
     input: &AuditInput<'_>,
     handle: DeformableBodyHandle,
@@ -163,19 +164,20 @@ fn penalty_energy(
         ImplicitScheme::Bdf2 => 2.0 * h / 3.0,
     };
     let settings = &constraints.contacts.settings;
-    constraints
+    let nodes = constraints
         .contacts()
         .iter()
         .filter_map(|contact| match contact.at {
             BodyPoint::Node(n) => {
                 let n = n as usize;
-                let gap = contact.gap(body.positions()[n]).min(0.0);
-                let stiffness = contact.penalty_stiffness(body.masses()[n], settings, effective);
-                Some(0.5 * stiffness * gap * gap)
+                let penalty =
+                    contact.penalty(body.positions()[n], body.masses()[n], settings, effective);
+                Some(penalty.map_or(0.0, |penalty| penalty.energy))
             }
             BodyPoint::Embedded(_) => None,
         })
-        .sum()
+        .sum::<f64>();
+    nodes + contact::corner_penalty_energy(body, &constraints.contacts, effective)
 }
 
 /// The energy (J) of a dynamic rigid body under gravity `g` (m/s²), its gravitational part at

@@ -12,7 +12,7 @@
 //! [`ImplicitIntegrator::linear_solver`] says; the scheme is BDF2 only when every body of the
 //! group has the history for it, backward Euler otherwise, so that all take the same `ĥ`.
 
-use super::potential::Potential;
+use super::potential::{Potential, StepStart};
 use super::rigid_response::{Placement, RigidResponse};
 use super::{
     CrushWatch, ImplicitIntegrator, ImplicitReport, Outcome, STIFFENING_ROUNDS, Stop, end_substep,
@@ -69,18 +69,22 @@ impl Group<'_, '_> {
 }
 
 /// Stiffens the contacts with colliders that the group's bodies, at their positions, press
-/// deeper than their resting depth (see [`contact::stiffen_deep_contacts`]), each body's rigid
+/// deeper than their resting depth from where `starts` began them (see
+/// [`contact::stiffen_deep_contacts`]), each body's rigid
 /// partners at the velocities their `responses` give them there (those of a body whose contacts
 /// stiffened are to be solved again). Returns whether any did.
 fn stiffen_deep_contacts(
     group: &Group,
+    starts: &[StepStart],
     constraints: &mut [&mut BodyConstraints],
     responses: &mut [RigidResponse],
 ) -> bool {
     let mut stiffened = false;
-    for ((body, constraints), response) in group.bodies.iter().zip(constraints).zip(responses) {
+    let members = group.bodies.iter().zip(starts).zip(constraints);
+    for (((body, start), constraints), response) in members.zip(responses) {
         response.solve(body, constraints);
-        if contact::stiffen_deep_contacts(body, &mut constraints.contacts, response.step()) {
+        let contacts = &mut constraints.contacts;
+        if contact::stiffen_deep_contacts(body, contacts, response.step(), &start.positions) {
             response.forget_solution();
             stiffened = true;
         }
@@ -437,7 +441,7 @@ impl ImplicitIntegrator {
             });
             if failed
                 || round == STIFFENING_ROUNDS
-                || !stiffen_deep_contacts(&group, &mut constraints, &mut responses)
+                || !stiffen_deep_contacts(&group, &starts, &mut constraints, &mut responses)
             {
                 break;
             }

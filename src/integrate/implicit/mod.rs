@@ -404,7 +404,12 @@ impl ImplicitIntegrator {
         for _ in 0..STIFFENING_ROUNDS {
             response.solve(body, constraints);
             if outcome.stop == Stop::Failed
-                || !contact::stiffen_deep_contacts(body, &mut constraints.contacts, response.step())
+                || !contact::stiffen_deep_contacts(
+                    body,
+                    &mut constraints.contacts,
+                    response.step(),
+                    &start.positions,
+                )
             {
                 break;
             }

@@ -10,26 +10,24 @@
 //! the impulse, the triangle's nodes its opposite by the contact point's barycentric weights,
 //! and the plane follows the triangle through the step.
 //!
-//! The implicit side is the penalty `k/2 min(0, g)²` on the gap `g = (v − p(x))·n` between the
-//! vertex `v`, carried over the step by its rigid body's velocity, and the triangle's contact
-//! point `p(x) = Σ w_i x_i`, with `k` the penalty factor times the point's effective `m/ĥ²`, and
-//! the lagged friction on the point's slip relative to the vertex; after the step their forces'
-//! opposite goes to the rigid body at the vertex.
+//! The implicit side is in [`implicit`].
+
+mod implicit;
+
+pub(in crate::contact) use implicit::stiffen_deep_corners;
+pub(crate) use implicit::{
+    corner_penalty_energy, for_each_corner_stencil, for_each_corner_term, lag_corner_friction,
+    record_corner_impulses,
+};
 
 use super::detect::NearCollider;
-use super::node_contact::lagged_friction;
-use super::penalty::effective_mass;
+use super::stiffening::Stiffening;
 use super::support;
 use super::surface_tree::{SurfaceTree, TrianglePoint};
-use super::{
-    Coefficients, ContactSet, ContactSettings, ContactSides, ImplicitStep, SoftPoint,
-    VelocityConstraint, penalty_tangent,
-};
+use super::{Coefficients, ContactSet, ContactSides, SoftPoint, VelocityConstraint};
 use crate::body::DeformableBody;
-use crate::rigid::{RigidPoint, RigidProxy};
-use crate::stencil::Stencil;
+use crate::rigid::RigidProxy;
 use rapier3d::geometry::{ColliderHandle, Shape};
-use rapier3d::glamx::DMat3;
 use rapier3d::glamx::DVec3;
 use rapier3d::math::Pose;
 use rapier3d::parry::bounding_volume::BoundingVolume;
@@ -59,6 +57,18 @@ pub(crate) struct CornerContact {
     /// point's position (m) at the start of the step.
     lagged_normal_force: f64,
     slip_origin: DVec3,
+    /// Which of the collider's points it is, so that the next detection finds the stiffening
+    /// of its implicit penalty that its load called for (see [`super::stiffening`]).
+    pub(super) feature: CornerFeature,
+    pub(super) stiffening: Stiffening,
+}
+
+/// Which point of a collider a corner contact is: a vertex by its place among the shape's
+/// vertices (part after part in a compound), or a rounded part's closest point to a triangle.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub(super) enum CornerFeature {
+    Vertex(u32),
+    Rounded([u32; 3]),
 }
 
 /// Where a step leaves a corner: its vertex and its contact plane's point (m) and unit normal.
@@ -166,7 +176,8 @@ pub(super) fn find_corner_contacts(
     let bounds = tree.bounds.loosened(reach as f32);
     let skipped = |triangle: &[u32; 3]| triangle.iter().any(|n| glued.contains(n));
     let mut found = Vec::new();
-    let contact = |vertex: DVec3, hit: TrianglePoint, follows_face: bool| CornerContact {
+    let mut vertices = 0;
+    let contact = |vertex: DVec3, hit: TrianglePoint, (follows_face, feature)| CornerContact {
         collider,
         proxy: None,
         vertex,
@@ -179,17 +190,21 @@ pub(super) fn find_corner_contacts(
         impulse: DVec3::ZERO,
         lagged_normal_force: 0.0,
         slip_origin: DVec3::ZERO,
+        feature,
+        stiffening: Stiffening::default(),
     };
     for_each_part(shape.as_ref(), pose, &mut |part, part_pose| {
         if has_vertices(part) {
             for_each_vertex(part, part_pose, &mut |vertex, outward| {
+                let feature = CornerFeature::Vertex(vertices);
+                vertices += 1;
                 if !bounds.contains_local_point(vertex.as_vec3()) {
                     return;
                 }
                 if let Some(hit) = tree.nearest_facing(body, vertex, outward, reach, skipped)
                     && !beside_the_body(body, vertex, &hit)
                 {
-                    found.push(contact(vertex, hit, true));
+                    found.push(contact(vertex, hit, (true, feature)));
                 }
             });
         } else if part.as_support_map().is_some() {
@@ -198,7 +213,10 @@ pub(super) fn find_corner_contacts(
                 (part, part_pose),
                 reach,
                 skipped,
-                &mut |c| found.push(contact(c.vertex, c.on_triangle, c.follows_face)),
+                &mut |c| {
+                    let feature = CornerFeature::Rounded(c.on_triangle.triangle);
+                    found.push(contact(c.vertex, c.on_triangle, (c.follows_face, feature)));
+                },
             );
         }
     });
@@ -326,173 +344,5 @@ impl ContactSides for Corner<'_> {
         }
         self.on_triangle
             .apply(-impulse, self.velocities, self.masses, self.pinned);
-    }
-}
-
-/// A corner's sides at the body's current positions: the triangle's point as a stencil, its
-/// position (m) and effective mass (kg), and the vertex's velocity (m/s).
-type Sides<'a> = (Stencil<'a>, DVec3, f64, DVec3);
-
-impl CornerContact {
-    /// The contact's [`Sides`] with the body at `body` and the rigid proxies `proxies`: the
-    /// mass is the triangle point's, plus the vertex's rigid body's effective mass along the
-    /// normal when that body is dynamic.
-    fn sides(&self, body: &DeformableBody, proxies: &[RigidProxy]) -> Sides<'_> {
-        let at = self.on_triangle.stencil();
-        let point = at.interpolate(&body.positions);
-        let rigid = self
-            .proxy
-            .map(|p| &proxies[p])
-            .filter(|rigid| rigid.is_dynamic())
-            .map_or(0.0, |rigid| {
-                rigid.effective_mass_along(self.vertex, self.normal)
-            });
-        let mass = effective_mass(&at, &body.masses, &body.pinned) + rigid;
-        (at, point, mass, self.vertex_velocity(proxies))
-    }
-
-    /// The vertex's velocity (m/s), with its rigid body's proxy among `proxies`.
-    fn vertex_velocity(&self, proxies: &[RigidProxy]) -> DVec3 {
-        self.proxy
-            .map_or(DVec3::ZERO, |p| proxies[p].velocity_at(self.vertex))
-    }
-
-    /// The penalty stiffness (N/m) and gap (m) of the contact in an implicit step of
-    /// `settings` and `step`, with the triangle's point at `point` (m) of effective mass `mass`
-    /// (kg) and the vertex moving at `vertex_velocity` (m/s); `None` while the vertex stays
-    /// outside.
-    fn penalty(
-        &self,
-        point: DVec3,
-        mass: f64,
-        vertex_velocity: DVec3,
-        (settings, step): (&ContactSettings, &ImplicitStep),
-    ) -> Option<(f64, f64)> {
-        let gap = (self.vertex + vertex_velocity * step.length - point).dot(self.normal);
-        (gap < 0.0).then(|| (settings.penalty_stiffness(mass, step.effective), gap))
-    }
-
-    /// The lagged friction of the triangle's point at `point` (m) against the vertex moving at
-    /// `vertex_velocity` (m/s) over an implicit step of `settings` and `step`: energy (J), force
-    /// on the point (N), tangent (N/m).
-    fn friction_term(
-        &self,
-        point: DVec3,
-        vertex_velocity: DVec3,
-        (settings, step): (&ContactSettings, &ImplicitStep),
-    ) -> Option<(f64, DVec3, DMat3)> {
-        lagged_friction(
-            self.coefficients.friction * self.lagged_normal_force,
-            self.normal,
-            point - self.slip_origin - vertex_velocity * step.length,
-            settings.stiction_speed * step.effective,
-        )
-    }
-
-    /// The dynamic rigid body's vertex the corner's terms act against, if it has one.
-    fn partner(&self, step: &ImplicitStep) -> Option<RigidPoint> {
-        self.proxy
-            .filter(|&p| step.rigid[p].is_dynamic())
-            .map(|proxy| RigidPoint {
-                proxy,
-                point: self.vertex,
-            })
-    }
-
-    /// The implicit force (N) on the triangle's point at `point` (m), of effective mass `mass`
-    /// (kg), the vertex moving at `vertex_velocity` (m/s).
-    fn implicit_force(
-        &self,
-        point: DVec3,
-        mass: f64,
-        vertex_velocity: DVec3,
-        step: (&ContactSettings, &ImplicitStep),
-    ) -> DVec3 {
-        let penalty = self
-            .penalty(point, mass, vertex_velocity, step)
-            .map_or(DVec3::ZERO, |(k, gap)| self.normal * (k * gap));
-        let friction = self
-            .friction_term(point, vertex_velocity, step)
-            .map_or(DVec3::ZERO, |(_, force, _)| force);
-        penalty + friction
-    }
-}
-
-/// Readies the corners' implicit friction for an implicit `step` from the body's positions:
-/// each friction limit is the penalty force there, with the vertex where it is at the step's
-/// start (as a node's contact takes it against its collider where that is), and slip is
-/// measured from there.
-pub(crate) fn lag_corner_friction(
-    body: &DeformableBody,
-    contacts: &mut ContactSet,
-    step: ImplicitStep,
-) {
-    let settings = contacts.settings;
-    for contact in &mut contacts.corners {
-        let (_, point, mass, _) = contact.sides(body, step.rigid);
-        contact.lagged_normal_force = contact
-            .penalty(point, mass, DVec3::ZERO, (&settings, &step))
-            .map_or(0.0, |(k, gap)| -k * gap);
-        contact.slip_origin = point;
-    }
-}
-
-/// Calls `each(point, partner, energy (J), force (N), tangent (N/m))` for the implicit penalty
-/// and friction of every corner in the implicit `step`, at the body's positions, on the
-/// triangle's contact point: the penalty `k g²/2` with force `k g n` (into the body) and tangent
-/// `k n nᵀ`, then the lagged friction; `partner` is the vertex when its rigid body is dynamic.
-pub(crate) fn for_each_corner_term(
-    body: &DeformableBody,
-    contacts: &ContactSet,
-    step: ImplicitStep,
-    mut each: impl FnMut(Stencil, Option<RigidPoint>, f64, DVec3, DMat3),
-) {
-    let terms = (&contacts.settings, &step);
-    for contact in &contacts.corners {
-        let (at, point, mass, velocity) = contact.sides(body, step.rigid);
-        let partner = contact.partner(&step);
-        if let Some((k, gap)) = contact.penalty(point, mass, velocity, terms) {
-            let tangent = penalty_tangent(k, contact.normal);
-            each(
-                at,
-                partner,
-                0.5 * k * gap * gap,
-                contact.normal * (k * gap),
-                tangent,
-            );
-        }
-        if let Some((energy, force, tangent)) = contact.friction_term(point, velocity, terms) {
-            each(at, partner, energy, force, tangent);
-        }
-    }
-}
-
-/// Calls `each` with the stencil of every corner's triangle point.
-pub(crate) fn for_each_corner_stencil(contacts: &ContactSet, mut each: impl FnMut(Stencil)) {
-    for contact in &contacts.corners {
-        each(contact.on_triangle.stencil());
-    }
-}
-
-/// Records the impulses (N s) the implicit corner terms gave the triangles over the implicit
-/// `step`, at the positions that ended it and the rigid velocities of `step`: the collider
-/// receives their opposite at the vertex, its rigid body's proxy among `proxies` too, and the
-/// vertex travels with its body.
-pub(crate) fn record_corner_impulses(
-    body: &DeformableBody,
-    contacts: &mut ContactSet,
-    step: ImplicitStep,
-    proxies: &mut [RigidProxy],
-) {
-    let settings = contacts.settings;
-    for contact in &mut contacts.corners {
-        let (_, point, mass, velocity) = contact.sides(body, step.rigid);
-        let force = contact.implicit_force(point, mass, velocity, (&settings, &step));
-        let on_collider = -force * step.length;
-        contact.impulse += on_collider;
-        if let Some(p) = contact.proxy {
-            proxies[p].apply(on_collider, contact.vertex);
-        }
-        contact.vertex += velocity * step.length;
     }
 }
