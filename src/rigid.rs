@@ -54,6 +54,8 @@ pub(crate) struct RigidProxy {
     turn: DQuat,
     /// The body's gravity scale if dynamic, zero otherwise.
     fall: f64,
+    /// Whether rapier's own contacts hold the body (see [`RigidProxy::hold`]).
+    held: bool,
     /// Per-axis inverse mass (1/kg) and world inverse inertia (1/(kg m²)); zero unless dynamic.
     inv_mass: DVec3,
     inv_inertia: DMat3,
@@ -94,6 +96,7 @@ impl RigidProxy {
             start_com: props.world_com.as_dvec3(),
             turn: DQuat::IDENTITY,
             fall,
+            held: false,
             inv_mass,
             inv_inertia,
             impulse: DVec3::ZERO,
@@ -118,6 +121,13 @@ impl RigidProxy {
     /// hold up (standing on rigid ground), whose weight rapier's step will carry.
     pub(crate) fn hold(&mut self) {
         self.fall = 0.0;
+        self.held = true;
+    }
+
+    /// Whether rapier's own contacts hold the body up (see [`RigidProxy::hold`]): an implicit
+    /// soft step, which moves the body by the soft forces alone, does not see what they do.
+    pub(crate) fn is_held(&self) -> bool {
+        self.held
     }
 
     /// The index in `proxies` of the proxy of the rigid body `fresh` is the proxy of, added

@@ -144,9 +144,9 @@ fn two_soft_bodies_colliding_in_zero_gravity_conserve_momentum() {
     // opposite; bound 1e-6 relative, the issue's. Angular momentum: a node acts on its contact
     // point while within the contact margin of it, so the change is bounded by the margin times
     // the impulse exchanged (the struck cube's final momentum). The bodies' energy never rises.
-    // Under the automatic integrator
-    // (explicit for bodies touching each other) and under forced implicit steps, whose
-    // penalties push node and triangle equally and oppositely.
+    // Under the automatic integrator (the cheaper, explicit or implicit, for bodies touching
+    // each other) and under forced implicit steps, whose penalties push node and triangle
+    // equally and oppositely.
     for force in [None, Some(IntegratorKind::Implicit)] {
         soft_bodies_collide(force);
     }

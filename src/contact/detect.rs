@@ -78,7 +78,7 @@ pub(crate) fn detect(
     let contact_points = contact_points(body);
     let last = last_contacts(previous);
     let last_corners: HashMap<_, _> = (previous.0.corners.iter())
-        .map(|c| ((c.collider, c.feature), c.stiffening))
+        .map(|c| (c.key(), c.stiffening))
         .collect();
     for view in colliders {
         if !body.collision_groups.test(view.groups) {
@@ -103,7 +103,7 @@ pub(crate) fn detect(
                 let proxy = proxy.or_else(|| near.proxy_in(&mut proxies));
                 for contact in &mut found {
                     contact.proxy = proxy;
-                    let last = last_corners.get(&(contact.collider, contact.feature));
+                    let last = last_corners.get(&contact.key());
                     contact.stiffening = last.copied().unwrap_or_default();
                 }
             }

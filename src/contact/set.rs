@@ -41,13 +41,14 @@ impl ContactSet {
         !self.corners.is_empty() || self.has_self_contacts()
     }
 
-    /// How deep (m) the deepest surface point lay behind its collider's plane when the
-    /// contacts were found (zero when none did).
+    /// How deep (m) the deepest surface point lay behind its collider's plane, or rigid corner
+    /// behind its soft face, when the contacts were found (zero when none did).
     pub(crate) fn deepest_found(&self) -> f64 {
-        (self.nodes.iter())
+        let points = (self.nodes.iter())
             .filter(|c| matches!(c.obstacle, Obstacle::Collider { .. }))
-            .map(|c| -c.gap(c.detected_at))
-            .fold(0.0, f64::max)
+            .map(|c| -c.gap(c.detected_at));
+        let corners = self.corners.iter().map(CornerContact::depth_found);
+        points.chain(corners).fold(0.0, f64::max)
     }
 
     /// Whether the set holds self-contacts (points against the body's own triangles).

@@ -4,7 +4,7 @@
 //! [`CostModel`] measured on the machine, and the cheaper is taken. Explicit integration is
 //! preferred at equal cost: it has no numerical damping.
 
-use super::cost::{CostModel, Workload};
+use super::cost::{CostModel, NewtonHistory, Workload};
 use super::refusal::FrameInputs;
 use super::{
     BodyInStep, ImplicitIntegrator, ImplicitReport, SolverWorkspace, StepReport, SymplecticEuler,
@@ -165,8 +165,9 @@ impl AutomaticIntegrator {
 
     /// Advances `body` by `frame_dt` (s) under gravity (m/s²) against its `constraints`, with
     /// `workspace` its solver caches, by the cheaper integrator (or the forced one); explicit
-    /// while the body has self-contacts or corners of dynamic rigid bodies against its surface
-    /// (the implicit step exchanges angular momentum through them only approximately).
+    /// while it has self-contacts, corners of dynamic rigid bodies that rapier's own contacts
+    /// also hold against its surface, or points or corners found deeper behind their contact
+    /// planes than the contacts' resting depth.
     ///
     /// A frame refused again from exactly what the last refused frame started from (the body's
     /// positions, velocities and loads, its constraints, the frame's length and gravity, the
@@ -202,8 +203,9 @@ impl AutomaticIntegrator {
                 prediction.cheaper()
             }
         });
+        let implicit = self.implicit_for(&prediction, [&workspace.newton]);
         let inputs = workspace.refusals.watching().then(|| {
-            let plan = (choice, needed, self.implicit_for(&prediction));
+            let plan = (choice, needed, implicit);
             let previous = workspace.previous_step.as_ref();
             FrameInputs::of((body, constraints), (frame_dt, gravity), plan, previous)
         });
@@ -218,6 +220,7 @@ impl AutomaticIntegrator {
             },
             (frame_dt, gravity),
             (choice, prediction, needed),
+            &implicit,
         );
         if outcome.is_err() {
             // The factorization a refused frame kept is not reused: the next frame's outcome is
@@ -229,12 +232,14 @@ impl AutomaticIntegrator {
     }
 
     /// A frame of `frame_dt` (s) under `gravity` (m/s²) of `step`'s body by the integrator
-    /// `choice`, predicted as `prediction`, the explicit frame taking `needed` substeps.
+    /// `choice`, predicted as `prediction`, the explicit frame taking `needed` substeps, the
+    /// implicit one run by `implicit` when chosen.
     fn frame(
         &self,
         mut step: BodyInStep<'_>,
         (frame_dt, gravity): (f64, DVec3),
         (choice, prediction, needed): (IntegratorKind, CostPrediction, f64),
+        implicit: &ImplicitIntegrator,
     ) -> Result<AutomaticReport, Error> {
         let started = Instant::now();
         let explicit_frame = |step: &mut BodyInStep<'_>| {
@@ -252,7 +257,7 @@ impl AutomaticIntegrator {
             outcome
         };
         let (explicit, implicit, fell_back) = self.with_fallback(
-            (choice, &prediction),
+            (choice, implicit),
             &mut step,
             explicit_frame,
             implicit_frame,
@@ -268,14 +273,20 @@ impl AutomaticIntegrator {
         ))
     }
 
-    /// The implicit integrator a frame predicted as `prediction` runs with. Chosen, not forced,
-    /// while the explicit frame can be taken (within `max_substeps`), it gives the frame up to
-    /// the explicit integrator (see [`AutomaticIntegrator::with_fallback`]) as soon as it would
-    /// cost more than the explicit frame was predicted to: a failing frame is not refined, and
-    /// its substeps' Newton iterations stop at what the explicit frame's predicted time buys
-    /// (at least [`NEWTON_BUDGET_FLOOR`]). Forced, or where the explicit frame cannot be taken,
-    /// it is [`AutomaticIntegrator::implicit`] as set.
-    fn implicit_for(&self, prediction: &CostPrediction) -> ImplicitIntegrator {
+    /// The implicit integrator a frame predicted as `prediction` runs with, for bodies of Newton
+    /// `histories`. Chosen, not forced, while the explicit frame can be taken (within
+    /// `max_substeps`), it gives the frame up to the explicit integrator (see
+    /// [`AutomaticIntegrator::with_fallback`]) as soon as it would cost more than the explicit
+    /// frame was predicted to: a failing frame is not refined, and its substeps' Newton
+    /// iterations stop at what the explicit frame's predicted time buys, with what the bodies'
+    /// last implicit frames saved of theirs ([`NewtonHistory::budget`]; at least
+    /// [`NEWTON_BUDGET_FLOOR`]). Forced, or where the explicit frame cannot be taken, it is
+    /// [`AutomaticIntegrator::implicit`] as set.
+    fn implicit_for<'h>(
+        &self,
+        prediction: &CostPrediction,
+        histories: impl IntoIterator<Item = &'h NewtonHistory>,
+    ) -> ImplicitIntegrator {
         let explicit_possible =
             prediction.explicit_substeps <= f64::from(self.explicit.max_substeps);
         if self.force.is_some() || !explicit_possible || prediction.implicit_seconds <= 0.0 {
@@ -284,19 +295,23 @@ impl AutomaticIntegrator {
         let substeps = f64::from(self.implicit.substeps.max(1));
         let per_iteration =
             prediction.implicit_seconds / (prediction.newton_iterations.max(1.0) * substeps);
-        let affordable = (prediction.explicit_seconds / per_iteration / substeps).ceil();
+        let affordable = prediction.explicit_seconds / per_iteration / substeps;
+        let budget = (histories.into_iter())
+            .map(|history| history.budget(affordable))
+            .fold(f64::INFINITY, f64::min)
+            .ceil();
         ImplicitIntegrator {
             max_refinement: 1,
-            max_newton_iterations: (affordable.min(usize::MAX as f64) as usize)
+            max_newton_iterations: (budget.min(usize::MAX as f64) as usize)
                 .max(NEWTON_BUDGET_FLOOR)
                 .min(self.implicit.max_newton_iterations),
             ..self.implicit
         }
     }
 
-    /// Runs a frame of `target` (one body or a group) predicted as `prediction` with the
-    /// integrator `choice`, by `explicit` or `implicit` (which steps with the implicit
-    /// integrator it is given); unless a choice is forced, a frame the one cannot take is
+    /// Runs a frame of `target` (one body or a group) with the integrator `choice`, by
+    /// `explicit` or `implicit` (which steps with the implicit integrator it is given: `chosen`
+    /// when implicit was chosen); unless a choice is forced, a frame the one cannot take is
     /// redone by the other (each leaves the bodies as they were when it fails): an explicit
     /// frame that would need more than `max_substeps` or gave a non-finite state, by
     /// [`AutomaticIntegrator::implicit`] as set; an implicit frame, chosen, whose Newton solve,
@@ -309,7 +324,7 @@ impl AutomaticIntegrator {
     /// first integrator's error.
     fn with_fallback<T, E, I>(
         &self,
-        (choice, prediction): (IntegratorKind, &CostPrediction),
+        (choice, chosen): (IntegratorKind, &ImplicitIntegrator),
         target: &mut T,
         mut explicit: impl FnMut(&mut T) -> Result<E, Error>,
         mut implicit: impl FnMut(&mut T, &ImplicitIntegrator) -> Result<I, Error>,
@@ -323,7 +338,7 @@ impl AutomaticIntegrator {
                 }
                 Err(error) => Err(error),
             },
-            IntegratorKind::Implicit => match implicit(target, &self.implicit_for(prediction)) {
+            IntegratorKind::Implicit => match implicit(target, chosen) {
                 Ok(report) => Ok((None, Some(report), false)),
                 Err(
                     error @ (Error::NewtonDidNotConverge { .. }
@@ -342,12 +357,12 @@ impl AutomaticIntegrator {
     /// The predictions for soft `bodies` stepping together with `between` contact points among
     /// them, in order (the explicit substeps those of the stiffest body: the group takes the
     /// shortest stable step), the group's (their sum), and the integrator for the group: the
-    /// forced one, else explicit: the contacts between the bodies, like a body's self-contacts,
-    /// exchange angular momentum only approximately in an implicit step (the penalty acts at
-    /// the triangle's point, its reaction at the node), and the group's implicit cost is not
-    /// priced (forced implicit, the showcase's stack, two soft blocks under a rigid box, took
-    /// 3.8 times its bodies' predictions; left to the cheaper prediction, 30 of its 210 frames
-    /// went back to the explicit integrator and the audit flagged energy gains).
+    /// forced one, else explicit while a member's contacts need it
+    /// ([`BodyConstraints::needs_explicit_contacts`]), else the cheaper. The contacts between
+    /// the bodies exchange angular momentum within the contact margin times the impulse either
+    /// way (the penalty acts at the triangle's point, its reaction at the node;
+    /// `tests/soft_contact.rs`); the group's implicit cost is its bodies' (the showcase's stack
+    /// measured 3.5 times its prediction).
     ///
     /// # Errors
     /// [`Error::InvalidSetting`] for an invalid explicit setting.
@@ -380,11 +395,17 @@ impl AutomaticIntegrator {
             explicit_seconds: explicit,
             implicit_seconds: predictions.iter().map(|p| p.implicit_seconds).sum(),
         };
-        Ok((
-            predictions,
-            total,
-            self.force.unwrap_or(IntegratorKind::Explicit),
-        ))
+        let choice = self.force.unwrap_or_else(|| {
+            if bodies
+                .iter()
+                .any(|s| s.constraints.needs_explicit_contacts())
+            {
+                IntegratorKind::Explicit
+            } else {
+                total.cheaper()
+            }
+        });
+        Ok((predictions, total, choice))
     }
 
     /// Advances soft `bodies` touching each other through `between` (indices into `bodies`)
@@ -423,9 +444,14 @@ impl AutomaticIntegrator {
             }
             outcome
         };
+        let chosen = self.implicit_for(&total, bodies.iter().map(|b| &b.workspace.newton));
         let mut group: Group<'_, '_> = (&mut *bodies, &mut *between);
-        let (explicit, implicit, fell_back) =
-            self.with_fallback((choice, &total), &mut group, explicit_frame, implicit_frame)?;
+        let (explicit, implicit, fell_back) = self.with_fallback(
+            (choice, &chosen),
+            &mut group,
+            explicit_frame,
+            implicit_frame,
+        )?;
         let reports: Vec<(Option<StepReport>, Option<ImplicitReport>)> = match (explicit, implicit)
         {
             (Some(reports), _) => {

@@ -125,7 +125,9 @@ impl CostModel {
 /// (each new frame weighs [`NewtonHistory::WEIGHT`]), and drawn back towards the cost model's
 /// assumption by each explicit frame (by [`NewtonHistory::FORGETTING`]), so that a body that
 /// left the implicit integrator after a few hard frames (an impact) tries it again once they are
-/// forgotten. The same run gives the same history, so the choices it drives repeat bit for bit.
+/// forgotten. It also keeps the Newton iterations a budget of the automatic choice allowed and
+/// its frames left unspent, for a harder frame to use (see [`NewtonHistory::budget`]). The same
+/// run gives the same history, so the choices it drives repeat bit for bit.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 #[cfg_attr(
     feature = "serde-serialize",
@@ -133,6 +135,9 @@ impl CostModel {
 )]
 pub(crate) struct NewtonHistory {
     mean: Option<f64>,
+    /// Newton iterations per substep allowed and left unspent by the last implicit frames.
+    #[cfg_attr(feature = "serde-serialize", serde(default))]
+    saved: f64,
 }
 
 impl NewtonHistory {
@@ -142,9 +147,25 @@ impl NewtonHistory {
     /// The fraction of its distance to the assumption an explicit frame draws the mean back.
     const FORGETTING: f64 = 1.0 / 16.0;
 
-    /// Takes in an implicit frame of `iterations` Newton iterations over `substeps`.
-    fn record(&mut self, iterations: usize, substeps: u32) {
+    /// The most frames' worth of Newton iterations a body saves up (see
+    /// [`NewtonHistory::budget`]).
+    const SAVED_FRAMES: f64 = 8.0;
+
+    /// The Newton iterations per substep a frame allowed `affordable` of them may take: those,
+    /// plus what the last implicit frames were allowed and left unspent, up to
+    /// [`NewtonHistory::SAVED_FRAMES`] frames' worth. So a frame harder than the rest (a box
+    /// landing on a soft stack took 46 iterations where its neighbours took one or two) may
+    /// spend what easy ones saved, while the body's implicit frames together stay within what
+    /// the explicit frames would have cost.
+    pub(crate) fn budget(&self, affordable: f64) -> f64 {
+        (self.saved + affordable).min(Self::SAVED_FRAMES * affordable)
+    }
+
+    /// Takes in an implicit frame of `iterations` Newton iterations over `substeps`, allowed
+    /// `allowed` per substep.
+    fn record(&mut self, iterations: usize, substeps: u32, allowed: usize) {
         let per_substep = iterations as f64 / f64::from(substeps.max(1));
+        self.saved = (allowed as f64 - per_substep).max(0.0);
         self.mean = Some(match self.mean {
             Some(mean) => mean + Self::WEIGHT * (per_substep - mean),
             None => per_substep,
@@ -158,14 +179,16 @@ impl NewtonHistory {
         outcome: &Result<ImplicitReport, Error>,
         integrator: &ImplicitIntegrator,
     ) {
+        let allowed = integrator.max_newton_iterations;
         match outcome {
-            Ok(report) => self.record(report.newton_iterations, report.substeps),
-            Err(_) => self.record(integrator.max_newton_iterations, 1),
+            Ok(report) => self.record(report.newton_iterations, report.substeps, allowed),
+            Err(_) => self.record(allowed, 1, allowed),
         }
     }
 
-    /// Takes in an explicit frame: the mean moves towards `assumed`.
+    /// Takes in an explicit frame: the mean moves towards `assumed`, and nothing is saved.
     pub(crate) fn forget(&mut self, assumed: f64) {
+        self.saved = 0.0;
         if let Some(mean) = &mut self.mean {
             *mean += Self::FORGETTING * (assumed - *mean);
         }
@@ -193,8 +216,8 @@ mod tests {
             1.0,
             "nothing to forget before an implicit frame"
         );
-        history.record(8, 2);
-        history.record(8, 1);
+        history.record(8, 2, 100);
+        history.record(8, 1, 100);
         assert_eq!(history.or(1.0), 5.0);
         history.forget(1.0);
         assert_eq!(history.or(1.0), 4.75);
@@ -208,5 +231,27 @@ mod tests {
         });
         history.record_outcome(&refused, &integrator);
         assert_eq!(history.or(1.0), 8.5625);
+    }
+
+    #[test]
+    fn a_frame_may_spend_what_easy_frames_left_of_their_budget_up_to_eight_frames_worth() {
+        // Closed form, a budget of 10 a frame: nothing saved → 10; a frame allowed 10 that took
+        // 2 leaves 8 → 18; one allowed 100 that took 1 leaves 99 → capped at 80; an explicit
+        // frame or a refused one leaves nothing → 10.
+        let mut history = NewtonHistory::default();
+        assert_eq!(history.budget(10.0), 10.0);
+        history.record(2, 1, 10);
+        assert_eq!(history.budget(10.0), 18.0);
+        history.record(1, 1, 100);
+        assert_eq!(history.budget(10.0), 80.0);
+        history.forget(1.0);
+        assert_eq!(history.budget(10.0), 10.0);
+        history.record(1, 1, 100);
+        let refused = Err(Error::NewtonDidNotConverge {
+            residual: 1.0,
+            substeps: 1,
+        });
+        history.record_outcome(&refused, &ImplicitIntegrator::default());
+        assert_eq!(history.budget(10.0), 10.0);
     }
 }

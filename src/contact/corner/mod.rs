@@ -96,6 +96,17 @@ impl CornerContact {
         self.normal = place.normal;
     }
 
+    /// The collider and which of its points: what a contact's stiffening is kept by from one
+    /// detection to the next.
+    pub(super) fn key(&self) -> (ColliderHandle, CornerFeature) {
+        (self.collider, self.feature)
+    }
+
+    /// How deep (m) the vertex lies behind its contact plane where the detection left them.
+    pub(crate) fn depth_found(&self) -> f64 {
+        (self.point - self.vertex).dot(self.normal)
+    }
+
     /// Where (m) and with what mean force (N) the soft body pushed the collider over the last
     /// step, of length `dt` (s).
     pub(crate) fn force_on_collider(&self, dt: f64) -> (DVec3, DVec3) {
