@@ -173,11 +173,9 @@ fn a_cage_carrying_a_fine_mesh_rests_on_a_rapier_ground() {
 /// velocities in f32.
 #[test]
 fn an_embedded_surface_hitting_a_free_ball_conserves_momentum() {
-    let mut world = FvmWorld::default();
-    world.physics.gravity = Vec3::ZERO;
     let radius = 0.05f32;
-    let ball = common::insert_ball(
-        &mut world,
+    let (mut world, ball) = common::ball_without_gravity(
+        None,
         RigidBodyBuilder::dynamic().translation(Vec3::new(0.2, 0.03, 0.0)),
         (0.5, radius),
     );

@@ -56,7 +56,7 @@ fn a_stack_of_two_soft_cubes_compresses_as_uniaxial_elasticity_says() {
     // the bottom one by (W + W/2) H/(E A). The bottom cube is twice as stiff (E = 2e5 Pa against
     // 1e5 Pa): different materials. Tolerance 5 %, as the plate test: linear tetrahedra
     // represent the self-weight's linear stress only approximately. Under the automatic
-    // integrator (explicit for bodies touching each other) and under forced implicit steps,
+    // integrator (the cheaper for bodies touching each other) and under forced implicit steps,
     // which solve the two cubes as one system.
     for force in [None, Some(IntegratorKind::Implicit)] {
         stack_of_two(force);

@@ -243,16 +243,21 @@ pub fn homogeneous_deformation_rate() -> DMat3 {
     )
 }
 
-/// Inserts into `world` the dynamic rigid body `body` with a ball collider of `radius` (m)
-/// weighing `mass` (kg), friction 0.5; returns its handle.
-pub fn insert_ball(
-    world: &mut FvmWorld,
+/// A world without gravity, `integrator` forced (or automatic), holding the dynamic rigid body
+/// `body` with a ball collider of `radius` (m) weighing `mass` (kg), friction 0.5; returns the
+/// world and the ball's handle.
+pub fn ball_without_gravity(
+    integrator: Option<IntegratorKind>,
     body: rapier3d::prelude::RigidBodyBuilder,
     (mass, radius): (f32, f32),
-) -> rapier3d::prelude::RigidBodyHandle {
+) -> (FvmWorld, rapier3d::prelude::RigidBodyHandle) {
+    let mut world = FvmWorld::default();
+    world.coupling.integrator.force = integrator;
+    world.physics.gravity = Vec3::ZERO;
     let density = mass / (4.0 / 3.0 * std::f32::consts::PI * radius.powi(3));
     let collider = ColliderBuilder::ball(radius).density(density).friction(0.5);
-    world.physics.insert(body, collider).0
+    let ball = world.physics.insert(body, collider).0;
+    (world, ball)
 }
 
 /// The total linear momentum (kg m/s) and angular momentum about the origin (kg m²/s) of the soft
