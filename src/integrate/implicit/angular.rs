@@ -19,6 +19,14 @@
 //! pinned point `c`, `I_c δω = δL`; about the line through collinear pinned nodes (a hinge),
 //! `δω = a (a·δL) / I_a`; none when the pins hold every rotation. The step's positions are kept;
 //! only the velocities it ends with change. The deformation's numerical damping is untouched.
+//!
+//! A pinned body swings under its constant loads `F` (its weight): their torque about the pins
+//! stays at the step's start, `L₁ = L₀ + k Σ (x₀ − c) × F` (the load's share of `δL` is not
+//! given back), with the kick `k = (h₀ + h)/2` over the last step `h₀` and this one. About the
+//! pins the rotation is then stepped as leapfrog steps it (`ω` the velocity of the half step,
+//! the angle advanced by `h ω`), which keeps a swing's energy however the substeps' length
+//! changes from step to step; with the torque at the step's end, or with `k = h` when the
+//! substeps' length follows the swing's speed, the swing loses energy every half period.
 //! A body that only its weight and dynamic rigid bodies act on is given, the same way, what makes
 //! its angular momentum change by exactly the angular impulse they gave it, counted where the
 //! rigid bodies take the opposite ([`keep_exchanged`]): the exchange is then exact, the drain
@@ -32,13 +40,33 @@ use rapier3d::glamx::{DMat3, DVec3};
 const COLLINEAR: f64 = 1e-9;
 
 /// Gives back to `body` the angular momentum a backward Euler step of `h` (s) took, its nodes
-/// having started the step at the velocities `before` (m/s); see the module documentation.
-pub(super) fn give_back(body: &mut DeformableBody, before: &[DVec3], h: f64) {
-    let lost: DVec3 = (0..body.positions.len())
-        .filter(|&n| !body.pinned[n])
-        .map(|n| before[n].cross(body.velocities[n]) * (body.masses[n] * h))
+/// having started it at `positions` (m) and `velocities` (m/s) under the constant forces `load`
+/// (N per node), the step before it `previous` (s) long; see the module documentation.
+pub(super) fn give_back(
+    body: &mut DeformableBody,
+    (positions, velocities, load): (&[DVec3], &[DVec3], &[DVec3]),
+    (h, previous): (f64, Option<f64>),
+) {
+    let Some(pivot) = pivot(body) else {
+        return;
+    };
+    let free = |n: &usize| !body.pinned[*n];
+    let mut lost: DVec3 = (0..body.positions.len())
+        .filter(free)
+        .map(|n| velocities[n].cross(body.velocities[n]) * (body.masses[n] * h))
         .sum();
-    turn_by(body, lost);
+    if let Pivot::Point(centre) | Pivot::Hinge(centre, _) = pivot {
+        // A swing: the loads' torque about the pins at the step's start, over the kick.
+        let kick = previous.map_or(h, |previous| (previous + h) / 2.0);
+        lost += (0..body.positions.len())
+            .filter(free)
+            .map(|n| {
+                (positions[n] - centre).cross(load[n]) * (kick - h)
+                    - body.velocities[n].cross(load[n]) * (h * h)
+            })
+            .sum::<DVec3>();
+    }
+    turn_about(body, pivot, lost);
 }
 
 /// Gives back to `body`, free (nothing pinned, nothing but uniform gravity and its own forces
@@ -98,10 +126,18 @@ fn momentum_about(
 /// Adds to the free nodes of `body` the rotation the pins allow whose angular momentum is `lost`
 /// (N m s).
 fn turn_by(body: &mut DeformableBody, lost: DVec3) {
+    if let Some(pivot) = pivot(body) {
+        turn_about(body, pivot, lost);
+    }
+}
+
+/// Adds to the free nodes of `body` the rotation about `pivot` whose angular momentum is `lost`
+/// (N m s).
+fn turn_about(body: &mut DeformableBody, pivot: Pivot, lost: DVec3) {
     if lost == DVec3::ZERO || !lost.is_finite() {
         return;
     }
-    let Some((centre, turn)) = allowed_rotation(body, lost) else {
+    let Some((centre, turn)) = pivot.rotation(body, lost) else {
         return;
     };
     for n in 0..body.positions.len() {
@@ -118,16 +154,25 @@ pub(super) fn spin(body: &DeformableBody) -> f64 {
     solve(inertia, body.angular_momentum()).map_or(0.0, |turn| turn.length())
 }
 
-/// The rotation (its centre, m, and angular velocity, rad/s) the pins of `body` allow whose
-/// angular momentum is `lost` (N m s), or `None` when they hold every rotation.
-fn allowed_rotation(body: &DeformableBody, lost: DVec3) -> Option<(DVec3, DVec3)> {
+/// What the pins of a body leave it free to turn about.
+#[derive(Clone, Copy)]
+enum Pivot {
+    /// Nothing pinned: its centre of mass (m).
+    Free(DVec3),
+    /// Its pinned nodes all at one point (m).
+    Point(DVec3),
+    /// Its pinned nodes on one line: a point of it (m) and its direction (unit).
+    Hinge(DVec3, DVec3),
+}
+
+/// What the pins of `body` leave it free to turn about, or `None` when they hold every rotation.
+fn pivot(body: &DeformableBody) -> Option<Pivot> {
     let pinned: Vec<DVec3> = (0..body.positions.len())
         .filter(|&n| body.pinned[n])
         .map(|n| body.positions[n])
         .collect();
     let Some(&first) = pinned.first() else {
-        let centre = body.center_of_mass();
-        return solve(inertia_about(body, centre), lost).map(|turn| (centre, turn));
+        return Some(Pivot::Free(body.center_of_mass()));
     };
     let far = pinned.iter().copied().max_by(|a, b| {
         (*a - first)
@@ -139,17 +184,31 @@ fn allowed_rotation(body: &DeformableBody, lost: DVec3) -> Option<(DVec3, DVec3)
         .map(|x| (*x - first).length())
         .fold(f64::MIN_POSITIVE, f64::max);
     if span <= COLLINEAR * size {
-        return solve(inertia_about(body, first), lost).map(|turn| (first, turn));
+        return Some(Pivot::Point(first));
     }
     let axis = (far - first) / span;
     let off_line = |p: &DVec3| (*p - first).cross(axis).length() > COLLINEAR * size;
-    if pinned.iter().any(off_line) {
-        return None;
+    (!pinned.iter().any(off_line)).then_some(Pivot::Hinge(first, axis))
+}
+
+impl Pivot {
+    /// The rotation about the pivot (its centre, m, and angular velocity, rad/s) whose angular
+    /// momentum is `lost` (N m s), or `None` for a body without inertia about it.
+    fn rotation(self, body: &DeformableBody, lost: DVec3) -> Option<(DVec3, DVec3)> {
+        match self {
+            Pivot::Free(centre) | Pivot::Point(centre) => {
+                solve(inertia_about(body, centre), lost).map(|turn| (centre, turn))
+            }
+            Pivot::Hinge(centre, axis) => {
+                let about_axis: f64 = (0..body.positions.len())
+                    .map(|n| {
+                        body.masses[n] * (body.positions[n] - centre).cross(axis).length_squared()
+                    })
+                    .sum();
+                (about_axis > 0.0).then(|| (centre, axis * (axis.dot(lost) / about_axis)))
+            }
+        }
     }
-    let about_axis: f64 = (0..body.positions.len())
-        .map(|n| body.masses[n] * (body.positions[n] - first).cross(axis).length_squared())
-        .sum();
-    (about_axis > 0.0).then(|| (first, axis * (axis.dot(lost) / about_axis)))
 }
 
 /// The inertia tensor (kg m²) of the body's nodes about `point` (m).

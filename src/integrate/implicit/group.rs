@@ -446,16 +446,11 @@ impl ImplicitIntegrator {
                 break;
             }
         }
-        let outcome = solved.unwrap_or_else(Outcome::start);
-        for (((body, constraints), (start, response)), last) in body_refs
-            .into_iter()
-            .zip(constraints)
-            .zip(starts.into_iter().zip(responses))
-            .zip(last.iter_mut())
-        {
-            *last = Some(end_substep(body, constraints, (start, response), h, false));
+        let ends = (starts.into_iter().zip(responses)).zip(last.iter_mut());
+        for ((body, constraints), ended) in body_refs.into_iter().zip(constraints).zip(ends) {
+            end_member_substep(body, constraints, ended, h);
         }
-        Ok(outcome)
+        Ok(solved.unwrap_or_else(Outcome::start))
     }
 
     /// Newton's method on the group's potential, from the inertial prediction or from where
@@ -609,4 +604,16 @@ impl ImplicitIntegrator {
         }
         Ok(direction)
     }
+}
+
+/// Ends a group member's implicit substep of `h` (s) from its `start`, recording it as the
+/// member's `last` step ([`end_substep`]).
+fn end_member_substep(
+    body: &mut DeformableBody,
+    constraints: &mut BodyConstraints,
+    ((start, response), last): ((StepStart, RigidResponse), &mut Option<PreviousStep>),
+    h: f64,
+) {
+    let previous = last.as_ref().map(|step| step.h);
+    *last = Some(end_substep(body, constraints, (start, response), (h, previous), false));
 }
