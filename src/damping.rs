@@ -138,17 +138,21 @@ impl RayleighDamping {
         *f * self.stress_of_rate(&rate)
     }
 
-    /// Differential of [`RayleighDamping::step_first_piola`] for a change `df` of `F` (Pa).
-    pub(crate) fn step_first_piola_differential(
+    /// Differentials of [`RayleighDamping::step_first_piola`] for the changes `dfs` of `F` (Pa),
+    /// the rate's stress evaluated once for all of them.
+    pub(crate) fn step_first_piola_differentials<const N: usize>(
         &self,
         f: &DMat3,
         green_previous: &DMat3,
         h: f64,
-        df: &DMat3,
-    ) -> DMat3 {
+        dfs: &[DMat3; N],
+    ) -> [DMat3; N] {
         let rate = (green_strain(f) - *green_previous) * (1.0 / h);
-        let d_rate = symmetric_part(&(f.transpose() * *df)) * (1.0 / h);
-        *df * self.stress_of_rate(&rate) + *f * self.stress_of_rate(&d_rate)
+        let stress = self.stress_of_rate(&rate);
+        dfs.map(|df| {
+            let d_rate = symmetric_part(&(f.transpose() * df)) * (1.0 / h);
+            df * stress + *f * self.stress_of_rate(&d_rate)
+        })
     }
 }
 
@@ -184,7 +188,7 @@ mod tests {
             let numeric_dp = (damping.step_first_piola(&(f + df * eps), &previous, h)
                 - damping.step_first_piola(&(f - df * eps), &previous, h))
                 * (0.5 / eps);
-            let analytic_dp = damping.step_first_piola_differential(&f, &previous, h, &df);
+            let [analytic_dp] = damping.step_first_piola_differentials(&f, &previous, h, &[df]);
             let dp_scale = analytic_dp
                 .to_cols_array()
                 .iter()

@@ -138,7 +138,7 @@ mod tests {
         perturb_positions(&mut body, 7, 0.01);
         let mut stiffness = Stiffness::new(&body);
         let diagonal = vec![3.0e3; body.node_count()];
-        stiffness.assemble(&body, Some(&diagonal), false, |_, _, _| DMat3::ZERO);
+        stiffness.assemble(&body, Some(&diagonal), false, |_, _, _| [DMat3::ZERO; 9]);
         (body, stiffness)
     }
 

@@ -129,18 +129,18 @@ fn small_strain_terms(f: &DMat3) -> Option<(f64, f64)> {
 }
 
 impl StableNeoHookean {
-    /// `J - 1` (dimensionless), accurate at small strain.
-    pub(super) fn volume_change(&self, f: &DMat3) -> f64 {
-        small_strain_terms(f).map_or_else(|| f.determinant() - 1.0, |(j_minus_one, _)| j_minus_one)
+    /// `J - 1` and `(I_C - 3)/2 - (J - 1)` (dimensionless), accurate at small strain: both from
+    /// one evaluation of [`small_strain_terms`].
+    pub(super) fn strain_terms(&self, f: &DMat3) -> (f64, f64) {
+        small_strain_terms(f).unwrap_or_else(|| {
+            let j_minus_one = f.determinant() - 1.0;
+            (j_minus_one, 0.5 * (double_dot(f, f) - 3.0) - j_minus_one)
+        })
     }
 
-    /// `μ/2 (I_C - 3) - μ (J - 1)` (J/m³): the energy without its volumetric term.
-    pub(super) fn shear_energy_density(&self, f: &DMat3) -> f64 {
-        let deviatoric = small_strain_terms(f).map_or_else(
-            || 0.5 * (double_dot(f, f) - 3.0) - (f.determinant() - 1.0),
-            |(_, deviatoric)| deviatoric,
-        );
-        self.mu * deviatoric
+    /// `J - 1` (dimensionless), accurate at small strain.
+    pub(super) fn volume_change(&self, f: &DMat3) -> f64 {
+        self.strain_terms(f).0
     }
 }
 
@@ -148,9 +148,8 @@ impl HyperelasticModel for StableNeoHookean {
     /// Evaluated from the Green strain at small strain, without the cancellation of the textbook
     /// form (see [`StableNeoHookean`]'s shear and volume terms).
     fn energy_density(&self, f: &DMat3) -> f64 {
-        let j_minus_one = self.volume_change(f);
-        let energy =
-            self.shear_energy_density(f) + 0.5 * self.lambda_prime * j_minus_one * j_minus_one;
+        let (j_minus_one, deviatoric) = self.strain_terms(f);
+        let energy = self.mu * deviatoric + 0.5 * self.lambda_prime * j_minus_one * j_minus_one;
         self.compression(j_minus_one)
             .map_or(energy, |c| energy + c[0])
     }

@@ -132,8 +132,8 @@ impl VolumetricTerm for StableNeoHookean {
     }
 
     fn energy_density_without_volumetric(&self, f: &DMat3) -> f64 {
-        let x = self.volume_change(f);
-        let energy = self.shear_energy_density(f) + self.mu / 6.0 * x.powi(2);
+        let (x, deviatoric) = self.strain_terms(f);
+        let energy = self.mu * deviatoric + self.mu / 6.0 * x.powi(2);
         self.compression(x).map_or(energy, |c| energy + c[0])
     }
 }

@@ -615,5 +615,11 @@ fn end_member_substep(
     h: f64,
 ) {
     let previous = last.as_ref().map(|step| step.h);
-    *last = Some(end_substep(body, constraints, (start, response), (h, previous), false));
+    *last = Some(end_substep(
+        body,
+        constraints,
+        (start, response),
+        (h, previous),
+        false,
+    ));
 }

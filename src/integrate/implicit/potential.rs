@@ -235,9 +235,9 @@ impl Potential<'_> {
         project: bool,
     ) {
         let damping = body.damping;
-        stiffness.assemble(body, Some(inertia), project, |t, f, df| match &damping {
-            Some(d) => d.step_first_piola_differential(f, &self.start.green[t], self.start.h, df),
-            None => DMat3::ZERO,
+        stiffness.assemble(body, Some(inertia), project, |t, f, dfs| match &damping {
+            Some(d) => d.step_first_piola_differentials(f, &self.start.green[t], self.start.h, dfs),
+            None => [DMat3::ZERO; 9],
         });
         let mut rigid = self.rigid.borrow_mut();
         rigid.solve(body, self.constraints);
