@@ -4,6 +4,7 @@
 //! [`CostModel`] measured on the machine, and the cheaper is taken. Explicit integration is
 //! preferred at equal cost: it has no numerical damping.
 
+use super::choice::{AutomaticReport, CostPrediction, IntegratorKind};
 use super::cost::{CostModel, NewtonHistory, Workload};
 use super::refusal::FrameInputs;
 use super::{
@@ -21,77 +22,6 @@ use std::time::Instant;
 /// before it is handed to the explicit integrator (see [`AutomaticIntegrator::implicit_for`]):
 /// smooth motion takes one to three, an impact or a change of contacts up to about ten.
 const NEWTON_BUDGET_FLOOR: usize = 10;
-
-/// Which integrator advanced a frame.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-#[cfg_attr(
-    feature = "serde-serialize",
-    derive(serde::Serialize, serde::Deserialize)
-)]
-pub enum IntegratorKind {
-    /// [`SymplecticEuler`].
-    Explicit,
-    /// [`ImplicitIntegrator`].
-    Implicit,
-}
-
-/// The predicted cost of a frame with each integrator.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct CostPrediction {
-    /// Substeps the explicit stability limit requires.
-    pub explicit_substeps: f64,
-    /// Contact points the explicit substeps sweep (those found at the frame's start).
-    pub contact_points: usize,
-    /// Newton iterations per implicit substep expected (the body's recent mean).
-    pub newton_iterations: f64,
-    /// Predicted time of the explicit frame (s).
-    pub explicit_seconds: f64,
-    /// Predicted time of the implicit frame (s).
-    pub implicit_seconds: f64,
-}
-
-impl CostPrediction {
-    /// The cheaper integrator, explicit on a tie.
-    pub fn cheaper(&self) -> IntegratorKind {
-        if self.explicit_seconds <= self.implicit_seconds {
-            IntegratorKind::Explicit
-        } else {
-            IntegratorKind::Implicit
-        }
-    }
-
-    /// The predicted time (s) of the frame with `kind`.
-    pub fn seconds(&self, kind: IntegratorKind) -> f64 {
-        match kind {
-            IntegratorKind::Explicit => self.explicit_seconds,
-            IntegratorKind::Implicit => self.implicit_seconds,
-        }
-    }
-}
-
-/// What an automatic frame did and why.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct AutomaticReport {
-    /// The integrator used.
-    pub choice: IntegratorKind,
-    /// The prediction the choice was made on.
-    pub prediction: CostPrediction,
-    /// The explicit frame's report, if explicit.
-    pub explicit: Option<StepReport>,
-    /// The implicit frame's report, if implicit.
-    pub implicit: Option<ImplicitReport>,
-    /// Whether the frame was redone with the other integrator than the one chosen: chosen
-    /// explicit, because crushed elements lowered the stability limit partway below what
-    /// `max_substeps` allows, or the explicit frame produced a non-finite state; chosen
-    /// implicit, because its Newton solve failed or it crushed an element even in the most
-    /// substeps it may take.
-    pub fell_back: bool,
-    /// Wall-clock time the frame's integration took (s), prediction and contact detection
-    /// excluded; for bodies stepped together, the group's time shared in proportion to each
-    /// body's predicted cost with the integrator used. Measured, so it differs from run to run;
-    /// nothing in the step depends on it.
-    pub seconds: f64,
-}
 
 /// Picks, frame by frame, the cheaper of an explicit and an implicit integrator.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -474,30 +404,6 @@ impl AutomaticIntegrator {
                 AutomaticReport::of(prediction, frame, fell_back, seconds)
             })
             .collect())
-    }
-}
-
-impl AutomaticReport {
-    /// The report of a frame predicted as `prediction`, taken by the integrator whose report
-    /// `frame` holds (explicit, implicit), redone or not (`fell_back`), in `seconds`.
-    fn of(
-        prediction: CostPrediction,
-        (explicit, implicit): (Option<StepReport>, Option<ImplicitReport>),
-        fell_back: bool,
-        seconds: f64,
-    ) -> Self {
-        Self {
-            choice: if explicit.is_some() {
-                IntegratorKind::Explicit
-            } else {
-                IntegratorKind::Implicit
-            },
-            prediction,
-            explicit,
-            implicit,
-            fell_back,
-            seconds,
-        }
     }
 }
 

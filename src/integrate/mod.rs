@@ -5,6 +5,7 @@
 //! the workspace the solver's caches.
 
 mod automatic;
+mod choice;
 mod cost;
 mod crush;
 mod explicit;
@@ -13,7 +14,8 @@ mod mesh_time_step;
 mod refusal;
 mod workspace;
 
-pub use automatic::{AutomaticIntegrator, AutomaticReport, CostPrediction, IntegratorKind};
+pub use automatic::AutomaticIntegrator;
+pub use choice::{AutomaticReport, CostPrediction, IntegratorKind};
 pub use cost::CostModel;
 pub use crush::COLLAPSE_RATIO;
 pub(crate) use crush::CrushWatch;

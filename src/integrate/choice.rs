@@ -1,0 +1,100 @@
+//! What the automatic choice decides a frame on and reports of it: the integrator taken
+//! ([`IntegratorKind`]), the predicted cost of a frame with each ([`CostPrediction`], from the
+//! [`CostModel`](super::CostModel)), and the frame's report ([`AutomaticReport`]).
+
+use super::{ImplicitReport, StepReport};
+
+/// Which integrator advanced a frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(
+    feature = "serde-serialize",
+    derive(serde::Serialize, serde::Deserialize)
+)]
+pub enum IntegratorKind {
+    /// [`SymplecticEuler`](super::SymplecticEuler).
+    Explicit,
+    /// [`ImplicitIntegrator`](super::ImplicitIntegrator).
+    Implicit,
+}
+
+/// The predicted cost of a frame with each integrator.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CostPrediction {
+    /// Substeps the explicit stability limit requires.
+    pub explicit_substeps: f64,
+    /// Contact points the explicit substeps sweep (those found at the frame's start).
+    pub contact_points: usize,
+    /// Newton iterations per implicit substep expected (the body's recent mean).
+    pub newton_iterations: f64,
+    /// Predicted time of the explicit frame (s).
+    pub explicit_seconds: f64,
+    /// Predicted time of the implicit frame (s).
+    pub implicit_seconds: f64,
+}
+
+impl CostPrediction {
+    /// The cheaper integrator, explicit on a tie.
+    pub fn cheaper(&self) -> IntegratorKind {
+        if self.explicit_seconds <= self.implicit_seconds {
+            IntegratorKind::Explicit
+        } else {
+            IntegratorKind::Implicit
+        }
+    }
+
+    /// The predicted time (s) of the frame with `kind`.
+    pub fn seconds(&self, kind: IntegratorKind) -> f64 {
+        match kind {
+            IntegratorKind::Explicit => self.explicit_seconds,
+            IntegratorKind::Implicit => self.implicit_seconds,
+        }
+    }
+}
+
+/// What an automatic frame did and why.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AutomaticReport {
+    /// The integrator used.
+    pub choice: IntegratorKind,
+    /// The prediction the choice was made on.
+    pub prediction: CostPrediction,
+    /// The explicit frame's report, if explicit.
+    pub explicit: Option<StepReport>,
+    /// The implicit frame's report, if implicit.
+    pub implicit: Option<ImplicitReport>,
+    /// Whether the frame was redone with the other integrator than the one chosen: chosen
+    /// explicit, because crushed elements lowered the stability limit partway below what
+    /// `max_substeps` allows, or the explicit frame produced a non-finite state; chosen
+    /// implicit, because its Newton solve failed or it crushed an element even in the most
+    /// substeps it may take.
+    pub fell_back: bool,
+    /// Wall-clock time the frame's integration took (s), prediction and contact detection
+    /// excluded; for bodies stepped together, the group's time shared in proportion to each
+    /// body's predicted cost with the integrator used. Measured, so it differs from run to run;
+    /// nothing in the step depends on it.
+    pub seconds: f64,
+}
+
+impl AutomaticReport {
+    /// The report of a frame predicted as `prediction`, taken by the integrator whose report
+    /// `frame` holds (explicit, implicit), redone or not (`fell_back`), in `seconds`.
+    pub(super) fn of(
+        prediction: CostPrediction,
+        (explicit, implicit): (Option<StepReport>, Option<ImplicitReport>),
+        fell_back: bool,
+        seconds: f64,
+    ) -> Self {
+        Self {
+            choice: if explicit.is_some() {
+                IntegratorKind::Explicit
+            } else {
+                IntegratorKind::Implicit
+            },
+            prediction,
+            explicit,
+            implicit,
+            fell_back,
+            seconds,
+        }
+    }
+}
