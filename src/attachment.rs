@@ -188,13 +188,23 @@ impl Attachment {
         settings: &ContactSettings,
         step: &ImplicitStep,
     ) -> f64 {
-        let rigid = &step.rigid[self.proxy];
+        self.stiffness_against(body, settings, (&step.rigid[self.proxy], step.effective))
+    }
+
+    /// [`Attachment::spring_stiffness`] (N/m) against the body's `rigid` proxy in a step of
+    /// effective length `effective` (s).
+    fn stiffness_against(
+        &self,
+        body: &DeformableBody,
+        settings: &ContactSettings,
+        (rigid, effective): (&RigidProxy, f64),
+    ) -> f64 {
         let partner = if rigid.is_dynamic() {
             rigid.least_effective_mass(self.anchor)
         } else {
             0.0
         };
-        settings.penalty_stiffness(body.masses[self.node as usize] + partner, step.effective)
+        settings.penalty_stiffness(body.masses[self.node as usize] + partner, effective)
     }
 
     /// The dynamic rigid body's point the spring pulls against, if the body is dynamic.
@@ -223,6 +233,26 @@ pub(crate) fn for_each_spring<'a>(
             each(attachment, stiffness, attachment.spring_target(step));
         }
     }
+}
+
+/// The energy (J) the implicit springs of `attachments` hold, `Σ k/2 |x − anchor|²`, with the
+/// nodes of `body` where they are and each anchor where the last implicit step of effective
+/// length `effective` (s) left it, against the rigid bodies' `proxies` of that step.
+pub(crate) fn spring_energy(
+    body: &DeformableBody,
+    attachments: &[Attachment],
+    (proxies, settings): (&[RigidProxy], &ContactSettings),
+    effective: f64,
+) -> f64 {
+    (attachments.iter())
+        .filter(|a| !body.pinned[a.node as usize])
+        .filter_map(|a| {
+            let rigid = proxies.get(a.proxy)?;
+            let stiffness = a.stiffness_against(body, settings, (rigid, effective));
+            let stretch = body.positions[a.node as usize] - a.anchor;
+            Some(0.5 * stiffness * stretch.length_squared())
+        })
+        .sum()
 }
 
 /// Records the impulses (N s) the implicit springs gave the nodes over the implicit `step`, at

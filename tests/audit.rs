@@ -457,3 +457,64 @@ fn custom_tolerances_are_the_ones_applied() {
     let found = audit.check_world(&world, &Vec::new());
     assert_eq!(found.body(handle).unwrap().collapsed_elements, tets);
 }
+
+#[test]
+fn the_energy_of_a_body_glued_to_a_fixed_body_counts_its_implicit_springs() {
+    // A 20 x 5 x 5 cm bar (E = 1e6 Pa) whose nodes along one top edge are glued to a fixed rigid
+    // body, released horizontal, forced implicit in one coupling substep a frame. The implicit
+    // step pulls each glued node to its anchor with a spring `k = penalty_factor m/ĥ²` that
+    // holds `k |x − a|²/2` at the step's end (the anchors of a fixed body stay where the nodes
+    // were glued): the audit's energy of the body is its kinetic, elastic and gravitational
+    // energy plus those springs', to round-off (1e-12 of the total); the springs' share is
+    // checked to be well above round-off, so that leaving it out fails (it was left out).
+    let material = Material::new(MaterialModel::StableNeoHookean, 1e6, 0.3, 1000.0).unwrap();
+    let mesh = mesh::cuboid(DVec3::new(0.1, 0.025, 0.025), [8, 2, 2]).unwrap();
+    let hinge = mesh.nodes_where(|p| p.x < -0.0999 && p.y > 0.0249);
+    let body = DeformableBodyBuilder::new(mesh, material)
+        .damping(RayleighDamping::stiffness_proportional(2e-3, material.lame()).unwrap())
+        .translation(DVec3::new(0.0, 0.5, 0.0))
+        .build()
+        .unwrap();
+    let mut world = FvmWorld::default();
+    world.coupling.substeps = 1;
+    world.coupling.integrator.force = Some(IntegratorKind::Implicit);
+    let gravity = world.physics.gravity.as_dvec3();
+    let handle = world.soft_bodies.insert(body);
+    let (bar, _) = world.physics.insert(
+        RigidBodyBuilder::fixed().translation(Vec3::new(-0.1, 0.525, 0.0)),
+        ColliderBuilder::cuboid(0.005, 0.005, 0.03).sensor(true),
+    );
+    world.attach(handle, hinge.iter().copied(), bar).unwrap();
+    // The anchors where the world keeps them: through the fixed body's pose, in f32 as rapier's.
+    let pose = *world.physics.bodies[bar].position();
+    let anchors: Vec<DVec3> = (hinge.iter())
+        .map(|&n| world.soft_bodies[handle].positions()[n as usize].as_vec3())
+        .map(|x| (pose.transform_point(pose.inverse_transform_point(x))).as_dvec3())
+        .collect();
+    let mut audit = Audit::default();
+    audit.restart_world(&world);
+    for frame in 0..20 {
+        let results = world.step();
+        let found = audit.check_world(&world, &results);
+        let report = results[0].1.as_ref().unwrap().implicit.unwrap();
+        let body = &world.soft_bodies[handle];
+        let factor = world.coupling.contact.penalty_factor;
+        let h = report.substep_dt;
+        let springs: f64 = (hinge.iter().zip(&anchors))
+            .map(|(&n, a)| {
+                let n = n as usize;
+                0.5 * factor * body.masses()[n] / (h * h)
+                    * (body.positions()[n] - *a).length_squared()
+            })
+            .sum();
+        let moving = body.kinetic_energy() + body.elastic_energy();
+        let expected = moving + body.gravity_potential_energy(gravity) + springs;
+        let counted = found.body(handle).unwrap().energy.unwrap().energy;
+        println!(
+            "frame {frame}: springs {springs:.6e} J, audit beyond the rest {:.6e} J",
+            counted - (expected - springs)
+        );
+        assert!((counted - expected).abs() < 1e-12 * expected.abs().max(moving));
+        assert!(springs > 1e-6 * expected.abs());
+    }
+}

@@ -9,7 +9,9 @@
 //!   contact penalties hold: `k g²/2` for each node inside its contact plane (`g < 0`) and each
 //!   rigid corner behind its face, with `k = penalty_factor m / ĥ²` (`m` the node's or the
 //!   face point's mass, `ĥ` the substep's effective step) and the stiffenings the contact's load
-//!   called for (see `contact::stiffening`). Embedded contact points' penalties are not counted.
+//!   called for (see `contact::stiffening`), and `k |x − a|²/2` for each node glued to a rigid
+//!   body's anchor `a` (its implicit spring, `k` counting the body's least effective mass there
+//!   when dynamic). Embedded contact points' penalties are not counted.
 //!   A sleeping body not stepped in the frame keeps the energy it had when it was last measured:
 //!   its state does not change, and the penalty energy its last implicit step held is still
 //!   there (measured afresh it would drop out, then count as a gain when the body wakes).
@@ -42,6 +44,7 @@
 //! (deformable bodies that may touch), and each deformable body is given its cluster's check.
 
 use super::{AuditInput, EnergyCheck};
+use crate::attachment;
 use crate::body::{DeformableBody, DeformableBodyHandle};
 use crate::contact::{self, BodyPoint};
 use crate::coupling::{SoftStepResults, iterations_per_substep};
@@ -147,8 +150,8 @@ fn rigid_integration_step(input: &AuditInput<'_>) -> f64 {
 }
 
 /// The energy (J) the implicit contact penalties of the deformable body `handle` hold now (its
-/// points' and the rigid corners' against its faces), after an implicit step in substeps of
-/// `h` (s).
+/// points' and the rigid corners' against its faces) and its attachments' implicit springs,
+/// after an implicit step in substeps of `h` (s).
 fn penalty_energy(
     input: &AuditInput<'_>,
     handle: DeformableBodyHandle,
@@ -177,7 +180,10 @@ fn penalty_energy(
             BodyPoint::Embedded(_) => None,
         })
         .sum::<f64>();
-    nodes + contact::corner_penalty_energy(body, &constraints.contacts, effective)
+    let springs = (&constraints.rigid_proxies[..], settings);
+    nodes
+        + contact::corner_penalty_energy(body, &constraints.contacts, effective)
+        + attachment::spring_energy(body, &constraints.attachments, springs, effective)
 }
 
 /// The energy (J) of a dynamic rigid body under gravity `g` (m/s²), its gravitational part at
