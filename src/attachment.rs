@@ -235,6 +235,23 @@ pub(crate) fn for_each_spring<'a>(
     }
 }
 
+/// The anchors (m) of the `attachments` of the free nodes of `body` whose rigid bodies, among
+/// `proxies`, do not move (fixed, or kinematic at rest): points the body turns about as about
+/// pinned nodes.
+pub(crate) fn still_anchors(
+    body: &DeformableBody,
+    attachments: &[Attachment],
+    proxies: &[RigidProxy],
+) -> Vec<DVec3> {
+    (attachments.iter())
+        .filter(|a| !body.pinned[a.node as usize])
+        .filter_map(|a| {
+            let rigid = proxies.get(a.proxy)?;
+            (!rigid.is_dynamic() && rigid.velocity_at(a.anchor) == DVec3::ZERO).then_some(a.anchor)
+        })
+        .collect()
+}
+
 /// The energy (J) the implicit springs of `attachments` hold, `Σ k/2 |x − anchor|²`, with the
 /// nodes of `body` where they are and each anchor where the last implicit step of effective
 /// length `effective` (s) left it, against the rigid bodies' `proxies` of that step.

@@ -17,7 +17,10 @@
 //! nodes, `Δv = δω × (x₁ − c)`, the rotations the pins allow: about the centre of mass `c` with
 //! `I_c δω = δL` when nothing is pinned (linear momentum unchanged: `Σ m Δv = 0`); about a single
 //! pinned point `c`, `I_c δω = δL`; about the line through collinear pinned nodes (a hinge),
-//! `δω = a (a·δL) / I_a`; none when the pins hold every rotation. The step's positions are kept;
+//! `δω = a (a·δL) / I_a`; none when the pins hold every rotation. Nodes glued to rigid bodies
+//! that do not move (fixed, or kinematic at rest) count as pins here when their anchors lie at
+//! one point or on one line (a body glued by a face is given the drain about its centre of mass,
+//! as a free body). The step's positions are kept;
 //! only the velocities it ends with change. The deformation's numerical damping is untouched.
 //!
 //! A pinned body swings under its constant loads `F` (its weight): their torque about the pins
@@ -41,13 +44,15 @@ const COLLINEAR: f64 = 1e-9;
 
 /// Gives back to `body` the angular momentum a backward Euler step of `h` (s) took, its nodes
 /// having started it at `positions` (m) and `velocities` (m/s) under the constant forces `load`
-/// (N per node), the step before it `previous` (s) long; see the module documentation.
+/// (N per node), the step before it `previous` (s) long, glued at the anchors `still` (m) to
+/// rigid bodies that do not move; see the module documentation.
 pub(super) fn give_back(
     body: &mut DeformableBody,
     (positions, velocities, load): (&[DVec3], &[DVec3], &[DVec3]),
+    still: &[DVec3],
     (h, previous): (f64, Option<f64>),
 ) {
-    let Some(pivot) = pivot(body) else {
+    let Some(pivot) = pivot(body, still) else {
         return;
     };
     let free = |n: &usize| !body.pinned[*n];
@@ -126,7 +131,7 @@ fn momentum_about(
 /// Adds to the free nodes of `body` the rotation the pins allow whose angular momentum is `lost`
 /// (N m s).
 fn turn_by(body: &mut DeformableBody, lost: DVec3) {
-    if let Some(pivot) = pivot(body) {
+    if let Some(pivot) = pivot(body, &[]) {
         turn_about(body, pivot, lost);
     }
 }
@@ -165,16 +170,18 @@ enum Pivot {
     Hinge(DVec3, DVec3),
 }
 
-/// What the pins of `body` leave it free to turn about, or `None` when they hold every rotation.
-fn pivot(body: &DeformableBody) -> Option<Pivot> {
-    let pinned: Vec<DVec3> = (0..body.positions.len())
+/// What the pins of `body` and its anchors `still` (m) on rigid bodies that do not move leave it
+/// free to turn about, or `None` when pins hold every rotation. Anchors that hold every rotation
+/// without pins (a body glued by a face) leave the centre of mass, as a free body's.
+fn pivot(body: &DeformableBody, still: &[DVec3]) -> Option<Pivot> {
+    let pinned = (0..body.positions.len())
         .filter(|&n| body.pinned[n])
-        .map(|n| body.positions[n])
-        .collect();
-    let Some(&first) = pinned.first() else {
+        .map(|n| body.positions[n]);
+    let held: Vec<DVec3> = pinned.chain(still.iter().copied()).collect();
+    let Some(&first) = held.first() else {
         return Some(Pivot::Free(body.center_of_mass()));
     };
-    let far = pinned.iter().copied().max_by(|a, b| {
+    let far = held.iter().copied().max_by(|a, b| {
         (*a - first)
             .length_squared()
             .total_cmp(&(*b - first).length_squared())
@@ -188,7 +195,13 @@ fn pivot(body: &DeformableBody) -> Option<Pivot> {
     }
     let axis = (far - first) / span;
     let off_line = |p: &DVec3| (*p - first).cross(axis).length() > COLLINEAR * size;
-    (!pinned.iter().any(off_line)).then_some(Pivot::Hinge(first, axis))
+    if !held.iter().any(off_line) {
+        Some(Pivot::Hinge(first, axis))
+    } else if body.pinned.contains(&true) {
+        None
+    } else {
+        Some(Pivot::Free(body.center_of_mass()))
+    }
 }
 
 impl Pivot {

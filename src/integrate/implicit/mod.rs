@@ -29,6 +29,7 @@ pub use report::ImplicitReport;
 use super::{CrushWatch, PreviousStep, SolverWorkspace};
 use crate::Error;
 use crate::assembly::Stiffness;
+use crate::attachment;
 use crate::body::DeformableBody;
 use crate::chord::{self, Chord};
 use crate::constraint::{self, BodyConstraints};
@@ -705,7 +706,9 @@ fn end_substep(
             angular::keep_exchanged(body, before, exchanged + weight_moment);
         } else {
             let begun = (&start.positions[..], &start.velocities[..], &start.load[..]);
-            angular::give_back(body, begun, (h, previous));
+            let (attachments, proxies) = (&constraints.attachments, &constraints.rigid_proxies);
+            let still = attachment::still_anchors(body, attachments, proxies);
+            angular::give_back(body, begun, &still, (h, previous));
         }
     }
     PreviousStep {
