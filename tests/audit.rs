@@ -467,24 +467,13 @@ fn the_energy_of_a_body_glued_to_a_fixed_body_counts_its_implicit_springs() {
     // were glued): the audit's energy of the body is its kinetic, elastic and gravitational
     // energy plus those springs', to round-off (1e-12 of the total); the springs' share is
     // checked to be well above round-off, so that leaving it out fails (it was left out).
-    let material = Material::new(MaterialModel::StableNeoHookean, 1e6, 0.3, 1000.0).unwrap();
-    let mesh = mesh::cuboid(DVec3::new(0.1, 0.025, 0.025), [8, 2, 2]).unwrap();
-    let hinge = mesh.nodes_where(|p| p.x < -0.0999 && p.y > 0.0249);
-    let body = DeformableBodyBuilder::new(mesh, material)
-        .damping(RayleighDamping::stiffness_proportional(2e-3, material.lame()).unwrap())
-        .translation(DVec3::new(0.0, 0.5, 0.0))
-        .build()
-        .unwrap();
+    let (builder, hinge) = common::bar_with_hinge(DVec3::new(0.0, 0.5, 0.0));
     let mut world = FvmWorld::default();
     world.coupling.substeps = 1;
     world.coupling.integrator.force = Some(IntegratorKind::Implicit);
     let gravity = world.physics.gravity.as_dvec3();
-    let handle = world.soft_bodies.insert(body);
-    let (bar, _) = world.physics.insert(
-        RigidBodyBuilder::fixed().translation(Vec3::new(-0.1, 0.525, 0.0)),
-        ColliderBuilder::cuboid(0.005, 0.005, 0.03).sensor(true),
-    );
-    world.attach(handle, hinge.iter().copied(), bar).unwrap();
+    let handle = world.soft_bodies.insert(builder.build().unwrap());
+    let bar = common::glue_to_fixed_axle(&mut world, handle, &hinge, Vec3::new(-0.1, 0.525, 0.0));
     // The anchors where the world keeps them: through the fixed body's pose, in f32 as rapier's.
     let pose = *world.physics.bodies[bar].position();
     let anchors: Vec<DVec3> = (hinge.iter())

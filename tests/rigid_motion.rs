@@ -8,7 +8,6 @@ mod common;
 use common::{Lcg, OBJECTIVE_MODELS};
 use rapier_fvm::prelude::*;
 use rapier_fvm::world::FvmWorld;
-use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder};
 
 const YOUNG: f64 = 1e7;
 
@@ -195,27 +194,18 @@ fn a_free_spinning_body_keeps_its_momentum_and_kinetic_energy_under_every_integr
 /// integrator `force`d or automatic, 5 s: the heights (m) its free end's top corner rises to,
 /// against its start, at the turning points on its starting side.
 fn hinged_bar_returns(force: Option<IntegratorKind>, glued: bool) -> Vec<f64> {
-    let material = Material::new(MaterialModel::StableNeoHookean, 1e6, 0.3, 1000.0).unwrap();
-    let mesh = mesh::cuboid(DVec3::new(0.1, 0.025, 0.025), [8, 2, 2]).unwrap();
-    let hinge = mesh.nodes_where(|p| p.x < -0.0999 && p.y > 0.0249);
-    let tip = mesh.nearest_node(DVec3::new(0.1, 0.025, 0.0)) as usize;
+    let (builder, hinge) = common::bar_with_hinge(DVec3::ZERO);
     let pins = if glued { Vec::new() } else { hinge.clone() };
-    let body = DeformableBodyBuilder::new(mesh, material)
-        .damping(RayleighDamping::stiffness_proportional(2e-3, material.lame()).unwrap())
-        .pinned_nodes(pins)
-        .build()
-        .unwrap();
+    let body = builder.pinned_nodes(pins).build().unwrap();
+    let tip = body.mesh().nearest_node(DVec3::new(0.1, 0.025, 0.0)) as usize;
     let start = body.positions()[tip].y;
     let mut world = FvmWorld::default();
     world.physics.gravity = rapier_fvm::glamx::Vec3::new(0.0, -9.81, 0.0);
     world.coupling.integrator.force = force;
     let handle = world.soft_bodies.insert(body);
     if glued {
-        let (axle, _) = world.physics.insert(
-            RigidBodyBuilder::fixed().translation(rapier_fvm::glamx::Vec3::new(-0.1, 0.025, 0.0)),
-            ColliderBuilder::cuboid(0.005, 0.005, 0.03).sensor(true),
-        );
-        world.attach(handle, hinge, axle).unwrap();
+        let axle = rapier_fvm::glamx::Vec3::new(-0.1, 0.025, 0.0);
+        common::glue_to_fixed_axle(&mut world, handle, &hinge, axle);
     }
     let mut heights = vec![start];
     for _ in 0..300 {

@@ -568,3 +568,32 @@ pub fn momenta(body: &DeformableBody) -> (DVec3, DVec3, f64) {
     }
     (linear, angular, scale)
 }
+
+/// A 20 x 5 x 5 cm bar along x (stable Neo-Hookean, E = 1e6 Pa, ν = 0.3, 1000 kg/m³, stiffness
+/// damping 2e-3 s, 8 x 2 x 2 cells) centred at `centre` (m), to be built, and its hinge: the
+/// nodes along the top edge of its −x end.
+pub fn bar_with_hinge(centre: DVec3) -> (DeformableBodyBuilder, Vec<u32>) {
+    let material = Material::new(MaterialModel::StableNeoHookean, 1e6, 0.3, 1000.0).unwrap();
+    let mesh = mesh::cuboid(DVec3::new(0.1, 0.025, 0.025), [8, 2, 2]).unwrap();
+    let hinge = mesh.nodes_where(|p| p.x < -0.0999 && p.y > 0.0249);
+    let builder = DeformableBodyBuilder::new(mesh, material)
+        .damping(RayleighDamping::stiffness_proportional(2e-3, material.lame()).unwrap())
+        .translation(centre);
+    (builder, hinge)
+}
+
+/// Glues the `hinge` nodes of the soft body `handle` to a fixed rigid body (a sensor 1 x 1 x 6 cm
+/// centred at `axle`, m), the axle they turn about, and returns it.
+pub fn glue_to_fixed_axle(
+    world: &mut FvmWorld,
+    handle: DeformableBodyHandle,
+    hinge: &[u32],
+    axle: Vec3,
+) -> rapier3d::prelude::RigidBodyHandle {
+    let (fixed, _) = world.physics.insert(
+        rapier3d::prelude::RigidBodyBuilder::fixed().translation(axle),
+        ColliderBuilder::cuboid(0.005, 0.005, 0.03).sensor(true),
+    );
+    world.attach(handle, hinge.iter().copied(), fixed).unwrap();
+    fixed
+}
