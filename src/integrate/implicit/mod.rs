@@ -666,9 +666,9 @@ impl ImplicitIntegrator {
 /// or pushes at the step's end, all it started with; to a body alone, unpinned and without loads
 /// but its weight that only dynamic rigid bodies push, exactly what they and its weight gave it
 /// ([`constraint::partner_angular_impulse`]: equal and opposite to what the rigid bodies take);
-/// to others the drain, a pinned body's swing with its loads' torque at the step's start over
-/// the kick of `previous`, the last substep's length (s), and `h`. Returns the substep's start,
-/// for the next one.
+/// to others the drain, a body pinned or glued to still rigid bodies at a point or along a line
+/// swinging with its loads' torque at the step's start over the kick of `previous`, the last
+/// substep's length (s), and `h`. Returns the substep's start, for the next one.
 fn end_substep(
     body: &mut DeformableBody,
     constraints: &mut BodyConstraints,
