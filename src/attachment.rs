@@ -5,7 +5,8 @@
 //! velocity (the node's velocity relative to the anchor's, with a fifth of the position drift
 //! corrected per substep), solved with the 3 x 3 effective mass of node and body; the body gets
 //! the opposite impulse at the node. The implicit integrator adds a stiff spring to the anchor's
-//! position at the end of the step, `k = penalty_factor m/ĥ²`, to its potential, the anchor
+//! position at the end of the step, `k = penalty_factor m/h²` (`h` the step's penalty step, see
+//! `contact::ImplicitStep`), to its potential, the anchor
 //! carried by its body at the velocity the step's solve gives it (a dynamic body's response to
 //! the springs and contacts is part of the solve). In both, the body's velocity follows the
 //! impulses, and the anchor moves with it, as for contacts.
@@ -179,7 +180,8 @@ impl Attachment {
         self.anchor + step.rigid[self.proxy].velocity_at(self.anchor) * step.length
     }
 
-    /// The implicit spring's stiffness (N/m) in `step`: the penalty factor times `m/ĥ²`, with
+    /// The implicit spring's stiffness (N/m) in `step`: the penalty factor times `m/h²` (`h` its
+    /// penalty step), with
     /// `m` the node's mass plus, for a dynamic body, the least effective mass of the body at the
     /// anchor, so that the spring holds a heavy body as firmly as a light one.
     fn spring_stiffness(
@@ -188,23 +190,23 @@ impl Attachment {
         settings: &ContactSettings,
         step: &ImplicitStep,
     ) -> f64 {
-        self.stiffness_against(body, settings, (&step.rigid[self.proxy], step.effective))
+        self.stiffness_against(body, settings, (&step.rigid[self.proxy], step.penalty_step))
     }
 
     /// [`Attachment::spring_stiffness`] (N/m) against the body's `rigid` proxy in a step of
-    /// effective length `effective` (s).
+    /// penalty step `penalty_step` (s).
     fn stiffness_against(
         &self,
         body: &DeformableBody,
         settings: &ContactSettings,
-        (rigid, effective): (&RigidProxy, f64),
+        (rigid, penalty_step): (&RigidProxy, f64),
     ) -> f64 {
         let partner = if rigid.is_dynamic() {
             rigid.least_effective_mass(self.anchor)
         } else {
             0.0
         };
-        settings.penalty_stiffness(body.masses[self.node as usize] + partner, effective)
+        settings.penalty_stiffness(body.masses[self.node as usize] + partner, penalty_step)
     }
 
     /// The dynamic rigid body's point the spring pulls against, if the body is dynamic.
@@ -253,19 +255,20 @@ pub(crate) fn still_anchors(
 }
 
 /// The energy (J) the implicit springs of `attachments` hold, `Σ k/2 |x − anchor|²`, with the
-/// nodes of `body` where they are and each anchor where the last implicit step of effective
-/// length `effective` (s) left it, against the rigid bodies' `proxies` of that step.
+/// nodes of `body` where they are and each anchor where the last implicit step, of penalty step
+/// `penalty_step` (s, see `contact::ImplicitStep`), left it, against the rigid bodies' `proxies`
+/// of that step.
 pub(crate) fn spring_energy(
     body: &DeformableBody,
     attachments: &[Attachment],
     (proxies, settings): (&[RigidProxy], &ContactSettings),
-    effective: f64,
+    penalty_step: f64,
 ) -> f64 {
     (attachments.iter())
         .filter(|a| !body.pinned[a.node as usize])
         .filter_map(|a| {
             let rigid = proxies.get(a.proxy)?;
-            let stiffness = a.stiffness_against(body, settings, (rigid, effective));
+            let stiffness = a.stiffness_against(body, settings, (rigid, penalty_step));
             let stretch = body.positions[a.node as usize] - a.anchor;
             Some(0.5 * stiffness * stretch.length_squared())
         })

@@ -5,7 +5,7 @@
 //! `x_n − Σ w_i x_i` (weights `1, −w_a, −w_b, −w_c`), against the plane through the contact
 //! point with the triangle's normal as detected. It adds the penalty `k/2 min(0, g)²` on the gap
 //! `g`, `k` [`ContactSettings::penalty_factor`](super::ContactSettings::penalty_factor) times
-//! the point's effective `m/ĥ²`, and the lagged friction on the slip relative to the triangle.
+//! the point's effective `m/h²` (`h` the penalty step, see [`ImplicitStep`]), and the lagged friction on the slip relative to the triangle.
 //! The weights sum to zero, so node and triangle take equal and opposite forces: the group's
 //! momentum changes only by the out-of-balance force Newton leaves.
 
@@ -54,28 +54,29 @@ impl JointContacts {
         pairs
     }
 
-    /// Readies friction for an implicit step of effective length `h` (s) from the nodes where
-    /// they are at its start: each contact's friction limit is its penalty force there, and slip
-    /// is measured from there.
-    pub(crate) fn lag_friction(&mut self, nodes: NodeSlices, h: f64) {
+    /// Readies friction for an implicit step of effective length and penalty step `steps` (s,
+    /// see [`ImplicitStep`]) from the nodes where they are at its start: each contact's friction
+    /// limit is its penalty force there, and slip is measured from there.
+    pub(crate) fn lag_friction(&mut self, nodes: NodeSlices, steps: (f64, f64)) {
         lag_friction_at(
             (nodes, None),
             &mut self.contacts,
             &self.settings,
-            between_bodies(h),
+            between_bodies(steps),
         );
     }
 
     /// Calls `each(point, energy (J), force (N), tangent (N/m))` for the penalty and friction of
-    /// every contact with the nodes at `nodes`, in an implicit step of effective length `h` (s):
-    /// node `a` of the point's stencil takes `w_a` of the force.
+    /// every contact with the nodes at `nodes`, in an implicit step of effective length and
+    /// penalty step `steps` (s, see [`ImplicitStep`]): node `a` of the point's stencil takes
+    /// `w_a` of the force.
     pub(crate) fn for_each_term(
         &self,
         nodes: NodeSlices,
-        h: f64,
+        steps: (f64, f64),
         mut each: impl FnMut(Stencil, f64, DVec3, DMat3),
     ) {
-        let step = between_bodies(h);
+        let step = between_bodies(steps);
         for_each_term_at(
             (nodes, None),
             &self.contacts,
@@ -88,12 +89,13 @@ impl JointContacts {
     }
 }
 
-/// An implicit step of effective length `h` (s) as terms between soft bodies see it: no rigid
-/// body, nothing carried.
-fn between_bodies(h: f64) -> ImplicitStep<'static> {
+/// An implicit step of effective length and penalty step `steps` (s) as terms between soft
+/// bodies see it: no rigid body, nothing carried.
+fn between_bodies((effective, penalty_step): (f64, f64)) -> ImplicitStep<'static> {
     ImplicitStep {
-        effective: h,
-        length: h,
+        effective,
+        penalty_step,
+        length: effective,
         rigid: &[],
     }
 }

@@ -16,7 +16,8 @@
 //!   contacts (sequential impulses, as rapier's own solver).
 //! - [`ImplicitIntegrator`](crate::integrate::ImplicitIntegrator), as a stiff penalty in the
 //!   incremental potential, `k/2 min(0, g)²` per contact with `g` the signed distance to the plane
-//!   and `k` at least [`ContactSettings::penalty_factor`] times the node's `m/h²` (its own mass,
+//!   and `k` at least [`ContactSettings::penalty_factor`] times the node's `m/h²` (`h` the effective
+//!   step of the whole step the integrator takes, not of its substeps; the node's own mass,
 //!   against a fixed collider as against a dynamic rigid body: the body's mass counted in would
 //!   make each contact switching on or off a jump of curvature hundreds of times the node's
 //!   inertia, and Newton wander between them), whose resting
@@ -103,8 +104,15 @@ use rapier3d::dynamics::CoefficientCombineRule;
 /// An implicit step as the contact and attachment terms see it.
 #[derive(Clone, Copy)]
 pub(crate) struct ImplicitStep<'a> {
-    /// The effective step `ĥ` (s): the penalties' `m/ĥ²` and friction's stick length use it.
+    /// The effective step `ĥ` (s): friction's stick length uses it.
     pub(crate) effective: f64,
+    /// The step (s) whose `m/h²` the penalties and the attachments' springs take: the effective
+    /// step's share of the whole step the integrator was given (a coupling substep, or the
+    /// frame), whatever number of substeps it cuts that into. A stiffness that followed the
+    /// substeps would jump when their number changes (a body's spin, a refined frame), and a
+    /// spring holding a load releases `½ (1/k₁ − 1/k₂) f²` at each jump (a rope glued to a
+    /// swinging ball gained 1.8e-3 J in a frame so).
+    pub(crate) penalty_step: f64,
     /// The step's length `h` (s): rigid bodies carry their colliders, vertices and anchors over
     /// it at their velocity.
     pub(crate) length: f64,

@@ -101,20 +101,20 @@ fn carried(contact: &NodeContact, step: &ImplicitStep) -> Carried {
 }
 
 /// The implicit force (N) on a contact's point at `x` (m, its position relative to the
-/// obstacle's travel), of effective mass `mass` (kg), in an implicit step of effective length
-/// `h` (s): the penalty and the lagged friction.
+/// obstacle's travel), of effective mass `mass` (kg), in the implicit `step`: the penalty and
+/// the lagged friction.
 fn implicit_force(
     contact: &NodeContact,
     x: DVec3,
     mass: f64,
     settings: &ContactSettings,
-    h: f64,
+    step: &ImplicitStep,
 ) -> DVec3 {
     let friction = contact
-        .friction_term(x, settings, h)
+        .friction_term(x, settings, step.effective)
         .map_or(DVec3::ZERO, |(_, force, _)| force);
     let penalty = contact
-        .penalty(x, mass, settings, h)
+        .penalty(x, mass, settings, step.penalty_step)
         .map_or(DVec3::ZERO, |penalty| contact.normal * penalty.push);
     friction + penalty
 }
@@ -138,7 +138,7 @@ pub(crate) fn record_penalty_impulses(
         let obstacle = carried(contact, &step);
         let x = point.position(positions) - obstacle.travel;
         let mass = effective_mass(&at, partners.masses, partners.pinned);
-        let impulse = implicit_force(contact, x, mass, &settings, step.effective) * step.length;
+        let impulse = implicit_force(contact, x, mass, &settings, &step) * step.length;
         if !matches!(contact.obstacle, Obstacle::OwnTriangle(_)) {
             partners.apply(&contact.obstacle, -impulse, contact.point);
         }
@@ -171,7 +171,7 @@ pub(crate) fn stiffen_deep_contacts(
         let mass = effective_mass(&point.stencil(), nodes.masses, nodes.pinned);
         let end = point.position(nodes.positions) - obstacle.travel;
         let path = (point.position(start), end);
-        stiffened |= contact.stiffen_if_deep(path, mass, &settings, step.effective);
+        stiffened |= contact.stiffen_if_deep(path, mass, &settings, step.penalty_step);
     }
     let corners = (&mut contacts.corners[..], &settings);
     stiffened | corner::stiffen_deep_corners((body, start), corners, step)
@@ -205,7 +205,7 @@ pub(super) fn lag_friction_at(
         let x = point.position(nodes.positions);
         let mass = effective_mass(&point.stencil(), nodes.masses, nodes.pinned);
         contact.lagged_normal_force = contact
-            .penalty(x, mass, settings, step.effective)
+            .penalty(x, mass, settings, step.penalty_step)
             .map_or(0.0, |penalty| penalty.push);
         contact.slip_origin = x;
     }
@@ -251,7 +251,7 @@ pub(super) fn for_each_term_at(
         let obstacle = carried(contact, &step);
         let mass = effective_mass(&at, nodes.masses, nodes.pinned);
         let x = point.position(nodes.positions) - obstacle.travel;
-        if let Some(penalty) = contact.penalty(x, mass, settings, step.effective) {
+        if let Some(penalty) = contact.penalty(x, mass, settings, step.penalty_step) {
             each(
                 at,
                 obstacle.partner,

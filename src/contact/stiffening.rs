@@ -3,7 +3,7 @@
 //! A point `d` (m) behind its contact plane holds the energy
 //! `e(d) = ½ k d² + Σᵢ ½ Δkᵢ (d − aᵢ)₊²` (J), pushed out by the force `e'(d)` (N) with the
 //! stiffness `e''(d)` (N/m): `k` is the contact's own penalty (the penalty factor times the
-//! point's `m/ĥ²`), and each `Δkᵢ` a stiffening its load called for when an implicit step left
+//! point's `m/h²`, `h` the step's penalty step, see `contact::ImplicitStep`), and each `Δkᵢ` a stiffening its load called for when an implicit step left
 //! the point deeper than the resting depth `r`
 //! ([`ContactSettings::resting_depth`](super::ContactSettings::resting_depth)), acting only
 //! beyond `aᵢ`, the depth that step started the point at. It is sized for the load to be held at

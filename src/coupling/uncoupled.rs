@@ -10,7 +10,7 @@
 //! integrator's own [`substeps`](crate::integrate::ImplicitIntegrator::substeps) still set its
 //! accuracy), and an explicit one takes the substeps its stability needs in one go. Its implicit
 //! penalties are as stiff as in a coupling substep, `penalty_factor m / (dt/N)²` for `N`
-//! substeps: the penalty's `m/ĥ²` scaling would otherwise let a load press a point `N²` times
+//! substeps: the penalty's `m/h²` scaling would otherwise let a load press a point `N²` times
 //! deeper (the showcase's fingers, pressed 2 mm into the gripped cube, squeezed it with 14.46 N
 //! instead of 17.38 N; with the substeps' stiffness 17.37 N).
 //!

@@ -1,7 +1,7 @@
 //! The implicit side of rigid corners against soft faces: the penalty `k/2 min(0, g)²` on the
 //! gap `g = (v − p(x))·n` between the vertex `v`, carried over the step by its rigid body's
 //! velocity, and the triangle's contact point `p(x) = Σ w_i x_i`, with `k` the penalty factor
-//! times the point's effective `m/ĥ²` stiffened by its load (see [`super::super::stiffening`]),
+//! times the point's effective `m/h²` (`h` the penalty step, see [`ImplicitStep`]) stiffened by its load (see [`super::super::stiffening`]),
 //! and the lagged friction on the point's slip relative to the vertex; after the step their
 //! forces' opposite goes to the rigid body at the vertex.
 
@@ -43,7 +43,7 @@ impl CornerContact {
 
     /// The penalty of the contact in an implicit step of `settings` and `step`, with the
     /// triangle's point at `point` (m) of effective mass `mass` (kg) and the vertex moving at
-    /// `vertex_velocity` (m/s): the penalty factor times `m/ĥ²`, stiffened by its load (see
+    /// `vertex_velocity` (m/s): the penalty factor times `m/h²` (`h` the step's penalty step), stiffened by its load (see
     /// [`super::stiffening`]); `None` while the vertex stays outside.
     fn penalty(
         &self,
@@ -53,7 +53,7 @@ impl CornerContact {
         (settings, step): (&ContactSettings, &ImplicitStep),
     ) -> Option<Penalty> {
         let depth = -self.gap(point, vertex_velocity, step.length);
-        (self.stiffening).penalty(settings.penalty_stiffness(mass, step.effective), depth)
+        (self.stiffening).penalty(settings.penalty_stiffness(mass, step.penalty_step), depth)
     }
 
     /// The lagged friction of the triangle's point at `point` (m) against the vertex moving at
@@ -166,18 +166,19 @@ pub(in crate::contact) fn stiffen_deep_corners(
         let (at, point, mass, velocity) = contact.sides(body, step.rigid);
         let started = contact.gap(at.interpolate(start), DVec3::ZERO, 0.0);
         let ended = contact.gap(point, velocity, step.length);
-        let base = settings.penalty_stiffness(mass, step.effective);
+        let base = settings.penalty_stiffness(mass, step.penalty_step);
         let depths = (-started, -ended);
         (contact.stiffening).stiffen(base, depths, settings.resting_depth) | stiffened
     })
 }
 
 /// The energy (J) the corners' implicit penalties hold with the body and the vertices where
-/// they are, at a penalty of an implicit step of effective length `effective` (s).
+/// they are, at a penalty of an implicit step of penalty step `penalty_step` (s, see
+/// [`ImplicitStep`]).
 pub(crate) fn corner_penalty_energy(
     body: &DeformableBody,
     contacts: &ContactSet,
-    effective: f64,
+    penalty_step: f64,
 ) -> f64 {
     let settings = &contacts.settings;
     (contacts.corners.iter())
@@ -185,7 +186,7 @@ pub(crate) fn corner_penalty_energy(
             let at = contact.on_triangle.stencil();
             let depth = -contact.gap(at.interpolate(&body.positions), DVec3::ZERO, 0.0);
             let mass = effective_mass(&at, &body.masses, &body.pinned);
-            let base = settings.penalty_stiffness(mass, effective);
+            let base = settings.penalty_stiffness(mass, penalty_step);
             contact.stiffening.penalty(base, depth)
         })
         .map(|penalty| penalty.energy)

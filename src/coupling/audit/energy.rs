@@ -7,8 +7,9 @@
 //!   `-Σ m g·x`, the potential `U` of their loads
 //!   ([`DeformableBody::load_potential_energy`]), and after an implicit step the energy its
 //!   contact penalties hold: `k g²/2` for each node inside its contact plane (`g < 0`) and each
-//!   rigid corner behind its face, with `k = penalty_factor m / ĥ²` (`m` the node's or the
-//!   face point's mass, `ĥ` the substep's effective step) and the stiffenings the contact's load
+//!   rigid corner behind its face, with `k = penalty_factor m / h²` (`m` the node's or the
+//!   face point's mass, `h` the effective step of the whole step the integrator took, however
+//!   many substeps it cut it into) and the stiffenings the contact's load
 //!   called for (see `contact::stiffening`), and `k |x − a|²/2` for each node glued to a rigid
 //!   body's anchor `a` (its implicit spring, `k` counting the body's least effective mass there
 //!   when dynamic). Embedded contact points' penalties are not counted.
@@ -95,9 +96,10 @@ pub(super) fn energies(
             .iter()
             .find(|(h, _)| *h == handle)
             .and_then(|(_, r)| r.as_ref().ok());
-        let penalty = report
-            .and_then(|r| r.implicit)
-            .map_or(0.0, |r| penalty_energy(input, handle, body, r.substep_dt));
+        let penalty = report.and_then(|r| r.implicit).map_or(0.0, |r| {
+            let whole_step = r.substep_dt * f64::from(r.substeps.max(1));
+            penalty_energy(input, handle, body, whole_step)
+        });
         let moving = body.kinetic_energy() + body.elastic_energy() + penalty;
         let total = moving + body.gravity_potential_energy(g) + body.load_potential_energy();
         let ratio = report.and_then(|r| r.explicit).map_or(0.0, |e| {
@@ -151,7 +153,7 @@ fn rigid_integration_step(input: &AuditInput<'_>) -> f64 {
 
 /// The energy (J) the implicit contact penalties of the deformable body `handle` hold now (its
 /// points' and the rigid corners' against its faces) and its attachments' implicit springs,
-/// after an implicit step in substeps of `h` (s).
+/// after an implicit step whose penalty step (see `contact::ImplicitStep`) was `h` (s).
 fn penalty_energy(
     input: &AuditInput<'_>,
     handle: DeformableBodyHandle,

@@ -96,11 +96,18 @@ fn stiffen_deep_contacts(
 struct GroupPotential<'a> {
     members: Vec<Potential<'a>>,
     between: &'a JointContacts,
-    /// The effective step `ĥ` (s) every body of the group takes.
+    /// The effective step `ĥ` (s) every body of the group takes, and the penalty step (s, see
+    /// [`ImplicitStep`](crate::contact::ImplicitStep)).
     effective: f64,
+    penalty_step: f64,
 }
 
 impl GroupPotential<'_> {
+    /// The effective step and the penalty step (s).
+    fn steps(&self) -> (f64, f64) {
+        (self.effective, self.penalty_step)
+    }
+
     /// `E` (J) with the bodies where `group` has them.
     fn energy(&self, group: &Group) -> f64 {
         let own: f64 = self
@@ -112,7 +119,7 @@ impl GroupPotential<'_> {
         let positions = group.copy_positions();
         let mut between = 0.0;
         self.between
-            .for_each_term(nodes(group, &positions), self.effective, |_, e, _, _| {
+            .for_each_term(nodes(group, &positions), self.steps(), |_, e, _, _| {
                 between += e;
             });
         own + between
@@ -127,17 +134,14 @@ impl GroupPotential<'_> {
             residual.extend(member.residual(body, forces));
         }
         let positions = group.copy_positions();
-        self.between.for_each_term(
-            nodes(group, &positions),
-            self.effective,
-            |at, _, force, _| {
+        self.between
+            .for_each_term(nodes(group, &positions), self.steps(), |at, _, force, _| {
                 for (&node, w) in at.nodes.iter().zip(at.weights) {
                     if !group.pinned[node as usize] {
                         residual[node as usize] += force * *w;
                     }
                 }
-            },
-        );
+            });
         residual
     }
 
@@ -159,7 +163,7 @@ impl GroupPotential<'_> {
         let positions = group.copy_positions();
         self.between.for_each_term(
             nodes(group, &positions),
-            self.effective,
+            self.steps(),
             |at, _, _, tangent| {
                 joint.add_stencil_block(at, &tangent, &group.pinned);
             },
@@ -403,10 +407,11 @@ impl ImplicitIntegrator {
             offsets: solver.offsets.clone(),
         };
         let effective = starts[0].h;
+        let penalty_step = self.penalty_step(effective);
         let positions = group.copy_positions();
         solver
             .between
-            .lag_friction(nodes(&group, &positions), effective);
+            .lag_friction(nodes(&group, &positions), (effective, penalty_step));
         let mut solved: Option<Outcome> = None;
         for round in 0..=STIFFENING_ROUNDS {
             let potential = GroupPotential {
@@ -422,6 +427,7 @@ impl ImplicitIntegrator {
                     .collect(),
                 between: &solver.between,
                 effective,
+                penalty_step,
             };
             let parts = (&mut solver.joint, &mut solver.parts[..]);
             let outcome = if round == 0 {

@@ -430,6 +430,13 @@ impl ImplicitIntegrator {
         Ok(outcome)
     }
 
+    /// The penalty step (s, see [`ImplicitStep`](crate::contact::ImplicitStep)) of substeps of
+    /// effective length `effective` (s): that length times the number of substeps, the
+    /// effective step of the whole step the integrator was given.
+    fn penalty_step(&self, effective: f64) -> f64 {
+        effective * f64::from(self.substeps.max(1))
+    }
+
     /// Readies `body` and its `constraints` for an implicit substep of `h` (s) under `gravity`
     /// (m/s²) after `previous`: the step's start, and the touched rigid bodies' response, at
     /// rest. The rigid bodies fall, as rapier will make them (unless held); the constraints
@@ -445,7 +452,8 @@ impl ImplicitIntegrator {
         for proxy in &mut constraints.rigid_proxies {
             proxy.fall(gravity, h);
         }
-        let response = RigidResponse::new(constraints.rigid_proxies.clone(), start.h, h);
+        let steps = (start.h, self.penalty_step(start.h), h);
+        let response = RigidResponse::new(constraints.rigid_proxies.clone(), steps);
         for kind in constraint::IMPLICIT {
             kind.begin(body, constraints, response.start());
         }

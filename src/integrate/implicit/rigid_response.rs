@@ -65,8 +65,10 @@ pub(super) struct RigidResponse {
     /// The last Newton direction's columns of `U` and `Z = K⁻¹ U` (see
     /// [`RigidResponse::take_in`]).
     solved_columns: Option<(Columns, Columns)>,
-    /// The effective step `ĥ` and the step's length `h` (s).
+    /// The effective step `ĥ`, the penalty step (see [`ImplicitStep`]) and the step's length
+    /// `h` (s).
     effective: f64,
+    penalty_step: f64,
     length: f64,
 }
 
@@ -160,9 +162,12 @@ fn inverse_mass(proxy: &RigidProxy) -> Matrix6<f64> {
 }
 
 impl RigidResponse {
-    /// The response of the bodies `base` (at the substep's start) in a step of effective length
-    /// `effective` and length `length` (s).
-    pub(super) fn new(base: Vec<RigidProxy>, effective: f64, length: f64) -> Self {
+    /// The response of the bodies `base` (at the substep's start) in a step of effective length,
+    /// penalty step and length `(effective, penalty_step, length)` (s).
+    pub(super) fn new(
+        base: Vec<RigidProxy>,
+        (effective, penalty_step, length): (f64, f64, f64),
+    ) -> Self {
         Self {
             trial: base.clone(),
             impulses: vec![[DVec3::ZERO; 2]; base.len()],
@@ -172,6 +177,7 @@ impl RigidResponse {
             kinetic: 0.0,
             solved_columns: None,
             effective,
+            penalty_step,
             length,
         }
     }
@@ -189,6 +195,7 @@ impl RigidResponse {
     fn step_with<'a>(&self, rigid: &'a [RigidProxy]) -> ImplicitStep<'a> {
         ImplicitStep {
             effective: self.effective,
+            penalty_step: self.penalty_step,
             length: self.length,
             rigid,
         }
