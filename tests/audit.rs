@@ -461,17 +461,28 @@ fn custom_tolerances_are_the_ones_applied() {
 #[test]
 fn the_energy_of_a_body_glued_to_a_fixed_body_counts_its_implicit_springs() {
     // A 20 x 5 x 5 cm bar (E = 1e6 Pa) whose nodes along one top edge are glued to a fixed rigid
-    // body, released horizontal, forced implicit in one coupling substep a frame. The implicit
-    // step pulls each glued node to its anchor with a spring `k = penalty_factor m/h²` (`h` the
-    // frame's step, however many substeps the swing cuts it into) that holds `k |x − a|²/2` at
-    // the step's end (the anchors of a fixed body stay where the nodes
-    // were glued): the audit's energy of the body is its kinetic, elastic and gravitational
-    // energy plus those springs', to round-off (1e-12 of the total); the springs' share is
-    // checked to be well above round-off, so that leaving it out fails (it was left out).
+    // body, released horizontal, forced implicit (backward Euler, then BDF2) in one coupling
+    // substep a frame. The implicit step pulls each glued node to its anchor with a spring
+    // `k = penalty_factor m/h²` (`h` the frame's effective step, however many substeps the
+    // swing cuts it into) that holds `k |x − a|²/2` at the step's end (the anchors of a fixed
+    // body stay where the nodes were glued): the audit's energy of the body is its kinetic,
+    // elastic and gravitational energy plus those springs', to round-off (1e-12 of the total);
+    // the springs' share is checked to be well above round-off, so that leaving it out fails
+    // (it was left out; and BDF2's first step, a backward Euler one, was counted with BDF2's
+    // stiffness).
+    for scheme in [ImplicitScheme::BackwardEuler, ImplicitScheme::Bdf2] {
+        glued_springs_counted(scheme);
+    }
+}
+
+/// The check of [`the_energy_of_a_body_glued_to_a_fixed_body_counts_its_implicit_springs`]
+/// under `scheme`.
+fn glued_springs_counted(scheme: ImplicitScheme) {
     let (builder, hinge) = common::bar_with_hinge(DVec3::new(0.0, 0.5, 0.0));
     let mut world = FvmWorld::default();
     world.coupling.substeps = 1;
     world.coupling.integrator.force = Some(IntegratorKind::Implicit);
+    world.coupling.integrator.implicit.scheme = scheme;
     let gravity = world.physics.gravity.as_dvec3();
     let handle = world.soft_bodies.insert(builder.build().unwrap());
     let bar = common::glue_to_fixed_axle(&mut world, handle, &hinge, Vec3::new(-0.1, 0.525, 0.0));
@@ -489,8 +500,14 @@ fn the_energy_of_a_body_glued_to_a_fixed_body_counts_its_implicit_springs() {
         let report = results[0].1.as_ref().unwrap().implicit.unwrap();
         let body = &world.soft_bodies[handle];
         let factor = world.coupling.contact.penalty_factor;
-        // The springs take the whole step's `m/h²`, whatever its substeps.
-        let h = report.substep_dt * f64::from(report.substeps);
+        // The springs take the whole step's effective `m/h²`, whatever its substeps: two thirds
+        // of the step for BDF2 once it has a step before it (its first is backward Euler's).
+        let whole = report.substep_dt * f64::from(report.substeps);
+        let h = if scheme == ImplicitScheme::Bdf2 && frame > 0 {
+            2.0 * whole / 3.0
+        } else {
+            whole
+        };
         let springs: f64 = (hinge.iter().zip(&anchors))
             .map(|(&n, a)| {
                 let n = n as usize;
@@ -502,7 +519,7 @@ fn the_energy_of_a_body_glued_to_a_fixed_body_counts_its_implicit_springs() {
         let expected = moving + body.gravity_potential_energy(gravity) + springs;
         let counted = found.body(handle).unwrap().energy.unwrap().energy;
         println!(
-            "frame {frame}: springs {springs:.6e} J, audit beyond the rest {:.6e} J",
+            "{scheme:?} frame {frame}: springs {springs:.6e} J, audit beyond the rest {:.6e} J",
             counted - (expected - springs)
         );
         assert!((counted - expected).abs() < 1e-12 * expected.abs().max(moving));

@@ -49,7 +49,7 @@ use crate::attachment;
 use crate::body::{DeformableBody, DeformableBodyHandle};
 use crate::contact::{self, BodyPoint};
 use crate::coupling::{SoftStepResults, iterations_per_substep};
-use crate::integrate::{ImplicitScheme, IntegratorKind, SymplecticEuler};
+use crate::integrate::{IntegratorKind, SymplecticEuler};
 use rapier3d::dynamics::{RigidBody, RigidBodyHandle};
 use rapier3d::glamx::{DMat3, DQuat, DVec3};
 use std::collections::HashMap;
@@ -96,10 +96,8 @@ pub(super) fn energies(
             .iter()
             .find(|(h, _)| *h == handle)
             .and_then(|(_, r)| r.as_ref().ok());
-        let penalty = report.and_then(|r| r.implicit).map_or(0.0, |r| {
-            let whole_step = r.substep_dt * f64::from(r.substeps.max(1));
-            penalty_energy(input, handle, body, whole_step)
-        });
+        let penalty = (report.and_then(|r| r.implicit))
+            .map_or(0.0, |r| penalty_energy(input, handle, body, r.penalty_step));
         let moving = body.kinetic_energy() + body.elastic_energy() + penalty;
         let total = moving + body.gravity_potential_energy(g) + body.load_potential_energy();
         let ratio = report.and_then(|r| r.explicit).map_or(0.0, |e| {
@@ -153,20 +151,17 @@ fn rigid_integration_step(input: &AuditInput<'_>) -> f64 {
 
 /// The energy (J) the implicit contact penalties of the deformable body `handle` hold now (its
 /// points' and the rigid corners' against its faces) and its attachments' implicit springs,
-/// after an implicit step whose penalty step (see `contact::ImplicitStep`) was `h` (s).
+/// after an implicit step whose penalty step
+/// ([`ImplicitReport::penalty_step`](crate::integrate::ImplicitReport::penalty_step)) was
+/// `penalty_step` (s).
 fn penalty_energy(
     input: &AuditInput<'_>,
     handle: DeformableBodyHandle,
     body: &DeformableBody,
-    h: f64,
+    penalty_step: f64,
 ) -> f64 {
     let Some(constraints) = input.coupling.constraints(handle) else {
         return 0.0;
-    };
-    let implicit = &input.coupling.integrator.implicit;
-    let effective = match implicit.scheme {
-        ImplicitScheme::BackwardEuler => h,
-        ImplicitScheme::Bdf2 => 2.0 * h / 3.0,
     };
     let settings = &constraints.contacts.settings;
     let nodes = constraints
@@ -175,8 +170,12 @@ fn penalty_energy(
         .filter_map(|contact| match contact.at {
             BodyPoint::Node(n) => {
                 let n = n as usize;
-                let penalty =
-                    contact.penalty(body.positions()[n], body.masses()[n], settings, effective);
+                let penalty = contact.penalty(
+                    body.positions()[n],
+                    body.masses()[n],
+                    settings,
+                    penalty_step,
+                );
                 Some(penalty.map_or(0.0, |penalty| penalty.energy))
             }
             BodyPoint::Embedded(_) => None,
@@ -184,8 +183,8 @@ fn penalty_energy(
         .sum::<f64>();
     let springs = (&constraints.rigid_proxies[..], settings);
     nodes
-        + contact::corner_penalty_energy(body, &constraints.contacts, effective)
-        + attachment::spring_energy(body, &constraints.attachments, springs, effective)
+        + contact::corner_penalty_energy(body, &constraints.contacts, penalty_step)
+        + attachment::spring_energy(body, &constraints.attachments, springs, penalty_step)
 }
 
 /// The energy (J) of a dynamic rigid body under gravity `g` (m/s²), its gravitational part at

@@ -456,7 +456,7 @@ impl ImplicitIntegrator {
         for ((body, constraints), ended) in body_refs.into_iter().zip(constraints).zip(ends) {
             end_member_substep(body, constraints, ended, h);
         }
-        Ok(solved.unwrap_or_else(Outcome::start))
+        Ok(solved.unwrap_or_else(|| Outcome::start(penalty_step)))
     }
 
     /// Newton's method on the group's potential, from the inertial prediction or from where
@@ -508,7 +508,7 @@ impl ImplicitIntegrator {
         let mut residual = potential.residual(group, &mut forces);
         let reference = potential.force_scale(group, &residual);
         let mut history: Vec<f64> = Vec::new();
-        let mut outcome = Outcome::start();
+        let mut outcome = Outcome::start(potential.penalty_step);
         loop {
             let relative = norm(&residual) / reference;
             outcome.residual = relative;

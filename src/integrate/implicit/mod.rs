@@ -480,7 +480,7 @@ impl ImplicitIntegrator {
         let reference = incremental.force_scale(body, &residual);
         // Relative residuals of the earlier iterations, newest last.
         let mut history: Vec<f64> = Vec::new();
-        let mut outcome = Outcome::start();
+        let mut outcome = Outcome::start(self.penalty_step(incremental.start.h));
         solver.chord.start_step();
         let finish = |solver: &mut Solver, outcome: Outcome| -> Result<Outcome, Error> {
             solver.chord.end_step(outcome.reused_factorizations > 0);

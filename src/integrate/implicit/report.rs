@@ -10,6 +10,11 @@ pub struct ImplicitReport {
     pub substeps: u32,
     /// Length of each substep (s): the frame step over the substeps.
     pub substep_dt: f64,
+    /// The step (s) whose `m/h²` the contacts' penalties and the glue's springs took in the
+    /// last substep: its effective step (`substep_dt`, or two thirds of it for a BDF2 step)
+    /// times the substeps, whatever their number. The energy those terms hold after the frame
+    /// is counted with it.
+    pub penalty_step: f64,
     /// Newton iterations over all substeps, those that reused a factorization included.
     pub newton_iterations: usize,
     /// Conjugate gradient iterations over all substeps (zero when every system was solved by
@@ -69,6 +74,8 @@ pub(super) struct Outcome {
     pub(super) residual: f64,
     /// How the solve ended.
     pub(super) stop: Stop,
+    /// The penalty step (s, see [`ImplicitReport::penalty_step`]) of the substep.
+    pub(super) penalty_step: f64,
 }
 
 impl ImplicitReport {
@@ -78,6 +85,7 @@ impl ImplicitReport {
         Self {
             substeps,
             substep_dt,
+            penalty_step: substep_dt * f64::from(substeps.max(1)),
             newton_iterations: 0,
             linear_iterations: 0,
             reused_factorizations: 0,
@@ -100,6 +108,7 @@ impl ImplicitReport {
         self.relative_residual = self.relative_residual.max(outcome.residual);
         self.converged &= outcome.stop == Stop::Converged;
         self.stalled_substeps += u32::from(outcome.stop == Stop::Stalled);
+        self.penalty_step = outcome.penalty_step;
     }
 }
 
@@ -124,11 +133,13 @@ impl Outcome {
             projected_tangents: self.projected_tangents + next.projected_tangents,
             residual: next.residual,
             stop: next.stop,
+            penalty_step: next.penalty_step,
         }
     }
 
-    /// No iteration yet; the residual and convergence are set on return.
-    pub(super) fn start() -> Self {
+    /// No iteration yet, of a substep of penalty step `penalty_step` (s); the residual and
+    /// convergence are set on return.
+    pub(super) fn start(penalty_step: f64) -> Self {
         Self {
             iterations: 0,
             linear_iterations: 0,
@@ -137,6 +148,7 @@ impl Outcome {
             projected_tangents: 0,
             residual: f64::NAN,
             stop: Stop::Failed,
+            penalty_step,
         }
     }
 }
