@@ -20,6 +20,19 @@ pub(crate) fn on_pool<R: Send>(work: impl FnOnce() -> R + Send) -> R {
     work()
 }
 
+/// `a()` and `b()` at once, each on a thread of rayon's pool with the `parallel` feature (both
+/// on the calling thread, one after the other, without it or on a pool of one thread): for
+/// two pieces of work that share nothing.
+pub(crate) fn both<RA: Send, RB: Send>(
+    a: impl FnOnce() -> RA + Send,
+    b: impl FnOnce() -> RB + Send,
+) -> (RA, RB) {
+    #[cfg(feature = "parallel")]
+    return on_pool(|| rayon::join(a, b));
+    #[cfg(not(feature = "parallel"))]
+    (a(), b())
+}
+
 /// `work(index, chunk)` on each `chunk`-long piece of `data` (the last may be shorter), the
 /// results in chunk order.
 pub(crate) fn map_chunks<T: Send, R: Send>(
@@ -73,6 +86,18 @@ pub(crate) fn for_each<T: Send>(items: &mut [T], work: impl Fn(&mut T) + Sync + 
         return;
     }
     items.iter_mut().for_each(work);
+}
+
+/// `work(item)` for each of `items`, each on one thread, the results in order.
+pub(crate) fn map_each<T: Send, R: Send>(
+    items: &mut [T],
+    work: impl Fn(&mut T) -> R + Sync + Send,
+) -> Vec<R> {
+    #[cfg(feature = "parallel")]
+    if items.len() > 1 {
+        return on_pool(|| items.par_iter_mut().map(work).collect());
+    }
+    items.iter_mut().map(work).collect()
 }
 
 /// The threads work may be spread over: rayon's current pool's with the `parallel` feature, else

@@ -173,6 +173,34 @@ impl DeformableBodySet {
         found.into_iter().flatten().collect()
     }
 
+    /// Takes the bodies of distinct `handles` out of their slots for a while: until
+    /// [`DeformableBodySet::give_back`] the slots stay reserved (the handles valid, the count
+    /// unchanged) but lookups and iterators skip them, so that the lent bodies and the rest of
+    /// the set can be worked on at once. Handles not in the set are skipped.
+    pub(crate) fn lend(
+        &mut self,
+        handles: &[DeformableBodyHandle],
+    ) -> Vec<(DeformableBodyHandle, DeformableBody)> {
+        (handles.iter())
+            .filter_map(|&handle| {
+                let slot = self.slots.get_mut(handle.index as usize)?;
+                let body = (slot.generation == handle.generation)
+                    .then(|| slot.body.take())
+                    .flatten()?;
+                Some((handle, body))
+            })
+            .collect()
+    }
+
+    /// Puts bodies taken by [`DeformableBodySet::lend`] back into their slots.
+    pub(crate) fn give_back(&mut self, lent: Vec<(DeformableBodyHandle, DeformableBody)>) {
+        for (handle, body) in lent {
+            let slot = &mut self.slots[handle.index as usize];
+            debug_assert!(slot.generation == handle.generation && slot.body.is_none());
+            slot.body = Some(body);
+        }
+    }
+
     /// Whether `handle` refers to a body of the set.
     pub fn contains(&self, handle: DeformableBodyHandle) -> bool {
         self.get(handle).is_some()

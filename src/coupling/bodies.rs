@@ -123,6 +123,22 @@ impl<T: Clone + Default> BodyMap<T> {
 }
 
 impl LinkSet {
+    /// Takes the links of distinct `handles` out of the set (made if missing), in the order
+    /// given, for [`LinkSet::give_back`].
+    pub(super) fn lend(
+        &mut self,
+        handles: &[DeformableBodyHandle],
+    ) -> Vec<(DeformableBodyHandle, BodyLinks)> {
+        (handles.iter())
+            .map(|&handle| (handle, self.map.remove(&handle).unwrap_or_default()))
+            .collect()
+    }
+
+    /// Puts links taken by [`LinkSet::lend`] back.
+    pub(super) fn give_back(&mut self, lent: Vec<(DeformableBodyHandle, BodyLinks)>) {
+        self.map.extend(lent);
+    }
+
     /// Records that the bodies `stepped` (which have links) last stepped over `h` (s).
     pub(super) fn set_last_step(&mut self, stepped: &[DeformableBodyHandle], h: f64) {
         for &handle in stepped {

@@ -5,7 +5,8 @@
 //! [`SoftCoupling::substeps`] rapier steps of `h = dt / substeps`, and the deformable bodies step
 //! between them. A body that needs no coupling (within its reach over the frame only fixed and
 //! kinematic colliders: no dynamic rigid body, no other deformable body) steps once over the
-//! whole frame before the substeps, which skip it (`uncoupled`). One coupling substep, in order:
+//! whole frame, beside the substeps (on another thread with the `parallel` feature), which skip
+//! it (`uncoupled`). One coupling substep, in order:
 //!
 //! 1. **Kinematic paths.** Each position-based kinematic body told where to be at the end of the
 //!    frame is told the part of its straight path it reaches by the end of this substep.
@@ -83,6 +84,7 @@ use rapier3d::glamx::DVec3;
 use rapier3d::math::Vector;
 use rapier3d::pipeline::{EventHandler, PhysicsHooks, PhysicsPipeline};
 use sleep::SleepSet;
+use uncoupled::Uncoupled;
 
 /// Each deformable body's result over a frame: the report of its last substep, or the first
 /// error it met (a body whose step was refused keeps the state it had before that substep for the
@@ -232,25 +234,79 @@ impl SoftCoupling {
         let substeps = self.substeps;
         let h = f64::from(frame.dt) / f64::from(substeps);
         let gravity = rapier.gravity.as_dvec3();
-        let mut substep_parameters = frame;
-        substep_parameters.dt = frame.dt / substeps as f32;
-        substep_parameters.num_solver_iterations =
-            iterations_per_substep(frame.num_solver_iterations, substeps);
+        self.links.prune(soft_bodies);
+        self.sleeping.prune(soft_bodies);
         let mut outcomes = unstepped(soft_bodies);
         let paths = KinematicPath::all(rapier.bodies);
-        let uncoupled = if substeps > 1 {
+        let frame_dt = f64::from(frame.dt);
+        let alone = if substeps > 1 {
             let rigid = RigidSets {
                 bodies: rapier.bodies,
                 colliders: rapier.colliders,
                 narrow_phase: rapier.narrow_phase,
             };
-            let frame_dt = f64::from(frame.dt);
-            self.step_uncoupled(soft_bodies, rigid, &mut outcomes, (frame_dt, gravity))
+            self.find_uncoupled(soft_bodies, &rigid, &outcomes, (frame_dt, gravity))
         } else {
             Vec::new()
         };
+        let mut uncoupled = Uncoupled::take(&alone, soft_bodies, &mut self.links);
+        let integrator = self.integrator;
+        let substepping = (pipeline, &mut rapier, (hooks, events));
+        let coupled = (&mut outcomes[..], &alone[..], &paths[..]);
+        let stepped = if uncoupled.is_empty() {
+            self.coupling_substeps(substepping, soft_bodies, coupled, (h, gravity));
+            Vec::new()
+        } else {
+            let (stepped, ()) = crate::parallel::both(
+                || uncoupled.step(&integrator, (frame_dt, gravity)),
+                || self.coupling_substeps(substepping, soft_bodies, coupled, (h, gravity)),
+            );
+            stepped
+        };
+        let rigid = RigidSets {
+            bodies: rapier.bodies,
+            colliders: rapier.colliders,
+            narrow_phase: rapier.narrow_phase,
+        };
+        let steps = (uncoupled, stepped);
+        self.finish_uncoupled(
+            soft_bodies,
+            rigid,
+            &mut outcomes,
+            steps,
+            (frame_dt, h, gravity),
+        );
+        self.loads.finish(frame_dt);
+        results(outcomes)
+    }
+
+    /// The coupling substeps of a frame (see the module's documentation), each a soft step of
+    /// `h` (s) under `gravity` (m/s²) of every body but those `skip`ped, then one rapier step
+    /// with `pipeline` on the `rapier` sets with the `hooks` and `events`; the kinematic bodies
+    /// follow their `paths`, and each body's `outcomes` records its last report or first error.
+    fn coupling_substeps(
+        &mut self,
+        (pipeline, rapier, (hooks, events)): (
+            &mut PhysicsPipeline,
+            &mut RapierSets<'_>,
+            (&dyn PhysicsHooks, &dyn EventHandler),
+        ),
+        soft_bodies: &mut DeformableBodySet,
+        (outcomes, skip, paths): (
+            &mut [(DeformableBodyHandle, Outcome)],
+            &[DeformableBodyHandle],
+            &[KinematicPath],
+        ),
+        (h, gravity): (f64, DVec3),
+    ) {
+        let frame = *rapier.integration_parameters;
+        let substeps = self.substeps;
+        let mut substep_parameters = frame;
+        substep_parameters.dt = frame.dt / substeps as f32;
+        substep_parameters.num_solver_iterations =
+            iterations_per_substep(frame.num_solver_iterations, substeps);
         for substep in 1..=substeps {
-            for path in &paths {
+            for path in paths {
                 path.advance(rapier.bodies, substep as f32 / substeps as f32);
             }
             let rigid = RigidSets {
@@ -258,15 +314,12 @@ impl SoftCoupling {
                 colliders: rapier.colliders,
                 narrow_phase: rapier.narrow_phase,
             };
-            let carried =
-                self.step_soft_bodies(soft_bodies, rigid, &mut outcomes, &uncoupled, (h, gravity));
+            let carried = self.step_soft_bodies(soft_bodies, rigid, outcomes, skip, (h, gravity));
             let iterations = substep_parameters.num_solver_iterations;
             let carry = RapierCarry::lead(&carried, rapier.bodies, gravity, (h, iterations));
             rapier.step_rapier(pipeline, &substep_parameters, hooks, events);
             carry.settle(rapier.bodies);
         }
-        self.loads.finish(f64::from(frame.dt));
-        results(outcomes)
     }
 
     /// Why a frame of `dt` (s) cannot be stepped, if it cannot: a negative or non-finite step, or
@@ -300,6 +353,8 @@ impl SoftCoupling {
         gravity: DVec3,
     ) -> SoftStepResults {
         self.loads.clear();
+        self.links.prune(soft_bodies);
+        self.sleeping.prune(soft_bodies);
         let mut outcomes = unstepped(soft_bodies);
         self.step_soft_bodies(soft_bodies, rigid, &mut outcomes, &[], (h, gravity));
         if h > 0.0 {

@@ -8,10 +8,11 @@ use super::carry::Carried;
 use super::groups::{GroupStep, step_groups, touching_groups};
 use super::loads::FrameLoads;
 use super::{Outcome, RigidSets, SoftCoupling, rapier_view};
+use crate::Error;
 use crate::body::{DeformableBody, DeformableBodyHandle, DeformableBodySet};
 use crate::constraint::{self, BodyConstraints};
 use crate::contact::{self, BetweenContact};
-use crate::integrate::{BodyInStep, IntegratorKind};
+use crate::integrate::{AutomaticReport, BodyInStep, IntegratorKind};
 use rapier3d::dynamics::RigidBodySet;
 use rapier3d::geometry::NarrowPhase;
 use rapier3d::glamx::DVec3;
@@ -35,8 +36,6 @@ impl SoftCoupling {
         skip: &[DeformableBodyHandle],
         (h, gravity): (f64, DVec3),
     ) -> Vec<Carried> {
-        self.links.prune(soft_bodies);
-        self.sleeping.prune(soft_bodies);
         let margin = self.contact.margin;
         let sleep = (h, gravity, margin);
         (self.sleeping).wake_disturbed(
@@ -67,10 +66,8 @@ impl SoftCoupling {
 
     /// Steps the bodies `live` over `h` (s) under `gravity` (m/s²), in the groups the contacts
     /// `between` them (indices into `live`) link: each group at once, the rigid bodies they
-    /// touch that rest on something held within the step; then each body's outcome is recorded,
-    /// its stillness observed and its impulses handed to rapier and the loads (a refused body
-    /// holding the rigid bodies it touches as a fixed obstacle would). Returns the dynamic rigid
-    /// bodies implicit steps moved.
+    /// touch that rest on something held within the step; then records the steps
+    /// ([`SoftCoupling::record_steps`]). Returns the dynamic rigid bodies implicit steps moved.
     pub(super) fn step_live(
         &mut self,
         soft_bodies: &mut DeformableBodySet,
@@ -79,7 +76,6 @@ impl SoftCoupling {
         (live, between): (&[DeformableBodyHandle], Vec<BetweenContact>),
         (h, gravity): (f64, DVec3),
     ) -> Vec<Carried> {
-        let margin = self.contact.margin;
         let groups = touching_groups(live.len(), between);
         let handles: Vec<DeformableBodyHandle> = (groups.iter())
             .flat_map(|(group, _)| group.iter().map(|&i| live[i]))
@@ -97,11 +93,34 @@ impl SoftCoupling {
             hold_supported_bodies(step.constraints, rigid.bodies, rigid.narrow_phase);
         }
         let stepped = step_groups(&mut ready, &self.integrator, &self.contact, (h, gravity));
-        let steps = ready.into_iter().flat_map(|group| group.bodies);
+        let stepped = stepped.into_iter().flatten().collect();
+        self.record_steps(
+            soft_bodies,
+            rigid,
+            outcomes,
+            (&handles, stepped),
+            (h, gravity),
+        )
+    }
+
+    /// Records the results `stepped` of the bodies `handles` over a step of `h` (s) under
+    /// `gravity` (m/s²): each body's outcome, its stillness observed and its impulses handed to
+    /// rapier and the loads (a refused body holding the rigid bodies it touches as a fixed
+    /// obstacle would). Returns the dynamic rigid bodies implicit steps moved.
+    pub(super) fn record_steps(
+        &mut self,
+        soft_bodies: &mut DeformableBodySet,
+        rigid: &mut RigidSets<'_>,
+        outcomes: &mut [(DeformableBodyHandle, Outcome)],
+        (handles, stepped): (&[DeformableBodyHandle], Vec<Result<AutomaticReport, Error>>),
+        (h, gravity): (f64, DVec3),
+    ) -> Vec<Carried> {
+        let margin = self.contact.margin;
+        let steps = (self.links.many_mut(handles).into_iter())
+            .zip(soft_bodies.get_many_mut(handles))
+            .map(|(links, body)| links.with(body));
         let mut carried = Vec::new();
-        for ((handle, mut step), result) in
-            handles.iter().zip(steps).zip(stepped.into_iter().flatten())
-        {
+        for ((handle, mut step), result) in handles.iter().zip(steps).zip(stepped) {
             if result.is_err() {
                 constraint::hold_partners(step.body, step.constraints, h, gravity);
             }
@@ -125,7 +144,7 @@ impl SoftCoupling {
                 }
             }
         }
-        self.links.set_last_step(&handles, h);
+        self.links.set_last_step(handles, h);
         carried
     }
 

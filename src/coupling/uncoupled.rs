@@ -4,7 +4,7 @@
 //! nodes and twice each collider's travel around that collider, holds no dynamic rigid body
 //! (touched or glued) and no other deformable body exchanges nothing with anything that moves in
 //! response. Fixed and kinematic colliders go where they go whatever it does, so stepping it
-//! once over `dt` before the rigid substeps, against the colliders carried at their velocities
+//! once over `dt` beside the rigid substeps, against the colliders carried at their velocities
 //! over the frame, is the same physics in one step instead of [`SoftCoupling::substeps`]:
 //! an implicit body then pays for one Newton solve per frame instead of one per substep (the
 //! integrator's own [`substeps`](crate::integrate::ImplicitIntegrator::substeps) still set its
@@ -14,35 +14,38 @@
 //! deeper (the showcase's fingers, pressed 2 mm into the gripped cube, squeezed it with 14.46 N
 //! instead of 17.38 N; with the substeps' stiffness 17.37 N).
 //!
-//! The pass runs before the kinematic bodies are told the first part of their path, so that their
-//! velocities are those of the whole frame. A body found with a dynamic partner, or near another
+//! They are found before the kinematic bodies are told the first part of their path, so that
+//! their velocities are those of the whole frame. Sharing nothing with the bodies of the coupling
+//! substeps, they are taken out of the sets ([`Uncoupled`]) and step at the same time as those
+//! substeps (on another thread with the `parallel` feature); their outcomes, loads and
+//! stillness are recorded after the substeps, and they may fall asleep then. A body found with a dynamic partner, or near another
 //! deformable body, steps in the coupling substeps as before; so does a body with
 //! [`self_contact`](crate::body::DeformableBody::self_contact) on, whose parts touch each other
 //! as two bodies do (its contacts, found once per frame, would keep the arms they had at
 //! detection over the whole frame: the halves of a body colliding in zero gravity changed its
 //! angular momentum by 1.5e-2 kg m²/s, twenty times the margin's bound, instead of within it).
 
+use super::bodies::{BodyLinks, LinkSet};
 use super::reach::{body_reach, overlap};
 use super::{Outcome, RigidSets, SoftCoupling, rapier_view};
-use crate::body::{DeformableBodyHandle, DeformableBodySet};
+use crate::Error;
+use crate::body::{DeformableBody, DeformableBodyHandle, DeformableBodySet};
 use crate::contact::ContactSettings;
+use crate::integrate::{AutomaticIntegrator, AutomaticReport};
 use rapier3d::glamx::DVec3;
 
 impl SoftCoupling {
-    /// Steps over the whole frame `dt` (s) under `gravity` (m/s²) every awake body of
-    /// `outcomes`, not stepped yet, whose state a step can take and that needs no coupling (see
-    /// the module's documentation), recording its outcome; returns those bodies, for the
-    /// coupling substeps to skip. A body that fails the tests is left to the substeps, which
-    /// detect its contacts again (and report its errors).
-    pub(super) fn step_uncoupled(
+    /// The awake bodies of `outcomes`, not stepped yet, whose state a step can take and that
+    /// need no coupling over the frame `dt` (s) under `gravity` (m/s²) (see the module's
+    /// documentation), their contacts found for the whole frame. A body that fails the tests
+    /// is left to the substeps, which detect its contacts again (and report its errors).
+    pub(super) fn find_uncoupled(
         &mut self,
-        soft_bodies: &mut DeformableBodySet,
-        mut rigid: RigidSets<'_>,
-        outcomes: &mut [(DeformableBodyHandle, Outcome)],
+        soft_bodies: &DeformableBodySet,
+        rigid: &RigidSets<'_>,
+        outcomes: &[(DeformableBodyHandle, Outcome)],
         (dt, gravity): (f64, DVec3),
     ) -> Vec<DeformableBodyHandle> {
-        self.links.prune(soft_bodies);
-        self.sleeping.prune(soft_bodies);
         let margin = self.contact.margin;
         let reaches: Vec<_> = (soft_bodies.iter())
             .map(|(handle, body)| (handle, body_reach(body, margin, dt, gravity)))
@@ -58,36 +61,108 @@ impl SoftCoupling {
             penalty_factor: self.contact.penalty_factor * substeps * substeps,
             ..self.contact
         };
-        let alone: Vec<DeformableBodyHandle> = {
-            let views = rapier_view::collider_views(rigid.colliders, rigid.bodies, dt);
-            let lookup = rapier_view::rigid_lookup(rigid.bodies, dt);
-            let mut alone = Vec::new();
-            for (handle, outcome) in outcomes.iter() {
-                let body = &soft_bodies[*handle];
-                let coupled_before = (self.links.get(*handle))
-                    .is_some_and(|links| links.constraints.touches_dynamic_body());
-                if outcome.is_some()
-                    || body.self_contact
-                    || self.sleeping.is_asleep(*handle)
-                    || coupled_before
-                    || near_another(*handle)
-                    || body.check_state().is_err()
-                {
-                    continue;
-                }
-                let constraints = &mut self.links.entry(*handle).constraints;
-                let detected =
-                    constraints.detect_among(body, &views, &lookup, dt, gravity, &settings);
-                if detected.is_ok() && !constraints.touches_dynamic_body() {
-                    alone.push(*handle);
-                }
+        let views = rapier_view::collider_views(rigid.colliders, rigid.bodies, dt);
+        let lookup = rapier_view::rigid_lookup(rigid.bodies, dt);
+        let mut alone = Vec::new();
+        for (handle, outcome) in outcomes {
+            let body = &soft_bodies[*handle];
+            let coupled_before = (self.links.get(*handle))
+                .is_some_and(|links| links.constraints.touches_dynamic_body());
+            if outcome.is_some()
+                || body.self_contact
+                || self.sleeping.is_asleep(*handle)
+                || coupled_before
+                || near_another(*handle)
+                || body.check_state().is_err()
+            {
+                continue;
             }
-            alone
-        };
-        if !alone.is_empty() {
-            let live = (&alone[..], Vec::new());
-            self.step_live(soft_bodies, &mut rigid, outcomes, live, (dt, gravity));
+            let constraints = &mut self.links.entry(*handle).constraints;
+            let detected = constraints.detect_among(body, &views, &lookup, dt, gravity, &settings);
+            if detected.is_ok() && !constraints.touches_dynamic_body() {
+                alone.push(*handle);
+            }
         }
         alone
+    }
+}
+
+impl SoftCoupling {
+    /// Puts the bodies of `uncoupled` back, once the coupling substeps of the frame (`dt`, s,
+    /// cut into substeps of `h`, s, under `gravity`, m/s²) are done, and records their results
+    /// `stepped` as a coupling substep records its bodies' (outcomes, stillness, loads); those
+    /// still long enough fall asleep.
+    pub(super) fn finish_uncoupled(
+        &mut self,
+        soft_bodies: &mut DeformableBodySet,
+        mut rigid: RigidSets<'_>,
+        outcomes: &mut [(DeformableBodyHandle, Outcome)],
+        (uncoupled, stepped): (Uncoupled, Vec<Result<AutomaticReport, Error>>),
+        (dt, h, gravity): (f64, f64, DVec3),
+    ) {
+        if uncoupled.is_empty() {
+            return;
+        }
+        let alone = uncoupled.give_back(soft_bodies, &mut self.links);
+        let results = (&alone[..], stepped);
+        self.record_steps(soft_bodies, &mut rigid, outcomes, results, (dt, gravity));
+        let links = &self.links;
+        let constraints = |handle| links.get(handle).map(|l: &BodyLinks| &l.constraints);
+        let sleep = (h, gravity, self.contact.margin);
+        (self.sleeping).settle(soft_bodies, constraints, &mut rigid, &self.sleep, sleep);
+    }
+}
+
+/// The bodies that need no coupling, taken out of the sets with their links while they step.
+pub(super) struct Uncoupled {
+    bodies: Vec<(DeformableBodyHandle, DeformableBody)>,
+    links: Vec<(DeformableBodyHandle, BodyLinks)>,
+}
+
+impl Uncoupled {
+    /// Takes the bodies `alone` and their links out of `soft_bodies` and `links`.
+    pub(super) fn take(
+        alone: &[DeformableBodyHandle],
+        soft_bodies: &mut DeformableBodySet,
+        links: &mut LinkSet,
+    ) -> Self {
+        Self {
+            bodies: soft_bodies.lend(alone),
+            links: links.lend(alone),
+        }
+    }
+
+    /// Whether no body was taken.
+    pub(super) fn is_empty(&self) -> bool {
+        self.bodies.is_empty()
+    }
+
+    /// Steps each body over the frame `dt` (s) under `gravity` (m/s²) with `integrator`: a
+    /// result per body, in the order taken.
+    pub(super) fn step(
+        &mut self,
+        integrator: &AutomaticIntegrator,
+        (dt, gravity): (f64, DVec3),
+    ) -> Vec<Result<AutomaticReport, Error>> {
+        let mut steps: Vec<_> = (self.bodies.iter_mut())
+            .zip(self.links.iter_mut())
+            .map(|((_, body), (_, links))| links.with(body))
+            .collect();
+        let step = |s: &mut crate::integrate::BodyInStep<'_>| {
+            integrator.step(s.body, s.constraints, s.workspace, dt, gravity)
+        };
+        crate::parallel::map_each(&mut steps, step)
+    }
+
+    /// Puts the bodies and their links back into `soft_bodies` and `links`; returns their handles.
+    fn give_back(
+        self,
+        soft_bodies: &mut DeformableBodySet,
+        links: &mut LinkSet,
+    ) -> Vec<DeformableBodyHandle> {
+        let handles = self.bodies.iter().map(|(handle, _)| *handle).collect();
+        soft_bodies.give_back(self.bodies);
+        links.give_back(self.links);
+        handles
     }
 }
