@@ -198,13 +198,13 @@ impl BodyConstraints {
     /// step solves under the soft forces alone (with them implicit, the game scene's foam block
     /// against a 27 g box standing on the ground gained 1e-5 to 4e-5 J a frame for a hundred
     /// frames); or surface points or rigid corners found deeper behind their contact planes
-    /// than [`ContactSettings::resting_depth`], which an implicit step's penalty pushes out
-    /// within the step (a 10 cm cube set 4 cm into the ground left it with 9.4 J, against at
+    /// than twice [`ContactSettings::resting_depth`] (an implicit step itself leaves a loaded
+    /// point up to that depth), which an implicit step's penalty pushes out within the step (a 10 cm cube set 4 cm into the ground left it with 9.4 J, against at
     /// most `depenetration_speed` in explicit substeps; rigid corners found deep gave 0.11 J in
     /// a frame of the game scene). The automatic integrator keeps the explicit one while there
     /// are any.
     pub(crate) fn needs_explicit_contacts(&self) -> bool {
-        self.contacts.deepest_found() > self.contacts.settings.resting_depth
+        self.contacts.deepest_found() > 2.0 * self.contacts.settings.resting_depth
             || self.contacts.has_self_contacts()
             || self.contacts.corners.iter().any(|corner| {
                 corner.proxy.is_some_and(|i| {

@@ -84,8 +84,8 @@ pub(crate) use joint::JointContacts;
 use node_contact::Obstacle;
 pub use node_contact::{BodyPoint, ContactTarget, NodeContact};
 pub(crate) use penalty::{
-    NodeSlices, for_each_contact_stencil, for_each_contact_term, lag_friction, penalty_tangent,
-    record_penalty_impulses, stiffen_deep_contacts,
+    NodeSlices, for_each_contact_stencil, for_each_contact_term, for_each_engaged_term,
+    lag_friction, penalty_tangent, record_penalty_impulses, stiffen_deep_contacts,
 };
 pub(crate) use self_contact::detect_self_contacts;
 pub(crate) use set::ContactSet;

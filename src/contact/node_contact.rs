@@ -211,6 +211,29 @@ impl NodeContact {
         (self.stiffening).penalty(settings.penalty_stiffness(mass, h), -self.gap(x))
     }
 
+    /// What the Newton system must add at the point's position `from` (m) for its penalty to be
+    /// the quadratic piece that holds at `to` (m), where a Newton step would take it, when that
+    /// piece is stiffer than the one at `from` (a point reaching its plane, or passing the depth
+    /// of a stiffening): the force (N) and the tangent (N/m) of the difference; effective mass
+    /// `mass` (kg), effective step `h` (s).
+    pub(crate) fn penalty_towards(
+        &self,
+        (from, to): (DVec3, DVec3),
+        mass: f64,
+        settings: &ContactSettings,
+        h: f64,
+    ) -> Option<(DVec3, DMat3)> {
+        let base = settings.penalty_stiffness(mass, h);
+        let depths = (-self.gap(from), -self.gap(to));
+        let (push, stiffness) = self.stiffening.piece_towards(base, depths)?;
+        let here =
+            (self.stiffening.penalty(base, depths.0)).map_or((0.0, 0.0), |p| (p.push, p.stiffness));
+        (stiffness > here.1).then(|| {
+            let tangent = penalty_tangent(stiffness - here.1, self.normal);
+            (self.normal * (push - here.0), tangent)
+        })
+    }
+
     /// Stiffens the penalty of the point an implicit step of effective length `h` (s) took from
     /// `start` to `end` (m), of effective mass `mass` (kg), when it left it deeper than
     /// [`ContactSettings::resting_depth`] (see [`Stiffening::stiffen`]). Returns whether it
@@ -246,6 +269,23 @@ impl NodeContact {
             self.friction * self.lagged_normal_force,
             self.normal,
             travel,
+            settings.stiction_speed * h,
+        )
+    }
+
+    /// What the Newton system must add at the point's position `from` (m) for its lagged
+    /// friction to be the sticking piece when a Newton step to `to` (m) would carry its slip
+    /// through the stick zone (see [`stick_towards`]); the step's effective length `h` (s).
+    pub(crate) fn friction_towards(
+        &self,
+        (from, to): (DVec3, DVec3),
+        settings: &ContactSettings,
+        h: f64,
+    ) -> Option<(DVec3, DMat3)> {
+        stick_towards(
+            self.friction * self.lagged_normal_force,
+            self.normal,
+            (from - self.slip_origin, to - self.slip_origin),
             settings.stiction_speed * h,
         )
     }
@@ -297,6 +337,34 @@ fn nearest_on_carried(
     }
 }
 
+/// What a Newton system must add, for a point whose travel relative to the surface over the step
+/// is `from` (m), to take its lagged friction (limit `μ λ`, N; see [`lagged_friction`]) as the
+/// sticking quadratic `μ λ |u|²/2ε` when the point slides (`|u| ≥ ε = stick`, m) and a Newton
+/// step to the travel `to` (m) would carry its slip `u` through the stick zone `|u| < ε`, to rest
+/// there or to slide the other way: the difference of the forces (N) and of the tangents (N/m,
+/// positive semi-definite: the sticking piece is the stiffer in every direction of the plane of
+/// unit `normal`); `None` otherwise.
+pub(super) fn stick_towards(
+    limit: f64,
+    normal: DVec3,
+    (from, to): (DVec3, DVec3),
+    stick: f64,
+) -> Option<(DVec3, DMat3)> {
+    let plane = DMat3::IDENTITY - penalty_tangent(1.0, normal);
+    let (slip, along) = (plane * from, plane * (to - from));
+    let s = slip.length();
+    // The point of the slip's path nearest to no slip.
+    let nearest =
+        (-slip.dot(along) / along.length_squared().max(f64::MIN_POSITIVE)).clamp(0.0, 1.0);
+    if limit <= 0.0 || s < stick || (slip + along * nearest).length() >= stick {
+        return None;
+    }
+    let direction = slip / s;
+    let force = direction * (limit * (1.0 - s / stick));
+    let sliding = (plane - penalty_tangent(1.0, direction)) * (limit / s);
+    Some((force, plane * (limit / stick) - sliding))
+}
+
 /// The lagged friction dissipation `μ λ f(|u|)` of a point whose travel relative to the surface
 /// over the step is `travel` (m), for the friction limit `μ λ` (N): its energy (J), its force on
 /// the point (N) and its positive semi-definite tangent (N/m), with `u` the travel's part in the
@@ -328,4 +396,34 @@ pub(super) fn lagged_friction(
             (plane - penalty_tangent(1.0, direction)) * (limit / s),
         )
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_slip_carried_through_the_stick_zone_takes_the_sticking_piece() {
+        let (limit, stick, normal) = (2.0, 1e-3, DVec3::Y);
+        let from = DVec3::new(3e-3, 0.0, 1e-3);
+        let (_, force, tangent) = lagged_friction(limit, normal, from, stick).unwrap();
+        // A step to the other side, past no slip: the sliding term plus the difference is the
+        // sticking quadratic's force and tangent at the start, to round-off.
+        let to = DVec3::new(-2e-3, 5e-4, -1e-3);
+        let (extra_force, extra_tangent) = stick_towards(limit, normal, (from, to), stick).unwrap();
+        let slip = DVec3::new(from.x, 0.0, from.z);
+        let plane = DMat3::IDENTITY - penalty_tangent(1.0, normal);
+        assert!((force + extra_force + slip * (limit / stick)).length() < 1e-12);
+        let difference = tangent + extra_tangent - plane * (limit / stick);
+        assert!(difference.to_cols_array().iter().all(|c| c.abs() < 1e-9));
+        // The difference is positive semi-definite (every direction of the plane, none across).
+        for d in [DVec3::X, DVec3::Z, DVec3::new(1.0, 0.0, -3.0), DVec3::Y] {
+            assert!(d.dot(extra_tangent * d) >= -1e-12);
+        }
+        // A step that keeps sliding away from no slip, or a point already sticking: nothing.
+        assert!(stick_towards(limit, normal, (from, from * 2.0), stick).is_none());
+        assert!(stick_towards(limit, normal, (from * 0.1, -from), stick).is_none());
+        // No friction limit: nothing.
+        assert!(stick_towards(0.0, normal, (from, to), stick).is_none());
+    }
 }

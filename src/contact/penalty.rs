@@ -271,6 +271,44 @@ pub(super) fn for_each_term_at(
     }
 }
 
+/// Calls `each(point, force (N), tangent (N/m))` for every contact of `contacts` with a collider
+/// that no dynamic rigid body carries whose point the nodes' move by `direction` (m per node)
+/// would take onto a stiffer piece of its penalty, in the implicit `step`: from in front of its
+/// plane to behind it, or past the depth of a stiffening. The force and tangent are what the
+/// Newton system must add for the point's penalty to be that piece's quadratic (see
+/// [`NodeContact::penalty_towards`]): a direction computed with the piece the point is on
+/// carries it deep into the stiffer one, where the line search keeps a sliver of the step, and
+/// each iteration brings only the next few points there (see `integrate::implicit`).
+pub(crate) fn for_each_engaged_term(
+    body: &DeformableBody,
+    contacts: &ContactSet,
+    step: ImplicitStep,
+    direction: &[DVec3],
+    mut each: impl FnMut(Stencil, DVec3, DMat3),
+) {
+    let nodes = NodeSlices::of(body);
+    for contact in &contacts.nodes {
+        let obstacle = carried(contact, &step);
+        if !matches!(contact.obstacle, Obstacle::Collider { .. }) || obstacle.partner.is_some() {
+            continue;
+        }
+        let point = contact_point(contact, body.embedding.as_ref());
+        let at = point.stencil();
+        let x = point.position(nodes.positions) - obstacle.travel;
+        let moved = (x, x + at.interpolate(direction));
+        let mass = effective_mass(&at, nodes.masses, nodes.pinned);
+        let settings = &contacts.settings;
+        if let Some((force, tangent)) =
+            contact.penalty_towards(moved, mass, settings, step.penalty_step)
+        {
+            each(at, force, tangent);
+        }
+        if let Some((force, tangent)) = contact.friction_towards(moved, settings, step.effective) {
+            each(at, force, tangent);
+        }
+    }
+}
+
 /// The nodes contact terms act on: positions (m), masses (kg) and which are pinned; one
 /// body's, or a group's side by side (see [`super::joint`]).
 #[derive(Clone, Copy)]

@@ -58,6 +58,20 @@ impl Stiffening {
         })
     }
 
+    /// The quadratic piece of the penalty (own stiffness `base`, N/m) that holds at the depth
+    /// `to` (m), extended to the depth `from` (m): its push (N) and stiffness (N/m) there, or
+    /// `None` when `to` is in front of the plane.
+    pub(crate) fn piece_towards(&self, base: f64, (from, to): (f64, f64)) -> Option<(f64, f64)> {
+        (to > 0.0).then(|| {
+            let (mut push, mut stiffness) = (base * from, base);
+            for &(at, extra) in self.hinges().iter().filter(|(at, _)| to > *at) {
+                push += extra * (from - at);
+                stiffness += extra;
+            }
+            (push, stiffness)
+        })
+    }
+
     /// Stiffens a contact of own stiffness `base` (N/m) whose point an implicit step took from
     /// `start` to `end` (depths behind its plane, m), deeper than `resting` (m): beyond the
     /// start, so that the force at the end holds the point at half of `resting`, or no nearer
@@ -120,6 +134,27 @@ mod tests {
         // A point no deeper than the resting depth is left alone, as is one that rose.
         assert!(!stiffening.stiffen(base, (0.5e-3, 0.9e-3), resting));
         assert!(!stiffening.stiffen(base, (5e-3, 4e-3), resting));
+    }
+
+    #[test]
+    fn the_piece_towards_a_depth_is_the_penalty_there_and_extends_it_as_one_quadratic() {
+        let (base, resting) = (1e3, 1e-3);
+        let mut stiffening = Stiffening::default();
+        assert!(stiffening.stiffen(base, (0.2e-3, 10e-3), resting));
+        for (from, to) in [
+            (-1e-3, 0.1e-3),
+            (-1e-3, 3e-3),
+            (0.1e-3, 3e-3),
+            (0.3e-3, 0.5e-3),
+        ] {
+            let (push, stiffness) = stiffening.piece_towards(base, (from, to)).unwrap();
+            // One quadratic: at `to` its push and stiffness are the penalty's there.
+            let there = stiffening.penalty(base, to).unwrap();
+            assert!((push + stiffness * (to - from) - there.push).abs() < 1e-12);
+            assert_eq!(stiffness, there.stiffness);
+        }
+        // In front of the plane no piece holds.
+        assert!(stiffening.piece_towards(base, (1e-3, -1e-4)).is_none());
     }
 
     #[test]

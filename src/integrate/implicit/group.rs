@@ -12,7 +12,8 @@
 //! [`ImplicitIntegrator::linear_solver`] says; the scheme is BDF2 only when every body of the
 //! group has the history for it, backward Euler otherwise, so that all take the same `ĥ`.
 
-use super::potential::{Potential, StepStart};
+use super::direction::engaging;
+use super::potential::{Engaged, Potential, StepStart};
 use super::rigid_response::{Placement, RigidResponse};
 use super::{
     CrushWatch, ImplicitIntegrator, ImplicitReport, Outcome, STIFFENING_ROUNDS, Stop, end_substep,
@@ -560,8 +561,8 @@ impl ImplicitIntegrator {
     }
 
     /// The Newton direction (m per node of the group) of the group's exact tangent (projected
-    /// where it is not positive definite), with the members' chambers' liquids taken in, then
-    /// each body's rigid partners' response.
+    /// where it is not positive definite), solved again with the contact pieces it lands on (see
+    /// [`super::direction`]).
     fn group_direction(
         &self,
         group: &Group,
@@ -570,13 +571,45 @@ impl ImplicitIntegrator {
         (inertia, residual): (&[Vec<f64>], &[DVec3]),
         outcome: &mut Outcome,
     ) -> Result<Vec<DVec3>, Error> {
+        let solve = |rhs: &[DVec3], engaged: Option<&Engaged>| {
+            let system = (inertia, rhs, engaged);
+            let tangents = (&mut *joint, &mut *parts);
+            let direction = self.solve_group(group, potential, tangents, system, &mut *outcome)?;
+            Ok((direction, ()))
+        };
+        let engaged_for = |direction: &[DVec3]| {
+            let members = (potential.members.iter().enumerate()).map(|(k, member)| {
+                let own = &direction[group.offsets[k]..group.offsets[k + 1]];
+                (group.offsets[k], member.engaged(group.bodies[k], own))
+            });
+            Engaged::gather(members, group.node_count())
+        };
+        Ok(engaging(residual, solve, engaged_for)?.0)
+    }
+
+    /// The solution (m per node of the group) of the Newton system for the right-hand side `rhs`
+    /// (N) with the group's exact tangent and the `engaged` contacts' tangents, with the members'
+    /// chambers' liquids taken in, then each body's rigid partners' response.
+    fn solve_group(
+        &self,
+        group: &Group,
+        potential: &GroupPotential,
+        (joint, parts): (&mut Stiffness, &mut [Stiffness]),
+        (inertia, residual, engaged): (&[Vec<f64>], &[DVec3], Option<&Engaged>),
+        outcome: &mut Outcome,
+    ) -> Result<Vec<DVec3>, Error> {
         let solution = solve_newton_system(
             Method::Direct,
             self.tolerance / outcome.residual,
             joint,
             residual,
             outcome.iterations,
-            |joint, project| potential.assemble(group, (joint, &mut *parts), inertia, project),
+            |joint, project| {
+                potential.assemble(group, (joint, &mut *parts), inertia, project);
+                if let Some(engaged) = engaged {
+                    engaged.add_to(joint, &group.pinned);
+                }
+            },
         )?;
         outcome.factorizations += solution.factorizations;
         outcome.projected_tangents += usize::from(solution.projected);

@@ -14,11 +14,13 @@
 //! iteration solves the Newton system with the exact tangent (or, where that is not positive
 //! definite, with element stress tangents projected to be positive semi-definite) by the chosen
 //! [`LinearSolver`] (a sparse Cholesky factorization or a preconditioned conjugate gradient),
-//! then a backtracking line search makes `E` decrease. While an earlier factorization keeps
+//! solved again where it would carry contact points onto stiffer pieces of their penalty or
+//! friction (`direction`), then a backtracking line search makes `E` decrease. While an earlier factorization keeps
 //! cutting the out-of-balance force tenfold per iteration, iterations solve with it instead of
 //! assembling and factoring anew ([`crate::chord`]). Both schemes are stable at any step length.
 
 mod angular;
+mod direction;
 mod group;
 mod potential;
 mod report;
@@ -34,7 +36,7 @@ use crate::body::DeformableBody;
 use crate::chord::{self, Chord};
 use crate::constraint::{self, BodyConstraints};
 use crate::contact;
-use crate::linear_solver::{LinearSolver, Method, solve_newton_system};
+use crate::linear_solver::{LinearSolver, Method};
 use crate::newton::{Search, check_tolerance, descend, norm, round_off_floor};
 use potential::{Potential, StepStart};
 use rapier3d::glamx::DVec3;
@@ -623,47 +625,6 @@ impl ImplicitIntegrator {
                 Stop::Failed
             }
         })
-    }
-
-    /// The Newton direction (m per node) of the exact tangent, which the chord keeps for reuse
-    /// when it was factored.
-    fn exact_direction(
-        &self,
-        body: &DeformableBody,
-        solver: &mut Solver,
-        incremental: &Potential,
-        inertia: &[f64],
-        residual: &[DVec3],
-        outcome: &mut Outcome,
-    ) -> Result<Vec<DVec3>, Error> {
-        // The exact Hessian converges fastest; where it is indefinite (compressed elements)
-        // the per-element projection restores a descent direction.
-        let solution = solve_newton_system(
-            solver.method,
-            self.tolerance / outcome.residual,
-            &mut solver.stiffness,
-            residual,
-            outcome.iterations,
-            |stiffness, project| incremental.assemble(body, stiffness, inertia, project),
-        )?;
-        outcome.linear_iterations += solution.cg_iterations;
-        outcome.factorizations += solution.factorizations;
-        outcome.projected_tangents += usize::from(solution.projected);
-        if solution.fell_back {
-            solver.method = Method::Direct;
-        }
-        let mut direction = solution.direction;
-        if let Some(factor) = &solution.factor {
-            direction = incremental.take_in_unassembled(body, (factor, false), residual, direction);
-        }
-        if let Some(factor) = solution.factor
-            && self.reuse_factorization
-        {
-            solver.chord.keep(factor, incremental.start.h);
-            #[cfg(feature = "serde-serialize")]
-            solver.chord.remember(&solver.stiffness);
-        }
-        Ok(direction)
     }
 }
 

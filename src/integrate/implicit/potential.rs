@@ -13,12 +13,14 @@ use crate::assembly::Factor;
 use crate::assembly::{Stiffness, solve};
 use crate::body::DeformableBody;
 use crate::constraint::{self, BodyConstraints};
+use crate::contact;
 use crate::damping::RayleighDamping;
 use crate::element::deformation_gradient;
 use crate::integrate::PreviousStep;
 use crate::load::ChamberSolve;
 use crate::material::green_strain;
 use crate::newton::norm;
+use crate::stencil::Stencil;
 use rapier3d::glamx::{DMat3, DVec3};
 use std::cell::RefCell;
 
@@ -119,6 +121,46 @@ impl StepStart {
             green,
             load,
             cone_origins,
+        }
+    }
+}
+
+/// What a Newton system adds for contacts to act by the pieces of their penalty and friction a
+/// direction lands on (see [`Potential::engaged`]).
+pub(super) struct Engaged {
+    /// Their forces (N per node), added to the system's right-hand side.
+    pub(super) forces: Vec<DVec3>,
+    /// Their tangents (N/m), each on a point's nodes with their weights.
+    tangents: Vec<(Vec<u32>, Vec<f64>, DMat3)>,
+}
+
+impl Engaged {
+    /// The terms of bodies solved as one system of `total` nodes, each body's `parts` placed
+    /// from its first node's number; `None` if none has any.
+    pub(super) fn gather(
+        parts: impl IntoIterator<Item = (usize, Option<Engaged>)>,
+        total: usize,
+    ) -> Option<Self> {
+        let mut all = Self {
+            forces: vec![DVec3::ZERO; total],
+            tangents: Vec::new(),
+        };
+        for (offset, part) in parts {
+            let Some(part) = part else { continue };
+            all.forces[offset..offset + part.forces.len()].copy_from_slice(&part.forces);
+            let placed = (part.tangents.into_iter()).map(|(nodes, weights, tangent)| {
+                let nodes = nodes.iter().map(|n| n + offset as u32).collect();
+                (nodes, weights, tangent)
+            });
+            all.tangents.extend(placed);
+        }
+        (!all.tangents.is_empty()).then_some(all)
+    }
+
+    /// Adds the tangents to `stiffness`, none on the `pinned` nodes.
+    pub(super) fn add_to(&self, stiffness: &mut Stiffness, pinned: &[bool]) {
+        for (nodes, weights, tangent) in &self.tangents {
+            stiffness.add_stencil_block(Stencil { nodes, weights }, tangent, pinned);
         }
     }
 }
@@ -242,6 +284,29 @@ impl Potential<'_> {
         let mut rigid = self.rigid.borrow_mut();
         rigid.solve(body, self.constraints);
         constraint::add_implicit_tangents(body, self.constraints, rigid.step(), stiffness);
+    }
+
+    /// The contacts the Newton `direction` (m per node) would carry onto stiffer pieces of their
+    /// penalty or friction ([`contact::for_each_engaged_term`]), for the Newton system to be
+    /// solved again with those pieces; `None` if there are none.
+    pub(super) fn engaged(&self, body: &DeformableBody, direction: &[DVec3]) -> Option<Engaged> {
+        let rigid = self.rigid.borrow();
+        let mut engaged = Engaged {
+            forces: vec![DVec3::ZERO; body.positions.len()],
+            tangents: Vec::new(),
+        };
+        let contacts = &self.constraints.contacts;
+        contact::for_each_engaged_term(body, contacts, rigid.step(), direction, |at, f, t| {
+            for (&node, weight) in at.nodes.iter().zip(at.weights) {
+                if !body.pinned[node as usize] {
+                    engaged.forces[node as usize] += f * *weight;
+                }
+            }
+            engaged
+                .tangents
+                .push((at.nodes.to_vec(), at.weights.to_vec(), t));
+        });
+        (!engaged.tangents.is_empty()).then_some(engaged)
     }
 
     /// The Newton direction (m per node) for `residual` (N) solved with `factor`, an earlier
