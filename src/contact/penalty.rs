@@ -273,12 +273,13 @@ pub(super) fn for_each_term_at(
 
 /// Calls `each(point, force (N), tangent (N/m))` for every contact of `contacts` with a collider
 /// that no dynamic rigid body carries whose point the nodes' move by `direction` (m per node)
-/// would take onto a stiffer piece of its penalty, in the implicit `step`: from in front of its
-/// plane to behind it, or past the depth of a stiffening. The force and tangent are what the
-/// Newton system must add for the point's penalty to be that piece's quadratic (see
-/// [`NodeContact::penalty_towards`]): a direction computed with the piece the point is on
+/// would take onto a stiffer piece of its penalty or friction, in the implicit `step`: from in
+/// front of its plane to behind it, past the depth of a stiffening, or with its slip through
+/// the friction's stick zone. The force and tangent are what the Newton system must add for the
+/// point's penalty or friction to be that piece's quadratic ([`NodeContact::penalty_towards`],
+/// [`NodeContact::friction_towards`]): a direction computed with the piece the point is on
 /// carries it deep into the stiffer one, where the line search keeps a sliver of the step, and
-/// each iteration brings only the next few points there (see `integrate::implicit`).
+/// each iteration brings only the next few points there (see `integrate::implicit::direction`).
 pub(crate) fn for_each_engaged_term(
     body: &DeformableBody,
     contacts: &ContactSet,

@@ -19,10 +19,11 @@ use rapier3d::glamx::DVec3;
 
 impl SoftCoupling {
     /// One coupling substep of `h` (s): each body but those in `skip` (stepped over the whole
-    /// frame already) whose state passes [`DeformableBody::check_state`] finds its contacts with
-    /// the colliders (the others keep their state and take its error), bodies touching each
-    /// other are grouped and stepped together, the others alone, and the impulses they gave
-    /// rigid bodies go to rapier and to the loads. Each body's outcome becomes its last report or its first error. A body whose
+    /// frame beside the substeps, taken out of `soft_bodies` meanwhile) whose state passes
+    /// [`DeformableBody::check_state`] finds its contacts with the colliders (the others keep
+    /// their state and take its error), bodies touching each other are grouped and stepped
+    /// together, the others alone, and the impulses they gave rigid bodies go to rapier and to
+    /// the loads. Each body's outcome becomes its last report or its first error. A body whose
     /// step is refused, in this substep or an earlier one of the frame, stays where it was and
     /// holds the rigid bodies it touches or is glued to as a fixed obstacle would
     /// ([`constraint::hold_partners`]): rapier's step must not let them sink into it meanwhile.

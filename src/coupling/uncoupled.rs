@@ -17,9 +17,9 @@
 //! They are found before the kinematic bodies are told the first part of their path, so that
 //! their velocities are those of the whole frame. Sharing nothing with the bodies of the coupling
 //! substeps, they are taken out of the sets ([`Uncoupled`]) and step at the same time as those
-//! substeps (on another thread with the `parallel` feature); their outcomes, loads and
-//! stillness are recorded after the substeps, and they may fall asleep then. A body found with a dynamic partner, or near another
-//! deformable body, steps in the coupling substeps as before; so does a body with
+//! substeps (on another thread with the `parallel` feature); their outcomes, loads and stillness
+//! are recorded after the substeps, and they may fall asleep then. A body found with a dynamic
+//! partner, or near another deformable body, steps in the coupling substeps; so does a body with
 //! [`self_contact`](crate::body::DeformableBody::self_contact) on, whose parts touch each other
 //! as two bodies do (its contacts, found once per frame, would keep the arms they had at
 //! detection over the whole frame: the halves of a body colliding in zero gravity changed its
