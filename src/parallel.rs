@@ -88,18 +88,6 @@ pub(crate) fn for_each<T: Send>(items: &mut [T], work: impl Fn(&mut T) + Sync + 
     items.iter_mut().for_each(work);
 }
 
-/// `work(item)` for each of `items`, each on one thread, the results in order.
-pub(crate) fn map_each<T: Send, R: Send>(
-    items: &mut [T],
-    work: impl Fn(&mut T) -> R + Sync + Send,
-) -> Vec<R> {
-    #[cfg(feature = "parallel")]
-    if items.len() > 1 {
-        return on_pool(|| items.par_iter_mut().map(work).collect());
-    }
-    items.iter_mut().map(work).collect()
-}
-
 /// The threads work may be spread over: rayon's current pool's with the `parallel` feature, else
 /// one.
 pub(crate) fn threads() -> usize {

@@ -250,7 +250,7 @@ impl SoftCoupling {
             Vec::new()
         };
         let mut uncoupled = Uncoupled::take(&alone, soft_bodies, &mut self.links);
-        let integrator = self.integrator;
+        let (integrator, settings) = (self.integrator, self.contact);
         let substepping = (pipeline, &mut rapier, (hooks, events));
         let coupled = (&mut outcomes[..], &alone[..], &paths[..]);
         let stepped = if uncoupled.is_empty() {
@@ -258,7 +258,7 @@ impl SoftCoupling {
             Vec::new()
         } else {
             let (stepped, ()) = crate::parallel::both(
-                || uncoupled.step(&integrator, (frame_dt, gravity)),
+                || uncoupled.step((&integrator, &settings), (frame_dt, gravity)),
                 || self.coupling_substeps(substepping, soft_bodies, coupled, (h, gravity)),
             );
             stepped

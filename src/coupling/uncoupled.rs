@@ -26,6 +26,7 @@
 //! angular momentum by 1.5e-2 kg m²/s, twenty times the margin's bound, instead of within it).
 
 use super::bodies::{BodyLinks, LinkSet};
+use super::groups::{GroupStep, step_groups};
 use super::reach::{body_reach, overlap};
 use super::{Outcome, RigidSets, SoftCoupling, rapier_view};
 use crate::Error;
@@ -137,21 +138,23 @@ impl Uncoupled {
         self.bodies.is_empty()
     }
 
-    /// Steps each body over the frame `dt` (s) under `gravity` (m/s²) with `integrator`: a
-    /// result per body, in the order taken.
+    /// Steps each body over the frame `dt` (s) under `gravity` (m/s²) with `integrator`, each a
+    /// group of its own ([`step_groups`]; `settings` serve contacts between bodies, which
+    /// these have none of): a result per body, in the order taken.
     pub(super) fn step(
         &mut self,
-        integrator: &AutomaticIntegrator,
+        (integrator, settings): (&AutomaticIntegrator, &ContactSettings),
         (dt, gravity): (f64, DVec3),
     ) -> Vec<Result<AutomaticReport, Error>> {
-        let mut steps: Vec<_> = (self.bodies.iter_mut())
+        let mut groups: Vec<GroupStep> = (self.bodies.iter_mut())
             .zip(self.links.iter_mut())
-            .map(|((_, body), (_, links))| links.with(body))
+            .map(|((_, body), (_, links))| GroupStep {
+                bodies: vec![links.with(body)],
+                between: Vec::new(),
+            })
             .collect();
-        let step = |s: &mut crate::integrate::BodyInStep<'_>| {
-            integrator.step(s.body, s.constraints, s.workspace, dt, gravity)
-        };
-        crate::parallel::map_each(&mut steps, step)
+        let stepped = step_groups(&mut groups, integrator, settings, (dt, gravity));
+        stepped.into_iter().flatten().collect()
     }
 
     /// Puts the bodies and their links back into `soft_bodies` and `links`; returns their handles.
