@@ -57,6 +57,7 @@ mod rapier_view;
 mod reach;
 mod sleep;
 mod substep;
+mod touches;
 mod uncoupled;
 
 pub use audit::{
@@ -84,6 +85,7 @@ use rapier3d::glamx::DVec3;
 use rapier3d::math::Vector;
 use rapier3d::pipeline::{EventHandler, PhysicsHooks, PhysicsPipeline};
 use sleep::SleepSet;
+use touches::RigidTouches;
 use uncoupled::Uncoupled;
 
 /// Each deformable body's result over a frame: the report of its last substep, or the first
@@ -182,6 +184,8 @@ pub struct SoftCoupling {
     pub sleep: SleepSettings,
     /// What each deformable body exerted on each rigid body over the last frame or substep.
     loads: FrameLoads,
+    /// The dynamic rigid bodies rapier's contacts held together over the last frame.
+    touches: RigidTouches,
     /// Each deformable body's constraints and solver caches, by handle.
     links: LinkSet,
     /// Each deformable body's sleep, by handle.
@@ -196,6 +200,7 @@ impl Default for SoftCoupling {
             substeps: 4,
             sleep: SleepSettings::default(),
             loads: FrameLoads::default(),
+            touches: RigidTouches::default(),
             links: LinkSet::default(),
             sleeping: SleepSet::default(),
         }
@@ -224,11 +229,13 @@ impl SoftCoupling {
     ) -> SoftStepResults {
         let frame = *rapier.integration_parameters;
         self.loads.clear();
+        self.touches.clear();
         if let Some(error) = self.frame_error(frame.dt) {
             return refused(soft_bodies, &error);
         }
         if frame.dt == 0.0 {
             rapier.step_rapier(pipeline, &frame, hooks, events);
+            self.record_touches(&rapier);
             return Vec::new();
         }
         let substeps = self.substeps;
@@ -319,7 +326,13 @@ impl SoftCoupling {
             let carry = RapierCarry::lead(&carried, rapier.bodies, gravity, (h, iterations));
             rapier.step_rapier(pipeline, &substep_parameters, hooks, events);
             carry.settle(rapier.bodies);
+            self.record_touches(rapier);
         }
+    }
+
+    /// Records the dynamic rigid bodies the `rapier` step that just ran holds in contact.
+    fn record_touches(&mut self, rapier: &RapierSets<'_>) {
+        (self.touches).record(rapier.bodies, rapier.colliders, rapier.narrow_phase);
     }
 
     /// Why a frame of `dt` (s) cannot be stepped, if it cannot: a negative or non-finite step, or
@@ -353,6 +366,8 @@ impl SoftCoupling {
         gravity: DVec3,
     ) -> SoftStepResults {
         self.loads.clear();
+        self.touches.clear();
+        (self.touches).record(rigid.bodies, rigid.colliders, rigid.narrow_phase);
         self.links.prune(soft_bodies);
         self.sleeping.prune(soft_bodies);
         let mut outcomes = unstepped(soft_bodies);
@@ -377,6 +392,14 @@ impl SoftCoupling {
     /// included.
     pub fn collider_loads(&self) -> &[ColliderLoad] {
         self.loads.colliders()
+    }
+
+    /// The pairs of dynamic rigid bodies rapier's own contacts held together in any rapier step
+    /// of the last frame of [`SoftCoupling::step`] (for [`SoftCoupling::substep`], in the rapier
+    /// step before it): energy the rigid bodies exchange among themselves, not with the
+    /// deformable bodies.
+    pub(crate) fn rigid_touches(&self) -> &[(RigidBodyHandle, RigidBodyHandle)] {
+        self.touches.pairs()
     }
 
     /// The mean force (N) and torque about its centre of mass (N m) deformable body `soft`

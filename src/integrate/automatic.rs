@@ -97,7 +97,7 @@ impl AutomaticIntegrator {
     /// `workspace` its solver caches, by the cheaper integrator (or the forced one); explicit
     /// while it has self-contacts, corners of dynamic rigid bodies that rapier's own contacts
     /// also hold against its surface, or points or corners found deeper behind their contact
-    /// planes than the contacts' resting depth.
+    /// planes than twice the contacts' resting depth.
     ///
     /// A frame refused again from exactly what the last refused frame started from (the body's
     /// positions, velocities and loads, its constraints, the frame's length and gravity, the
