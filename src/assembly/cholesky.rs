@@ -14,6 +14,7 @@ use std::sync::Arc;
 
 /// The unknowns from which a factor's numeric factorization and solves run on rayon's threads
 /// (with the `parallel` feature).
+#[cfg(feature = "parallel")]
 pub(crate) const PARALLEL_UNKNOWNS: usize = 30_000;
 
 /// The parallelism for a factor of `unknowns` unknowns.

@@ -21,6 +21,7 @@ pub const TETS_PER_LATTICE: usize = 8 * TETS_PER_HEXAHEDRON;
 /// The corners of a hexahedron in the order of VTK and Gmsh (bottom face `0 1 2 3`
 /// counter-clockwise seen from above, top face `4 5 6 7` above it) by their place
 /// `i + 2j + 4k` on the unit cube.
+#[cfg(feature = "import")]
 pub const FILE_ORDER_CORNERS: [usize; 8] = [0, 1, 3, 2, 4, 5, 7, 6];
 
 /// The position `(i, j, k)` of unit-cube corner `b`.

@@ -20,7 +20,9 @@ pub use quadratic::QuadraticTetMesh;
 pub(crate) use quadratic::SUB_TETS;
 pub use quadratic_hex::QuadraticHexMesh;
 pub use validate::MAX_COORDINATE;
-pub(crate) use validate::{DEGENERATE_RELATIVE_VOLUME, check_position};
+#[cfg(feature = "import")]
+pub(crate) use validate::DEGENERATE_RELATIVE_VOLUME;
+pub(crate) use validate::check_position;
 use validate::{check_element_volume, name_parent_element, validate_topology};
 
 use crate::Error;
