@@ -19,9 +19,9 @@ pub use generators::{cuboid, cylinder, sphere, tube};
 pub use quadratic::QuadraticTetMesh;
 pub(crate) use quadratic::SUB_TETS;
 pub use quadratic_hex::QuadraticHexMesh;
-pub use validate::MAX_COORDINATE;
 #[cfg(feature = "import")]
 pub(crate) use validate::DEGENERATE_RELATIVE_VOLUME;
+pub use validate::MAX_COORDINATE;
 pub(crate) use validate::check_position;
 use validate::{check_element_volume, name_parent_element, validate_topology};
 
