@@ -7,10 +7,9 @@
 //! each chunk's dense tangents are computed on one thread into its own scratch, then the batch's
 //! tangents are added into the matrix by one thread per range of node columns (each range a
 //! disjoint part of the values, the ranges sharing out the band of nodes the batch touches),
-//! element by element in order. Each element's tangent is the same
-//! arithmetic whatever the thread, and each entry receives its terms in element order, so the
-//! matrix is the same to the bit whatever the number of threads. A batch bounds the scratch's
-//! memory (a few MB).
+//! element by element in order. Each element's tangent is the same arithmetic whatever the
+//! thread, and each entry receives its terms in element order, so the matrix is the same to the
+//! bit whatever the number of threads. A batch bounds the scratch's memory (a few MB).
 
 use super::{Stiffness, StressTangent};
 use crate::element::Elements;

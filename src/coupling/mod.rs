@@ -185,6 +185,7 @@ pub struct SoftCoupling {
     /// What each deformable body exerted on each rigid body over the last frame or substep.
     loads: FrameLoads,
     /// The dynamic rigid bodies rapier's contacts held together over the last frame.
+    #[cfg_attr(feature = "serde-serialize", serde(default))]
     touches: RigidTouches,
     /// Each deformable body's constraints and solver caches, by handle.
     links: LinkSet,
