@@ -123,19 +123,12 @@ impl BlockRows {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::assembly::perturb_positions;
+    use crate::assembly::deformed_block;
     use crate::prelude::*;
 
     /// A deformed, partly pinned 3 x 2 x 2 cube's tangent.
     fn assembled() -> (DeformableBody, Stiffness) {
-        let mesh = mesh::cuboid(DVec3::splat(0.1), [3, 2, 2]).expect("a mesh");
-        let material =
-            Material::new(MaterialModel::StableNeoHookean, 1e5, 0.3, 1000.0).expect("a material");
-        let mut body = DeformableBodyBuilder::new(mesh, material)
-            .pinned_nodes([0, 5, 17])
-            .build()
-            .expect("a body");
-        perturb_positions(&mut body, 7, 0.01);
+        let body = deformed_block([3, 2, 2], [0, 5, 17], (7, 0.01));
         let mut stiffness = Stiffness::new(&body);
         let diagonal = vec![3.0e3; body.node_count()];
         stiffness.assemble(&body, Some(&diagonal), false, |_, _, _| [DMat3::ZERO; 9]);

@@ -249,21 +249,13 @@ impl Stiffness {
 #[cfg(all(test, feature = "parallel"))]
 mod tests {
     use super::*;
-    use crate::assembly::perturb_positions;
-    use crate::prelude::*;
+    use crate::assembly::deformed_block;
     use rapier3d::glamx::DMat3;
 
     /// The tangent of a deformed, partly pinned cube of 12 cells a side (8 640 tetrahedra: two
     /// batches, the second partly filled) assembled on a pool of `threads` threads.
     fn assembled_on(threads: usize) -> Vec<f64> {
-        let mesh = mesh::cuboid(DVec3::splat(0.1), [12; 3]).expect("a mesh");
-        let material =
-            Material::new(MaterialModel::StableNeoHookean, 1e5, 0.3, 1000.0).expect("a material");
-        let mut body = DeformableBodyBuilder::new(mesh, material)
-            .pinned_nodes([0, 100, 1000])
-            .build()
-            .expect("a body");
-        perturb_positions(&mut body, 11, 0.005);
+        let body = deformed_block([12; 3], [0, 100, 1000], (11, 0.005));
         let mut stiffness = Stiffness::new(&body);
         rayon::ThreadPoolBuilder::new()
             .num_threads(threads)

@@ -513,3 +513,23 @@ pub(crate) fn perturb_positions(body: &mut DeformableBody, mut seed: u64, amplit
         }
     }
 }
+
+/// A 20 cm rubber block (stable Neo-Hookean, E = 1e5 Pa, ν = 0.3) of `cells`, its nodes `pinned`,
+/// every node moved as [`perturb_positions`] moves them with `seed` and `amplitude` (m).
+#[cfg(test)]
+pub(crate) fn deformed_block(
+    cells: [usize; 3],
+    pinned: [u32; 3],
+    (seed, amplitude): (u64, f64),
+) -> DeformableBody {
+    use crate::prelude::*;
+    let mesh = mesh::cuboid(DVec3::splat(0.1), cells).expect("a mesh");
+    let material =
+        Material::new(MaterialModel::StableNeoHookean, 1e5, 0.3, 1000.0).expect("a material");
+    let mut body = DeformableBodyBuilder::new(mesh, material)
+        .pinned_nodes(pinned)
+        .build()
+        .expect("a body");
+    perturb_positions(&mut body, seed, amplitude);
+    body
+}

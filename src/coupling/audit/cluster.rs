@@ -79,21 +79,17 @@ pub(super) fn clusters(input: &AuditInput<'_>) -> Vec<Cluster> {
 /// Adds to each of `clusters` the rigid bodies `touches` holds against one of its rigid members,
 /// until no pair joins one more (two clusters a pair links become one).
 fn join_touching(clusters: &mut Vec<Vec<Member>>, touches: &[(RigidBodyHandle, RigidBodyHandle)]) {
-    let member_of_a_cluster = |clusters: &[Vec<Member>], rigid| {
-        clusters.iter().any(|c| c.contains(&Member::Rigid(rigid)))
+    let cluster_of = |clusters: &[Vec<Member>], rigid| {
+        clusters
+            .iter()
+            .position(|c| c.contains(&Member::Rigid(rigid)))
     };
     let mut joined = true;
     while joined {
         joined = false;
         for &(a, b) in touches {
-            let (in_a, in_b) = (
-                member_of_a_cluster(clusters, a),
-                member_of_a_cluster(clusters, b),
-            );
-            let same = clusters
-                .iter()
-                .any(|c| c.contains(&Member::Rigid(a)) && c.contains(&Member::Rigid(b)));
-            if (in_a || in_b) && !same {
+            let (of_a, of_b) = (cluster_of(clusters, a), cluster_of(clusters, b));
+            if of_a != of_b {
                 merge(clusters, vec![Member::Rigid(a), Member::Rigid(b)]);
                 joined = true;
             }
