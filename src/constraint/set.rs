@@ -193,26 +193,16 @@ impl BodyConstraints {
 
     /// Whether the last detection found contacts an implicit step does not take well:
     /// self-contacts, through which it does not exchange angular momentum exactly (the penalty
-    /// acts at the triangle's point, its reaction at the node); corners of dynamic rigid bodies
-    /// that rapier's own contacts hold (see [`RigidProxy::hold`]), whose motion the implicit
-    /// step solves under the soft forces alone (with them implicit, a 50 g board leaning on a
-    /// block, its foot on the ground, still moved at 2.2 mm/s after 2 s, its tilt steady: the
-    /// implicit step and rapier's take turns at it); or surface points or rigid corners found
-    /// deeper behind their contact planes than twice [`ContactSettings::resting_depth`] (an
-    /// implicit step itself leaves a loaded point up to that depth), which an implicit step's
-    /// penalty pushes out within the step (a 10 cm cube set 4 cm into the ground left it with
-    /// 9.4 J, against at most `depenetration_speed` in explicit substeps; rigid corners found
-    /// deep gave 0.11 J in a frame of the game scene). The automatic integrator keeps the
-    /// explicit one while there are any.
+    /// acts at the triangle's point, its reaction at the node); or surface points or rigid
+    /// corners found deeper behind their contact planes than twice
+    /// [`ContactSettings::resting_depth`] (an implicit step itself leaves a loaded point up to
+    /// that depth), which an implicit step's penalty pushes out within the step (a 10 cm cube set
+    /// 4 cm into the ground left it with 9.4 J, against at most `depenetration_speed` in
+    /// explicit substeps; rigid corners found deep gave 0.11 J in a frame of the game scene).
+    /// The automatic integrator keeps the explicit one while there are any.
     pub(crate) fn needs_explicit_contacts(&self) -> bool {
         self.contacts.deepest_found() > 2.0 * self.contacts.settings.resting_depth
             || self.contacts.has_self_contacts()
-            || self.contacts.corners.iter().any(|corner| {
-                corner.proxy.is_some_and(|i| {
-                    (self.rigid_proxies.get(i))
-                        .is_some_and(|rigid| rigid.is_dynamic() && rigid.is_held())
-                })
-            })
     }
 
     /// Whether the constraints are coupled to each other (through a dynamic rigid body's

@@ -22,8 +22,9 @@
 //! raised by `a = g h (n − 1)/(2n)` (times its gravity scale), so that rapier moves it by `h v`,
 //! and after the step `a` is taken off again, so that it ends at `v`. The offset does not depend
 //! on the impulses, so a body several soft bodies touch is carried right by all their impulses
-//! together. A body that rapier's own contacts hold up is held in the soft step (no gravity
-//! there) and left to rapier, whose contacts would answer the offset; so is a sleeping one.
+//! together. A body that rapier's own contacts hold up moves in the soft step as rapier's last
+//! step moved it (no gravity of its own there, see `pull.rs`) and is left to rapier, whose
+//! contacts would answer the offset; so is a sleeping one.
 //!
 //! Explicit substeps carry a body along a path of their own (each substep falling and moving by
 //! its share, the impulses coming in over the substeps) and are not matched here: rapier moves

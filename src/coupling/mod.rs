@@ -15,9 +15,10 @@
 //! 2. **Contacts.** Each deformable body finds the colliders its surface can reach within `h`
 //!    ([`BodyConstraints::detect_contacts`]), and
 //!    the bodies find each other's surfaces.
-//! 3. **Support.** Rigid bodies that rapier's narrow phase finds touching something are held in
-//!    place within the soft step: otherwise they would fall freely there, the ground that holds
-//!    them acting only in rapier's step.
+//! 3. **Support.** Rigid bodies that rapier's narrow phase finds touching something move within
+//!    the soft step as rapier's last step moved them (gravity and rapier's contacts and joints
+//!    together, `pull.rs`), not by gravity alone: otherwise they would fall freely there, the
+//!    ground that holds them acting only in rapier's step.
 //! 4. **Soft step.** Bodies touching each other step together, so that their contacts are
 //!    solved with both bodies' nodes: explicitly in the same sweeps, or, when the implicit
 //!    integrator is forced (or the explicit frame would take too many substeps), as one implicit
@@ -40,6 +41,8 @@
 //!    per frame is about unchanged. A dynamic body an implicit soft step moved is carried by it
 //!    as that step assumed (`carry`: rapier's iterations, each integrating gravity over its
 //!    share of `h`, would carry it `(n − 1)/(2n) |g| h²` less far down in `n` iterations).
+//!    What the step did to each rigid body rapier's contacts hold is measured for stage 3 of the
+//!    next substep.
 //!
 //! Sub-cycling keeps the rigid bodies' view of the deformable bodies one short substep old, which
 //! removes the friction ratchet and the rocking that a single rapier step per frame shows.
@@ -53,6 +56,7 @@ mod carry;
 mod groups;
 mod kinematic;
 mod loads;
+mod pull;
 mod rapier_view;
 mod reach;
 mod sleep;
@@ -76,6 +80,7 @@ use bodies::LinkSet;
 use carry::RapierCarry;
 use kinematic::KinematicPath;
 use loads::FrameLoads;
+use pull::RapierPull;
 use rapier3d::dynamics::{
     CCDSolver, ImpulseJointSet, IntegrationParameters, IslandManager, MultibodyJointSet,
     RigidBodyHandle, RigidBodySet,
@@ -187,6 +192,9 @@ pub struct SoftCoupling {
     /// The dynamic rigid bodies rapier's contacts held together over the last frame.
     #[cfg_attr(feature = "serde-serialize", serde(default))]
     touches: RigidTouches,
+    /// What rapier's last step did to the rigid bodies its contacts hold.
+    #[cfg_attr(feature = "serde-serialize", serde(default))]
+    pull: RapierPull,
     /// Each deformable body's constraints and solver caches, by handle.
     links: LinkSet,
     /// Each deformable body's sleep, by handle.
@@ -202,6 +210,7 @@ impl Default for SoftCoupling {
             sleep: SleepSettings::default(),
             loads: FrameLoads::default(),
             touches: RigidTouches::default(),
+            pull: RapierPull::default(),
             links: LinkSet::default(),
             sleeping: SleepSet::default(),
         }
@@ -325,8 +334,11 @@ impl SoftCoupling {
             let carried = self.step_soft_bodies(soft_bodies, rigid, outcomes, skip, (h, gravity));
             let iterations = substep_parameters.num_solver_iterations;
             let carry = RapierCarry::lead(&carried, rapier.bodies, gravity, (h, iterations));
+            let proxies = (self.links.iter()).flat_map(|(_, l)| &l.constraints.rigid_proxies);
+            let before = RapierPull::before(proxies, rapier.bodies);
             rapier.step_rapier(pipeline, &substep_parameters, hooks, events);
             carry.settle(rapier.bodies);
+            self.pull = RapierPull::measure(before, rapier.bodies, h);
             self.record_touches(rapier);
         }
     }

@@ -7,6 +7,7 @@ use super::bodies::BodyLinks;
 use super::carry::Carried;
 use super::groups::{GroupStep, step_groups, touching_groups};
 use super::loads::FrameLoads;
+use super::pull::RapierPull;
 use super::{Outcome, RigidSets, SoftCoupling, rapier_view};
 use crate::Error;
 use crate::body::{DeformableBody, DeformableBodyHandle, DeformableBodySet};
@@ -14,7 +15,6 @@ use crate::constraint::{self, BodyConstraints};
 use crate::contact::{self, BetweenContact};
 use crate::integrate::{AutomaticReport, BodyInStep, IntegratorKind};
 use rapier3d::dynamics::RigidBodySet;
-use rapier3d::geometry::NarrowPhase;
 use rapier3d::glamx::DVec3;
 
 impl SoftCoupling {
@@ -91,7 +91,7 @@ impl SoftCoupling {
             })
             .collect();
         for step in ready.iter_mut().flat_map(|group| group.bodies.iter_mut()) {
-            hold_supported_bodies(step.constraints, rigid.bodies, rigid.narrow_phase);
+            hold_supported_bodies(step.constraints, rigid, &self.pull);
         }
         let stepped = step_groups(&mut ready, &self.integrator, &self.contact, (h, gravity));
         let stepped = stepped.into_iter().flatten().collect();
@@ -164,7 +164,7 @@ impl SoftCoupling {
             .zip(soft_bodies.get_many_mut(held))
             .map(|(links, body)| links.with(body));
         for (handle, mut step) in held.iter().zip(holds) {
-            hold_supported_bodies(step.constraints, rigid.bodies, rigid.narrow_phase);
+            hold_supported_bodies(step.constraints, rigid, &self.pull);
             constraint::hold_partners(step.body, step.constraints, h, gravity);
             self.sleeping.observe(
                 (*handle, step.body, step.constraints),
@@ -236,9 +236,10 @@ fn hand_over(
 /// would otherwise fall freely, the ground that holds them acting only in rapier's step.
 fn hold_supported_bodies(
     constraints: &mut BodyConstraints,
-    bodies: &RigidBodySet,
-    narrow_phase: &NarrowPhase,
+    rigid: &RigidSets<'_>,
+    pull: &RapierPull,
 ) {
+    let (bodies, narrow_phase) = (&*rigid.bodies, rigid.narrow_phase);
     for proxy in &mut constraints.rigid_proxies {
         let supported = bodies.get(proxy.handle).is_some_and(|rigid| {
             rigid.colliders().iter().any(|&collider| {
@@ -248,7 +249,7 @@ fn hold_supported_bodies(
             })
         });
         if supported {
-            proxy.hold();
+            proxy.hold(pull.on(proxy.handle));
         }
     }
 }
