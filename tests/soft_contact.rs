@@ -251,7 +251,7 @@ fn a_body_of_two_separate_cubes_lands_on_itself_only_with_self_contact() {
     // 60 Hz frames. With self-contact the upper cube rests on the lower one: no more overlap than
     // the contact margin plus 1 mm (the bound for a drop), and the ground carries the
     // whole weight within 1 % (the support bound), under the automatic integrator
-    // (explicit while there are self-contacts) and under forced implicit steps alike. Without it
+    // and under forced implicit steps alike. Without it
     // the upper cube falls through to the ground.
     let young = 1e5;
     let material = rubber(young);
@@ -313,11 +313,14 @@ fn the_halves_of_a_body_colliding_in_zero_gravity_conserve_its_momentum() {
     // nodes of the same body and sum to zero by construction (the barycentric weights sum to
     // one): the body's linear momentum is conserved to round-off; bound 1e-6 relative, the
     // issue's for momentum exchange.
-    // The angular momentum changes by the impulses' lever-arm mismatch: a node acts on its
-    // contact point while the two are within the contact margin of each other, so the change is
-    // bounded by the margin times the impulse exchanged (the right cube's final momentum).
-    // Both under the automatic integrator (explicit while there are self-contacts) and under
-    // forced implicit steps, whose penalties push node and triangle equally and oppositely.
+    // In the explicit sweeps the angular momentum changes by the impulses' lever-arm mismatch:
+    // a node acts on its contact point while the two are within the contact margin of each
+    // other, so the change is bounded by the margin times the impulse exchanged (the right
+    // cube's final momentum). Implicit steps, whose penalties push node and triangle equally
+    // and oppositely, give a body that nothing else acts on the angular momentum it started
+    // with, so there it is kept to 1e-6 of the initial momentum times 10 cm (measured 8.7e-12
+    // kg m²/s; 1.8e-4 before self-contacts counted as internal). Under the automatic
+    // integrator (which picks by cost, here explicit) and forced implicit steps.
     for force in [None, Some(IntegratorKind::Implicit)] {
         halves_collide(force);
     }
@@ -380,4 +383,7 @@ fn halves_collide(force: Option<IntegratorKind>) {
     assert!(right_speed > 0.1);
     assert!((p1 - p0).length() <= 1e-6 * p0.length());
     assert!((l1 - l0).length() <= world.coupling.contact.margin * right_mass * right_speed);
+    if force == Some(IntegratorKind::Implicit) {
+        assert!((l1 - l0).length() <= 1e-6 * p0.length() * 0.1);
+    }
 }

@@ -71,6 +71,16 @@ pub(crate) struct ImplicitTerm<'a> {
     pub(crate) tangent: DMat3,
 }
 
+impl ImplicitTerm<'_> {
+    /// Whether the term acts between nodes of the body alone (a self-contact: weights `1, −w_a,
+    /// −w_b, −w_c`, no rigid partner): its forces sum to zero, and it takes no momentum from the
+    /// body. The barycentric weights come from single-precision queries, so their sum is zero
+    /// to within 1e-7 (a term against anything else has weights summing to one).
+    pub(crate) fn is_internal(&self) -> bool {
+        self.partner.is_none() && self.at.weights.iter().sum::<f64>().abs() < 1e-6
+    }
+}
+
 /// A constraint kind's implicit side: terms of the incremental potential.
 pub(crate) trait ImplicitSide {
     /// Called once at the start of an implicit `step`, before Newton (the rigid bodies of
@@ -358,7 +368,7 @@ pub(crate) fn for_each_implicit_term(
 /// over the terms, `F` each term's force on the body where the step ends and `a` its rigid
 /// body's point, fixed over the step (a corner's vertex, a contact plane's point, an anchor);
 /// `None` when a term pushes the body against something else (a fixed or kinematic collider or
-/// anchor, its own surface), which takes angular momentum anyway. The body receives `F h` at its
+/// anchor), which takes angular momentum anyway; its own surface (a self-contact) gives none. The body receives `F h` at its
 /// own point, where its nodes end the step; the two differ by the points' relative travel.
 pub(crate) fn partner_angular_impulse(
     body: &DeformableBody,
@@ -370,7 +380,7 @@ pub(crate) fn partner_angular_impulse(
         Some(partner) => {
             impulse = impulse.map(|sum| sum + partner.point.cross(term.force * step.length));
         }
-        None if term.force != DVec3::ZERO => impulse = None,
+        None if term.force != DVec3::ZERO && !term.is_internal() => impulse = None,
         None => {}
     });
     impulse
@@ -399,6 +409,20 @@ pub(crate) fn implicit_energy(
     let mut energy = 0.0;
     for_each_implicit_term(body, constraints, step, &mut |term| energy += term.energy);
     energy
+}
+
+/// Whether an implicit term of `constraints` in the implicit `step` pushes the body against
+/// something else (a term with energy that is not [internal](ImplicitTerm::is_internal)).
+pub(crate) fn pushed_from_outside(
+    body: &DeformableBody,
+    constraints: &BodyConstraints,
+    step: ImplicitStep,
+) -> bool {
+    let mut pushed = false;
+    for_each_implicit_term(body, constraints, step, &mut |term| {
+        pushed |= term.energy != 0.0 && !term.is_internal();
+    });
+    pushed
 }
 
 /// Adds every implicit term's tangent (N/m) into `stiffness`, in the implicit `step`, as if the

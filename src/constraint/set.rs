@@ -191,10 +191,8 @@ impl BodyConstraints {
         contact::collider_impulses(body, &self.contacts)
     }
 
-    /// Whether the last detection found contacts an implicit step does not take well:
-    /// self-contacts, through which it does not exchange angular momentum exactly (the penalty
-    /// acts at the triangle's point, its reaction at the node); or surface points or rigid
-    /// corners found deeper behind their contact planes than twice
+    /// Whether the last detection found contacts an implicit step does not take well: surface
+    /// points or rigid corners found deeper behind their contact planes than twice
     /// [`ContactSettings::resting_depth`] (an implicit step itself leaves a loaded point up to
     /// that depth), which an implicit step's penalty pushes out within the step (a 10 cm cube set
     /// 4 cm into the ground left it with 9.4 J, against at most `depenetration_speed` in
@@ -202,7 +200,6 @@ impl BodyConstraints {
     /// The automatic integrator keeps the explicit one while there are any.
     pub(crate) fn needs_explicit_contacts(&self) -> bool {
         self.contacts.deepest_found() > 2.0 * self.contacts.settings.resting_depth
-            || self.contacts.has_self_contacts()
     }
 
     /// Whether the constraints are coupled to each other (through a dynamic rigid body's

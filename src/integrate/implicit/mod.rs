@@ -649,7 +649,7 @@ fn end_substep(
     let free = alone
         && !body.pinned.contains(&true)
         && constraints.attachments.is_empty()
-        && constraint::implicit_energy(body, constraints, response.step()) == 0.0;
+        && !constraint::pushed_from_outside(body, constraints, response.step());
     let exchanged = (alone && !body.pinned.contains(&true) && body.loads.is_empty())
         .then(|| constraint::partner_angular_impulse(body, constraints, response.step()))
         .flatten();
