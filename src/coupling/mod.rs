@@ -41,8 +41,6 @@
 //!    per frame is about unchanged. A dynamic body an implicit soft step moved is carried by it
 //!    as that step assumed (`carry`: rapier's iterations, each integrating gravity over its
 //!    share of `h`, would carry it `(n − 1)/(2n) |g| h²` less far down in `n` iterations).
-//!    What the step did to each rigid body rapier's contacts hold is measured for stage 3 of the
-//!    next substep.
 //!
 //! Sub-cycling keeps the rigid bodies' view of the deformable bodies one short substep old, which
 //! removes the friction ratchet and the rocking that a single rapier step per frame shows.
@@ -334,11 +332,8 @@ impl SoftCoupling {
             let carried = self.step_soft_bodies(soft_bodies, rigid, outcomes, skip, (h, gravity));
             let iterations = substep_parameters.num_solver_iterations;
             let carry = RapierCarry::lead(&carried, rapier.bodies, gravity, (h, iterations));
-            let proxies = (self.links.iter()).flat_map(|(_, l)| &l.constraints.rigid_proxies);
-            let before = RapierPull::before(proxies, rapier.bodies);
             rapier.step_rapier(pipeline, &substep_parameters, hooks, events);
             carry.settle(rapier.bodies);
-            self.pull = RapierPull::measure(before, rapier.bodies, h);
             self.record_touches(rapier);
         }
     }

@@ -1,31 +1,34 @@
 //! What rapier's step did to each held rigid body, as an acceleration: `a = (v' − v)/h` and
-//! `α = (ω' − ω)/h`, with `v`, `ω` the body's velocities handed to rapier (after the soft
-//! impulses) and `v'`, `ω'` those rapier's step of `h` left: gravity, and rapier's own contacts
-//! and joints.
+//! `α = (ω' − ω)/h`, with `v`, `ω` the body's velocities when a soft substep of `h` handed its
+//! impulses over and `v'`, `ω'` those it has when the next soft substep begins: rapier's step in
+//! between (gravity, and rapier's own contacts and joints), whether
+//! [`SoftCoupling::step`](super::SoftCoupling::step) ran it or the caller of
+//! [`SoftCoupling::substep`](super::SoftCoupling::substep) did.
 //!
 //! A held body (one rapier's contacts hold up, see
-//! [`RigidProxy::hold`](crate::rigid::RigidProxy::hold)) is moved in the next soft step by
-//! that pull and the soft forces: the soft step then sees the body as rapier will move
-//! it, and a board whose foot rapier's ground holds while its top leans on a soft block rests,
-//! instead of being pushed away by the block alone and pulled back by rapier's step in turn.
+//! [`RigidProxy::hold`](crate::rigid::RigidProxy::hold)) is moved in the next soft step by that
+//! pull and the soft forces: the soft step then sees the body as rapier will move it, and a board
+//! whose foot rapier's ground holds while its top leans on a soft block rests, instead of being
+//! pushed away by the block alone and pulled back by rapier's step in turn.
 
 use crate::rigid::RigidProxy;
 use rapier3d::dynamics::{RigidBodyHandle, RigidBodySet};
 use rapier3d::glamx::DVec3;
 
-/// The pull of rapier's step on each held rigid body: linear (m/s²) and angular (rad/s²).
+/// The pull of rapier's last step on each held rigid body, and the velocities handed to the
+/// coming one.
 #[derive(Debug, Clone, Default)]
 #[cfg_attr(
     feature = "serde-serialize",
     derive(serde::Serialize, serde::Deserialize)
 )]
 pub(crate) struct RapierPull {
+    /// Per body: linear (m/s²) and angular (rad/s²) pull.
     pulls: Vec<(RigidBodyHandle, DVec3, DVec3)>,
-}
-
-/// The held bodies' velocities handed to a rapier step, to measure its pull with.
-pub(super) struct BeforeRapier {
-    velocities: Vec<(RigidBodyHandle, DVec3, DVec3)>,
+    /// Per held body: its velocities (m/s, rad/s) when the last soft substep ended.
+    handed: Vec<(RigidBodyHandle, DVec3, DVec3)>,
+    /// That substep's length (s).
+    h: f64,
 }
 
 impl RapierPull {
@@ -36,27 +39,32 @@ impl RapierPull {
             .map_or((DVec3::ZERO, DVec3::ZERO), |&(_, a, alpha)| (a, alpha))
     }
 
-    /// Notes the velocities in `bodies` of the held proxies of `proxies` before rapier's step.
-    pub(super) fn before<'a>(
+    /// Notes, as a soft substep of `h` (s) ends, the velocities in `bodies` of the held dynamic
+    /// bodies among `proxies`.
+    pub(super) fn note_handed<'a>(
+        &mut self,
         proxies: impl Iterator<Item = &'a RigidProxy>,
         bodies: &RigidBodySet,
-    ) -> BeforeRapier {
-        let mut velocities = Vec::new();
+        h: f64,
+    ) {
+        self.handed.clear();
+        self.h = h;
         for proxy in proxies.filter(|p| p.is_dynamic() && p.is_held()) {
-            if velocities.iter().any(|(h, _, _)| *h == proxy.handle) {
+            if self.handed.iter().any(|(h, _, _)| *h == proxy.handle) {
                 continue;
             }
             if let Some(body) = bodies.get(proxy.handle) {
                 let (v, w) = (body.linvel().as_dvec3(), body.angvel().as_dvec3());
-                velocities.push((proxy.handle, v, w));
+                self.handed.push((proxy.handle, v, w));
             }
         }
-        BeforeRapier { velocities }
     }
 
-    /// The pull of rapier's step of `h` (s) on the bodies noted `before`.
-    pub(super) fn measure(before: BeforeRapier, bodies: &RigidBodySet, h: f64) -> Self {
-        let pulls = (before.velocities.into_iter())
+    /// Measures, as a soft substep begins, the pull of the rapier step since the last one ended
+    /// from the velocities in `bodies` (a body asleep or gone has none).
+    pub(super) fn measure(&mut self, bodies: &RigidBodySet) {
+        let h = self.h;
+        self.pulls = (self.handed.drain(..))
             .filter_map(|(handle, v, w)| {
                 let body = bodies.get(handle).filter(|b| !b.is_sleeping())?;
                 let a = (body.linvel().as_dvec3() - v) / h;
@@ -64,6 +72,5 @@ impl RapierPull {
                 Some((handle, a, alpha))
             })
             .collect();
-        Self { pulls }
     }
 }

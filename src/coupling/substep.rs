@@ -27,8 +27,10 @@ impl SoftCoupling {
     /// step is refused, in this substep or an earlier one of the frame, stays where it was and
     /// holds the rigid bodies it touches or is glued to as a fixed obstacle would
     /// ([`constraint::hold_partners`]): rapier's step must not let them sink into it meanwhile.
-    /// Returns the dynamic rigid bodies implicit steps moved, for rapier's step to carry them
-    /// as those steps did ([`RapierCarry`](super::carry::RapierCarry)).
+    /// The rigid bodies rapier's contacts hold move in the soft step by what rapier's step did
+    /// to them since the last substep ended ([`RapierPull`]). Returns the dynamic rigid bodies
+    /// implicit steps moved, for rapier's step to carry them as those steps did
+    /// ([`RapierCarry`](super::carry::RapierCarry)).
     pub(super) fn step_soft_bodies(
         &mut self,
         soft_bodies: &mut DeformableBodySet,
@@ -39,6 +41,7 @@ impl SoftCoupling {
     ) -> Vec<Carried> {
         let margin = self.contact.margin;
         let sleep = (h, gravity, margin);
+        self.pull.measure(rigid.bodies);
         (self.sleeping).wake_disturbed(
             soft_bodies,
             &mut rigid,
@@ -62,6 +65,8 @@ impl SoftCoupling {
         let links = &self.links;
         let constraints = |handle| links.get(handle).map(|l: &BodyLinks| &l.constraints);
         (self.sleeping).settle(soft_bodies, constraints, &mut rigid, &self.sleep, sleep);
+        let proxies = (self.links.iter()).flat_map(|(_, l)| &l.constraints.rigid_proxies);
+        self.pull.note_handed(proxies, rigid.bodies, h);
         carried
     }
 
