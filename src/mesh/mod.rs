@@ -222,8 +222,10 @@ impl TetMesh {
 }
 
 /// Signed volume of a tetrahedron (m^3): positive when positively oriented.
+#[inline]
 pub(crate) fn signed_volume(positions: &[DVec3], tet: &[u32; 4]) -> f64 {
-    let [a, b, c, d] = tet.map(|i| positions[i as usize]);
+    let node = |k: usize| positions[tet[k] as usize];
+    let (a, b, c, d) = (node(0), node(1), node(2), node(3));
     (b - a).cross(c - a).dot(d - a) / 6.0
 }
 
