@@ -368,8 +368,9 @@ pub(crate) fn for_each_implicit_term(
 /// over the terms, `F` each term's force on the body where the step ends and `a` its rigid
 /// body's point, fixed over the step (a corner's vertex, a contact plane's point, an anchor);
 /// `None` when a term pushes the body against something else (a fixed or kinematic collider or
-/// anchor), which takes angular momentum anyway; its own surface (a self-contact) gives none. The body receives `F h` at its
-/// own point, where its nodes end the step; the two differ by the points' relative travel.
+/// anchor), which takes angular momentum anyway; its own surface (a self-contact, internal)
+/// gives none. The body receives `F h` at its own point, where its nodes end the step; the two
+/// differ by the points' relative travel.
 pub(crate) fn partner_angular_impulse(
     body: &DeformableBody,
     constraints: &BodyConstraints,

@@ -237,8 +237,9 @@ fn hand_over(
     step.constraints.transfer_contact_impulses(bodies);
 }
 
-/// Holds the rigid bodies a body's `constraints` touch that rigid contacts support: within the soft step they
-/// would otherwise fall freely, the ground that holds them acting only in rapier's step.
+/// Holds the rigid bodies a body's `constraints` touch that rigid contacts support, moving them
+/// in the soft step by rapier's `pull` on them instead of gravity: they would otherwise fall
+/// freely there, the ground that holds them acting only in rapier's step.
 fn hold_supported_bodies(
     constraints: &mut BodyConstraints,
     rigid: &RigidSets<'_>,
