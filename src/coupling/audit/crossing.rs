@@ -13,9 +13,8 @@
 
 use super::PenetrationTarget;
 use super::Penetrations;
-use super::penetration::{Checked, depth_inside};
+use super::penetration::{Checked, depth_inside, disjoint};
 use crate::body::{DeformableBody, DeformableBodyHandle};
-use crate::contact::contact_point_positions;
 use rapier3d::glamx::DVec3;
 
 /// Records in `found` the contact points of `checked` that went through `other` (handle
@@ -27,22 +26,24 @@ pub(super) fn through_soft(
     other_before: &[DVec3],
     found: &mut Penetrations,
 ) {
-    let body = checked.body;
-    let Some(previous) = checked.previous else {
+    let (Some(before), Some(before_bounds)) = (&checked.before, checked.bounds_before()) else {
         return;
     };
-    if !body.collision_groups.test(other.collision_groups)
-        || previous.len() != body.positions().len()
+    if !checked.body.collision_groups.test(other.collision_groups)
         || other_before.len() != other.positions().len()
     {
         return;
     }
-    let carried = centre_of_mass(other, other.positions()) - centre_of_mass(other, other_before);
     let bounds = other.position_bounds();
     let (lo, hi) = (bounds.0 - checked.tolerance, bounds.1 + checked.tolerance);
-    let now = contact_point_positions(body, body.positions());
-    let before = contact_point_positions(body, previous);
-    for ((to, _), (from, _)) in now.iter().zip(&before) {
+    let carried = centre_of_mass(other, other.positions()) - centre_of_mass(other, other_before);
+    // Every path lies in the box of its ends.
+    let starts = (before_bounds.0 + carried, before_bounds.1 + carried);
+    let ends = checked.bounds_now();
+    if disjoint((starts.0.min(ends.0), starts.1.max(ends.1)), (lo, hi)) {
+        return;
+    }
+    for ((to, _), (from, _)) in checked.now.iter().zip(before) {
         let from = *from + carried;
         let (path_lo, path_hi) = (from.min(*to), from.max(*to));
         if path_lo.cmpgt(hi).any() || path_hi.cmplt(lo).any() {

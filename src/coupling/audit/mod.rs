@@ -206,12 +206,15 @@ impl Audit {
             members: clusters.iter().flat_map(|c| c.members.clone()).collect(),
             exchanging: clusters.iter().flat_map(|c| c.exchanging.clone()).collect(),
         });
-        let bodies = (input.soft_bodies.iter())
-            .map(|(handle, _)| {
+        let mut handles: Vec<_> = input.soft_bodies.iter().map(|(handle, _)| handle).collect();
+        let audits = crate::parallel::map_chunks(&mut handles, 1, |_, handle| {
+            self.body_audit(&input, handle[0], previous, results)
+        });
+        let bodies = (handles.into_iter().zip(audits))
+            .map(|(handle, mut audit)| {
                 let cluster = clusters
                     .iter()
                     .find(|c| c.members.contains(&Member::Soft(handle)));
-                let mut audit = self.body_audit(&input, handle, previous, results);
                 audit.energy = cluster.map_or_else(|| energy_of(&[]), checked);
                 (handle, audit)
             })
@@ -238,12 +241,8 @@ impl Audit {
         let glued = input.coupling.constraints(handle).map_or(Vec::new(), |c| {
             c.attachments.iter().map(|a| (a.body, a.node)).collect()
         });
-        let checked = Checked {
-            body,
-            glued,
-            previous: previous.and_then(|p| p.positions.get(&handle).map(Vec::as_slice)),
-            tolerance,
-        };
+        let before = previous.and_then(|p| p.positions.get(&handle).map(Vec::as_slice));
+        let checked = Checked::new(body, glued, before, tolerance);
         let mut penetrations = Penetrations::default();
         let poses = previous.map_or(HashMap::new(), |p| p.collider_poses.clone());
         penetration::against_colliders(

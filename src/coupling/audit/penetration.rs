@@ -28,16 +28,79 @@ use rapier3d::parry::query::Ray;
 use std::collections::HashMap;
 
 /// A deformable body as the contact check sees it: the body, the nodes glued to rigid bodies,
-/// its positions (m) at the end of the previous frame if known, and the tolerance (m).
+/// its contact points now and at the end of the previous frame if known (m, each with the nodes
+/// it interpolates), and the tolerance (m).
 pub(super) struct Checked<'a> {
     pub(super) body: &'a DeformableBody,
     pub(super) glued: Vec<(RigidBodyHandle, u32)>,
-    pub(super) previous: Option<&'a [DVec3]>,
+    pub(super) now: Vec<(DVec3, Vec<u32>)>,
+    pub(super) before: Option<Vec<(DVec3, Vec<u32>)>>,
     pub(super) tolerance: f64,
+}
+
+impl<'a> Checked<'a> {
+    /// The check of `body` with `glued` nodes, whose nodes were at `previous` (m) at the end of
+    /// the previous frame if known (ignored unless one per node), within `tolerance` (m).
+    pub(super) fn new(
+        body: &'a DeformableBody,
+        glued: Vec<(RigidBodyHandle, u32)>,
+        previous: Option<&[DVec3]>,
+        tolerance: f64,
+    ) -> Self {
+        let before = previous
+            .filter(|previous| previous.len() == body.positions().len())
+            .map(|previous| contact_point_positions(body, previous));
+        let now = contact_point_positions(body, body.positions());
+        Self {
+            body,
+            glued,
+            now,
+            before,
+            tolerance,
+        }
+    }
+
+    /// The box (m) holding the contact points now.
+    pub(super) fn bounds_now(&self) -> (DVec3, DVec3) {
+        bounds_of(self.now.iter().map(|(x, _)| *x))
+    }
+
+    /// The box (m) holding the contact points at the end of the previous frame, if known.
+    pub(super) fn bounds_before(&self) -> Option<(DVec3, DVec3)> {
+        (self.before.as_ref()).map(|before| bounds_of(before.iter().map(|(x, _)| *x)))
+    }
+
+    /// The longest distance (m) a contact point moved over the frame (zero if not known).
+    fn longest_move(&self) -> f64 {
+        let Some(before) = &self.before else {
+            return 0.0;
+        };
+        (self.now.iter().zip(before))
+            .map(|((to, _), (from, _))| (*to - *from).length())
+            .fold(0.0, f64::max)
+    }
+}
+
+/// The smallest box `(lo, hi)` (m) holding `points` (empty, lo above hi, if there are none).
+pub(super) fn bounds_of(points: impl Iterator<Item = DVec3>) -> (DVec3, DVec3) {
+    points.fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), x| {
+        (lo.min(x), hi.max(x))
+    })
+}
+
+/// Whether the boxes `(lo, hi)` (m) share no point.
+pub(super) fn disjoint(a: (DVec3, DVec3), b: (DVec3, DVec3)) -> bool {
+    a.0.cmpgt(b.1).any() || a.1.cmplt(b.0).any()
 }
 
 /// Records in `found` the body's points deeper than the tolerance in `colliders`, and those
 /// that crossed one since the previous frame, whose colliders were at `poses` then.
+///
+/// A collider is passed over whole when its box, widened by the longest path a point can have
+/// taken in its frame, misses the points' box: a point's path (its start carried along with
+/// the collider's motion) lies within the path's length of its end, and that length is at most
+/// the point's own move plus how far the collider's motion carried its start, the latter
+/// largest at a corner of the box of the starts (the carrying is affine, its length convex).
 pub(super) fn against_colliders(
     checked: &Checked<'_>,
     colliders: &ColliderSet,
@@ -45,14 +108,26 @@ pub(super) fn against_colliders(
     poses: &HashMap<ColliderHandle, Pose>,
     found: &mut Penetrations,
 ) {
-    let body = checked.body;
-    let now = contact_point_positions(body, body.positions());
-    let before = checked
-        .previous
-        .filter(|previous| previous.len() == body.positions().len())
-        .map(|previous| contact_point_positions(body, previous));
+    let (now_bounds, before_bounds) = (checked.bounds_now(), checked.bounds_before());
+    let longest_move = checked.longest_move();
     for (handle, collider) in colliders.iter() {
-        if collider.is_sensor() || !body.collision_groups.test(collider.collision_groups()) {
+        if collider.is_sensor()
+            || !checked
+                .body
+                .collision_groups
+                .test(collider.collision_groups())
+        {
+            continue;
+        }
+        let aabb = collider.compute_aabb();
+        let aabb = (aabb.mins.as_dvec3(), aabb.maxs.as_dvec3());
+        let then = poses.get(&handle);
+        let carried = match (before_bounds, then) {
+            (Some(before), Some(then)) => longest_carry(collider.position(), then, before),
+            _ => 0.0,
+        };
+        let reach = longest_move + carried;
+        if disjoint((aabb.0 - reach, aabb.1 + reach), now_bounds) {
             continue;
         }
         let parent = collider.parent().filter(|h| bodies.get(*h).is_some());
@@ -60,16 +135,16 @@ pub(super) fn against_colliders(
             .filter(|(rigid, _)| Some(*rigid) == parent)
             .map(|(_, node)| *node)
             .collect();
-        for (i, (x, nodes)) in now.iter().enumerate() {
+        for (i, (x, nodes)) in checked.now.iter().enumerate() {
             if nodes.iter().any(|n| glued.contains(n)) {
                 continue;
             }
-            let depth = depth_in(collider, *x);
+            let depth = depth_in(collider, aabb, *x);
             if depth > checked.tolerance {
                 found.add_penetration(depth, PenetrationTarget::Collider(handle));
-            } else if let (Some(before), Some(pose)) = (&before, poses.get(&handle))
+            } else if let (Some(before), Some(then)) = (&checked.before, then)
                 && depth <= 0.0
-                && crossed(collider, pose, before[i].0, *x, checked.tolerance)
+                && crossed((collider, aabb), then, (before[i].0, *x), checked.tolerance)
             {
                 found.crossed += 1;
                 found
@@ -80,10 +155,26 @@ pub(super) fn against_colliders(
     }
 }
 
-/// How deep (m) `x` lies inside `collider` (zero or less outside): its distance to the surface.
-fn depth_in(collider: &Collider, x: DVec3) -> f64 {
-    let aabb = collider.compute_aabb();
-    let (lo, hi) = (aabb.mins.as_dvec3(), aabb.maxs.as_dvec3());
+/// The farthest (m) the motion of a collider from pose `then` to `now` carries a point of the
+/// box `(lo, hi)` (m): its largest at one of the box's corners.
+fn longest_carry(now: &Pose, then: &Pose, (lo, hi): (DVec3, DVec3)) -> f64 {
+    (0..8)
+        .map(|corner| {
+            let pick = |bit: usize, l: f64, h: f64| if corner >> bit & 1 == 0 { l } else { h };
+            let x = DVec3::new(
+                pick(0, lo.x, hi.x),
+                pick(1, lo.y, hi.y),
+                pick(2, lo.z, hi.z),
+            );
+            let carried = now.transform_point(then.inverse_transform_point(x.as_vec3()));
+            (carried.as_dvec3() - x).length()
+        })
+        .fold(0.0, f64::max)
+}
+
+/// How deep (m) `x` lies inside `collider`, whose box is `(lo, hi)` (m), (zero or less
+/// outside): its distance to the surface.
+fn depth_in(collider: &Collider, (lo, hi): (DVec3, DVec3), x: DVec3) -> f64 {
     if x.cmplt(lo).any() || x.cmpgt(hi).any() {
         return 0.0;
     }
@@ -97,15 +188,23 @@ fn depth_in(collider: &Collider, x: DVec3) -> f64 {
     }
 }
 
-/// Whether the point that was at `from` (m) when `collider` was at `then` went through it on its
-/// way to `to` (m), a path longer than `tolerance` (m).
-fn crossed(collider: &Collider, then: &Pose, from: DVec3, to: DVec3, tolerance: f64) -> bool {
+/// Whether the point that was at `from` (m) when `collider` (whose box is `aabb`, m) was at
+/// `then` went through it on its way to `to` (m), a path longer than `tolerance` (m).
+fn crossed(
+    (collider, aabb): (&Collider, (DVec3, DVec3)),
+    then: &Pose,
+    (from, to): (DVec3, DVec3),
+    tolerance: f64,
+) -> bool {
     let pose = collider.position();
     // Where the point started, carried along with the collider's motion over the frame.
     let from = pose
         .transform_point(then.inverse_transform_point(from.as_vec3()))
         .as_dvec3();
     let path = to - from;
+    if disjoint((from.min(to), from.max(to)), aabb) {
+        return false;
+    }
     let shape = collider.shape();
     // A point inside at the start was a penetration then, not a crossing now.
     if path.length() <= tolerance || shape.project_point(pose, from.as_vec3(), false).is_inside {
@@ -139,12 +238,14 @@ pub(super) fn against_soft(
     other_handle: DeformableBodyHandle,
     found: &mut Penetrations,
 ) {
-    if !checked.body.collision_groups.test(other.collision_groups) {
+    let bounds = other.position_bounds();
+    if !checked.body.collision_groups.test(other.collision_groups)
+        || disjoint(bounds, checked.bounds_now())
+    {
         return;
     }
-    let (body, bounds) = (checked.body, other.position_bounds());
-    for (point, _) in contact_point_positions(body, body.positions()) {
-        if let Some(depth) = depth_inside(other, bounds, point)
+    for (point, _) in &checked.now {
+        if let Some(depth) = depth_inside(other, bounds, *point)
             && depth > checked.tolerance
         {
             found.add_penetration(depth, PenetrationTarget::SoftBody(other_handle));
