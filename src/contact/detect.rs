@@ -76,6 +76,14 @@ pub(crate) fn detect(
     let mut tree = None;
     let mut corners = Vec::new();
     let contact_points = contact_points(body);
+    let point_bounds = (contact_points.iter())
+        .map(|at| {
+            at.stencil(body.embedding.as_ref())
+                .interpolate(&body.positions)
+        })
+        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), x| {
+            (lo.min(x), hi.max(x))
+        });
     let last = last_contacts(previous);
     let last_corners: HashMap<_, _> = (previous.0.corners.iter())
         .map(|c| (c.key(), c.stiffening))
@@ -86,7 +94,13 @@ pub(crate) fn detect(
         }
         let near = near_collider(body, glued, view, reach);
         let mut proxy = None;
-        for &at in &contact_points {
+        // A point is a candidate only within the collider's widened box (`node_contact_with`).
+        let candidates = if near.overlaps(point_bounds) {
+            contact_points.as_slice()
+        } else {
+            &[]
+        };
+        for &at in candidates {
             let Some(contact) = node_contact_with(body, &near, (at, last.get(&(at, view.handle))))
             else {
                 continue;
