@@ -76,14 +76,10 @@ pub(crate) fn detect(
     let mut tree = None;
     let mut corners = Vec::new();
     let contact_points = contact_points(body);
-    let point_bounds = (contact_points.iter())
-        .map(|at| {
-            at.stencil(body.embedding.as_ref())
-                .interpolate(&body.positions)
-        })
-        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), x| {
-            (lo.min(x), hi.max(x))
-        });
+    let point_bounds = crate::mesh::bounding_box((contact_points.iter()).map(|at| {
+        at.stencil(body.embedding.as_ref())
+            .interpolate(&body.positions)
+    }));
     let last = last_contacts(previous);
     let last_corners: HashMap<_, _> = (previous.0.corners.iter())
         .map(|c| (c.key(), c.stiffening))

@@ -154,10 +154,7 @@ impl DeformableBody {
 
     /// The corners (m) of the box bounding the body's nodes now.
     pub(crate) fn position_bounds(&self) -> (DVec3, DVec3) {
-        self.positions.iter().fold(
-            (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-            |(lo, hi), x| (lo.min(*x), hi.max(*x)),
-        )
+        crate::mesh::bounding_box(self.positions.iter().copied())
     }
 
     /// The body's fastest node speed (m/s).

@@ -193,12 +193,7 @@ pub struct SolverPrediction {
 pub fn predict(body: &DeformableBody, h: f64, tolerance: f64) -> SolverPrediction {
     let material = body.material();
     let highest = 2.0 * material.dilatational_wave_speed() / body.wave_length_scale();
-    let (low, high) = body
-        .positions()
-        .iter()
-        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(low, high), x| {
-            (low.min(*x), high.max(*x))
-        });
+    let (low, high) = crate::mesh::bounding_box(body.positions().iter().copied());
     let lowest = body.mean_wave_speed() / (high - low).length();
     let beta = body.damping().map_or(0.0, |d| {
         d.p_wave_viscosity() / material.lame().p_wave_modulus()

@@ -221,6 +221,14 @@ impl TetMesh {
     }
 }
 
+/// The smallest box `(lo, hi)` (m) holding `points`; `lo` above `hi` (infinite) if there are
+/// none.
+pub(crate) fn bounding_box(points: impl IntoIterator<Item = DVec3>) -> (DVec3, DVec3) {
+    (points.into_iter()).fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), x| {
+        (lo.min(x), hi.max(x))
+    })
+}
+
 /// Signed volume of a tetrahedron (m^3): positive when positively oriented.
 #[inline]
 pub(crate) fn signed_volume(positions: &[DVec3], tet: &[u32; 4]) -> f64 {

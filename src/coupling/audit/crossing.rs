@@ -45,8 +45,7 @@ pub(super) fn through_soft(
     }
     for ((to, _), (from, _)) in checked.now.iter().zip(before) {
         let from = *from + carried;
-        let (path_lo, path_hi) = (from.min(*to), from.max(*to));
-        if path_lo.cmpgt(hi).any() || path_hi.cmplt(lo).any() {
+        if disjoint((from.min(*to), from.max(*to)), (lo, hi)) {
             continue;
         }
         if went_through(other, bounds, (from, *to), checked.tolerance) {

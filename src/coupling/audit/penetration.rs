@@ -20,6 +20,7 @@
 use super::{PenetrationTarget, Penetrations};
 use crate::body::{DeformableBody, DeformableBodyHandle};
 use crate::contact::{contact_point_positions, nearest_point_on_triangle};
+use crate::mesh::bounding_box;
 use rapier3d::dynamics::{RigidBodyHandle, RigidBodySet};
 use rapier3d::geometry::{Collider, ColliderHandle, ColliderSet};
 use rapier3d::glamx::DVec3;
@@ -62,12 +63,12 @@ impl<'a> Checked<'a> {
 
     /// The box (m) holding the contact points now.
     pub(super) fn bounds_now(&self) -> (DVec3, DVec3) {
-        bounds_of(self.now.iter().map(|(x, _)| *x))
+        bounding_box(self.now.iter().map(|(x, _)| *x))
     }
 
     /// The box (m) holding the contact points at the end of the previous frame, if known.
     pub(super) fn bounds_before(&self) -> Option<(DVec3, DVec3)> {
-        (self.before.as_ref()).map(|before| bounds_of(before.iter().map(|(x, _)| *x)))
+        (self.before.as_ref()).map(|before| bounding_box(before.iter().map(|(x, _)| *x)))
     }
 
     /// The longest distance (m) a contact point moved over the frame (zero if not known).
@@ -79,13 +80,6 @@ impl<'a> Checked<'a> {
             .map(|((to, _), (from, _))| (*to - *from).length())
             .fold(0.0, f64::max)
     }
-}
-
-/// The smallest box `(lo, hi)` (m) holding `points` (empty, lo above hi, if there are none).
-pub(super) fn bounds_of(points: impl Iterator<Item = DVec3>) -> (DVec3, DVec3) {
-    points.fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), x| {
-        (lo.min(x), hi.max(x))
-    })
 }
 
 /// Whether the boxes `(lo, hi)` (m) share no point.

@@ -128,10 +128,6 @@ impl Surface {
 
     /// The smallest and largest corner of the vertices' bounding box (m).
     fn bounds(&self) -> (DVec3, DVec3) {
-        self.vertices
-            .iter()
-            .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &p| {
-                (lo.min(p), hi.max(p))
-            })
+        crate::mesh::bounding_box(self.vertices.iter().copied())
     }
 }
