@@ -120,7 +120,8 @@ pub(super) fn against_colliders(
             (Some(before), Some(then)) => longest_carry(collider.position(), then, before),
             _ => 0.0,
         };
-        let reach = longest_move + carried;
+        // The tolerance on top covers the single-precision poses' round-off in `crossed`.
+        let reach = longest_move + carried + checked.tolerance;
         if disjoint((aabb.0 - reach, aabb.1 + reach), now_bounds) {
             continue;
         }
