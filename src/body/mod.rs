@@ -82,8 +82,8 @@ pub struct DeformableBody {
     pub restitution_combine_rule: CoefficientCombineRule,
     /// Whether the body's surface collides with itself (a body folding over itself, or made of
     /// separate parts): off by default, as it costs a bounding-volume query per surface node and
-    /// detection. Both integrators solve self-contacts; the automatic one picks the explicit
-    /// ([`SymplecticEuler`](crate::integrate::SymplecticEuler)) while there are some.
+    /// detection. Both integrators solve self-contacts; the automatic one picks between them by
+    /// cost, as for any other contact.
     pub self_contact: bool,
     /// Arbitrary user data, as on rapier's bodies.
     pub user_data: u128,

@@ -20,9 +20,9 @@
 //!    together, `pull.rs`), not by gravity alone: otherwise they would fall freely there, the
 //!    ground that holds them acting only in rapier's step.
 //! 4. **Soft step.** Bodies touching each other step together, so that their contacts are
-//!    solved with both bodies' nodes: explicitly in the same sweeps, or, when the implicit
-//!    integrator is forced (or the explicit frame would take too many substeps), as one implicit
-//!    system; the others step alone by [`SoftCoupling::integrator`]. The explicit substeps carry
+//!    solved with both bodies' nodes, by the cheaper integrator (or the forced one): explicitly
+//!    in the same sweeps, or as one implicit system; the others step alone by
+//!    [`SoftCoupling::integrator`]. The explicit substeps carry
 //!    the rigid bodies they touch along at the velocities the impulses leave them, as they move
 //!    the nodes, so that a fast body sweeps through the nodes in its path within the soft step:
 //!    a 2 cm ball at 30 m/s, 3 cm per coupling substep of a 1/240 s frame, meets the nodes it

@@ -95,8 +95,8 @@ impl AutomaticIntegrator {
 
     /// Advances `body` by `frame_dt` (s) under gravity (m/s²) against its `constraints`, with
     /// `workspace` its solver caches, by the cheaper integrator (or the forced one); explicit
-    /// while it has self-contacts, or points or corners found deeper behind their contact
-    /// planes than twice the contacts' resting depth.
+    /// while points or corners are found deeper behind their contact planes than twice the
+    /// contacts' resting depth.
     ///
     /// A frame refused again from exactly what the last refused frame started from (the body's
     /// positions, velocities and loads, its constraints, the frame's length and gravity, the
