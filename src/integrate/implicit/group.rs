@@ -12,7 +12,7 @@
 //! [`ImplicitIntegrator::linear_solver`] says; the scheme is BDF2 only when every body of the
 //! group has the history for it, backward Euler otherwise, so that all take the same `ĥ`.
 
-use super::direction::engaging;
+use super::direction::{UnengagedTangent, engaging};
 use super::potential::{Engaged, Potential, StepStart};
 use super::rigid_response::{Placement, RigidResponse};
 use super::{
@@ -571,9 +571,10 @@ impl ImplicitIntegrator {
         (inertia, residual): (&[Vec<f64>], &[DVec3]),
         outcome: &mut Outcome,
     ) -> Result<Vec<DVec3>, Error> {
+        let mut tangent = UnengagedTangent::default();
         let solve = |rhs: &[DVec3], engaged: Option<&Engaged>| {
             let system = (inertia, rhs, engaged);
-            let tangents = (&mut *joint, &mut *parts);
+            let tangents = (&mut *joint, &mut *parts, &mut tangent);
             let direction = self.solve_group(group, potential, tangents, system, &mut *outcome)?;
             Ok((direction, ()))
         };
@@ -588,13 +589,14 @@ impl ImplicitIntegrator {
     }
 
     /// The solution (m per node of the group) of the Newton system for the right-hand side `rhs`
-    /// (N) with the group's exact tangent and the `engaged` contacts' tangents, with the members'
-    /// chambers' liquids taken in, then each body's rigid partners' response.
+    /// (N) with the group's exact tangent (assembled once per projection into `tangent`) and the
+    /// `engaged` contacts' tangents, with the members' chambers' liquids taken in, then each
+    /// body's rigid partners' response.
     fn solve_group(
         &self,
         group: &Group,
         potential: &GroupPotential,
-        (joint, parts): (&mut Stiffness, &mut [Stiffness]),
+        (joint, parts, tangent): (&mut Stiffness, &mut [Stiffness], &mut UnengagedTangent),
         (inertia, residual, engaged): (&[Vec<f64>], &[DVec3], Option<&Engaged>),
         outcome: &mut Outcome,
     ) -> Result<Vec<DVec3>, Error> {
@@ -605,10 +607,9 @@ impl ImplicitIntegrator {
             residual,
             outcome.iterations,
             |joint, project| {
-                potential.assemble(group, (joint, &mut *parts), inertia, project);
-                if let Some(engaged) = engaged {
-                    engaged.add_to(joint, &group.pinned);
-                }
+                tangent.fill(joint, project, (engaged, &group.pinned), |joint| {
+                    potential.assemble(group, (joint, &mut *parts), inertia, project);
+                });
             },
         )?;
         outcome.factorizations += solution.factorizations;
