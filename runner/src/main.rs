@@ -191,13 +191,17 @@ fn run(
         );
         let c = &body.cost;
         println!(
-            "       {:<16} per step: predicted explicit {:.3} ms, implicit {:.3} ms; used {:.3} ms predicted, {:.3} ms measured ({:.2}x)",
+            "       {:<16} per step: predicted explicit {:.3} ms, implicit {:.3} ms; used {:.3} ms predicted, {:.3} ms measured ({:.2}x; explicit steps {:.2}x, median {:.2}x; implicit {:.2}x, median {:.2}x)",
             "",
             c.predicted_explicit_ms,
             c.predicted_implicit_ms,
             c.predicted_ms,
             c.measured_ms,
-            c.measured_over_predicted
+            c.measured_over_predicted,
+            c.explicit.measured_over_predicted,
+            c.explicit.median_measured_over_predicted,
+            c.implicit.measured_over_predicted,
+            c.implicit.median_measured_over_predicted,
         );
     }
     for probe in &report.probes {

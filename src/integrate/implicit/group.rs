@@ -29,7 +29,6 @@ use crate::linear_solver::{Method, solve_newton_system};
 use crate::load::{ChamberSolve, ChamberTerms};
 use crate::newton::{Configuration, Search, descend, norm, round_off_floor};
 use rapier3d::glamx::DVec3;
-use std::cell::RefCell;
 
 /// The group's bodies as Newton moves them, their nodes numbered body after body.
 struct Group<'s, 'b> {
@@ -420,10 +419,8 @@ impl ImplicitIntegrator {
                     .iter()
                     .zip(&constraints)
                     .zip(responses)
-                    .map(|((start, constraints), response)| Potential {
-                        start,
-                        constraints,
-                        rigid: RefCell::new(response),
+                    .map(|((start, constraints), response)| {
+                        Potential::new(start, constraints, response)
                     })
                     .collect(),
                 between: &solver.between,
@@ -437,6 +434,12 @@ impl ImplicitIntegrator {
                 let energy = potential.energy(&group);
                 self.newton_group(&mut group, &potential, parts, energy)
             };
+            // Each evaluation of the group's energy evaluates every member's once.
+            let evaluations = potential.members.first().map_or(0, Potential::evaluations);
+            let outcome = outcome.map(|o| Outcome {
+                energy_evaluations: evaluations,
+                ..o
+            });
             responses = (potential.members.into_iter())
                 .map(|member| member.rigid.into_inner())
                 .collect();

@@ -42,7 +42,6 @@ use potential::{Potential, StepStart};
 use rapier3d::glamx::DVec3;
 use report::{Outcome, Stop};
 use rigid_response::RigidResponse;
-use std::cell::RefCell;
 
 /// Newton stops early on a stalled residual below this relative value, or within
 /// [`ROUND_OFF_MARGIN`] of its measured round-off floor; above both, a slow descent is still
@@ -386,11 +385,7 @@ impl ImplicitIntegrator {
     ) -> Result<Outcome, Error> {
         let (start, response) =
             self.begin_substep(body, constraints, solver.last_step.as_ref(), (h, gravity));
-        let incremental = Potential {
-            start: &start,
-            constraints,
-            rigid: RefCell::new(response),
-        };
+        let incremental = Potential::new(&start, constraints, response);
         // Newton starts from the inertial prediction `x̂` (free flight: the warm start that makes
         // smooth motion cost one iteration), or from where the body is when that is the lower
         // potential (a prediction deep inside an obstacle or crushing elements).
@@ -403,6 +398,7 @@ impl ImplicitIntegrator {
             potential = here;
         }
         let mut outcome = self.minimize(body, solver, &incremental, potential)?;
+        outcome.energy_evaluations = incremental.evaluations();
         let mut response = incremental.rigid.into_inner();
         for _ in 0..STIFFENING_ROUNDS {
             response.solve(body, constraints);
@@ -417,13 +413,11 @@ impl ImplicitIntegrator {
                 break;
             }
             response.forget_solution();
-            let stiffened = Potential {
-                start: &start,
-                constraints,
-                rigid: RefCell::new(response),
-            };
+            let stiffened = Potential::new(&start, constraints, response);
             let potential = stiffened.energy(body);
-            outcome = outcome.then(self.minimize(body, solver, &stiffened, potential)?);
+            let mut again = self.minimize(body, solver, &stiffened, potential)?;
+            again.energy_evaluations = stiffened.evaluations();
+            outcome = outcome.then(again);
             response = stiffened.rigid.into_inner();
         }
         let previous = solver.last_step.as_ref().map(|step| step.h);

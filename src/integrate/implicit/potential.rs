@@ -22,7 +22,7 @@ use crate::material::green_strain;
 use crate::newton::norm;
 use crate::stencil::Stencil;
 use rapier3d::glamx::{DMat3, DVec3};
-use std::cell::RefCell;
+use std::cell::{Cell, RefCell};
 
 /// Per-step data of the incremental potential.
 pub(super) struct StepStart {
@@ -172,9 +172,32 @@ pub(super) struct Potential<'a> {
     pub(super) start: &'a StepStart,
     pub(super) constraints: &'a BodyConstraints,
     pub(super) rigid: RefCell<RigidResponse>,
+    /// Evaluations of [`Potential::energy`] so far (reported as
+    /// [`ImplicitReport::energy_evaluations`](super::ImplicitReport::energy_evaluations)).
+    evaluations: Cell<usize>,
 }
 
-impl Potential<'_> {
+impl<'a> Potential<'a> {
+    /// The potential of the step from `start`, with the `constraints`' terms and the dynamic
+    /// rigid bodies' `response`; not yet evaluated.
+    pub(super) fn new(
+        start: &'a StepStart,
+        constraints: &'a BodyConstraints,
+        response: RigidResponse,
+    ) -> Self {
+        Self {
+            start,
+            constraints,
+            rigid: RefCell::new(response),
+            evaluations: Cell::new(0),
+        }
+    }
+
+    /// Evaluations of the energy so far.
+    pub(super) fn evaluations(&self) -> usize {
+        self.evaluations.get()
+    }
+
     /// `-∇E` (N): elastic and damping forces, gravity and loads, contact penalties and the inertial pull
     /// toward `x̂`; zero on pinned nodes. `forces` is scratch for the internal forces.
     pub(super) fn residual(
@@ -237,6 +260,7 @@ impl Potential<'_> {
 
     /// The incremental potential `E(x)` (J) at the body's positions.
     pub(super) fn energy(&self, body: &DeformableBody) -> f64 {
+        self.evaluations.set(self.evaluations.get() + 1);
         let inertia: f64 = (0..body.positions.len())
             .map(|n| {
                 0.5 * body.masses[n] * (body.positions[n] - self.start.target[n]).length_squared()

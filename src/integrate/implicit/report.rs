@@ -28,6 +28,11 @@ pub struct ImplicitReport {
     /// tangent failed to factor and whose projected tangent was factored; none for systems
     /// solved by the conjugate gradient or with a reused factorization).
     pub factorizations: usize,
+    /// Evaluations of the incremental potential's energy over all substeps (the line searches'
+    /// and each Newton solve's start), each an integration over the body's elements and a solve
+    /// of its dynamic rigid partners' response; of a body stepped with others as one system, the
+    /// system's.
+    pub energy_evaluations: usize,
     /// Newton iterations whose exact tangent was not positive definite (the Cholesky
     /// factorization failed or the conjugate gradient met negative curvature), so that the
     /// tangent with element stress tangents projected to be positive semi-definite was solved.
@@ -70,6 +75,8 @@ pub(super) struct Outcome {
     pub(super) factorizations: usize,
     /// Iterations that solved the projected tangent.
     pub(super) projected_tangents: usize,
+    /// Evaluations of the energy (set by the caller, which holds the potential).
+    pub(super) energy_evaluations: usize,
     /// Final relative residual.
     pub(super) residual: f64,
     /// How the solve ended.
@@ -90,6 +97,7 @@ impl ImplicitReport {
             linear_iterations: 0,
             reused_factorizations: 0,
             factorizations: 0,
+            energy_evaluations: 0,
             projected_tangents: 0,
             relative_residual: 0.0,
             converged: true,
@@ -105,6 +113,7 @@ impl ImplicitReport {
         self.reused_factorizations += outcome.reused_factorizations;
         self.factorizations += outcome.factorizations;
         self.projected_tangents += outcome.projected_tangents;
+        self.energy_evaluations += outcome.energy_evaluations;
         self.relative_residual = self.relative_residual.max(outcome.residual);
         self.converged &= outcome.stop == Stop::Converged;
         self.stalled_substeps += u32::from(outcome.stop == Stop::Stalled);
@@ -131,6 +140,7 @@ impl Outcome {
             reused_factorizations: self.reused_factorizations + next.reused_factorizations,
             factorizations: self.factorizations + next.factorizations,
             projected_tangents: self.projected_tangents + next.projected_tangents,
+            energy_evaluations: self.energy_evaluations + next.energy_evaluations,
             residual: next.residual,
             stop: next.stop,
             penalty_step: next.penalty_step,
@@ -146,6 +156,7 @@ impl Outcome {
             reused_factorizations: 0,
             factorizations: 0,
             projected_tangents: 0,
+            energy_evaluations: 0,
             residual: f64::NAN,
             stop: Stop::Failed,
             penalty_step,
