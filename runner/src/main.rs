@@ -203,6 +203,13 @@ fn run(
             c.implicit.measured_over_predicted,
             c.implicit.median_measured_over_predicted,
         );
+        if c.implicit.steps > 0 {
+            let w = &c.implicit_work;
+            println!(
+                "       {:<16} implicit step: {:.2} Newton iterations, {:.2} factorizations, {:.2} energy evaluations",
+                "", w.newton_iterations, w.factorizations, w.energy_evaluations
+            );
+        }
     }
     for probe in &report.probes {
         println!(

@@ -5,7 +5,7 @@ use rapier_fvm::Error;
 use rapier_fvm::body::DeformableBody;
 use rapier_fvm::coupling::{BodyAudit, EnergyCheck};
 use rapier_fvm::element::{ElementOrder, ElementShape};
-use rapier_fvm::integrate::{AutomaticReport, IntegratorKind};
+use rapier_fvm::integrate::{AutomaticReport, ImplicitReport, IntegratorKind};
 use serde::Serialize;
 
 /// The whole report.
@@ -140,6 +140,8 @@ pub struct StepCost {
     pub explicit: IntegratorCost,
     /// The implicit steps: their measured over their predicted time.
     pub implicit: IntegratorCost,
+    /// What an implicit step did, on average: where its time went.
+    pub implicit_work: NewtonWork,
     #[serde(skip)]
     steps: f64,
 }
@@ -182,6 +184,35 @@ impl IntegratorCost {
     }
 }
 
+/// Means over a body's implicit steps of what each did (see
+/// [`rapier_fvm::integrate::ImplicitReport`]).
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct NewtonWork {
+    /// Newton iterations.
+    pub newton_iterations: f64,
+    /// Numeric Cholesky factorizations.
+    pub factorizations: f64,
+    /// Evaluations of the energy (each Newton solve's start and its line searches).
+    pub energy_evaluations: f64,
+    #[serde(skip)]
+    steps: f64,
+}
+
+impl NewtonWork {
+    /// Takes in an implicit step's `report`.
+    fn record(&mut self, report: &ImplicitReport) {
+        self.steps += 1.0;
+        let counts = [
+            (&mut self.newton_iterations, report.newton_iterations),
+            (&mut self.factorizations, report.factorizations),
+            (&mut self.energy_evaluations, report.energy_evaluations),
+        ];
+        for (mean, count) in counts {
+            *mean += (count as f64 - *mean) / self.steps;
+        }
+    }
+}
+
 /// The median of the sorted `values` (the mean of the middle two for an even count).
 fn median(values: &[f64]) -> f64 {
     let n = values.len();
@@ -220,6 +251,9 @@ impl StepCost {
                 IntegratorKind::Implicit => &mut self.implicit,
             };
             taken.record(used, report.seconds);
+        }
+        if let Some(implicit) = &report.implicit {
+            self.implicit_work.record(implicit);
         }
     }
 }
