@@ -633,18 +633,9 @@ fn the_report_counts_the_evaluations_of_the_energy() {
             .build()
             .unwrap()
     };
-    let integrator = ImplicitIntegrator::default();
     let step = |body: &mut DeformableBody| {
         let (mut constraints, mut workspace) = (BodyConstraints::new(), SolverWorkspace::new());
-        integrator
-            .step(
-                body,
-                &mut constraints,
-                &mut workspace,
-                1.0 / 60.0,
-                DVec3::ZERO,
-            )
-            .unwrap()
+        common::implicit_frame_without_gravity(body, &mut constraints, &mut workspace)
     };
     let mut resting = cube();
     let report = step(&mut resting);

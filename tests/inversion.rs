@@ -29,15 +29,7 @@ fn recover(body: &mut DeformableBody, frames: usize) -> Vec<usize> {
     let (mut constraints, mut workspace) = (BodyConstraints::new(), SolverWorkspace::new());
     (0..frames)
         .map(|_| {
-            ImplicitIntegrator::default()
-                .step(
-                    body,
-                    &mut constraints,
-                    &mut workspace,
-                    1.0 / 60.0,
-                    DVec3::ZERO,
-                )
-                .unwrap()
+            common::implicit_frame_without_gravity(body, &mut constraints, &mut workspace)
                 .inverted_elements
         })
         .collect()

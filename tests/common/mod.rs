@@ -285,6 +285,18 @@ pub fn soft_and_ball_momenta(
     (linear, angular)
 }
 
+/// One backward Euler frame of 1/60 s of `body` without gravity, with its `constraints` and
+/// solver `workspace`: the frame's report.
+pub fn implicit_frame_without_gravity(
+    body: &mut DeformableBody,
+    constraints: &mut BodyConstraints,
+    workspace: &mut SolverWorkspace,
+) -> ImplicitReport {
+    ImplicitIntegrator::default()
+        .step(body, constraints, workspace, 1.0 / 60.0, DVec3::ZERO)
+        .unwrap()
+}
+
 /// Sets every node of `body` moving at a random velocity (seed `seed`, up to 1 m/s per axis),
 /// takes ten free steps of 1/60 s without gravity (implicit or explicit), and returns the change
 /// of linear momentum and the scale it is measured against (kg m/s): the larger of the initial
@@ -298,15 +310,7 @@ pub fn free_momentum_change(body: &mut DeformableBody, seed: u64, implicit: bool
     let (mut constraints, mut workspace) = (BodyConstraints::new(), SolverWorkspace::new());
     for _ in 0..10 {
         if implicit {
-            ImplicitIntegrator::default()
-                .step(
-                    body,
-                    &mut constraints,
-                    &mut workspace,
-                    1.0 / 60.0,
-                    DVec3::ZERO,
-                )
-                .unwrap();
+            implicit_frame_without_gravity(body, &mut constraints, &mut workspace);
         } else {
             SymplecticEuler::default()
                 .step(
