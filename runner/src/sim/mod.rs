@@ -10,6 +10,7 @@
 //! | `plots/<probe>.png` | each probe against time |
 
 mod build;
+mod cost;
 mod loads;
 mod materials;
 mod meshes;
