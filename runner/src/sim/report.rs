@@ -6,9 +6,9 @@ use rapier_fvm::body::DeformableBody;
 use rapier_fvm::coupling::{BodyAudit, EnergyCheck};
 use rapier_fvm::element::{ElementOrder, ElementShape};
 use rapier_fvm::integrate::{AutomaticReport, IntegratorKind};
+use serde::Serialize;
 
 pub use super::cost::StepCost;
-use serde::Serialize;
 
 /// The whole report.
 #[derive(Debug, Clone, Serialize)]

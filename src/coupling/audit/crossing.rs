@@ -26,7 +26,7 @@ pub(super) fn through_soft(
     other_before: &[DVec3],
     found: &mut Penetrations,
 ) {
-    let (Some(before), Some(before_bounds)) = (&checked.before, checked.bounds_before()) else {
+    let (Some(before), Some(before_bounds)) = (&checked.before, checked.bounds_before) else {
         return;
     };
     if !checked.body.collision_groups.test(other.collision_groups)
@@ -39,7 +39,7 @@ pub(super) fn through_soft(
     let carried = centre_of_mass(other, other.positions()) - centre_of_mass(other, other_before);
     // Every path lies in the box of its ends.
     let starts = (before_bounds.0 + carried, before_bounds.1 + carried);
-    let ends = checked.bounds_now();
+    let ends = checked.bounds_now;
     if disjoint((starts.0.min(ends.0), starts.1.max(ends.1)), (lo, hi)) {
         return;
     }

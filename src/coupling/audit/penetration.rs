@@ -30,12 +30,16 @@ use std::collections::HashMap;
 
 /// A deformable body as the contact check sees it: the body, the nodes glued to rigid bodies,
 /// its contact points now and at the end of the previous frame if known (m, each with the nodes
-/// it interpolates), and the tolerance (m).
+/// it interpolates) with the boxes holding them, and the tolerance (m).
 pub(super) struct Checked<'a> {
     pub(super) body: &'a DeformableBody,
     pub(super) glued: Vec<(RigidBodyHandle, u32)>,
     pub(super) now: Vec<(DVec3, Vec<u32>)>,
     pub(super) before: Option<Vec<(DVec3, Vec<u32>)>>,
+    /// The box (m) holding the contact points now.
+    pub(super) bounds_now: (DVec3, DVec3),
+    /// The box (m) holding them at the end of the previous frame, if known.
+    pub(super) bounds_before: Option<(DVec3, DVec3)>,
     pub(super) tolerance: f64,
 }
 
@@ -52,23 +56,16 @@ impl<'a> Checked<'a> {
             .filter(|previous| previous.len() == body.positions().len())
             .map(|previous| contact_point_positions(body, previous));
         let now = contact_point_positions(body, body.positions());
+        let bounds = |points: &[(DVec3, Vec<u32>)]| bounding_box(points.iter().map(|(x, _)| *x));
         Self {
             body,
             glued,
+            bounds_now: bounds(&now),
+            bounds_before: before.as_deref().map(bounds),
             now,
             before,
             tolerance,
         }
-    }
-
-    /// The box (m) holding the contact points now.
-    pub(super) fn bounds_now(&self) -> (DVec3, DVec3) {
-        bounding_box(self.now.iter().map(|(x, _)| *x))
-    }
-
-    /// The box (m) holding the contact points at the end of the previous frame, if known.
-    pub(super) fn bounds_before(&self) -> Option<(DVec3, DVec3)> {
-        (self.before.as_ref()).map(|before| bounding_box(before.iter().map(|(x, _)| *x)))
     }
 
     /// The longest distance (m) a contact point moved over the frame (zero if not known).
@@ -102,7 +99,7 @@ pub(super) fn against_colliders(
     poses: &HashMap<ColliderHandle, Pose>,
     found: &mut Penetrations,
 ) {
-    let (now_bounds, before_bounds) = (checked.bounds_now(), checked.bounds_before());
+    let (now_bounds, before_bounds) = (checked.bounds_now, checked.bounds_before);
     let longest_move = checked.longest_move();
     for (handle, collider) in colliders.iter() {
         if collider.is_sensor()
@@ -235,7 +232,7 @@ pub(super) fn against_soft(
 ) {
     let bounds = other.position_bounds();
     if !checked.body.collision_groups.test(other.collision_groups)
-        || disjoint(bounds, checked.bounds_now())
+        || disjoint(bounds, checked.bounds_now)
     {
         return;
     }
