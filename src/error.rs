@@ -144,11 +144,70 @@ pub enum Error {
         /// Why it does not apply.
         reason: &'static str,
     },
-    /// A node belongs to no tetrahedron: it would have no mass and no stiffness.
-    #[error("node {node} belongs to no tetrahedron")]
+    /// A node belongs to no element (tetrahedron, or triangle of a 2D mesh): it would have no
+    /// mass and no stiffness.
+    #[error("node {node} belongs to no element")]
     UnreferencedNode {
         /// Index of the offending node.
         node: usize,
+    },
+    /// A triangle mesh has no nodes or no triangles.
+    #[error("the triangle mesh is empty ({nodes} nodes, {triangles} triangles)")]
+    EmptyTriangleMesh {
+        /// Number of nodes given.
+        nodes: usize,
+        /// Number of triangles given.
+        triangles: usize,
+    },
+    /// A triangle refers to a node that does not exist.
+    #[error("triangle {triangle} refers to node {node}, but the mesh has {node_count} nodes")]
+    TriangleNodeOutOfRange {
+        /// Index of the offending triangle.
+        triangle: usize,
+        /// The out-of-range node index.
+        node: u32,
+        /// Number of nodes in the mesh.
+        node_count: usize,
+    },
+    /// A triangle uses the same node twice.
+    #[error("triangle {triangle} uses node {node} more than once")]
+    TriangleRepeatedNode {
+        /// Index of the offending triangle.
+        triangle: usize,
+        /// The repeated node.
+        node: u32,
+    },
+    /// A triangle has (numerically) zero rest area: `|A| <= 1e-12 l²` with `l` its longest edge,
+    /// or an area that is not a normal `f64`.
+    #[error(
+        "triangle {triangle} is degenerate: rest area {area:e} m^2 is zero at the mesh's scale"
+    )]
+    DegenerateTriangle {
+        /// Index of the offending triangle.
+        triangle: usize,
+        /// Its signed rest area (m²).
+        area: f64,
+    },
+    /// A triangle has negative rest area (its nodes are ordered clockwise).
+    #[error(
+        "triangle {triangle} is inverted: rest area {area:e} m^2 < 0 (order its nodes counterclockwise)"
+    )]
+    InvertedTriangle {
+        /// Index of the offending triangle.
+        triangle: usize,
+        /// Its signed rest area (m²).
+        area: f64,
+    },
+    /// A node's control area is not positive: circumcentric control volumes on a mesh whose
+    /// obtuse triangles leave a node with a negative share of area (use median control volumes).
+    #[error(
+        "node {node} has a control area of {area:e} m^2: circumcentric control volumes need triangles that are not obtuse around it"
+    )]
+    NonPositiveControlArea {
+        /// Index of the offending node.
+        node: usize,
+        /// Its control area (m²).
+        area: f64,
     },
     /// A tetrahedron has (numerically) zero rest volume.
     #[error(

@@ -98,6 +98,7 @@ pub mod material;
 pub mod mesh;
 mod newton;
 mod parallel;
+pub mod planar;
 pub mod query;
 mod rigid;
 pub mod shape;
