@@ -1,10 +1,52 @@
 //! Pieces shared by the Newton solvers (static equilibrium, implicit integration of a body or of
-//! bodies touching each other): the residual norm and a backtracking line search that guarantees
-//! the minimized energy decreases, over any [`Configuration`] of nodes.
+//! bodies touching each other, in 3D and in the plane): the residual norm and a backtracking
+//! line search that guarantees the minimized energy decreases, over any [`Configuration`] of
+//! nodes whose positions are [`NodeVector`]s (`DVec3`, or `DVec2` for 2D bodies).
 
 use crate::Error;
 use crate::body::DeformableBody;
-use rapier3d::glamx::DVec3;
+use rapier3d::glamx::{DVec2, DVec3};
+use std::ops::{Add, Mul, Sub};
+
+/// A node's position or a per-node vector in 2D or 3D: what Newton's pieces compute with.
+pub(crate) trait NodeVector:
+    Copy + Add<Output = Self> + Sub<Output = Self> + Mul<f64, Output = Self>
+{
+    /// The number of components.
+    const DIM: usize;
+    /// The dot product.
+    fn dot(self, other: Self) -> f64;
+    /// The squared Euclidean length.
+    fn length_squared(self) -> f64;
+    /// The vector whose component `k` is `f(self_k, k)`.
+    fn map_components(self, f: impl FnMut(f64, usize) -> f64) -> Self;
+}
+
+impl NodeVector for DVec3 {
+    const DIM: usize = 3;
+    fn dot(self, other: Self) -> f64 {
+        DVec3::dot(self, other)
+    }
+    fn length_squared(self) -> f64 {
+        DVec3::length_squared(self)
+    }
+    fn map_components(self, mut f: impl FnMut(f64, usize) -> f64) -> Self {
+        DVec3::new(f(self.x, 0), f(self.y, 1), f(self.z, 2))
+    }
+}
+
+impl NodeVector for DVec2 {
+    const DIM: usize = 2;
+    fn dot(self, other: Self) -> f64 {
+        DVec2::dot(self, other)
+    }
+    fn length_squared(self) -> f64 {
+        DVec2::length_squared(self)
+    }
+    fn map_components(self, mut f: impl FnMut(f64, usize) -> f64) -> Self {
+        DVec2::new(f(self.x, 0), f(self.y, 1))
+    }
+}
 
 /// Refuses a Newton tolerance that is not positive and finite.
 pub(crate) fn check_tolerance(tolerance: f64) -> Result<(), Error> {
@@ -22,17 +64,20 @@ pub(crate) fn check_tolerance(tolerance: f64) -> Result<(), Error> {
 /// What Newton moves: the positions (m) of a set of nodes, one body's or a group's, in a fixed
 /// order.
 pub(crate) trait Configuration {
+    /// A node's position (m).
+    type Vector: NodeVector;
     /// The positions (m), in order.
-    fn copy_positions(&self) -> Vec<DVec3>;
+    fn copy_positions(&self) -> Vec<Self::Vector>;
     /// Sets the positions to `start + alpha direction` (m).
-    fn place(&mut self, start: &[DVec3], direction: &[DVec3], alpha: f64);
+    fn place(&mut self, start: &[Self::Vector], direction: &[Self::Vector], alpha: f64);
     /// Sets the positions to `positions` (m).
-    fn set(&mut self, positions: &[DVec3]) {
+    fn set(&mut self, positions: &[Self::Vector]) {
         self.place(positions, positions, 0.0);
     }
 }
 
 impl Configuration for DeformableBody {
+    type Vector = DVec3;
     fn copy_positions(&self) -> Vec<DVec3> {
         self.positions.clone()
     }
@@ -51,8 +96,8 @@ impl Configuration for DeformableBody {
 /// positions are put back.
 pub(crate) fn round_off_floor<C: Configuration>(
     config: &mut C,
-    residual: &[DVec3],
-    mut residual_at: impl FnMut(&mut C) -> Vec<DVec3>,
+    residual: &[C::Vector],
+    mut residual_at: impl FnMut(&mut C) -> Vec<C::Vector>,
 ) -> f64 {
     let start = config.copy_positions();
     // A multiplicative hash of the coordinate's index picks its sign: deterministic, and with
@@ -64,13 +109,14 @@ pub(crate) fn round_off_floor<C: Configuration>(
             -1.0
         }
     };
-    let ulps: Vec<DVec3> = start
+    let dim = C::Vector::DIM;
+    let ulps: Vec<C::Vector> = start
         .iter()
         .enumerate()
         .map(|(n, x)| {
-            let unit =
-                |c: f64, k: usize| c.abs().max(f64::MIN_POSITIVE) * f64::EPSILON * sign(3 * n + k);
-            DVec3::new(unit(x.x, 0), unit(x.y, 1), unit(x.z, 2))
+            x.map_components(|c, k| {
+                c.abs().max(f64::MIN_POSITIVE) * f64::EPSILON * sign(dim * n + k)
+            })
         })
         .collect();
     config.place(&start, &ulps, 1.0);
@@ -84,8 +130,27 @@ pub(crate) fn round_off_floor<C: Configuration>(
         .sqrt()
 }
 
+/// The largest relative residual accepted as round-off when Newton stops reducing it.
+pub(crate) const ROUND_OFF_CEILING: f64 = 1e-6;
+
+/// Whether Newton's relative residual `relative`, after the earlier ones in `history`, sits at
+/// its round-off floor: Newton more than halves the residual each iteration until round-off in
+/// the force sum sets a floor (about 1e-9 on 1e5 elements); a tiny residual (at most
+/// [`ROUND_OFF_CEILING`]) that fails to halve twice in a row is there.
+pub(crate) fn stalled_at_round_off(history: &[f64], relative: f64) -> bool {
+    let failed_to_halve = |older: f64, newer: f64| newer > 0.5 * older;
+    match history {
+        [.., older, last] => {
+            relative <= ROUND_OFF_CEILING
+                && failed_to_halve(*last, relative)
+                && failed_to_halve(*older, *last)
+        }
+        _ => false,
+    }
+}
+
 /// Euclidean norm of a field of per-node vectors.
-pub(crate) fn norm(v: &[DVec3]) -> f64 {
+pub(crate) fn norm<V: NodeVector>(v: &[V]) -> f64 {
     v.iter().map(|x| x.length_squared()).sum::<f64>().sqrt()
 }
 
@@ -109,13 +174,13 @@ pub(crate) enum Search {
 /// `None` (positions unchanged) if no step descends.
 pub(crate) fn descend<C: Configuration>(
     body: &mut C,
-    residual: &[DVec3],
+    residual: &[C::Vector],
     energy_now: f64,
-    direction: &[DVec3],
+    direction: &[C::Vector],
     search: Search,
     energy: impl Fn(&C) -> f64,
-    mut residual_at: impl FnMut(&mut C) -> Vec<DVec3>,
-) -> Option<(Vec<DVec3>, f64)> {
+    mut residual_at: impl FnMut(&mut C) -> Vec<C::Vector>,
+) -> Option<(Vec<C::Vector>, f64)> {
     let steps = match search {
         Search::Thorough => (1.0, MIN_STEP),
         Search::Short => (1.0, 0.5),
@@ -159,18 +224,25 @@ pub(crate) fn descend<C: Configuration>(
 
 /// A Newton update's search: the out-of-balance force (N) and the minimized energy (J) where it
 /// starts, and its direction (m per node).
-#[derive(Clone, Copy)]
-struct Searched<'a> {
-    residual: &'a [DVec3],
+struct Searched<'a, V> {
+    residual: &'a [V],
     energy: f64,
-    direction: &'a [DVec3],
+    direction: &'a [V],
 }
+
+impl<V> Clone for Searched<'_, V> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<V> Copy for Searched<'_, V> {}
 
 /// [`line_search`] over `steps` from `start` (where `body` is), then, if `refine` and the step
 /// it accepted is shorter than the full one, [`lowest_along`]: the energy (J) where `body` ends.
 fn search_energy<C: Configuration>(
     body: &mut C,
-    (start, searched): (&[DVec3], Searched),
+    (start, searched): (&[C::Vector], Searched<C::Vector>),
     energy: &impl Fn(&C) -> f64,
     steps: (f64, f64),
     refine: bool,
@@ -215,7 +287,7 @@ const REFINEMENTS: usize = 16;
 /// meets the same sufficient decrease.
 fn lowest_along<C: Configuration>(
     body: &mut C,
-    (start, direction): (&[DVec3], &[DVec3]),
+    (start, direction): (&[C::Vector], &[C::Vector]),
     (alpha, value): (f64, f64),
     energy: &impl Fn(&C) -> f64,
 ) -> f64 {
@@ -256,7 +328,7 @@ fn line_search<C: Configuration>(
         residual,
         energy: initial,
         direction,
-    }: Searched,
+    }: Searched<C::Vector>,
     energy: impl Fn(&C) -> f64,
     (largest, smallest): (f64, f64),
 ) -> Option<(f64, f64)> {

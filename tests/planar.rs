@@ -3,6 +3,7 @@
 //! forces and tangents as derivatives of the energy, and typed errors for bad meshes.
 
 use rapier_fvm::Error;
+use rapier_fvm::fvm::VolumetricTreatment;
 use rapier_fvm::glamx::{DMat2, DVec2};
 use rapier_fvm::material::{Material, MaterialModel};
 use rapier_fvm::planar::{
@@ -18,6 +19,14 @@ const MODELS: [MaterialModel; 4] = [
     MaterialModel::StableNeoHookean,
 ];
 const PLANES: [PlaneModel; 2] = [PlaneModel::PlaneStress, PlaneModel::PlaneStrain];
+
+/// The plane and volumetric treatments a body can have: both planes per element, and plane
+/// strain averaged on node patches.
+const SETUPS: [(PlaneModel, VolumetricTreatment); 3] = [
+    (PlaneModel::PlaneStress, VolumetricTreatment::PerElement),
+    (PlaneModel::PlaneStrain, VolumetricTreatment::PerElement),
+    (PlaneModel::PlaneStrain, VolumetricTreatment::NodalAverage),
+];
 
 /// A deterministic pseudo-random number in [-1, 1) for `i`.
 fn jitter(i: usize) -> f64 {
@@ -58,9 +67,10 @@ fn the_patch_test_holds_on_a_distorted_mesh() {
         .map(|(i, _)| i)
         .collect();
     for model in MODELS {
-        for plane in PLANES {
+        for (plane, volumetric) in SETUPS {
             let mut body = PlanarBodyBuilder::new(mesh.clone(), material(model, 0.3))
                 .plane(plane)
+                .volumetric(volumetric)
                 .thickness(0.05)
                 .pinned_nodes(boundary.iter().copied())
                 .build()
@@ -78,13 +88,13 @@ fn the_patch_test_holds_on_a_distorted_mesh() {
                 max_iterations: 50,
             };
             solve_planar_equilibrium(&mut body, &loads, &settings)
-                .unwrap_or_else(|e| panic!("{model:?} {plane:?}: {e}"));
+                .unwrap_or_else(|e| panic!("{model:?} {plane:?} {volumetric:?}: {e}"));
             let worst = (body.positions().iter().zip(&rest))
                 .map(|(x, p)| x.distance(a * *p + c))
                 .fold(0.0, f64::max);
             assert!(
                 worst < 1e-9 / 6.0,
-                "{model:?} {plane:?}: {worst:e} m off the affine map"
+                "{model:?} {plane:?} {volumetric:?}: {worst:e} m off the affine map"
             );
         }
     }
@@ -251,14 +261,15 @@ fn masses_follow_the_control_volumes() {
 
 /// Internal forces are minus the gradient of the elastic energy: central differences of the
 /// energy at a large deformation, to 1e-6 of the largest force (the differences' truncation
-/// and round-off are below 1e-8), every model and plane.
+/// and round-off are below 1e-8), every model, plane and volumetric treatment.
 #[test]
 fn forces_are_the_gradient_of_the_energy() {
     let mesh = TriangleMesh::rectangle(DVec2::new(1.0, 0.5), [3, 2]).unwrap();
     for model in MODELS {
-        for plane in PLANES {
+        for (plane, volumetric) in SETUPS {
             let mut body = PlanarBodyBuilder::new(mesh.clone(), material(model, 0.35))
                 .plane(plane)
+                .volumetric(volumetric)
                 .build()
                 .unwrap();
             for (i, x) in body.positions_mut().iter_mut().enumerate() {
@@ -280,7 +291,7 @@ fn forces_are_the_gradient_of_the_energy() {
                     let error = (numeric - forces[node][axis]).abs();
                     assert!(
                         error < 1e-6 * scale,
-                        "{model:?} {plane:?} node {node}: {error:e} N"
+                        "{model:?} {plane:?} {volumetric:?} node {node}: {error:e} N"
                     );
                 }
             }

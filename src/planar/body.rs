@@ -3,13 +3,19 @@
 //! Contract: nodal masses are `ρ t A_i` (density, rest thickness, the node's control area of the
 //! chosen [`ControlVolumes`]), summing to `ρ t A`; internal forces are the finite-volume forces
 //! of [`TriangleRest::forces`] under the [`PlanarLaw`] of the body's material and
-//! [`PlaneModel`], and are minus the gradient of [`PlanarBody::elastic_energy`].
+//! [`PlaneModel`] (with the volumetric term averaged on node patches if asked, see
+//! [`PlanarBodyBuilder::volumetric`]), and are minus the gradient of
+//! [`PlanarBody::elastic_energy`].
 
 use super::ControlVolumes;
 use super::element::TriangleRest;
+use super::evaluate::PlanarLawDyn;
 use super::mesh::TriangleMesh;
 use super::plane::{PlanarLaw, PlanarStress, PlaneModel};
+use super::volumetric::NodalPatches;
 use crate::Error;
+use crate::damping::RayleighDamping;
+use crate::fvm::VolumetricTreatment;
 use crate::material::{Material, with_hyperelastic_model};
 use rapier3d::glamx::{DMat2, DVec2};
 
@@ -39,6 +45,8 @@ pub struct PlanarBodyBuilder {
     plane: PlaneModel,
     thickness: f64,
     control_volumes: ControlVolumes,
+    volumetric: VolumetricTreatment,
+    damping: Option<RayleighDamping>,
     /// Held nodes and the axes (x, y) each is held along, in the order given.
     pinned: Vec<(usize, [bool; 2])>,
 }
@@ -53,6 +61,8 @@ impl PlanarBodyBuilder {
             plane: PlaneModel::PlaneStress,
             thickness: 1.0,
             control_volumes: ControlVolumes::Median,
+            volumetric: VolumetricTreatment::PerElement,
+            damping: None,
             pinned: Vec::new(),
         }
     }
@@ -75,6 +85,22 @@ impl PlanarBodyBuilder {
         self
     }
 
+    /// How the volumetric term is evaluated: per triangle, or averaged on node patches
+    /// ([`VolumetricTreatment::NodalAverage`], plane strain only: locking-free for nearly
+    /// incompressible bodies). [`VolumetricTreatment::ElementAverage`] is the per-triangle term
+    /// for linear triangles, as for linear tetrahedra.
+    pub fn volumetric(mut self, volumetric: VolumetricTreatment) -> Self {
+        self.volumetric = volumetric;
+        self
+    }
+
+    /// Rayleigh damping on the strain rate (see [`crate::damping`]; in plane stress with the
+    /// reduced volumetric viscosity, see [`PlaneModel::damping_stress`]). None by default.
+    pub fn damping(mut self, damping: RayleighDamping) -> Self {
+        self.damping = Some(damping);
+        self
+    }
+
     /// Nodes held where they are (by index).
     pub fn pinned_nodes(mut self, nodes: impl IntoIterator<Item = usize>) -> Self {
         self.pinned
@@ -94,8 +120,16 @@ impl PlanarBodyBuilder {
     /// # Errors
     /// [`Error::InvalidSetting`] for a thickness that is not positive and finite,
     /// [`Error::NodeOutOfRange`] for a pinned node that does not exist,
-    /// [`Error::NonPositiveControlArea`] from [`ControlVolumes::nodal_areas`].
+    /// [`Error::NonPositiveControlArea`] from [`ControlVolumes::nodal_areas`],
+    /// [`Error::UnsupportedOption`] for nodal averaging in plane stress.
     pub fn build(self) -> Result<PlanarBody, Error> {
+        let averaged = self.volumetric == VolumetricTreatment::NodalAverage;
+        if averaged && self.plane == PlaneModel::PlaneStress {
+            return Err(Error::UnsupportedOption {
+                option: "nodal averaging in plane stress",
+                reason: "a sheet free across its thickness does not lock: nothing holds its volume",
+            });
+        }
         if !(self.thickness.is_finite() && self.thickness > 0.0) {
             return Err(Error::InvalidSetting {
                 parameter: "thickness",
@@ -114,10 +148,14 @@ impl PlanarBodyBuilder {
         }
         let areas = self.control_volumes.nodal_areas(&self.mesh)?;
         let per_area = self.material.density() * self.thickness;
-        let rest = (0..self.mesh.triangles().len())
+        let rest: Vec<TriangleRest> = (0..self.mesh.triangles().len())
             .map(|t| TriangleRest::new(self.mesh.corners(t)))
             .collect();
+        let patches = averaged.then(|| NodalPatches::new(&self.mesh, &rest, &areas));
         Ok(PlanarBody {
+            patches,
+            velocities: vec![DVec2::ZERO; node_count],
+            damping: self.damping,
             positions: self.mesh.rest_positions().to_vec(),
             masses: areas.iter().map(|a| a * per_area).collect(),
             mesh: self.mesh,
@@ -143,6 +181,10 @@ pub struct PlanarBody {
     masses: Vec<f64>,
     positions: Vec<DVec2>,
     pub(super) pinned: Vec<[bool; 2]>,
+    /// The node patches of nodal averaging, if the body averages its volumetric term.
+    pub(super) patches: Option<NodalPatches>,
+    velocities: Vec<DVec2>,
+    damping: Option<RayleighDamping>,
 }
 
 impl PlanarBody {
@@ -191,6 +233,51 @@ impl PlanarBody {
         &mut self.positions
     }
 
+    /// Nodal velocities (m/s).
+    pub fn velocities(&self) -> &[DVec2] {
+        &self.velocities
+    }
+
+    /// Nodal velocities (m/s), to set (a held axis's is zeroed by the next step).
+    pub fn velocities_mut(&mut self) -> &mut [DVec2] {
+        &mut self.velocities
+    }
+
+    /// The damping, if any.
+    pub fn damping(&self) -> Option<&RayleighDamping> {
+        self.damping.as_ref()
+    }
+
+    /// The material.
+    pub fn material(&self) -> &Material {
+        &self.material
+    }
+
+    /// The kinetic energy (J).
+    pub fn kinetic_energy(&self) -> f64 {
+        (self.masses.iter().zip(&self.velocities))
+            .map(|(m, v)| 0.5 * m * v.length_squared())
+            .sum()
+    }
+
+    /// The linear momentum (kg m/s).
+    pub fn linear_momentum(&self) -> DVec2 {
+        (self.masses.iter().zip(&self.velocities))
+            .map(|(m, v)| *v * *m)
+            .sum()
+    }
+
+    /// The angular momentum about the origin (kg m²/s, counterclockwise positive).
+    pub fn angular_momentum(&self) -> f64 {
+        (self
+            .masses
+            .iter()
+            .zip(&self.positions)
+            .zip(&self.velocities))
+        .map(|((m, x), v)| m * x.perp_dot(*v))
+        .sum()
+    }
+
     /// Whether each node is held along x and along y.
     pub fn pinned(&self) -> &[[bool; 2]] {
         &self.pinned
@@ -206,10 +293,27 @@ impl PlanarBody {
         self.rest[t].gradient(&self.corners_in(t, &self.positions))
     }
 
-    /// The stress in triangle `t` (see [`PlanarStress`]).
+    /// The stress in triangle `t` (see [`PlanarStress`]): the model's at the triangle's
+    /// deformation gradient, with nodal averaging its volumetric part averaged as the forces
+    /// take it.
     pub fn stress(&self, t: usize) -> PlanarStress {
-        let f = self.deformation_gradient(t);
-        self.with_law(|law| law.stress(&f))
+        self.with_law(|law| {
+            let evaluation = self.evaluate(law, &self.positions);
+            let stress = law.stress(&evaluation.gradients[t]);
+            PlanarStress {
+                p: self.element_stress(law, &evaluation, t),
+                ..stress
+            }
+        })
+    }
+
+    /// How the volumetric term is evaluated.
+    pub fn volumetric(&self) -> VolumetricTreatment {
+        if self.patches.is_some() {
+            VolumetricTreatment::NodalAverage
+        } else {
+            VolumetricTreatment::PerElement
+        }
     }
 
     /// Runs `body` with the body's [`PlanarLaw`] for its material model.
@@ -220,14 +324,7 @@ impl PlanarBody {
 
     /// The elastic energy (J) at `positions` (m).
     pub fn elastic_energy_at(&self, positions: &[DVec2]) -> f64 {
-        self.with_law(|law| {
-            (self.rest.iter().enumerate())
-                .map(|(t, rest)| {
-                    let f = rest.gradient(&self.corners_in(t, positions));
-                    law.energy_density(&f) * rest.area() * self.thickness
-                })
-                .sum()
-        })
+        self.with_law(|law| self.energy_of(law, &self.evaluate(law, positions)))
     }
 
     /// The elastic energy (J) where the body is.
@@ -237,44 +334,11 @@ impl PlanarBody {
 
     /// The internal (elastic) forces (N) on the nodes at `positions` (m).
     pub fn internal_forces_at(&self, positions: &[DVec2]) -> Vec<DVec2> {
-        let mut forces = vec![DVec2::ZERO; positions.len()];
-        self.with_law(|law| {
-            for (t, rest) in self.rest.iter().enumerate() {
-                let f = rest.gradient(&self.corners_in(t, positions));
-                let p = law.stress(&f).p;
-                let nodes = self.mesh.triangles()[t];
-                for (node, force) in nodes.iter().zip(rest.forces(&p, self.thickness)) {
-                    forces[*node as usize] += force;
-                }
-            }
-        });
-        forces
+        self.with_law(|law| self.forces_of(law, &self.evaluate(law, positions)))
     }
 
     /// The internal forces (N) where the body is.
     pub fn internal_forces(&self) -> Vec<DVec2> {
         self.internal_forces_at(&self.positions)
-    }
-}
-
-/// A [`PlanarLaw`] whatever its model, for the body's loops.
-pub(super) trait PlanarLawDyn {
-    /// See [`PlanarLaw::stress`].
-    fn stress(&self, f: &DMat2) -> PlanarStress;
-    /// See [`PlanarLaw::energy_density`].
-    fn energy_density(&self, f: &DMat2) -> f64;
-    /// See [`PlanarLaw::tangent`].
-    fn tangent(&self, f: &DMat2) -> [DMat2; 4];
-}
-
-impl<M: crate::material::HyperelasticModel> PlanarLawDyn for PlanarLaw<M> {
-    fn stress(&self, f: &DMat2) -> PlanarStress {
-        PlanarLaw::stress(self, f)
-    }
-    fn energy_density(&self, f: &DMat2) -> f64 {
-        PlanarLaw::energy_density(self, f)
-    }
-    fn tangent(&self, f: &DMat2) -> [DMat2; 4] {
-        PlanarLaw::tangent(self, f)
     }
 }

@@ -14,6 +14,18 @@ use rapier3d::glamx::DVec2;
 /// Relative area below which a triangle counts as degenerate: `|A| <= 1e-12 l²`.
 const DEGENERATE_RELATIVE_AREA: f64 = 1e-12;
 
+/// How the cells of [`TriangleMesh::quadrilateral_with`] are cut into triangles.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Diagonals {
+    /// Along alternating diagonals, four triangles meeting at every other node ("union jack"):
+    /// no preferred direction, and free of volumetric locking in plane strain.
+    #[default]
+    Alternating,
+    /// All along the diagonal from the cell's first corner to its third: a preferred direction,
+    /// and the pattern on which linear triangles lock as `ν → 0.5` in plane strain.
+    Parallel,
+}
+
 /// A mesh of linear (3-node) triangles.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TriangleMesh {
@@ -141,12 +153,25 @@ impl TriangleMesh {
     /// The quadrilateral with counterclockwise `corners` (m), mapped bilinearly onto a grid of
     /// `cells[0]` cells from the first corner to the second and `cells[1]` from the second to
     /// the third, each cut into two triangles along alternating diagonals (so that the mesh has
-    /// no preferred direction). Cook's membrane is `[(0,0), (48,44), (48,60), (0,44)]`.
+    /// no preferred direction; see [`Diagonals`]). Cook's membrane is
+    /// `[(0,0), (48,44), (48,60), (0,44)]`.
     ///
     /// # Errors
     /// [`Error::InvalidGeneratorParameter`] for zero cells or more than 16 384 along a side;
     /// the errors of [`TriangleMesh::new`] for corners that fold the quadrilateral.
     pub fn quadrilateral(corners: [DVec2; 4], cells: [usize; 2]) -> Result<Self, Error> {
+        Self::quadrilateral_with(corners, cells, Diagonals::Alternating)
+    }
+
+    /// [`TriangleMesh::quadrilateral`] with the cells cut along `diagonals`.
+    ///
+    /// # Errors
+    /// As [`TriangleMesh::quadrilateral`].
+    pub fn quadrilateral_with(
+        corners: [DVec2; 4],
+        cells: [usize; 2],
+        diagonals: Diagonals,
+    ) -> Result<Self, Error> {
         check_cells("cells[0]", cells[0])?;
         check_cells("cells[1]", cells[1])?;
         let [nx, ny] = cells;
@@ -156,9 +181,7 @@ impl TriangleMesh {
             let v = j as f64 / ny as f64;
             for i in 0..=nx {
                 let u = i as f64 / nx as f64;
-                let bottom = p0.lerp(p1, u);
-                let top = p3.lerp(p2, u);
-                rest.push(bottom.lerp(top, v));
+                rest.push(p0.lerp(p1, u).lerp(p3.lerp(p2, u), v));
             }
         }
         let node = |i: usize, j: usize| (j * (nx + 1) + i) as u32;
@@ -171,7 +194,11 @@ impl TriangleMesh {
                     node(i + 1, j + 1),
                     node(i, j + 1),
                 ];
-                if (i + j) % 2 == 0 {
+                let rising = match diagonals {
+                    Diagonals::Alternating => (i + j) % 2 == 0,
+                    Diagonals::Parallel => true,
+                };
+                if rising {
                     triangles.extend([[a, b, c], [a, c, d]]);
                 } else {
                     triangles.extend([[a, b, d], [b, c, d]]);

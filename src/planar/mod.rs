@@ -34,14 +34,18 @@
 
 mod body;
 mod control_volume;
+mod dynamics;
 mod element;
+mod evaluate;
 mod mesh;
 mod plane;
 mod statics;
+mod volumetric;
 
 pub use body::{PlanarBody, PlanarBodyBuilder};
 pub use control_volume::{ControlVolumes, traction_along};
+pub use dynamics::{PlanarStepReport, SAFETY_FACTOR, step_explicit};
 pub use element::TriangleRest;
-pub use mesh::TriangleMesh;
+pub use mesh::{Diagonals, TriangleMesh};
 pub use plane::{PlanarLaw, PlanarStress, PlaneModel, apply_tangent};
 pub use statics::{edge_loads, solve_planar_equilibrium};

@@ -14,7 +14,8 @@
 //! Stresses are first Piola–Kirchhoff, per unit rest area of a section of unit rest thickness,
 //! so that for plane stress the thinning `s` is in them.
 
-use crate::material::HyperelasticModel;
+use crate::damping::RayleighDamping;
+use crate::material::{HyperelasticModel, VolumetricTerm};
 use rapier3d::glamx::{DMat2, DMat3, DVec2, DVec3};
 
 /// Iterations allowed to the out-of-plane stretch of plane stress.
@@ -139,6 +140,64 @@ impl<M: HyperelasticModel> PlanarLaw<M> {
         let response = self.model.first_piola_differential(&f3, &across);
         let (b, d) = (in_plane(&response), response.z_axis.z);
         columns.map(|c| in_plane(&c) - b * (c.z_axis.z / d))
+    }
+}
+
+/// The volumetric term `K/2 m(F)²` of plane strain (the stretch across the plane held at 1),
+/// for nodal averaging ([`super::PlanarBodyBuilder::volumetric`]).
+impl<M: VolumetricTerm> PlanarLaw<M> {
+    /// The bulk modulus `K` (Pa).
+    pub fn bulk_modulus(&self) -> f64 {
+        self.model.volumetric_modulus()
+    }
+
+    /// The volume measure `m(F)` (dimensionless).
+    pub fn volume_measure(&self, f: &DMat2) -> f64 {
+        self.model.volume_measure(&embed(f, 1.0))
+    }
+
+    /// Its in-plane gradient `∂m/∂F` (dimensionless).
+    pub fn volume_gradient(&self, f: &DMat2) -> DMat2 {
+        in_plane(&self.model.volume_measure_gradient(&embed(f, 1.0)))
+    }
+
+    /// The differential of the gradient for an in-plane change `df`.
+    pub fn volume_differential(&self, f: &DMat2, df: &DMat2) -> DMat2 {
+        in_plane(&(self.model).volume_measure_differential(&embed(f, 1.0), &embed(df, 0.0)))
+    }
+
+    /// `Ψ(F) − K/2 m(F)²` (J/m³).
+    pub fn energy_without_volumetric(&self, f: &DMat2) -> f64 {
+        self.model.energy_density_without_volumetric(&embed(f, 1.0))
+    }
+}
+
+impl PlaneModel {
+    /// The in-plane damping stress (Pa, first Piola–Kirchhoff) of `damping` for the in-plane
+    /// deformation gradient `f`, its rate `f_dot` (1/s) and the stretch `stretch` across the
+    /// plane: the 3D law `F (φ tr Ġ I + 2ψ Ġ)` with `Ġ₃₃ = 0` in plane strain, and in plane
+    /// stress the `Ġ₃₃` that leaves the damping stress across the sheet zero,
+    /// `Ġ₃₃ = −φ (Ġ₁₁ + Ġ₂₂)/(φ + 2ψ)` (the reduced viscosity `φ* = 2φψ/(φ + 2ψ)`, as `λ*`).
+    pub fn damping_stress(
+        self,
+        damping: &RayleighDamping,
+        f: &DMat2,
+        f_dot: &DMat2,
+        stretch: f64,
+    ) -> DMat2 {
+        let rate = f.transpose() * *f_dot;
+        let in_plane_rate = rate.x_axis.x + rate.y_axis.y;
+        let viscosity = damping.p_wave_viscosity();
+        let across = match self {
+            PlaneModel::PlaneStrain => 0.0,
+            PlaneModel::PlaneStress if viscosity > 0.0 => {
+                -damping.phi() * in_plane_rate / viscosity / stretch
+            }
+            PlaneModel::PlaneStress => 0.0,
+        };
+        let f3 = embed(f, stretch);
+        let f_dot3 = embed(f_dot, across);
+        in_plane(&damping.first_piola(&f3, &f_dot3))
     }
 }
 

@@ -1,18 +1,20 @@
-//! Static equilibrium of a 2D body: `f_int(x) + f_ext = 0` with the pinned nodes held, by
-//! Newton's method on the total potential energy `Π = E(x) − f_ext · x` with the sparse tangent
-//! `K = −∂f_int/∂x` (faer's Cholesky factorization, as in 3D) and a backtracking line search on
-//! `Π`. The linear law converges in one iteration.
+//! Static equilibrium of a 2D body: `f_int(x) + f_ext = 0` with the held nodes held, by
+//! Newton's method on the total potential energy `Π = E(x) − f_ext · (x − x₀)` with the sparse
+//! tangent `K = −∂f_int/∂x` (faer's Cholesky factorization) and the line search, tolerance and
+//! round-off floor of the 3D solver ([`crate::statics`], through [`crate::newton`]). The linear
+//! law converges in one iteration.
 
 use super::body::PlanarBody;
+use super::evaluate::patch_tangent;
 use crate::Error;
 use crate::assembly::{Factor, SymbolicFactor};
+use crate::newton::{
+    Configuration, ROUND_OFF_CEILING, Search, check_tolerance, descend, norm, stalled_at_round_off,
+};
 use crate::statics::{StaticReport, StaticSettings};
 use faer::Mat;
-use faer::sparse::{SparseColMat, Triplet};
+use faer::sparse::SparseColMat;
 use rapier3d::glamx::DVec2;
-
-/// Halvings allowed to a Newton step before the line search gives up.
-const MAX_HALVINGS: usize = 30;
 
 /// The nodal forces (N) of a uniform `traction` (N per m of edge length, per m of thickness
 /// times the body's thickness gives N) along the polyline of `nodes` (in order along the edge):
@@ -65,135 +67,97 @@ fn tangent(
 ) -> Option<SparseColMat<usize, f64>> {
     let mut triplets = Vec::with_capacity(body.triangle_rest().len() * 36);
     body.with_law(|law| {
-        for (t, rest) in body.triangle_rest().iter().enumerate() {
-            let f = rest.gradient(&body.corners_in(t, positions));
-            let columns = law.tangent(&f);
-            let nodes = body.mesh().triangles()[t];
-            let normals = rest.normals();
-            for (j, &node_j) in nodes.iter().enumerate() {
-                for (b, direction) in [DVec2::X, DVec2::Y].into_iter().enumerate() {
-                    let Some(col) = index[node_j as usize][b] else {
-                        continue;
-                    };
-                    let df = rest.gradient_change(j, direction);
-                    let dp = super::plane::apply_tangent(&columns, &df);
-                    for (i, &node_i) in nodes.iter().enumerate() {
-                        let k = (-(dp * normals[i]) * body.thickness()).to_array();
-                        for (a, row) in index[node_i as usize].iter().enumerate() {
-                            if let Some(row) = row {
-                                triplets.push(Triplet::new(*row, col, k[a]));
-                            }
-                        }
-                    }
-                }
-            }
-        }
+        let evaluation = body.evaluate(law, positions);
+        body.element_tangent(law, &evaluation, index, &mut triplets);
+        patch_tangent(body, law, &evaluation, index, &mut triplets);
     });
     SparseColMat::try_new_from_triplets(n, n, &triplets).ok()
 }
 
-/// Where Newton's method is: the positions (m), the out-of-balance force `f_int + f_ext` (N)
-/// over the free unknowns, and the scale (N) it is measured against: the larger of the loads'
-/// norm and the internal forces' on every node (the held nodes' are the reactions).
-struct Iterate {
+/// What Newton moves: the body's positions (m), evaluated with the body's elasticity.
+struct Placed<'a> {
+    body: &'a PlanarBody,
     positions: Vec<DVec2>,
-    residual: Vec<f64>,
-    scale: f64,
 }
 
-impl Iterate {
-    /// The residual's norm over its scale (dimensionless).
-    fn relative_residual(&self) -> f64 {
-        self.residual.iter().map(|v| v * v).sum::<f64>().sqrt() / self.scale
+impl Configuration for Placed<'_> {
+    type Vector = DVec2;
+    fn copy_positions(&self) -> Vec<DVec2> {
+        self.positions.clone()
+    }
+    fn place(&mut self, start: &[DVec2], direction: &[DVec2], alpha: f64) {
+        for ((x, x0), d) in self.positions.iter_mut().zip(start).zip(direction) {
+            *x = *x0 + *d * alpha;
+        }
     }
 }
 
-/// One static problem: the body, its loads (N) and its free unknowns.
+/// One static problem: the nodal loads (N), the free unknowns, and the positions (m) the
+/// loads' work is measured from.
 struct Problem<'a> {
-    body: &'a PlanarBody,
     loads: &'a [DVec2],
-    load_norm: f64,
     index: Vec<[Option<usize>; 2]>,
     n: usize,
+    start: Vec<DVec2>,
 }
 
 impl Problem<'_> {
-    /// The iterate at `positions` (m).
-    fn at(&self, positions: Vec<DVec2>) -> Iterate {
-        let forces = self.body.internal_forces_at(&positions);
-        let internal = forces
-            .iter()
-            .map(|f| f.length_squared())
-            .sum::<f64>()
-            .sqrt();
-        let mut residual = vec![0.0; self.n];
-        for (node, slots) in self.index.iter().enumerate() {
-            let f = (forces[node] + self.loads[node]).to_array();
-            for (a, slot) in slots.iter().enumerate() {
-                if let Some(k) = slot {
-                    residual[*k] = f[a];
-                }
-            }
-        }
-        let scale = self.load_norm.max(internal).max(f64::MIN_POSITIVE);
-        Iterate {
-            positions,
-            residual,
-            scale,
-        }
+    /// The out-of-balance force `f_int + f_ext` (N) per node where `placed` is, zero along
+    /// held axes.
+    fn residual(&self, placed: &Placed<'_>) -> Vec<DVec2> {
+        let forces = placed.body.internal_forces_at(&placed.positions);
+        (forces.iter().zip(self.loads).zip(&self.index))
+            .map(|((f, load), slots)| {
+                let sum = *f + *load;
+                DVec2::new(
+                    if slots[0].is_some() { sum.x } else { 0.0 },
+                    if slots[1].is_some() { sum.y } else { 0.0 },
+                )
+            })
+            .collect()
     }
 
-    /// The total potential energy `E(x) − f_ext · x` (J) at `positions` (m).
-    fn potential(&self, positions: &[DVec2]) -> f64 {
-        let work: f64 = positions
-            .iter()
-            .zip(self.loads)
-            .map(|(x, f)| x.dot(*f))
+    /// The total potential energy `E(x) − f_ext · (x − x₀)` (J) where `placed` is.
+    fn potential(&self, placed: &Placed<'_>) -> f64 {
+        let work: f64 = (placed.positions.iter().zip(&self.start).zip(self.loads))
+            .map(|((x, x0), f)| (*x - *x0).dot(*f))
             .sum();
-        self.body.elastic_energy_at(positions) - work
+        placed.body.elastic_energy_at(&placed.positions) - work
     }
 
-    /// The Newton step `K⁻¹ r` (m) from `iterate`, the `iteration`-th.
-    fn newton_step(&self, iterate: &Iterate, iteration: usize) -> Result<Mat<f64>, Error> {
-        let k = tangent(self.body, &iterate.positions, &self.index, self.n).ok_or(
+    /// The Newton direction `K⁻¹ r` (m per node) for `residual` where `placed` is, at Newton's
+    /// `iteration`.
+    fn direction(
+        &self,
+        placed: &Placed<'_>,
+        residual: &[DVec2],
+        iteration: usize,
+    ) -> Result<Vec<DVec2>, Error> {
+        let body = placed.body;
+        let k = tangent(body, &placed.positions, &self.index, self.n).ok_or(
             Error::AllocationFailed {
                 what: "the tangent of a 2D body",
-                bytes: (self.body.triangle_rest().len() as u64).saturating_mul(36 * 24),
+                bytes: (body.triangle_rest().len() as u64).saturating_mul(36 * 24),
             },
         )?;
         let indefinite = Error::IndefiniteStiffness { iteration };
         let symbolic = SymbolicFactor::try_new(k.symbolic()).ok_or(indefinite.clone())?;
         let factor = Factor::try_new(symbolic, k.as_ref()).ok_or(indefinite)?;
-        let mut step = Mat::from_fn(self.n, 1, |i, _| iterate.residual[i]);
-        factor.solve_in_place(step.as_mut());
-        Ok(step)
-    }
-
-    /// The first of the step's halvings from `iterate` that lowers the potential or the
-    /// out-of-balance force, if one does within [`MAX_HALVINGS`].
-    fn line_search(&self, iterate: &Iterate, step: &Mat<f64>) -> Option<Iterate> {
-        let start = self.potential(&iterate.positions);
-        let mut alpha = 1.0;
-        for _ in 0..MAX_HALVINGS {
-            let mut trial = iterate.positions.clone();
-            for (node, slots) in self.index.iter().enumerate() {
-                for (a, slot) in slots.iter().enumerate() {
-                    if let Some(k) = slot {
-                        trial[node][a] += step[(*k, 0)] * alpha;
-                    }
+        let mut rhs = Mat::<f64>::zeros(self.n, 1);
+        for (r, slots) in residual.iter().zip(&self.index) {
+            for (a, slot) in slots.iter().enumerate() {
+                if let Some(k) = slot {
+                    rhs[(*k, 0)] = r.to_array()[a];
                 }
             }
-            let lower = self.potential(&trial) <= start;
-            let next = self.at(trial);
-            if lower
-                || next.relative_residual() * next.scale
-                    < iterate.relative_residual() * iterate.scale
-            {
-                return Some(next);
-            }
-            alpha *= 0.5;
         }
-        None
+        factor.solve_in_place(rhs.as_mut());
+        let component = |slot: Option<usize>| slot.map_or(0.0, |k| rhs[(k, 0)]);
+        Ok(self
+            .index
+            .iter()
+            .map(|s| DVec2::new(component(s[0]), component(s[1])))
+            .collect())
     }
 }
 
@@ -221,12 +185,14 @@ fn check_input(body: &PlanarBody, loads: &[DVec2]) -> Result<(), Error> {
     }
 }
 
-/// Moves `body` to static equilibrium under the nodal `loads` (N, one per node) with its pinned
-/// nodes held: until the out-of-balance force is below `settings.tolerance` times the larger of
-/// the loads' norm and the internal forces' (the reactions of held nodes included), so that a
-/// body deformed by its held nodes alone converges too.
+/// Moves `body` to static equilibrium under the nodal `loads` (N, one per node) with its held
+/// nodes held, as [`crate::statics::solve_equilibrium`] does a 3D body: until the out-of-balance
+/// force is below `settings.tolerance` times the larger of the loads' norm and the first
+/// out-of-balance force's (so that a body deformed by its held nodes alone converges too), or
+/// sits at its round-off floor below 1e-6 of it.
 ///
 /// # Errors
+/// [`Error::InvalidSetting`] for a tolerance that is not positive and finite,
 /// [`Error::WrongNodeCount`] for loads of the wrong length, [`Error::NonFiniteInput`] for a
 /// non-finite load, [`Error::NonFiniteCoordinate`] for a position made non-finite,
 /// [`Error::NoFreeNode`], [`Error::AllocationFailed`], [`Error::IndefiniteStiffness`] (too few
@@ -236,41 +202,86 @@ pub fn solve_planar_equilibrium(
     loads: &[DVec2],
     settings: &StaticSettings,
 ) -> Result<StaticReport, Error> {
+    check_tolerance(settings.tolerance)?;
     check_input(body, loads)?;
     let (index, n) = free_unknowns(&body.pinned);
     if n == 0 {
         return Err(Error::NoFreeNode);
     }
-    let load_norm = loads.iter().map(|f| f.length_squared()).sum::<f64>().sqrt();
+    let start = body.positions().to_vec();
     let problem = Problem {
-        body,
         loads,
-        load_norm,
         index,
         n,
+        start: start.clone(),
     };
-    let mut iterate = problem.at(body.positions().to_vec());
-    let mut iterations = 0;
-    while iterate.relative_residual() > settings.tolerance {
-        if iterations == settings.max_iterations {
-            return Err(Error::StaticSolveDidNotConverge {
+    let mut placed = Placed {
+        body,
+        positions: start,
+    };
+    let (report, positions) = newton(&problem, &mut placed, settings)?;
+    body.positions_mut().copy_from_slice(&positions);
+    Ok(report)
+}
+
+/// Newton's iterations of [`solve_planar_equilibrium`]: the report and the positions (m)
+/// reached.
+fn newton(
+    problem: &Problem<'_>,
+    placed: &mut Placed<'_>,
+    settings: &StaticSettings,
+) -> Result<(StaticReport, Vec<DVec2>), Error> {
+    let mut residual = problem.residual(placed);
+    let reference = norm(problem.loads).max(norm(&residual));
+    let done = |iterations, relative_residual, placed: &Placed<'_>| {
+        Ok((
+            StaticReport {
                 iterations,
-                residual: iterate.relative_residual(),
-            });
-        }
-        let step = problem.newton_step(&iterate, iterations)?;
-        iterations += 1;
-        iterate = problem
-            .line_search(&iterate, &step)
-            .ok_or(Error::StaticSolveDidNotConverge {
-                iterations,
-                residual: iterate.relative_residual(),
-            })?;
+                relative_residual,
+            },
+            placed.positions.clone(),
+        ))
+    };
+    if reference == 0.0 {
+        return done(0, 0.0, placed);
     }
-    let relative_residual = iterate.relative_residual();
-    body.positions_mut().copy_from_slice(&iterate.positions);
-    Ok(StaticReport {
-        iterations,
-        relative_residual,
+    let mut history = Vec::new();
+    for iteration in 0..settings.max_iterations {
+        let relative = norm(&residual) / reference;
+        if relative <= settings.tolerance || stalled_at_round_off(&history, relative) {
+            return done(iteration, relative, placed);
+        }
+        history.push(relative);
+        let direction = problem.direction(placed, &residual, iteration)?;
+        let energy = |placed: &Placed<'_>| problem.potential(placed);
+        let potential = energy(placed);
+        let next = descend(
+            placed,
+            &residual,
+            potential,
+            &direction,
+            Search::Thorough,
+            energy,
+            |placed| problem.residual(placed),
+        );
+        match next {
+            Some((next, _)) => residual = next,
+            // No descent left above round-off: accept a tiny residual, refuse anything else.
+            None if relative <= ROUND_OFF_CEILING => return done(iteration, relative, placed),
+            None => {
+                return Err(Error::StaticSolveDidNotConverge {
+                    iterations: iteration,
+                    residual: relative,
+                });
+            }
+        }
+    }
+    let relative = norm(&residual) / reference;
+    if relative <= settings.tolerance {
+        return done(settings.max_iterations, relative, placed);
+    }
+    Err(Error::StaticSolveDidNotConverge {
+        iterations: settings.max_iterations,
+        residual: relative,
     })
 }

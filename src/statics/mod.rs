@@ -18,11 +18,11 @@ use crate::body::DeformableBody;
 use crate::integrate::SolverWorkspace;
 use crate::linear_solver::{Method, solve_newton_system};
 use crate::load::ChamberSolve;
-use crate::newton::{Search, check_tolerance, descend, norm, round_off_floor};
+use crate::newton::{
+    ROUND_OFF_CEILING, Search, check_tolerance, descend, norm, round_off_floor,
+    stalled_at_round_off,
+};
 use rapier3d::glamx::{DMat3, DVec3};
-
-/// The largest relative residual accepted as round-off when Newton stops reducing it.
-const ROUND_OFF_CEILING: f64 = 1e-6;
 
 /// Convergence settings of [`solve_equilibrium`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -109,15 +109,7 @@ fn newton(
     let start = body.positions.clone();
     for iteration in 0..settings.max_iterations {
         let relative = norm(&residual) / reference;
-        // Newton more than halves the residual each iteration until round-off in the force sum
-        // sets a floor (about 1e-9 on 1e5 elements); a tiny residual that fails to halve twice in
-        // a row is there.
-        let failed_to_halve = |older: f64, newer: f64| newer > 0.5 * older;
-        let at_round_off = relative <= ROUND_OFF_CEILING
-            && history.len() >= 2
-            && failed_to_halve(history[history.len() - 1], relative)
-            && failed_to_halve(history[history.len() - 2], history[history.len() - 1]);
-        if relative <= settings.tolerance || at_round_off {
+        if relative <= settings.tolerance || stalled_at_round_off(&history, relative) {
             return Ok(StaticReport {
                 iterations: iteration,
                 relative_residual: relative,

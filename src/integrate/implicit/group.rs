@@ -40,6 +40,7 @@ struct Group<'s, 'b> {
 }
 
 impl Configuration for Group<'_, '_> {
+    type Vector = DVec3;
     fn copy_positions(&self) -> Vec<DVec3> {
         self.bodies
             .iter()

@@ -1,0 +1,173 @@
+//! Explicit dynamics of a 2D body: symplectic Euler, `v ← v + h M⁻¹ (f_int(x, v) + M g + f_ext)`
+//! then `x ← x + h v`, with held axes kept at rest, in substeps below the stability limit.
+//!
+//! The internal forces are the elastic ones plus the Rayleigh damping's on the Green strain
+//! rate ([`PlaneModel::damping_stress`](super::PlaneModel::damping_stress)), which is zero for
+//! every rigid motion. Both have no net force and, evaluated at one configuration, no net
+//! torque, so a free body's linear and angular momentum are kept by each substep to round-off
+//! (`L' = Σ m (x + h v') × v' = Σ m x × v' = L`).
+//!
+//! The stability limit: `ω_max² ≤ max_i Σ_j |K_ij| / m_i` (Gershgorin's bound on `M⁻¹K`, with
+//! the tangent at the frame's start), and for damping of P-wave viscosity `η` against the
+//! P-wave modulus `M_p` (`β = η / M_p`, `ζ = β ω / 2`), the limit `2 (√(1 + ζ²) − ζ) / ω`.
+//! Substeps are that limit times [`SAFETY_FACTOR`]: the bound is an upper bound on `ω`, and the
+//! factor leaves room for the stiffening of large deformation within the frame.
+
+use super::body::PlanarBody;
+use super::evaluate::patch_tangent;
+use crate::Error;
+use faer::sparse::Triplet;
+use rapier3d::glamx::DVec2;
+
+/// The fraction of the stability limit a substep takes.
+pub const SAFETY_FACTOR: f64 = 0.5;
+
+/// The most substeps a frame may take.
+const MAX_SUBSTEPS: u32 = 1_000_000;
+
+/// What [`step_explicit`] did.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlanarStepReport {
+    /// Substeps taken.
+    pub substeps: u32,
+    /// Their length (s).
+    pub substep_dt: f64,
+}
+
+impl PlanarBody {
+    /// The explicit scheme's stability limit (s) where the body is (see the module's
+    /// documentation); infinite for a body with every axis held.
+    pub fn critical_time_step(&self) -> f64 {
+        let all: Vec<[Option<usize>; 2]> = (0..self.positions().len())
+            .map(|n| [Some(2 * n), Some(2 * n + 1)])
+            .collect();
+        let mut triplets: Vec<Triplet<usize, usize, f64>> = Vec::new();
+        self.with_law(|law| {
+            let evaluation = self.evaluate(law, self.positions());
+            self.element_tangent(law, &evaluation, &all, &mut triplets);
+            patch_tangent(self, law, &evaluation, &all, &mut triplets);
+        });
+        let mut row_sums = vec![0.0; 2 * self.positions().len()];
+        for t in &triplets {
+            row_sums[t.row] += t.val.abs();
+        }
+        let omega_squared = (row_sums.iter().enumerate())
+            .filter(|(row, _)| !self.pinned[row / 2][row % 2])
+            .map(|(row, sum)| sum / self.masses()[row / 2])
+            .fold(0.0, f64::max);
+        if omega_squared == 0.0 {
+            return f64::INFINITY;
+        }
+        let omega = omega_squared.sqrt();
+        let beta = self.damping().map_or(0.0, |d| {
+            d.p_wave_viscosity() / self.material().lame().p_wave_modulus()
+        });
+        let zeta = 0.5 * beta * omega;
+        2.0 / (omega * ((1.0 + zeta * zeta).sqrt() + zeta))
+    }
+
+    /// The internal forces (N): elastic and damping, where the body is and as it moves.
+    pub fn internal_forces_with_damping(&self) -> Vec<DVec2> {
+        let mut forces = self.internal_forces();
+        let Some(damping) = self.damping() else {
+            return forces;
+        };
+        let plane = self.plane();
+        self.with_law(|law| {
+            for (t, rest) in self.triangle_rest().iter().enumerate() {
+                let nodes = self.mesh().triangles()[t];
+                let f = rest.gradient(&self.corners_in(t, self.positions()));
+                let f_dot = rest.gradient(&nodes.map(|n| self.velocities()[n as usize]));
+                let stretch = law.stress(&f).stretch;
+                let p = plane.damping_stress(damping, &f, &f_dot, stretch);
+                for (node, force) in nodes.iter().zip(rest.forces(&p, self.thickness())) {
+                    forces[*node as usize] += force;
+                }
+            }
+        });
+        forces
+    }
+}
+
+/// Advances `body` by `dt` (s) under `gravity` (m/s²) and the nodal `loads` (N, one per node),
+/// in equal substeps below [`SAFETY_FACTOR`] times [`PlanarBody::critical_time_step`] at the
+/// start.
+///
+/// # Errors
+/// [`Error::InvalidTimeStep`] for a `dt` that is not positive and finite,
+/// [`Error::NonFiniteInput`] for a non-finite gravity or load, [`Error::WrongNodeCount`] for
+/// loads of the wrong length, [`Error::TooManySubsteps`] beyond a million substeps,
+/// [`Error::NonFiniteState`] if the step made a position or velocity non-finite. On error the
+/// body is left as it was.
+pub fn step_explicit(
+    body: &mut PlanarBody,
+    dt: f64,
+    gravity: DVec2,
+    loads: &[DVec2],
+) -> Result<PlanarStepReport, Error> {
+    if !(dt.is_finite() && dt > 0.0) {
+        return Err(Error::InvalidTimeStep {
+            dt,
+            reason: "a frame step must be positive and finite",
+        });
+    }
+    if !gravity.is_finite() || loads.iter().any(|f| !f.is_finite()) {
+        return Err(Error::NonFiniteInput {
+            parameter: "gravity or loads",
+        });
+    }
+    let node_count = body.positions().len();
+    if loads.len() != node_count {
+        return Err(Error::WrongNodeCount {
+            given: loads.len(),
+            node_count,
+        });
+    }
+    let limit = SAFETY_FACTOR * body.critical_time_step();
+    let needed = (dt / limit).ceil();
+    if needed.is_nan() || needed > f64::from(MAX_SUBSTEPS) {
+        return Err(Error::TooManySubsteps {
+            frame_dt: dt,
+            needed,
+            max: MAX_SUBSTEPS,
+        });
+    }
+    let substeps = (needed as u32).max(1);
+    let h = dt / f64::from(substeps);
+    let saved = (body.positions().to_vec(), body.velocities().to_vec());
+    for _ in 0..substeps {
+        substep(body, h, gravity, loads);
+    }
+    let state = body.positions().iter().zip(body.velocities());
+    if let Some(node) = state
+        .clone()
+        .position(|(x, v)| !(x.is_finite() && v.is_finite()))
+    {
+        body.positions_mut().copy_from_slice(&saved.0);
+        body.velocities_mut().copy_from_slice(&saved.1);
+        return Err(Error::NonFiniteState { node });
+    }
+    Ok(PlanarStepReport {
+        substeps,
+        substep_dt: h,
+    })
+}
+
+/// One symplectic Euler substep of `h` (s).
+fn substep(body: &mut PlanarBody, h: f64, gravity: DVec2, loads: &[DVec2]) {
+    let forces = body.internal_forces_with_damping();
+    let masses = body.masses().to_vec();
+    let pinned = body.pinned().to_vec();
+    for (n, v) in body.velocities_mut().iter_mut().enumerate() {
+        *v += (forces[n] + loads[n]) * (h / masses[n]) + gravity * h;
+        for axis in 0..2 {
+            if pinned[n][axis] {
+                v[axis] = 0.0;
+            }
+        }
+    }
+    let velocities = body.velocities().to_vec();
+    for (x, v) in body.positions_mut().iter_mut().zip(velocities) {
+        *x += v * h;
+    }
+}
