@@ -99,6 +99,21 @@ impl RayleighDamping {
         self.phi + 2.0 * self.psi
     }
 
+    /// The damping of a sheet free across its thickness (plane stress), acting on in-plane
+    /// strain rates: the 3D law with the rate across the sheet that leaves no stress across it,
+    /// `Ġ₃₃ = −φ (Ġ₁₁ + Ġ₂₂)/(φ + 2ψ)`, is `φ* tr Ġ I + 2ψ Ġ` in the plane with
+    /// `φ* = 2φψ/(φ + 2ψ)` (zero when `φ + 2ψ = 0`), as `λ* = 2λμ/(λ + 2μ)` is for the
+    /// stiffness. Its in-plane bulk viscosity `φ* + ψ` is non-negative whenever the 3D one is.
+    pub(crate) fn plane_stress(&self) -> Self {
+        let viscosity = self.p_wave_viscosity();
+        let phi = if viscosity > 0.0 {
+            2.0 * self.phi * self.psi / viscosity
+        } else {
+            0.0
+        };
+        Self { phi, psi: self.psi }
+    }
+
     /// Damping stress as a first Piola–Kirchhoff stress (Pa), for deformation gradient `f` and its
     /// rate `f_dot` (1/s).
     #[inline(always)]

@@ -14,9 +14,8 @@
 //! factor leaves room for the stiffening of large deformation within the frame.
 
 use super::body::PlanarBody;
-use super::evaluate::patch_tangent;
+use super::unknowns::Unknowns;
 use crate::Error;
-use faer::sparse::Triplet;
 use rapier3d::glamx::DVec2;
 
 /// The fraction of the stability limit a substep takes.
@@ -38,15 +37,8 @@ impl PlanarBody {
     /// The explicit scheme's stability limit (s) where the body is (see the module's
     /// documentation); infinite for a body with every axis held.
     pub fn critical_time_step(&self) -> f64 {
-        let all: Vec<[Option<usize>; 2]> = (0..self.positions().len())
-            .map(|n| [Some(2 * n), Some(2 * n + 1)])
-            .collect();
-        let mut triplets: Vec<Triplet<usize, usize, f64>> = Vec::new();
-        self.with_law(|law| {
-            let evaluation = self.evaluate(law, self.positions());
-            self.element_tangent(law, &evaluation, &all, &mut triplets);
-            patch_tangent(self, law, &evaluation, &all, &mut triplets);
-        });
+        let free = Unknowns::new(&vec![[false; 2]; self.positions().len()]);
+        let triplets = free.elastic_entries(self, self.positions());
         let mut row_sums = vec![0.0; 2 * self.positions().len()];
         for t in &triplets {
             row_sums[t.row] += t.val.abs();
@@ -73,18 +65,15 @@ impl PlanarBody {
             return forces;
         };
         let plane = self.plane();
-        self.with_law(|law| {
-            for (t, rest) in self.triangle_rest().iter().enumerate() {
-                let nodes = self.mesh().triangles()[t];
-                let f = rest.gradient(&self.corners_in(t, self.positions()));
-                let f_dot = rest.gradient(&nodes.map(|n| self.velocities()[n as usize]));
-                let stretch = law.stress(&f).stretch;
-                let p = plane.damping_stress(damping, &f, &f_dot, stretch);
-                for (node, force) in nodes.iter().zip(rest.forces(&p, self.thickness())) {
-                    forces[*node as usize] += force;
-                }
+        for (t, rest) in self.triangle_rest().iter().enumerate() {
+            let nodes = self.mesh().triangles()[t];
+            let f = rest.gradient(&self.corners_in(t, self.positions()));
+            let f_dot = rest.gradient(&nodes.map(|n| self.velocities()[n as usize]));
+            let p = plane.damping_stress(damping, &f, &f_dot);
+            for (node, force) in nodes.iter().zip(rest.forces(&p, self.thickness())) {
+                forces[*node as usize] += force;
             }
-        });
+        }
         forces
     }
 }

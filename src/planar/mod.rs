@@ -37,15 +37,18 @@ mod control_volume;
 mod dynamics;
 mod element;
 mod evaluate;
+mod implicit;
 mod mesh;
 mod plane;
 mod statics;
+mod unknowns;
 mod volumetric;
 
 pub use body::{PlanarBody, PlanarBodyBuilder};
 pub use control_volume::{ControlVolumes, traction_along};
 pub use dynamics::{PlanarStepReport, SAFETY_FACTOR, step_explicit};
 pub use element::TriangleRest;
+pub use implicit::{PlanarImplicitReport, step_implicit};
 pub use mesh::{Diagonals, TriangleMesh};
 pub use plane::{PlanarLaw, PlanarStress, PlaneModel, apply_tangent};
 pub use statics::{edge_loads, solve_planar_equilibrium};

@@ -173,32 +173,41 @@ impl<M: VolumetricTerm> PlanarLaw<M> {
 }
 
 impl PlaneModel {
-    /// The in-plane damping stress (Pa, first Piola–Kirchhoff) of `damping` for the in-plane
-    /// deformation gradient `f`, its rate `f_dot` (1/s) and the stretch `stretch` across the
-    /// plane: the 3D law `F (φ tr Ġ I + 2ψ Ġ)` with `Ġ₃₃ = 0` in plane strain, and in plane
-    /// stress the `Ġ₃₃` that leaves the damping stress across the sheet zero,
-    /// `Ġ₃₃ = −φ (Ġ₁₁ + Ġ₂₂)/(φ + 2ψ)` (the reduced viscosity `φ* = 2φψ/(φ + 2ψ)`, as `λ*`).
-    pub fn damping_stress(
-        self,
-        damping: &RayleighDamping,
-        f: &DMat2,
-        f_dot: &DMat2,
-        stretch: f64,
-    ) -> DMat2 {
-        let rate = f.transpose() * *f_dot;
-        let in_plane_rate = rate.x_axis.x + rate.y_axis.y;
-        let viscosity = damping.p_wave_viscosity();
-        let across = match self {
-            PlaneModel::PlaneStrain => 0.0,
-            PlaneModel::PlaneStress if viscosity > 0.0 => {
-                -damping.phi() * in_plane_rate / viscosity / stretch
-            }
-            PlaneModel::PlaneStress => 0.0,
-        };
-        let f3 = embed(f, stretch);
-        let f_dot3 = embed(f_dot, across);
-        in_plane(&damping.first_piola(&f3, &f_dot3))
+    /// The damping as it acts on in-plane rates: the 3D law with `Ġ₃₃ = 0` in plane strain;
+    /// in plane stress with the rate across the sheet that leaves no damping stress across it,
+    /// which is the 3D law with the reduced volumetric viscosity `φ* = 2φψ/(φ + 2ψ)` and
+    /// `Ġ₃₃ = 0` (exactly consistent with the elastic stretch across the sheet for
+    /// stiffness-proportional damping at small strain, where both rates are `−ν/(1 − ν) tr ε̇`).
+    pub fn in_plane_damping(self, damping: &RayleighDamping) -> RayleighDamping {
+        match self {
+            PlaneModel::PlaneStrain => *damping,
+            PlaneModel::PlaneStress => damping.plane_stress(),
+        }
     }
+
+    /// The in-plane damping stress (Pa, first Piola–Kirchhoff) of `damping` for the in-plane
+    /// deformation gradient `f` and its rate `f_dot` (1/s) (see
+    /// [`PlaneModel::in_plane_damping`]).
+    pub fn damping_stress(self, damping: &RayleighDamping, f: &DMat2, f_dot: &DMat2) -> DMat2 {
+        let damping = self.in_plane_damping(damping);
+        in_plane(&damping.first_piola(&embed(f, 1.0), &embed(f_dot, 0.0)))
+    }
+}
+
+/// `F₃` for the in-plane `f` with a unit stretch across the plane: the embedding in which the
+/// damping's in-plane terms are evaluated.
+pub(super) fn embed_flat(f: &DMat2) -> DMat3 {
+    embed(f, 1.0)
+}
+
+/// A change of `F₃` within the plane: `df` with no change across it.
+pub(super) fn embed_change(df: &DMat2) -> DMat3 {
+    embed(df, 0.0)
+}
+
+/// The in-plane block of a 3D tensor.
+pub(super) fn in_plane_block(m: &DMat3) -> DMat2 {
+    in_plane(m)
 }
 
 /// `dP` (Pa) for a change `df` of `F`, from the `tangent`'s columns.

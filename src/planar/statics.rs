@@ -5,15 +5,12 @@
 //! law converges in one iteration.
 
 use super::body::PlanarBody;
-use super::evaluate::patch_tangent;
+use super::unknowns::{Placed, Unknowns};
 use crate::Error;
-use crate::assembly::{Factor, SymbolicFactor};
 use crate::newton::{
-    Configuration, ROUND_OFF_CEILING, Search, check_tolerance, descend, norm, stalled_at_round_off,
+    ROUND_OFF_CEILING, Search, check_tolerance, descend, norm, stalled_at_round_off,
 };
 use crate::statics::{StaticReport, StaticSettings};
-use faer::Mat;
-use faer::sparse::SparseColMat;
 use rapier3d::glamx::DVec2;
 
 /// The nodal forces (N) of a uniform `traction` (N per m of edge length, per m of thickness
@@ -40,64 +37,11 @@ pub fn edge_loads(body: &PlanarBody, nodes: &[usize], traction: DVec2, total: bo
     loads
 }
 
-/// The free unknowns: for each node and axis, its index among the unknowns, or `None` if held
-/// along that axis; and their count.
-fn free_unknowns(pinned: &[[bool; 2]]) -> (Vec<[Option<usize>; 2]>, usize) {
-    let mut next = 0;
-    let mut number = |held: bool| {
-        (!held).then(|| {
-            next += 1;
-            next - 1
-        })
-    };
-    let index = pinned
-        .iter()
-        .map(|p| [number(p[0]), number(p[1])])
-        .collect();
-    (index, next)
-}
-
-/// The tangent `K = −∂f_int/∂x` (N/m) over the free unknowns at `positions`; `None` if faer
-/// cannot hold it (its only failure with indices below `n`: memory).
-fn tangent(
-    body: &PlanarBody,
-    positions: &[DVec2],
-    index: &[[Option<usize>; 2]],
-    n: usize,
-) -> Option<SparseColMat<usize, f64>> {
-    let mut triplets = Vec::with_capacity(body.triangle_rest().len() * 36);
-    body.with_law(|law| {
-        let evaluation = body.evaluate(law, positions);
-        body.element_tangent(law, &evaluation, index, &mut triplets);
-        patch_tangent(body, law, &evaluation, index, &mut triplets);
-    });
-    SparseColMat::try_new_from_triplets(n, n, &triplets).ok()
-}
-
-/// What Newton moves: the body's positions (m), evaluated with the body's elasticity.
-struct Placed<'a> {
-    body: &'a PlanarBody,
-    positions: Vec<DVec2>,
-}
-
-impl Configuration for Placed<'_> {
-    type Vector = DVec2;
-    fn copy_positions(&self) -> Vec<DVec2> {
-        self.positions.clone()
-    }
-    fn place(&mut self, start: &[DVec2], direction: &[DVec2], alpha: f64) {
-        for ((x, x0), d) in self.positions.iter_mut().zip(start).zip(direction) {
-            *x = *x0 + *d * alpha;
-        }
-    }
-}
-
 /// One static problem: the nodal loads (N), the free unknowns, and the positions (m) the
 /// loads' work is measured from.
 struct Problem<'a> {
     loads: &'a [DVec2],
-    index: Vec<[Option<usize>; 2]>,
-    n: usize,
+    unknowns: Unknowns,
     start: Vec<DVec2>,
 }
 
@@ -106,15 +50,7 @@ impl Problem<'_> {
     /// held axes.
     fn residual(&self, placed: &Placed<'_>) -> Vec<DVec2> {
         let forces = placed.body.internal_forces_at(&placed.positions);
-        (forces.iter().zip(self.loads).zip(&self.index))
-            .map(|((f, load), slots)| {
-                let sum = *f + *load;
-                DVec2::new(
-                    if slots[0].is_some() { sum.x } else { 0.0 },
-                    if slots[1].is_some() { sum.y } else { 0.0 },
-                )
-            })
-            .collect()
+        (self.unknowns).free_part(forces.iter().zip(self.loads).map(|(f, load)| *f + *load))
     }
 
     /// The total potential energy `E(x) − f_ext · (x − x₀)` (J) where `placed` is.
@@ -133,31 +69,8 @@ impl Problem<'_> {
         residual: &[DVec2],
         iteration: usize,
     ) -> Result<Vec<DVec2>, Error> {
-        let body = placed.body;
-        let k = tangent(body, &placed.positions, &self.index, self.n).ok_or(
-            Error::AllocationFailed {
-                what: "the tangent of a 2D body",
-                bytes: (body.triangle_rest().len() as u64).saturating_mul(36 * 24),
-            },
-        )?;
-        let indefinite = Error::IndefiniteStiffness { iteration };
-        let symbolic = SymbolicFactor::try_new(k.symbolic()).ok_or(indefinite.clone())?;
-        let factor = Factor::try_new(symbolic, k.as_ref()).ok_or(indefinite)?;
-        let mut rhs = Mat::<f64>::zeros(self.n, 1);
-        for (r, slots) in residual.iter().zip(&self.index) {
-            for (a, slot) in slots.iter().enumerate() {
-                if let Some(k) = slot {
-                    rhs[(*k, 0)] = r.to_array()[a];
-                }
-            }
-        }
-        factor.solve_in_place(rhs.as_mut());
-        let component = |slot: Option<usize>| slot.map_or(0.0, |k| rhs[(k, 0)]);
-        Ok(self
-            .index
-            .iter()
-            .map(|s| DVec2::new(component(s[0]), component(s[1])))
-            .collect())
+        let entries = (self.unknowns).elastic_entries(placed.body, &placed.positions);
+        self.unknowns.solve(&entries, residual, iteration)
     }
 }
 
@@ -204,15 +117,14 @@ pub fn solve_planar_equilibrium(
 ) -> Result<StaticReport, Error> {
     check_tolerance(settings.tolerance)?;
     check_input(body, loads)?;
-    let (index, n) = free_unknowns(&body.pinned);
-    if n == 0 {
+    let unknowns = Unknowns::new(&body.pinned);
+    if unknowns.count == 0 {
         return Err(Error::NoFreeNode);
     }
     let start = body.positions().to_vec();
     let problem = Problem {
         loads,
-        index,
-        n,
+        unknowns,
         start: start.clone(),
     };
     let mut placed = Placed {
