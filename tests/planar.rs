@@ -20,13 +20,51 @@ const MODELS: [MaterialModel; 4] = [
 ];
 const PLANES: [PlaneModel; 2] = [PlaneModel::PlaneStress, PlaneModel::PlaneStrain];
 
-/// The plane and volumetric treatments a body can have: both planes per element, and plane
-/// strain averaged on node patches.
-const SETUPS: [(PlaneModel, VolumetricTreatment); 3] = [
-    (PlaneModel::PlaneStress, VolumetricTreatment::PerElement),
-    (PlaneModel::PlaneStrain, VolumetricTreatment::PerElement),
-    (PlaneModel::PlaneStrain, VolumetricTreatment::NodalAverage),
+/// The plane, volumetric treatment and element order a body can have: both planes per element
+/// on linear and quadratic triangles, and plane strain averaged on node patches (linear).
+const SETUPS: [(PlaneModel, VolumetricTreatment, bool); 5] = [
+    (
+        PlaneModel::PlaneStress,
+        VolumetricTreatment::PerElement,
+        false,
+    ),
+    (
+        PlaneModel::PlaneStrain,
+        VolumetricTreatment::PerElement,
+        false,
+    ),
+    (
+        PlaneModel::PlaneStrain,
+        VolumetricTreatment::NodalAverage,
+        false,
+    ),
+    (
+        PlaneModel::PlaneStress,
+        VolumetricTreatment::PerElement,
+        true,
+    ),
+    (
+        PlaneModel::PlaneStrain,
+        VolumetricTreatment::PerElement,
+        true,
+    ),
 ];
+
+/// A body of `mesh` and `material` with a setup of [`SETUPS`].
+fn body_with(
+    mesh: &TriangleMesh,
+    material: Material,
+    (plane, volumetric, quadratic): (PlaneModel, VolumetricTreatment, bool),
+) -> PlanarBodyBuilder {
+    let builder = PlanarBodyBuilder::new(mesh.clone(), material)
+        .plane(plane)
+        .volumetric(volumetric);
+    if quadratic {
+        builder.quadratic()
+    } else {
+        builder
+    }
+}
 
 /// A deterministic pseudo-random number in [-1, 1) for `i`.
 fn jitter(i: usize) -> f64 {
@@ -62,20 +100,18 @@ fn the_patch_test_holds_on_a_distorted_mesh() {
     let mesh = distorted_square();
     let a = DMat2::from_cols(DVec2::new(1.08, 0.03), DVec2::new(-0.05, 0.93));
     let c = DVec2::new(0.2, -0.1);
-    let boundary: Vec<usize> = (mesh.rest_positions().iter().enumerate())
-        .filter(|(_, p)| p.x < 1e-9 || p.x > 1.0 - 1e-9 || p.y < 1e-9 || p.y > 1.0 - 1e-9)
-        .map(|(i, _)| i)
-        .collect();
+    let on_boundary = |p: &DVec2| p.x < 1e-9 || p.x > 1.0 - 1e-9 || p.y < 1e-9 || p.y > 1.0 - 1e-9;
     for model in MODELS {
-        for (plane, volumetric) in SETUPS {
-            let mut body = PlanarBodyBuilder::new(mesh.clone(), material(model, 0.3))
-                .plane(plane)
-                .volumetric(volumetric)
+        for setup in SETUPS {
+            let mut body = body_with(&mesh, material(model, 0.3), setup)
                 .thickness(0.05)
-                .pinned_nodes(boundary.iter().copied())
                 .build()
                 .unwrap();
-            let rest = mesh.rest_positions().to_vec();
+            let rest = body.rest_positions().to_vec();
+            let boundary: Vec<usize> = (0..rest.len()).filter(|&i| on_boundary(&rest[i])).collect();
+            for &i in &boundary {
+                body.pin(i, [true, true]).unwrap();
+            }
             for (i, x) in body.positions_mut().iter_mut().enumerate() {
                 *x = a * rest[i] + c + DVec2::new(jitter(7 * i), jitter(7 * i + 3)) * 1e-3;
             }
@@ -88,13 +124,13 @@ fn the_patch_test_holds_on_a_distorted_mesh() {
                 max_iterations: 50,
             };
             solve_planar_equilibrium(&mut body, &loads, &settings)
-                .unwrap_or_else(|e| panic!("{model:?} {plane:?} {volumetric:?}: {e}"));
+                .unwrap_or_else(|e| panic!("{model:?} {setup:?}: {e}"));
             let worst = (body.positions().iter().zip(&rest))
                 .map(|(x, p)| x.distance(a * *p + c))
                 .fold(0.0, f64::max);
             assert!(
                 worst < 1e-9 / 6.0,
-                "{model:?} {plane:?} {volumetric:?}: {worst:e} m off the affine map"
+                "{model:?} {setup:?}: {worst:e} m off the affine map"
             );
         }
     }
@@ -212,7 +248,7 @@ fn the_forces_do_not_depend_on_the_control_volumes() {
         let rest = TriangleRest::new(corners);
         let mut areas = [0.0; 2];
         for i in 0..3 {
-            let expected = p * rest.normals()[i];
+            let expected = rest.forces(&p, 1.0)[i];
             for (k, cv) in [ControlVolumes::Median, ControlVolumes::Circumcentric]
                 .into_iter()
                 .enumerate()
@@ -228,8 +264,9 @@ fn the_forces_do_not_depend_on_the_control_volumes() {
     }
 }
 
-/// Masses: `ρ t A` in all, for both control volumes; circumcentric ones refuse a mesh whose
-/// obtuse triangles leave a node a negative area, with the node named.
+/// Masses: `ρ t A` in all, for both control volumes and for quadratic triangles (HRZ);
+/// circumcentric control volumes refuse a mesh whose obtuse triangles leave a node a negative
+/// area, with the node named.
 #[test]
 fn masses_follow_the_control_volumes() {
     let mesh = TriangleMesh::disk(0.5, 4).unwrap();
@@ -243,6 +280,14 @@ fn masses_follow_the_control_volumes() {
         assert!((body.total_mass() - expected).abs() < 1e-12 * expected);
         assert!(body.masses().iter().all(|&m| m > 0.0));
     }
+    let quadratic = PlanarBodyBuilder::new(mesh.clone(), material(MaterialModel::Corotated, 0.3))
+        .thickness(0.02)
+        .quadratic()
+        .build()
+        .unwrap();
+    let expected = 1000.0 * 0.02 * mesh.area();
+    assert!((quadratic.total_mass() - expected).abs() < 1e-12 * expected);
+    assert!(quadratic.masses().iter().all(|&m| m > 0.0));
     let flat = [
         DVec2::new(0.0, 0.0),
         DVec2::new(1.0, 0.0),
@@ -266,10 +311,8 @@ fn masses_follow_the_control_volumes() {
 fn forces_are_the_gradient_of_the_energy() {
     let mesh = TriangleMesh::rectangle(DVec2::new(1.0, 0.5), [3, 2]).unwrap();
     for model in MODELS {
-        for (plane, volumetric) in SETUPS {
-            let mut body = PlanarBodyBuilder::new(mesh.clone(), material(model, 0.35))
-                .plane(plane)
-                .volumetric(volumetric)
+        for setup in SETUPS {
+            let mut body = body_with(&mesh, material(model, 0.35), setup)
                 .build()
                 .unwrap();
             for (i, x) in body.positions_mut().iter_mut().enumerate() {
@@ -291,7 +334,7 @@ fn forces_are_the_gradient_of_the_energy() {
                     let error = (numeric - forces[node][axis]).abs();
                     assert!(
                         error < 1e-6 * scale,
-                        "{model:?} {plane:?} {volumetric:?} node {node}: {error:e} N"
+                        "{model:?} {setup:?} node {node}: {error:e} N"
                     );
                 }
             }

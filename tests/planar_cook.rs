@@ -27,6 +27,7 @@ struct Setup {
     plane: PlaneModel,
     volumetric: VolumetricTreatment,
     diagonals: Diagonals,
+    quadratic: bool,
 }
 
 /// Plane stress, `E = 1`, `ν = 1/3`, on alternating diagonals.
@@ -38,6 +39,7 @@ fn plane_stress(model: MaterialModel) -> Setup {
         plane: PlaneModel::PlaneStress,
         volumetric: VolumetricTreatment::PerElement,
         diagonals: Diagonals::Alternating,
+        quadratic: false,
     }
 }
 
@@ -45,21 +47,29 @@ fn plane_stress(model: MaterialModel) -> Setup {
 /// under a total shear `load`, and the Newton iterations taken.
 fn membrane(cells: usize, setup: Setup, load: f64) -> (f64, usize) {
     let mesh = TriangleMesh::quadrilateral_with(CORNERS, [cells, cells], setup.diagonals).unwrap();
-    let clamped = mesh.nodes_on_line(DVec2::ZERO, DVec2::Y, 1e-9);
-    let loaded = mesh.nodes_on_line(DVec2::new(48.0, 0.0), DVec2::Y, 1e-9);
-    let middle = (mesh.rest_positions().iter())
+    let material = Material::new(setup.model, setup.young, setup.poisson, 1.0).unwrap();
+    let builder = PlanarBodyBuilder::new(mesh, material)
+        .plane(setup.plane)
+        .volumetric(setup.volumetric);
+    let mut body = if setup.quadratic {
+        builder.quadratic()
+    } else {
+        builder
+    }
+    .build()
+    .unwrap();
+    for node in body.nodes_on_line(DVec2::ZERO, DVec2::Y, 1e-9) {
+        body.pin(node, [true, true]).unwrap();
+    }
+    let loaded = body.nodes_on_line(DVec2::new(48.0, 0.0), DVec2::Y, 1e-9);
+    let middle = (body.rest_positions().iter())
         .position(|p| p.distance(DVec2::new(48.0, 52.0)) < 1e-9)
         .unwrap();
-    let material = Material::new(setup.model, setup.young, setup.poisson, 1.0).unwrap();
-    let mut body = PlanarBodyBuilder::new(mesh, material)
-        .plane(setup.plane)
-        .volumetric(setup.volumetric)
-        .pinned_nodes(clamped)
-        .build()
-        .unwrap();
     let loads = edge_loads(&body, &loaded, DVec2::new(0.0, load), true);
+    let total: DVec2 = loads.iter().sum();
+    assert!((total - DVec2::new(0.0, load)).length() < 1e-12 * load);
     let report = solve_planar_equilibrium(&mut body, &loads, &StaticSettings::default()).unwrap();
-    let rest = body.mesh().rest_positions()[middle];
+    let rest = body.rest_positions()[middle];
     (body.positions()[middle].y - rest.y, report.iterations)
 }
 
@@ -124,6 +134,7 @@ fn nodal_averaging_frees_nearly_incompressible_plane_strain() {
         plane: PlaneModel::PlaneStrain,
         volumetric,
         diagonals: Diagonals::Parallel,
+        quadratic: false,
     };
     let (locked, _) = membrane(64, setup(VolumetricTreatment::PerElement), 1.0);
     let (averaged, _) = membrane(64, setup(VolumetricTreatment::NodalAverage), 1.0);
@@ -148,4 +159,25 @@ fn nodal_averaging_frees_nearly_incompressible_plane_strain() {
         iterations, 1,
         "the averaged linear law is solved in one Newton step"
     );
+}
+
+/// Quadratic (6-node) triangles reach the reference far sooner: within 1 % at 32 elements
+/// (-0.76 %) and 0.2 % at 128 (-0.14 %), where linear triangles are -31.9 % and -11.9 % off;
+/// the linear law in one Newton step.
+#[test]
+fn quadratic_triangles_converge_sooner() {
+    let quadratic = Setup {
+        quadratic: true,
+        ..plane_stress(MaterialModel::Linear)
+    };
+    let (coarse, iterations) = membrane(4, quadratic, 1.0);
+    let (finer, _) = membrane(8, quadratic, 1.0);
+    let (coarse_error, finer_error) = (coarse / REFERENCE - 1.0, finer / REFERENCE - 1.0);
+    println!(
+        "quadratic: {coarse:.4} ({:+.2} %), {finer:.4} ({:+.2} %)",
+        100.0 * coarse_error,
+        100.0 * finer_error
+    );
+    assert!(coarse_error.abs() < 0.01 && finer_error.abs() < 0.002);
+    assert_eq!(iterations, 1);
 }

@@ -1,8 +1,9 @@
 //! [`PlanarBody`]: a 2D soft body on a triangle mesh, and its builder.
 //!
 //! Contract: nodal masses are `ρ t A_i` (density, rest thickness, the node's control area of the
-//! chosen [`ControlVolumes`]), summing to `ρ t A`; internal forces are the finite-volume forces
-//! of [`TriangleRest::forces`] under the [`PlanarLaw`] of the body's material and
+//! chosen [`ControlVolumes`], or HRZ shares of quadratic triangles), summing to `ρ t A`;
+//! internal forces are those of the elements' integration points (for linear triangles the
+//! finite-volume forces of [`TriangleRest::forces`]) under the [`PlanarLaw`] of the body's material and
 //! [`PlaneModel`] (with the volumetric term averaged on node patches if asked, see
 //! [`PlanarBodyBuilder::volumetric`]), and are minus the gradient of
 //! [`PlanarBody::elastic_energy`].
@@ -12,6 +13,7 @@ use super::element::TriangleRest;
 use super::evaluate::PlanarLawDyn;
 use super::mesh::TriangleMesh;
 use super::plane::{PlanarLaw, PlanarStress, PlaneModel};
+use super::points::{IntegrationPoints, QUADRATIC_MASS_FRACTIONS};
 use super::volumetric::NodalPatches;
 use crate::Error;
 use crate::damping::RayleighDamping;
@@ -47,6 +49,7 @@ pub struct PlanarBodyBuilder {
     control_volumes: ControlVolumes,
     volumetric: VolumetricTreatment,
     damping: Option<RayleighDamping>,
+    quadratic: bool,
     /// Held nodes and the axes (x, y) each is held along, in the order given.
     pinned: Vec<(usize, [bool; 2])>,
 }
@@ -63,6 +66,7 @@ impl PlanarBodyBuilder {
             control_volumes: ControlVolumes::Median,
             volumetric: VolumetricTreatment::PerElement,
             damping: None,
+            quadratic: false,
             pinned: Vec::new(),
         }
     }
@@ -98,6 +102,16 @@ impl PlanarBodyBuilder {
     /// reduced volumetric viscosity, see [`PlaneModel::damping_stress`]). None by default.
     pub fn damping(mut self, damping: RayleighDamping) -> Self {
         self.damping = Some(damping);
+        self
+    }
+
+    /// Quadratic (6-node) triangles: a node is added at the middle of each edge of the mesh
+    /// (numbered after the corners, see [`PlanarBody::rest_positions`]), the elements are
+    /// integrated at three points each and their masses lumped by HRZ (see
+    /// [`crate::planar`]'s integration points); far more accurate in bending per unknown.
+    /// Median control volumes and the volumetric term per element only.
+    pub fn quadratic(mut self) -> Self {
+        self.quadratic = true;
         self
     }
 
@@ -137,7 +151,8 @@ impl PlanarBodyBuilder {
                 reason: "must be positive and finite (m)",
             });
         }
-        let node_count = self.mesh.rest_positions().len();
+        let (rest_positions, points, masses) = self.discretize()?;
+        let node_count = rest_positions.len();
         let mut pinned = vec![[false; 2]; node_count];
         for &(node, held) in &self.pinned {
             let axes = pinned
@@ -146,26 +161,66 @@ impl PlanarBodyBuilder {
             axes[0] |= held[0];
             axes[1] |= held[1];
         }
-        let areas = self.control_volumes.nodal_areas(&self.mesh)?;
-        let per_area = self.material.density() * self.thickness;
-        let rest: Vec<TriangleRest> = (0..self.mesh.triangles().len())
-            .map(|t| TriangleRest::new(self.mesh.corners(t)))
-            .collect();
-        let patches = averaged.then(|| NodalPatches::new(&self.mesh, &rest, &areas));
+        let patches = if averaged {
+            let areas = self.control_volumes.nodal_areas(&self.mesh)?;
+            Some(NodalPatches::new(&points, &areas))
+        } else {
+            None
+        };
         Ok(PlanarBody {
             patches,
             velocities: vec![DVec2::ZERO; node_count],
             damping: self.damping,
-            positions: self.mesh.rest_positions().to_vec(),
-            masses: areas.iter().map(|a| a * per_area).collect(),
+            positions: rest_positions.clone(),
+            rest_positions,
+            masses,
             mesh: self.mesh,
             material: self.material,
             plane: self.plane,
             thickness: self.thickness,
             control_volumes: self.control_volumes,
-            rest,
+            points,
             pinned,
         })
+    }
+
+    /// The body's rest positions (m), integration points and nodal masses (kg).
+    fn discretize(&self) -> Result<(Vec<DVec2>, IntegrationPoints, Vec<f64>), Error> {
+        let per_area = self.material.density() * self.thickness;
+        let rest: Vec<TriangleRest> = (0..self.mesh.triangles().len())
+            .map(|t| TriangleRest::new(self.mesh.corners(t)))
+            .collect();
+        if !self.quadratic {
+            let areas = self.control_volumes.nodal_areas(&self.mesh)?;
+            let masses = areas.iter().map(|a| a * per_area).collect();
+            let points = IntegrationPoints::linear(self.mesh.triangles(), &rest);
+            return Ok((self.mesh.rest_positions().to_vec(), points, masses));
+        }
+        let unsupported = |option, reason| Err(Error::UnsupportedOption { option, reason });
+        if self.control_volumes != ControlVolumes::Median {
+            return unsupported(
+                "circumcentric control volumes with quadratic triangles",
+                "quadratic triangles lump their masses by HRZ",
+            );
+        }
+        if self.volumetric == VolumetricTreatment::NodalAverage {
+            return unsupported(
+                "nodal averaging with quadratic triangles",
+                "nodal averaging is the locking-free option of linear triangles",
+            );
+        }
+        let (positions, elements) = self.mesh.quadratic_nodes();
+        let mut masses = vec![0.0; positions.len()];
+        for (nodes, rest) in elements.iter().zip(&rest) {
+            for (n, fraction) in nodes.iter().zip(QUADRATIC_MASS_FRACTIONS) {
+                masses[*n as usize] += fraction * rest.area() * per_area;
+            }
+        }
+        Ok((
+            positions,
+            IntegrationPoints::quadratic(&elements, &rest),
+            masses,
+        ))
     }
 }
 
@@ -177,7 +232,8 @@ pub struct PlanarBody {
     plane: PlaneModel,
     thickness: f64,
     control_volumes: ControlVolumes,
-    rest: Vec<TriangleRest>,
+    points: IntegrationPoints,
+    rest_positions: Vec<DVec2>,
     masses: Vec<f64>,
     positions: Vec<DVec2>,
     pub(super) pinned: Vec<[bool; 2]>,
@@ -208,9 +264,33 @@ impl PlanarBody {
         self.control_volumes
     }
 
-    /// Per-triangle rest data.
-    pub fn triangle_rest(&self) -> &[TriangleRest] {
-        &self.rest
+    /// The integration points of the elements.
+    pub(super) fn points(&self) -> &IntegrationPoints {
+        &self.points
+    }
+
+    /// The rest positions (m) of the body's nodes: the mesh's, then, for quadratic triangles,
+    /// the mid-edge nodes.
+    pub fn rest_positions(&self) -> &[DVec2] {
+        &self.rest_positions
+    }
+
+    /// The nodes within `tolerance` (m) of the line through `point` along `direction`, in
+    /// order along it: a clamped or loaded edge, mid-edge nodes included.
+    pub fn nodes_on_line(&self, point: DVec2, direction: DVec2, tolerance: f64) -> Vec<usize> {
+        let normal = direction.perp().normalize();
+        let mut nodes: Vec<usize> = (self.rest_positions.iter().enumerate())
+            .filter(|(_, p)| (**p - point).dot(normal).abs() <= tolerance)
+            .map(|(i, _)| i)
+            .collect();
+        let along = |n: &usize| (self.rest_positions[*n] - point).dot(direction);
+        nodes.sort_by(|a, b| along(a).total_cmp(&along(b)));
+        nodes
+    }
+
+    /// Whether the elements are quadratic (6-node) triangles.
+    pub fn is_quadratic(&self) -> bool {
+        self.points.per_element() == 3
     }
 
     /// Nodal masses (kg).
@@ -278,30 +358,40 @@ impl PlanarBody {
         .sum()
     }
 
+    /// Holds node `node` along the axes set in `axes` (x, y), in addition to those it is
+    /// held along; its velocity along them is zeroed by the next step. For nodes a builder
+    /// cannot name, such as the mid-edge nodes of quadratic triangles.
+    ///
+    /// # Errors
+    /// [`Error::NodeOutOfRange`] for a node that does not exist.
+    pub fn pin(&mut self, node: usize, axes: [bool; 2]) -> Result<(), Error> {
+        let node_count = self.pinned.len();
+        let held = (self.pinned.get_mut(node)).ok_or(Error::NodeOutOfRange { node, node_count })?;
+        held[0] |= axes[0];
+        held[1] |= axes[1];
+        Ok(())
+    }
+
     /// Whether each node is held along x and along y.
     pub fn pinned(&self) -> &[[bool; 2]] {
         &self.pinned
     }
 
-    /// The world corners (m) of triangle `t` in `positions`.
-    pub(super) fn corners_in(&self, t: usize, positions: &[DVec2]) -> [DVec2; 3] {
-        self.mesh.triangles()[t].map(|n| positions[n as usize])
+    /// The deformation gradient (dimensionless) at integration point `q` (triangle `q`'s for
+    /// linear triangles; points `3e..3e + 3` are element `e`'s for quadratic ones).
+    pub fn deformation_gradient(&self, q: usize) -> DMat2 {
+        self.points.gradient(q, &self.positions)
     }
 
-    /// The deformation gradient (dimensionless) of triangle `t`.
-    pub fn deformation_gradient(&self, t: usize) -> DMat2 {
-        self.rest[t].gradient(&self.corners_in(t, &self.positions))
-    }
-
-    /// The stress in triangle `t` (see [`PlanarStress`]): the model's at the triangle's
+    /// The stress at integration point `q` (see [`PlanarStress`]): the model's at its
     /// deformation gradient, with nodal averaging its volumetric part averaged as the forces
     /// take it.
-    pub fn stress(&self, t: usize) -> PlanarStress {
+    pub fn stress(&self, q: usize) -> PlanarStress {
         self.with_law(|law| {
             let evaluation = self.evaluate(law, &self.positions);
-            let stress = law.stress(&evaluation.gradients[t]);
+            let stress = law.stress(&evaluation.gradients[q]);
             PlanarStress {
-                p: self.element_stress(law, &evaluation, t),
+                p: self.point_stress(law, &evaluation, q),
                 ..stress
             }
         })

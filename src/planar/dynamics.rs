@@ -65,14 +65,12 @@ impl PlanarBody {
             return forces;
         };
         let plane = self.plane();
-        for (t, rest) in self.triangle_rest().iter().enumerate() {
-            let nodes = self.mesh().triangles()[t];
-            let f = rest.gradient(&self.corners_in(t, self.positions()));
-            let f_dot = rest.gradient(&nodes.map(|n| self.velocities()[n as usize]));
+        let points = self.points();
+        for q in 0..points.len() {
+            let f = points.gradient(q, self.positions());
+            let f_dot = points.gradient(q, self.velocities());
             let p = plane.damping_stress(damping, &f, &f_dot);
-            for (node, force) in nodes.iter().zip(rest.forces(&p, self.thickness())) {
-                forces[*node as usize] += force;
-            }
+            points.add_forces(q, &p, self.thickness(), &mut forces);
         }
         forces
     }

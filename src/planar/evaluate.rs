@@ -2,11 +2,11 @@
 //! tangent `K = −∂f/∂x`, with the volumetric term per triangle or averaged on node patches
 //! ([`super::volumetric`]).
 //!
-//! Per triangle, with `F` its deformation gradient: the energy `t A Ψ(F)`, the forces
-//! `f_i = t P b_i` ([`super::TriangleRest::forces`]) and the tangent block
-//! `K_ij = −t dP(e ⊗ ∇N_j) b_i`; with nodal averaging `Ψ` becomes `Ψ_rest`, `P` the element stress
-//! `P + K (θ̄ − m) ∂m/∂F`, and `dP` that stress's differential at fixed averages, the patch term
-//! added by [`patch_tangent`].
+//! Per integration point `q` ([`super::points`]), with `F` its deformation gradient and `w` its
+//! rest area: the energy `t w Ψ(F)`, the forces `f_a = −t w P ∇N_a` (for a linear triangle the
+//! finite-volume `t P b_a`) and the tangent block `K_ab = t w dP(e ⊗ ∇N_b) ∇N_a`; with nodal
+//! averaging `Ψ` becomes `Ψ_rest`, `P` the point's stress `P + K (θ̄ − m) ∂m/∂F`, and `dP` that
+//! stress's differential at fixed averages, the patch term added by [`patch_tangent`].
 
 use super::body::PlanarBody;
 use super::plane::{PlanarLaw, PlanarStress, apply_tangent};
@@ -72,12 +72,13 @@ pub(super) struct Evaluation {
 impl PlanarBody {
     /// The evaluation of `positions` (m) under `law`.
     pub(super) fn evaluate(&self, law: &dyn PlanarLawDyn, positions: &[DVec2]) -> Evaluation {
-        let gradients: Vec<DMat2> = (self.triangle_rest().iter().enumerate())
-            .map(|(t, rest)| rest.gradient(&self.corners_in(t, positions)))
+        let points = self.points();
+        let gradients: Vec<DMat2> = (0..points.len())
+            .map(|q| points.gradient(q, positions))
             .collect();
         let averages = self.patches.as_ref().map(|patches| {
             let measures = gradients.iter().map(|f| law.volume_measure(f)).collect();
-            patches.averages(self.mesh(), self.triangle_rest(), measures)
+            patches.averages(points, measures)
         });
         Evaluation {
             gradients,
@@ -91,27 +92,28 @@ impl PlanarBody {
             Some(_) => law.energy_without_volumetric(f),
             None => law.energy_density(f),
         };
-        let elements: f64 = (self.triangle_rest().iter().zip(&evaluation.gradients))
-            .map(|(rest, f)| per_area(f) * rest.area())
+        let points = self.points();
+        let elements: f64 = (evaluation.gradients.iter().enumerate())
+            .map(|(q, f)| per_area(f) * points.weight(q))
             .sum();
         let patches = (self.patches.as_ref().zip(evaluation.averages.as_ref()))
             .map_or(0.0, |(p, a)| p.energy(a, law.bulk_modulus()));
         (elements + patches) * self.thickness()
     }
 
-    /// Triangle `t`'s stress (Pa) in `evaluation`: the model's, plus the averaged volumetric
+    /// Point `q`'s stress (Pa) in `evaluation`: the model's, plus the averaged volumetric
     /// term's correction `K (θ̄ − m) ∂m/∂F`.
-    pub(super) fn element_stress(
+    pub(super) fn point_stress(
         &self,
         law: &dyn PlanarLawDyn,
         evaluation: &Evaluation,
-        t: usize,
+        q: usize,
     ) -> DMat2 {
-        let f = &evaluation.gradients[t];
+        let f = &evaluation.gradients[q];
         let p = law.stress(f).p;
         match &evaluation.averages {
             Some(a) => {
-                p + law.volume_gradient(f) * (law.bulk_modulus() * (a.element[t] - a.measure[t]))
+                p + law.volume_gradient(f) * (law.bulk_modulus() * (a.element[q] - a.measure[q]))
             }
             None => p,
         }
@@ -120,22 +122,20 @@ impl PlanarBody {
     /// The nodal forces (N) of `evaluation`.
     pub(super) fn forces_of(&self, law: &dyn PlanarLawDyn, evaluation: &Evaluation) -> Vec<DVec2> {
         let mut forces = vec![DVec2::ZERO; self.positions().len()];
-        for (t, rest) in self.triangle_rest().iter().enumerate() {
-            let p = self.element_stress(law, evaluation, t);
-            let nodes = self.mesh().triangles()[t];
-            for (node, force) in nodes.iter().zip(rest.forces(&p, self.thickness())) {
-                forces[*node as usize] += force;
-            }
+        for q in 0..self.points().len() {
+            let p = self.point_stress(law, evaluation, q);
+            self.points()
+                .add_forces(q, &p, self.thickness(), &mut forces);
         }
         forces
     }
 
-    /// Triangle `t`'s stress differential for a change `df` of its `F`, the averages held.
-    fn element_differential(
+    /// Point `q`'s stress differential for a change `df` of its `F`, the averages held.
+    fn point_differential(
         &self,
         law: &dyn PlanarLawDyn,
         evaluation: &Evaluation,
-        t: usize,
+        q: usize,
         columns: &[DMat2; 4],
         df: &DMat2,
     ) -> DMat2 {
@@ -143,13 +143,13 @@ impl PlanarBody {
         let Some(a) = &evaluation.averages else {
             return dp;
         };
-        let f = &evaluation.gradients[t];
+        let f = &evaluation.gradients[q];
         let (k, g) = (law.bulk_modulus(), law.volume_gradient(f));
         let dm = g.x_axis.dot(df.x_axis) + g.y_axis.dot(df.y_axis);
-        dp - g * (k * dm) + law.volume_differential(f, df) * (k * (a.element[t] - a.measure[t]))
+        dp - g * (k * dm) + law.volume_differential(f, df) * (k * (a.element[q] - a.measure[q]))
     }
 
-    /// Adds the elements' tangent blocks of `evaluation` to `triplets`, over the unknowns of
+    /// Adds the points' tangent blocks of `evaluation` to `triplets`, over the unknowns of
     /// `index` (per node and axis, `None` where held).
     pub(super) fn element_tangent(
         &self,
@@ -158,18 +158,19 @@ impl PlanarBody {
         index: &[[Option<usize>; 2]],
         triplets: &mut Vec<Triplet<usize, usize, f64>>,
     ) {
-        for (t, rest) in self.triangle_rest().iter().enumerate() {
-            let columns = law.tangent(&evaluation.gradients[t]);
-            let nodes = self.mesh().triangles()[t];
+        let points = self.points();
+        for q in 0..points.len() {
+            let columns = law.tangent(&evaluation.gradients[q]);
+            let nodes = points.nodes(q);
             for (j, &node_j) in nodes.iter().enumerate() {
                 for (b, direction) in [DVec2::X, DVec2::Y].into_iter().enumerate() {
                     let Some(col) = index[node_j as usize][b] else {
                         continue;
                     };
-                    let df = rest.gradient_change(j, direction);
-                    let dp = self.element_differential(law, evaluation, t, &columns, &df);
+                    let df = points.gradient_change(q, j, direction);
+                    let dp = self.point_differential(law, evaluation, q, &columns, &df);
                     for (i, &node_i) in nodes.iter().enumerate() {
-                        let k = (-(dp * rest.normals()[i]) * self.thickness()).to_array();
+                        let k = (-points.force(q, i, &dp, self.thickness())).to_array();
                         for (a, row) in index[node_i as usize].iter().enumerate() {
                             if let Some(row) = row {
                                 triplets.push(Triplet::new(*row, col, k[a]));
@@ -192,16 +193,15 @@ pub(super) fn patch_tangent(
     triplets: &mut Vec<Triplet<usize, usize, f64>>,
 ) {
     let Some(patches) = &body.patches else { return };
-    // ∂m_e/∂x at corner i is ∂m/∂F ∇N_i = −∂m/∂F b_i / A.
-    let measure_gradients: Vec<[DVec2; 3]> =
-        (body.triangle_rest().iter().zip(&evaluation.gradients))
-            .map(|(rest, f)| {
-                let g = law.volume_gradient(f);
-                rest.normals().map(|b| -(g * b) / rest.area())
-            })
-            .collect();
-    let gradients =
-        patches.average_gradients(body.mesh(), body.triangle_rest(), &measure_gradients);
+    let points = body.points();
+    // ∂m_q/∂x_a = ∂m/∂F ∇N_a.
+    let measure_gradients: Vec<Vec<DVec2>> = (evaluation.gradients.iter().enumerate())
+        .map(|(q, f)| {
+            let g = law.volume_gradient(f);
+            points.gradients(q).iter().map(|n| g * *n).collect()
+        })
+        .collect();
+    let gradients = patches.average_gradients(points, &measure_gradients);
     let k = law.bulk_modulus() * body.thickness();
     for (a, entries) in gradients.iter().enumerate() {
         let weight = k * patches.control_area(a);

@@ -72,11 +72,12 @@ impl Step<'_> {
         let work: f64 = (x.iter().zip(&self.start).zip(&self.external))
             .map(|((x, x0), f)| (*x - *x0).dot(*f))
             .sum();
+        let points = body.points();
         let dissipation = self.damping.as_ref().map_or(0.0, |(damping, previous)| {
-            (body.triangle_rest().iter().enumerate())
-                .map(|(t, rest)| {
-                    let f = embed_flat(&rest.gradient(&body.corners_in(t, x)));
-                    damping.step_potential(&f, &previous[t], self.h) * rest.area()
+            (0..points.len())
+                .map(|q| {
+                    let f = embed_flat(&points.gradient(q, x));
+                    damping.step_potential(&f, &previous[q], self.h) * points.weight(q)
                 })
                 .sum::<f64>()
                 * body.thickness()
@@ -90,13 +91,11 @@ impl Step<'_> {
         let x = &placed.positions;
         let mut forces = body.internal_forces_at(x);
         if let Some((damping, previous)) = &self.damping {
-            for (t, rest) in body.triangle_rest().iter().enumerate() {
-                let f = embed_flat(&rest.gradient(&body.corners_in(t, x)));
-                let p = in_plane_block(&damping.step_first_piola(&f, &previous[t], self.h));
-                let nodes = body.mesh().triangles()[t];
-                for (n, force) in nodes.iter().zip(rest.forces(&p, body.thickness())) {
-                    forces[*n as usize] += force;
-                }
+            let points = body.points();
+            for (q, previous) in previous.iter().enumerate() {
+                let f = embed_flat(&points.gradient(q, x));
+                let p = in_plane_block(&damping.step_first_piola(&f, previous, self.h));
+                points.add_forces(q, &p, body.thickness(), &mut forces);
             }
         }
         let inverse_h2 = 1.0 / (self.h * self.h);
@@ -113,20 +112,23 @@ impl Step<'_> {
         };
         let body = self.body;
         let index = &self.unknowns.index;
-        for (t, rest) in body.triangle_rest().iter().enumerate() {
-            let f = embed_flat(&rest.gradient(&body.corners_in(t, &placed.positions)));
-            let changes: [DMat3; 6] = std::array::from_fn(|k| {
-                embed_change(&rest.gradient_change(k / 2, [DVec2::X, DVec2::Y][k % 2]))
-            });
-            let dps = damping.step_first_piola_differentials(&f, &previous[t], self.h, &changes);
-            let nodes = body.mesh().triangles()[t];
-            for (k, dp) in dps.iter().enumerate() {
+        let points = body.points();
+        for (q, previous) in previous.iter().enumerate() {
+            let f = embed_flat(&points.gradient(q, &placed.positions));
+            let nodes = points.nodes(q);
+            let changes: Vec<DMat3> = (0..2 * nodes.len())
+                .map(|k| {
+                    embed_change(&points.gradient_change(q, k / 2, [DVec2::X, DVec2::Y][k % 2]))
+                })
+                .collect();
+            for (k, change) in changes.iter().enumerate() {
                 let Some(col) = index[nodes[k / 2] as usize][k % 2] else {
                     continue;
                 };
-                let dp = in_plane_block(dp);
+                let [dp] = damping.step_first_piola_differentials(&f, previous, self.h, &[*change]);
+                let dp = in_plane_block(&dp);
                 for (i, &node_i) in nodes.iter().enumerate() {
-                    let value = (-(dp * rest.normals()[i]) * body.thickness()).to_array();
+                    let value = (-points.force(q, i, &dp, body.thickness())).to_array();
                     for (a, row) in index[node_i as usize].iter().enumerate() {
                         if let Some(row) = row {
                             entries.push(Triplet::new(*row, col, value[a]));
@@ -203,8 +205,9 @@ pub fn step_implicit(
         .map(|(m, f)| gravity * *m + *f)
         .collect();
     let damping = body.damping().map(|d| {
-        let previous = (body.triangle_rest().iter().enumerate())
-            .map(|(t, rest)| green_strain(&embed_flat(&rest.gradient(&body.corners_in(t, &start)))))
+        let points = body.points();
+        let previous = (0..points.len())
+            .map(|q| green_strain(&embed_flat(&points.gradient(q, &start))))
             .collect();
         (body.plane().in_plane_damping(d), previous)
     });

@@ -111,6 +111,33 @@ impl TriangleMesh {
     }
 }
 
+impl TriangleMesh {
+    /// The nodes of the mesh's 6-node triangles: the corners (same indices), then a node at the
+    /// middle of each edge, shared by the triangles on it; and each triangle's six nodes,
+    /// corners then the mid-edge nodes of edges 01, 12, 20.
+    pub(super) fn quadratic_nodes(&self) -> (Vec<DVec2>, Vec<[u32; 6]>) {
+        let mut rest = self.rest.clone();
+        let mut middle_of = std::collections::HashMap::new();
+        let mut middle = |a: u32, b: u32, rest: &mut Vec<DVec2>| -> u32 {
+            *middle_of.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                rest.push((rest[a as usize] + rest[b as usize]) / 2.0);
+                (rest.len() - 1) as u32
+            })
+        };
+        let elements = (self.triangles.iter())
+            .map(|&[a, b, c]| {
+                let (ab, bc, ca) = (
+                    middle(a, b, &mut rest),
+                    middle(b, c, &mut rest),
+                    middle(c, a, &mut rest),
+                );
+                [a, b, c, ab, bc, ca]
+            })
+            .collect();
+        (rest, elements)
+    }
+}
+
 /// Checks triangle `triangle` with `nodes` against the `rest` positions.
 fn check_triangle(triangle: usize, nodes: [u32; 3], rest: &[DVec2]) -> Result<(), Error> {
     for (k, &node) in nodes.iter().enumerate() {

@@ -40,6 +40,7 @@ mod evaluate;
 mod implicit;
 mod mesh;
 mod plane;
+mod points;
 mod statics;
 mod unknowns;
 mod volumetric;

@@ -13,26 +13,34 @@ use crate::newton::{
 use crate::statics::{StaticReport, StaticSettings};
 use rapier3d::glamx::DVec2;
 
-/// The nodal forces (N) of a uniform `traction` (N per m of edge length, per m of thickness
-/// times the body's thickness gives N) along the polyline of `nodes` (in order along the edge):
-/// each segment's load shared equally by its two ends. With `total` = true the traction is
-/// scaled so that the forces sum to `traction` itself (a total load in N).
+/// The nodal forces (N) of a uniform `traction` along the polyline of `nodes` (in order along
+/// the edge, as [`PlanarBody::nodes_on_line`] gives them): N per m of edge length and per m of
+/// thickness, or with `total` = true a total load (N) spread evenly along the edge. Each
+/// segment's load goes to its ends in halves; on quadratic triangles each element edge (corner,
+/// mid-edge node, corner) takes it in the consistent shares 1/6, 2/3, 1/6.
 pub fn edge_loads(body: &PlanarBody, nodes: &[usize], traction: DVec2, total: bool) -> Vec<DVec2> {
-    let rest = body.mesh().rest_positions();
+    let rest = body.rest_positions();
     let mut loads = vec![DVec2::ZERO; rest.len()];
-    let length: f64 = nodes
-        .windows(2)
-        .map(|w| rest[w[0]].distance(rest[w[1]]))
-        .sum();
+    let distance = |a: usize, b: usize| rest[a].distance(rest[b]);
+    let length: f64 = nodes.windows(2).map(|w| distance(w[0], w[1])).sum();
     let per_length = if total {
         traction / length
     } else {
         traction * body.thickness()
     };
-    for w in nodes.windows(2) {
-        let share = per_length * rest[w[0]].distance(rest[w[1]]) / 2.0;
-        loads[w[0]] += share;
-        loads[w[1]] += share;
+    if body.is_quadratic() {
+        for edge in nodes.windows(3).step_by(2) {
+            let load = per_length * distance(edge[0], edge[2]);
+            loads[edge[0]] += load / 6.0;
+            loads[edge[1]] += load * (2.0 / 3.0);
+            loads[edge[2]] += load / 6.0;
+        }
+    } else {
+        for w in nodes.windows(2) {
+            let share = per_length * distance(w[0], w[1]) / 2.0;
+            loads[w[0]] += share;
+            loads[w[1]] += share;
+        }
     }
     loads
 }

@@ -52,7 +52,7 @@ impl Unknowns {
 
     /// The elastic tangent `−∂f_int/∂x` (N/m) of `body` at `positions` over the unknowns.
     pub(super) fn elastic_entries(&self, body: &PlanarBody, positions: &[DVec2]) -> Vec<Entry> {
-        let mut entries = Vec::with_capacity(body.triangle_rest().len() * 36);
+        let mut entries = Vec::new();
         body.with_law(|law| {
             let evaluation = body.evaluate(law, positions);
             body.element_tangent(law, &evaluation, &self.index, &mut entries);

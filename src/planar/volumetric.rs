@@ -10,8 +10,7 @@
 //! `P(F_e) + K (θ̄_e − m_e) ∂m/∂F` with `θ̄_e = Σ_{a∈e} W_a θ_a / P_a`, and the tangent gains
 //! `Σ_a t W_a K g_a g_aᵀ`, `g_a = ∂θ_a/∂x`, which couples the nodes of a patch.
 
-use super::element::TriangleRest;
-use super::mesh::TriangleMesh;
+use super::points::IntegrationPoints;
 use rapier3d::glamx::DVec2;
 
 /// The patches of a mesh: each node's control and patch areas and its triangles.
@@ -37,13 +36,13 @@ pub(super) struct Averages {
 }
 
 impl NodalPatches {
-    /// The patches of `mesh` with its triangles' `rest` data and the nodes' `control_areas`
-    /// (m²).
-    pub(super) fn new(mesh: &TriangleMesh, rest: &[TriangleRest], control_areas: &[f64]) -> Self {
+    /// The patches of the linear triangles of `points` (one point each) and the nodes'
+    /// `control_areas` (m²).
+    pub(super) fn new(points: &IntegrationPoints, control_areas: &[f64]) -> Self {
         let mut patch_area = vec![0.0; control_areas.len()];
-        for (nodes, rest) in mesh.triangles().iter().zip(rest) {
-            for &n in nodes {
-                patch_area[n as usize] += rest.area();
+        for q in 0..points.len() {
+            for &n in points.nodes(q) {
+                patch_area[n as usize] += points.weight(q);
             }
         }
         let share = control_areas
@@ -59,25 +58,19 @@ impl NodalPatches {
     }
 
     /// The averages of the triangles' volume `measure`s.
-    pub(super) fn averages(
-        &self,
-        mesh: &TriangleMesh,
-        rest: &[TriangleRest],
-        measure: Vec<f64>,
-    ) -> Averages {
+    pub(super) fn averages(&self, points: &IntegrationPoints, measure: Vec<f64>) -> Averages {
         let mut node = vec![0.0; self.patch_area.len()];
-        for ((nodes, rest), m) in mesh.triangles().iter().zip(rest).zip(&measure) {
-            for &n in nodes {
-                node[n as usize] += rest.area() * m;
+        for (q, m) in measure.iter().enumerate() {
+            for &n in points.nodes(q) {
+                node[n as usize] += points.weight(q) * m;
             }
         }
         for (theta, p) in node.iter_mut().zip(&self.patch_area) {
             *theta /= p;
         }
-        let element = (mesh.triangles().iter())
-            .map(|nodes| {
-                nodes
-                    .iter()
+        let element = (0..points.len())
+            .map(|q| {
+                (points.nodes(q).iter())
                     .map(|&n| self.share[n as usize] * node[n as usize])
                     .sum()
             })
@@ -97,21 +90,19 @@ impl NodalPatches {
     }
 
     /// The gradients `g_a = ∂θ_a/∂x` (1/m) of every node's average, as (node, entries) with
-    /// the entries (neighbour node, gradient) summed over the patch, given each triangle's
-    /// `∂m/∂x` per corner (`measure_gradients`).
+    /// the entries (neighbour node, gradient) summed over the patch, given each point's
+    /// `∂m/∂x` per node (`measure_gradients`, in the order of the point's nodes).
     pub(super) fn average_gradients(
         &self,
-        mesh: &TriangleMesh,
-        rest: &[TriangleRest],
-        measure_gradients: &[[DVec2; 3]],
+        points: &IntegrationPoints,
+        measure_gradients: &[Vec<DVec2>],
     ) -> Vec<Vec<(u32, DVec2)>> {
         let mut gradients: Vec<Vec<(u32, DVec2)>> = vec![Vec::new(); self.patch_area.len()];
-        for ((nodes, rest), corner_gradients) in
-            mesh.triangles().iter().zip(rest).zip(measure_gradients)
-        {
+        for (q, node_gradients) in measure_gradients.iter().enumerate() {
+            let nodes = points.nodes(q);
             for &a in nodes {
-                let weight = rest.area() / self.patch_area[a as usize];
-                for (&b, g) in nodes.iter().zip(corner_gradients) {
+                let weight = points.weight(q) / self.patch_area[a as usize];
+                for (&b, g) in nodes.iter().zip(node_gradients) {
                     let entries = &mut gradients[a as usize];
                     match entries.iter_mut().find(|(n, _)| *n == b) {
                         Some((_, sum)) => *sum += *g * weight,
