@@ -110,7 +110,29 @@ pub fn step_explicit(
             node_count,
         });
     }
-    let limit = SAFETY_FACTOR * body.critical_time_step();
+    advance(body, dt, (gravity, loads), 0.0, &mut |_| None)
+}
+
+/// Forces (N per node) a step adds at each substep, computed where the body is and as it
+/// moves, or `None` for none: contacts with colliders (`planar::coupling`, feature `dim2`).
+pub(super) type ExtraForces<'a> = dyn FnMut(&PlanarBody) -> Option<Vec<DVec2>> + 'a;
+
+/// [`step_explicit`]'s substeps, with `extra` forces added at each and the stability limit
+/// lowered for a frequency `ω_extra²` (1/s²) they add to the highest.
+pub(super) fn advance(
+    body: &mut PlanarBody,
+    dt: f64,
+    (gravity, loads): (DVec2, &[DVec2]),
+    extra_frequency_squared: f64,
+    extra: &mut ExtraForces<'_>,
+) -> Result<PlanarStepReport, Error> {
+    let undamped = body.critical_time_step();
+    let limit = if extra_frequency_squared > 0.0 {
+        let omega = 2.0 / undamped;
+        SAFETY_FACTOR * undamped * omega / (omega * omega + extra_frequency_squared).sqrt()
+    } else {
+        SAFETY_FACTOR * undamped
+    };
     let needed = (dt / limit).ceil();
     if needed.is_nan() || needed > f64::from(MAX_SUBSTEPS) {
         return Err(Error::TooManySubsteps {
@@ -123,7 +145,8 @@ pub fn step_explicit(
     let h = dt / f64::from(substeps);
     let saved = (body.positions().to_vec(), body.velocities().to_vec());
     for _ in 0..substeps {
-        substep(body, h, gravity, loads);
+        let extra_forces = extra(body);
+        substep(body, h, gravity, loads, extra_forces.as_deref());
     }
     let state = body.positions().iter().zip(body.velocities());
     if let Some(node) = state
@@ -140,9 +163,20 @@ pub fn step_explicit(
     })
 }
 
-/// One symplectic Euler substep of `h` (s).
-fn substep(body: &mut PlanarBody, h: f64, gravity: DVec2, loads: &[DVec2]) {
-    let forces = body.internal_forces_with_damping();
+/// One symplectic Euler substep of `h` (s), with the `extra` forces (N per node) if any.
+fn substep(
+    body: &mut PlanarBody,
+    h: f64,
+    gravity: DVec2,
+    loads: &[DVec2],
+    extra: Option<&[DVec2]>,
+) {
+    let mut forces = body.internal_forces_with_damping();
+    if let Some(extra) = extra {
+        for (f, e) in forces.iter_mut().zip(extra) {
+            *f += *e;
+        }
+    }
     let masses = body.masses().to_vec();
     let pinned = body.pinned().to_vec();
     for (n, v) in body.velocities_mut().iter_mut().enumerate() {

@@ -34,6 +34,8 @@
 
 mod body;
 mod control_volume;
+#[cfg(feature = "dim2")]
+pub mod coupling;
 mod dynamics;
 mod element;
 mod evaluate;

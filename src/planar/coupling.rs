@@ -1,0 +1,359 @@
+//! 2D bodies in contact with rapier2d's colliders, coupled two-way with its rigid bodies
+//! (feature `dim2`). A frame of `dt` is cut into [`PlanarCoupling::substeps`] rapier steps of
+//! `h = dt / substeps` (or as many as the contacts need, see below), and between them:
+//!
+//! 1. **Colliders.** Every non-sensor collider is seen where it is, moving with its rigid body's
+//!    velocity.
+//! 2. **Soft step.** Each body steps explicitly over `h` ([`super::step_explicit`]'s substeps),
+//!    every node inside a collider pushed out by a penalty `f_n = max(0, k d − c v_n)` along the
+//!    collider's outward normal (`d` the depth, `v_n` the approach speed, `c = 2 √(k m)`, the
+//!    node's critical damping), and Coulomb friction `|f_t| ≤ μ f_n` against the relative
+//!    sliding velocity (regularized below [`STICKING_SPEED`]). The contact stiffness is
+//!    `k = (λ' + 2μ) t` of the body's material (`λ'` the plane model's), so that a node's
+//!    contact frequency is that of its elements.
+//! 3. **Exchange.** The opposite impulses, at the nodes, go to the dynamic rigid bodies, and
+//!    are summed per collider into the frame's mean forces ([`PlanarCoupling::collider_forces`]).
+//! 4. **Rigid step.** rapier2d steps its world over `h`.
+//!
+//! A dynamic rigid body pressed by `n` nodes feels a stiffness `n k` that its own step, which
+//! sees the soft body only through the impulses, integrates explicitly: stable for
+//! `h < 2 √(m / (n k))`. The substeps are raised to keep `h` below half of that for the lightest
+//! body the last frame's contacts held, so that no rigid body rings at the default settings.
+//!
+//! # Example: a box on a soft block on the ground
+//! ```
+//! use rapier2d::prelude::{ColliderBuilder, PhysicsWorld, RigidBodyBuilder};
+//! use rapier_fvm::glamx::DVec2;
+//! use rapier_fvm::material::{Material, MaterialModel};
+//! use rapier_fvm::planar::coupling::PlanarCoupling;
+//! use rapier_fvm::planar::{PlanarBodyBuilder, TriangleMesh};
+//!
+//! let mut world = PhysicsWorld::default();
+//! let ground = world.bodies.insert(RigidBodyBuilder::fixed().translation([0.0, -0.5].into()));
+//! let floor = ColliderBuilder::cuboid(2.0, 0.5).build();
+//! let floor = world.colliders.insert_with_parent(floor, ground, &mut world.bodies);
+//! let lid = world.bodies.insert(RigidBodyBuilder::dynamic().translation([0.0, 0.13].into()));
+//! let shape = ColliderBuilder::cuboid(0.05, 0.025).density(100.0).build();
+//! world.colliders.insert_with_parent(shape, lid, &mut world.bodies);
+//! // A 0.2 m x 0.1 m block of rubber, 10 cm thick, resting on the ground.
+//! let rubber = Material::new(MaterialModel::StableNeoHookean, 1e5, 0.3, 1000.0)?;
+//! let mesh = TriangleMesh::rectangle(DVec2::new(0.2, 0.1), [10, 5])?;
+//! let mut block = PlanarBodyBuilder::new(mesh, rubber).thickness(0.1).build()?;
+//! for x in block.positions_mut() {
+//!     *x += DVec2::new(-0.1, 0.0);
+//! }
+//! let mut bodies = vec![block];
+//! let mut coupling = PlanarCoupling::default();
+//! for _ in 0..60 {
+//!     for report in coupling.step(&mut world, &mut bodies)? {
+//!         report?;
+//!     }
+//! }
+//! // The ground carries the block (2 kg) and the box (0.5 kg) once they settle.
+//! assert!(coupling.force_on(floor).y < 0.0);
+//! # Ok::<(), rapier_fvm::Error>(())
+//! ```
+
+use super::body::PlanarBody;
+use super::dynamics::{PlanarStepReport, advance};
+use crate::Error;
+use rapier2d::dynamics::RigidBodyHandle;
+use rapier2d::geometry::{ColliderHandle, SharedShape};
+use rapier2d::glamx::DVec2;
+use rapier2d::math::Pose;
+use rapier2d::pipeline::PhysicsWorld;
+
+/// Below this sliding speed (m/s) friction is viscous, `μ f_n v_t / STICKING_SPEED`, instead of
+/// Coulomb's `μ f_n`: it holds a loaded contact at rest but lets it creep at that speed's scale.
+pub const STICKING_SPEED: f64 = 1e-3;
+
+/// The most coupling substeps a frame takes.
+const MAX_SUBSTEPS: u32 = 256;
+
+/// How 2D bodies step beside rapier2d's rigid bodies, and what they exerted on its colliders
+/// over the last frame.
+#[derive(Debug, Clone)]
+pub struct PlanarCoupling {
+    /// The fewest rapier steps per frame (at least 1); more are taken when the contacts with
+    /// light rigid bodies need them (see the module's documentation).
+    pub substeps: u32,
+    /// The friction coefficient between bodies and colliders.
+    pub friction: f64,
+    /// The mean force (N) the bodies exerted on each collider over the last frame.
+    forces: Vec<(ColliderHandle, DVec2)>,
+    /// The stiffest contact (N/m per kg of rigid body) of the last frame.
+    stiffness_per_mass: f64,
+}
+
+impl Default for PlanarCoupling {
+    fn default() -> Self {
+        Self {
+            substeps: 4,
+            friction: 0.5,
+            forces: Vec::new(),
+            stiffness_per_mass: 0.0,
+        }
+    }
+}
+
+/// A collider as a soft step sees it.
+struct ColliderView {
+    handle: ColliderHandle,
+    shape: SharedShape,
+    pose: Pose,
+    /// Its rigid body: handle, centre of mass (m), velocity (m/s) and angular velocity (rad/s).
+    parent: Option<(RigidBodyHandle, DVec2, DVec2, f64)>,
+    /// Whether that body is dynamic.
+    dynamic: bool,
+    /// Its rigid body's mass (kg), infinite if not dynamic.
+    mass: f64,
+}
+
+impl ColliderView {
+    /// The velocity (m/s) of the collider's material at `x` (m).
+    fn velocity_at(&self, x: DVec2) -> DVec2 {
+        self.parent
+            .map_or(DVec2::ZERO, |(_, com, v, w)| v + (x - com).perp() * w)
+    }
+}
+
+/// The colliders of `world`, as seen now.
+fn colliders_of(world: &PhysicsWorld) -> Vec<ColliderView> {
+    (world.colliders.iter())
+        .filter(|(_, c)| !c.is_sensor())
+        .map(|(handle, collider)| {
+            let body = collider
+                .parent()
+                .and_then(|h| world.bodies.get(h).map(|b| (h, b)));
+            ColliderView {
+                handle,
+                shape: collider.shared_shape().clone(),
+                pose: *collider.position(),
+                parent: body.map(|(h, b)| {
+                    let com = b.center_of_mass().as_dvec2();
+                    (h, com, b.linvel().as_dvec2(), f64::from(b.angvel()))
+                }),
+                dynamic: body.is_some_and(|(_, b)| b.is_dynamic()),
+                mass: body.map_or(f64::INFINITY, |(_, b)| {
+                    if b.is_dynamic() {
+                        f64::from(b.mass())
+                    } else {
+                        f64::INFINITY
+                    }
+                }),
+            }
+        })
+        .collect()
+}
+
+/// What a body's contacts exerted on each collider over a step: forces (N) and torques about
+/// the collider's rigid body's centre of mass (N m) summed over the explicit substeps, and the
+/// most nodes pressing on it at once.
+struct Exchange {
+    force: Vec<DVec2>,
+    torque: Vec<f64>,
+    pressing: Vec<usize>,
+}
+
+impl Exchange {
+    fn new(colliders: usize) -> Self {
+        Self {
+            force: vec![DVec2::ZERO; colliders],
+            torque: vec![0.0; colliders],
+            pressing: vec![0; colliders],
+        }
+    }
+
+    /// The contact forces (N per node) on `body` against `colliders`, with stiffness `k` (N/m)
+    /// and friction `mu`, their opposites added to the colliders' sums.
+    fn contact_forces(
+        &mut self,
+        body: &PlanarBody,
+        colliders: &[ColliderView],
+        (k, mu): (f64, f64),
+    ) -> Vec<DVec2> {
+        let mut forces = vec![DVec2::ZERO; body.positions().len()];
+        let mut pressing = vec![0usize; colliders.len()];
+        for (node, (x, v)) in body.positions().iter().zip(body.velocities()).enumerate() {
+            for (c, view) in colliders.iter().enumerate() {
+                let projection = view.shape.project_point(&view.pose, x.as_vec2(), false);
+                let push = projection.point.as_dvec2() - *x;
+                let depth = push.length();
+                if !projection.is_inside || depth == 0.0 {
+                    continue;
+                }
+                let normal = push / depth;
+                let relative = *v - view.velocity_at(*x);
+                let approach = relative.dot(normal);
+                let damping = 2.0 * (k * body.masses()[node]).sqrt();
+                let normal_force = (k * depth - damping * approach).max(0.0);
+                let sliding = relative - normal * approach;
+                let speed = sliding.length();
+                let friction = if speed > 0.0 {
+                    -sliding * (mu * normal_force * (speed / STICKING_SPEED).min(1.0) / speed)
+                } else {
+                    DVec2::ZERO
+                };
+                let force = normal * normal_force + friction;
+                forces[node] += force;
+                let arm = view.parent.map_or(DVec2::ZERO, |(_, com, ..)| *x - com);
+                self.force[c] -= force;
+                self.torque[c] -= arm.perp_dot(force);
+                pressing[c] += usize::from(normal_force > 0.0);
+            }
+        }
+        for (most, now) in self.pressing.iter_mut().zip(pressing) {
+            *most = (*most).max(now);
+        }
+        forces
+    }
+}
+
+/// The contact stiffness (N/m) of `body`'s nodes: `(λ' + 2μ) t`, the plane model's P-wave
+/// modulus (plane stress `λ' = λ*`) times the rest thickness.
+fn contact_stiffness(body: &PlanarBody) -> f64 {
+    let lame = body.material().lame();
+    let lambda = match body.plane() {
+        super::PlaneModel::PlaneStrain => lame.lambda,
+        super::PlaneModel::PlaneStress => {
+            2.0 * lame.lambda * lame.mu / (lame.lambda + 2.0 * lame.mu)
+        }
+    };
+    (lambda + 2.0 * lame.mu) * body.thickness()
+}
+
+impl PlanarCoupling {
+    /// The mean force (N) the bodies exerted on each collider over the last frame.
+    pub fn collider_forces(&self) -> &[(ColliderHandle, DVec2)] {
+        &self.forces
+    }
+
+    /// The mean force (N) the bodies exerted on `collider` over the last frame.
+    pub fn force_on(&self, collider: ColliderHandle) -> DVec2 {
+        (self.forces.iter())
+            .filter(|(h, _)| *h == collider)
+            .map(|(_, f)| *f)
+            .sum()
+    }
+
+    /// The substeps the next frame of `dt` (s) takes: [`PlanarCoupling::substeps`], or more
+    /// if the last frame's stiffest contact per kilogram of rigid body needs them.
+    fn substeps_for(&self, dt: f64) -> u32 {
+        // Half of the stable step 2/ω, ω² = n k / m.
+        let needed = (dt * self.stiffness_per_mass.sqrt()).ceil();
+        let needed = if needed.is_finite() {
+            needed.min(f64::from(MAX_SUBSTEPS)) as u32
+        } else {
+            1
+        };
+        self.substeps.max(1).max(needed).min(MAX_SUBSTEPS)
+    }
+
+    /// Advances `world` and `bodies` by one frame of `world.integration_parameters.dt` (s),
+    /// under the world's gravity: per body the report of its last soft step, or its first
+    /// error (the body then stays where that step found it and touches nothing after).
+    ///
+    /// # Errors
+    /// [`Error::InvalidTimeStep`] for a frame step that is not positive and finite (nothing
+    /// is stepped).
+    pub fn step(
+        &mut self,
+        world: &mut PhysicsWorld,
+        bodies: &mut [PlanarBody],
+    ) -> Result<Vec<Result<PlanarStepReport, Error>>, Error> {
+        let frame_dt = world.integration_parameters.dt;
+        let dt = f64::from(frame_dt);
+        if !(dt.is_finite() && dt > 0.0) {
+            return Err(Error::InvalidTimeStep {
+                dt,
+                reason: "a frame step must be positive and finite",
+            });
+        }
+        let substeps = self.substeps_for(dt);
+        let h = dt / f64::from(substeps);
+        let gravity = world.gravity.as_dvec2();
+        // None until a body's first soft step, which every body takes (one substep at least).
+        let mut reports: Vec<Option<Result<PlanarStepReport, Error>>> = vec![None; bodies.len()];
+        let mut impulses: Vec<(ColliderHandle, DVec2)> = Vec::new();
+        let mut stiffest = 0.0f64;
+        world.integration_parameters.dt = h as f32;
+        for _ in 0..substeps {
+            let colliders = colliders_of(world);
+            let total = self.soft_step(
+                bodies,
+                &mut reports,
+                &colliders,
+                (h, gravity),
+                &mut stiffest,
+            );
+            for (view, (impulse, angular)) in
+                colliders.iter().zip(total.force.iter().zip(&total.torque))
+            {
+                impulses.push((view.handle, *impulse));
+                if let (true, Some((handle, ..))) = (view.dynamic, view.parent) {
+                    let rigid = &mut world.bodies[handle];
+                    rigid.apply_impulse(impulse.as_vec2(), true);
+                    rigid.apply_torque_impulse(*angular as f32, true);
+                }
+            }
+            world.step();
+        }
+        world.integration_parameters.dt = frame_dt;
+        self.stiffness_per_mass = stiffest;
+        self.forces = mean_forces(impulses, dt);
+        Ok(reports.into_iter().flatten().collect())
+    }
+
+    /// Steps each body of `bodies` not refused earlier in the frame (its `reports`) by `h` (s)
+    /// under `gravity` (m/s²) against `colliders`: the impulses (N s) and angular impulses
+    /// (N m s) the contacts gave each collider, and `stiffest` raised to the stiffest contact
+    /// per kilogram of dynamic rigid body (N/m/kg).
+    fn soft_step(
+        &self,
+        bodies: &mut [PlanarBody],
+        reports: &mut [Option<Result<PlanarStepReport, Error>>],
+        colliders: &[ColliderView],
+        (h, gravity): (f64, DVec2),
+        stiffest: &mut f64,
+    ) -> Exchange {
+        let mut total = Exchange::new(colliders.len());
+        for (body, report) in bodies.iter_mut().zip(reports) {
+            if matches!(report, Some(Err(_))) {
+                continue;
+            }
+            let (k, mu) = (contact_stiffness(body), self.friction);
+            let lightest = body.masses().iter().copied().fold(f64::INFINITY, f64::min);
+            let loads = vec![DVec2::ZERO; body.positions().len()];
+            let mut exchange = Exchange::new(colliders.len());
+            let mut contacts =
+                |b: &PlanarBody| Some(exchange.contact_forces(b, colliders, (k, mu)));
+            let stepped = advance(body, h, (gravity, &loads), k / lightest, &mut contacts);
+            let Ok(stepped) = report.insert(stepped) else {
+                continue;
+            };
+            let pieces = exchange
+                .force
+                .iter()
+                .zip(&exchange.torque)
+                .zip(&exchange.pressing);
+            for (c, ((force, torque), pressing)) in pieces.enumerate() {
+                total.force[c] += *force * stepped.substep_dt;
+                total.torque[c] += torque * stepped.substep_dt;
+                *stiffest = stiffest.max(*pressing as f64 * k / colliders[c].mass);
+            }
+        }
+        total
+    }
+}
+
+/// The impulses (N s) per collider, summed and over `dt` (s): mean forces (N).
+fn mean_forces(impulses: Vec<(ColliderHandle, DVec2)>, dt: f64) -> Vec<(ColliderHandle, DVec2)> {
+    let mut forces: Vec<(ColliderHandle, DVec2)> = Vec::new();
+    for (handle, impulse) in impulses {
+        match forces.iter_mut().find(|(h, _)| *h == handle) {
+            Some((_, sum)) => *sum += impulse / dt,
+            None => forces.push((handle, impulse / dt)),
+        }
+    }
+    forces
+}
