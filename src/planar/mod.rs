@@ -41,6 +41,7 @@ mod element;
 mod evaluate;
 mod implicit;
 mod mesh;
+mod outline;
 mod plane;
 mod points;
 mod statics;

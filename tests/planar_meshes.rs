@@ -1,0 +1,158 @@
+//! The 2D mesh generators: the polygon outline meshed by a refined constrained Delaunay
+//! triangulation (areas exact, element size and quality as asked, bad outlines refused with
+//! typed errors), and a patch test on such a mesh, which nobody on the team laid out.
+
+use rapier_fvm::Error;
+use rapier_fvm::glamx::{DMat2, DVec2};
+use rapier_fvm::material::{Material, MaterialModel};
+use rapier_fvm::planar::{PlanarBodyBuilder, PlaneModel, TriangleMesh, solve_planar_equilibrium};
+use rapier_fvm::statics::StaticSettings;
+
+fn points(xy: &[(f64, f64)]) -> Vec<DVec2> {
+    xy.iter().map(|&(x, y)| DVec2::new(x, y)).collect()
+}
+
+/// The L-shaped bracket's outline, counterclockwise.
+fn bracket() -> Vec<DVec2> {
+    points(&[
+        (0.0, 0.0),
+        (1.0, 0.0),
+        (1.0, 0.4),
+        (0.4, 0.4),
+        (0.4, 1.0),
+        (0.0, 1.0),
+    ])
+}
+
+/// The smallest angle (degrees) of the triangle `a b c`.
+fn smallest_angle(a: DVec2, b: DVec2, c: DVec2) -> f64 {
+    let angle = |p: DVec2, q: DVec2, r: DVec2| (q - p).angle_to(r - p).abs().to_degrees();
+    angle(a, b, c).min(angle(b, c, a)).min(angle(c, a, b))
+}
+
+/// The mesh covers the outline exactly (area to 1e-12), in either orientation; no triangle is
+/// larger than the equilateral one of the edge length asked for, and none has an angle below
+/// 20° (the refinement aims at 25°; the bracket's corners are 90° and 270°).
+#[test]
+fn a_polygon_is_meshed_to_the_size_and_quality_asked() {
+    for outline in [bracket(), bracket().into_iter().rev().collect()] {
+        let mesh = TriangleMesh::polygon(&outline, 0.05).unwrap();
+        assert!((mesh.area() - 0.64).abs() < 1e-12, "area {}", mesh.area());
+        let target = 3f64.sqrt() / 4.0 * 0.05 * 0.05;
+        let mut worst_angle = f64::MAX;
+        for t in 0..mesh.triangles().len() {
+            let [a, b, c] = mesh.corners(t);
+            let area = 0.5 * (b - a).perp_dot(c - a);
+            assert!(
+                area > 0.0 && area <= target * (1.0 + 1e-9),
+                "triangle {t}: area {area}"
+            );
+            worst_angle = worst_angle.min(smallest_angle(a, b, c));
+        }
+        println!(
+            "{} triangles, smallest angle {worst_angle:.1}°",
+            mesh.triangles().len()
+        );
+        assert!(worst_angle >= 20.0, "smallest angle {worst_angle}°");
+    }
+}
+
+/// Bad outlines are typed errors naming what is wrong, never a panic of the triangulator.
+#[test]
+fn bad_outlines_are_typed_errors() {
+    let cases = [
+        (points(&[(0.0, 0.0), (1.0, 0.0)]), "outline"),
+        (
+            points(&[(0.0, 0.0), (1.0, 1.0), (1.0, 0.0), (0.0, 1.0)]),
+            "outline edge",
+        ),
+        (
+            points(&[(0.0, 0.0), (1.0, 0.0), (1.0, 0.0), (0.0, 1.0)]),
+            "outline edge",
+        ),
+        (
+            points(&[(0.0, 0.0), (1.0, 0.0), (2.0, 0.0)]),
+            "outline",
+        ),
+        (
+            points(&[(0.0, 0.0), (f64::NAN, 0.0), (0.0, 1.0)]),
+            "outline vertex",
+        ),
+        (
+            points(&[(0.0, 0.0), (2.0, 0.0), (1.0, 0.0), (1.0, 1.0)]),
+            "outline edge",
+        ),
+    ];
+    for (outline, named) in cases {
+        match TriangleMesh::polygon(&outline, 0.1) {
+            Err(Error::InvalidGeneratorParameter { parameter, .. }) => assert_eq!(parameter, named, "{outline:?}"),
+            other => panic!("{outline:?}: {other:?}"),
+        }
+    }
+    let bad_size = TriangleMesh::polygon(&bracket(), -1.0);
+    assert!(matches!(
+        bad_size,
+        Err(Error::InvalidGeneratorParameter {
+            parameter: "edge_length",
+            ..
+        })
+    ));
+    let too_fine = TriangleMesh::polygon(&bracket(), 1e-6);
+    assert!(matches!(
+        too_fine,
+        Err(Error::InvalidGeneratorParameter {
+            parameter: "edge_length",
+            ..
+        })
+    ));
+}
+
+/// The patch test on the bracket's triangulation: its outline moved by an affine map, every
+/// interior node follows it, to 1e-9 of the element size (every model, both planes).
+#[test]
+fn the_patch_test_holds_on_a_triangulated_polygon() {
+    let mesh = TriangleMesh::polygon(&bracket(), 0.1).unwrap();
+    let a = DMat2::from_cols(DVec2::new(1.05, -0.04), DVec2::new(0.02, 0.97));
+    let c = DVec2::new(-0.3, 0.2);
+    let outline = bracket();
+    let on_outline = |p: DVec2| {
+        (0..outline.len()).any(|i| {
+            let (u, v) = (outline[i], outline[(i + 1) % outline.len()]);
+            let t = ((p - u).dot(v - u) / (v - u).length_squared()).clamp(0.0, 1.0);
+            p.distance(u + (v - u) * t) < 1e-12
+        })
+    };
+    for model in [MaterialModel::Linear, MaterialModel::StableNeoHookean] {
+        for plane in [PlaneModel::PlaneStress, PlaneModel::PlaneStrain] {
+            let material = Material::new(model, 1e6, 0.3, 1000.0).unwrap();
+            let mut body = PlanarBodyBuilder::new(mesh.clone(), material)
+                .plane(plane)
+                .build()
+                .unwrap();
+            let rest = body.rest_positions().to_vec();
+            for (i, p) in rest.iter().enumerate() {
+                // Interior nodes start a millimetre off the map, in a fixed pattern.
+                let off = DVec2::new((i as f64 * 0.7).sin(), (i as f64 * 1.3).cos()) * 1e-3;
+                if on_outline(*p) {
+                    body.pin(i, [true, true]).unwrap();
+                    body.positions_mut()[i] = a * *p + c;
+                } else {
+                    body.positions_mut()[i] = a * *p + c + off;
+                }
+            }
+            let loads = vec![DVec2::ZERO; rest.len()];
+            let settings = StaticSettings {
+                tolerance: 1e-12,
+                max_iterations: 50,
+            };
+            solve_planar_equilibrium(&mut body, &loads, &settings).unwrap();
+            let worst = (body.positions().iter().zip(&rest))
+                .map(|(x, p)| x.distance(a * *p + c))
+                .fold(0.0, f64::max);
+            assert!(
+                worst < 1e-10,
+                "{model:?} {plane:?}: {worst:e} m off the affine map"
+            );
+        }
+    }
+}
