@@ -11,7 +11,8 @@
 //! 2. Nearly incompressible plane strain, λ = 7500, μ = 0.375 (ν = 0.499975), total shear 1:
 //!    `u_y(48, 52)` = 16.4326, the reference of Krysl's `FinEtools` for this case (quadratic NICE-T6
 //!    elements with Richardson extrapolation), on meshes of alternating and of parallel
-//!    diagonals, with the volumetric term per triangle and averaged on node patches.
+//!    diagonals, with the volumetric term per triangle and averaged on node patches; then on
+//!    quadratic triangles, with the term per element and averaged over each (mean dilatation).
 //!
 //! Run with `cargo run --release --example cooks_membrane`. The last line is a JSON summary.
 
@@ -156,10 +157,27 @@ fn main() -> Result<(), rapier_fvm::Error> {
             incompressible_errors.push(format!("\"{diagonals:?} {volumetric:?}\": {error:.5}"));
         }
     }
+    let mut quadratic_errors = Vec::new();
+    for volumetric in [
+        VolumetricTreatment::PerElement,
+        VolumetricTreatment::ElementAverage,
+    ] {
+        println!(
+            "\nplane strain, lambda = 7500, mu = 0.375, quadratic triangles on parallel diagonals, {volumetric:?}; reference {INCOMPRESSIBLE_REFERENCE}"
+        );
+        let setup = Setup {
+            quadratic: true,
+            ..incompressible(volumetric, Diagonals::Parallel)
+        };
+        let (finest, _) = table(setup, INCOMPRESSIBLE_REFERENCE, &[2, 4, 8, 16, 32])?;
+        let error = finest / INCOMPRESSIBLE_REFERENCE - 1.0;
+        quadratic_errors.push(format!("\"{volumetric:?}\": {error:.5}"));
+    }
     let rel_error = displacement / REFERENCE - 1.0;
     println!(
-        "{{\"displacement\": {displacement:.6}, \"reference\": {REFERENCE}, \"rel_error\": {rel_error:.6}, \"triangles\": {triangles}, \"plane\": \"stress\", \"point\": [48, 52], \"quadratic\": {{\"displacement\": {quadratic_displacement:.6}, \"triangles\": {quadratic_triangles}}}, \"incompressible_reference\": {INCOMPRESSIBLE_REFERENCE}, \"incompressible_rel_error_at_8192_triangles\": {{{}}}}}",
-        incompressible_errors.join(", ")
+        "{{\"displacement\": {displacement:.6}, \"reference\": {REFERENCE}, \"rel_error\": {rel_error:.6}, \"triangles\": {triangles}, \"plane\": \"stress\", \"point\": [48, 52], \"quadratic\": {{\"displacement\": {quadratic_displacement:.6}, \"triangles\": {quadratic_triangles}}}, \"incompressible_reference\": {INCOMPRESSIBLE_REFERENCE}, \"incompressible_rel_error_at_8192_triangles\": {{{}}}, \"incompressible_quadratic_rel_error_at_2048_elements\": {{{}}}}}",
+        incompressible_errors.join(", "),
+        quadratic_errors.join(", ")
     );
     Ok(())
 }

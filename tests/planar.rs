@@ -21,8 +21,9 @@ const MODELS: [MaterialModel; 4] = [
 const PLANES: [PlaneModel; 2] = [PlaneModel::PlaneStress, PlaneModel::PlaneStrain];
 
 /// The plane, volumetric treatment and element order a body can have: both planes per element
-/// on linear and quadratic triangles, and plane strain averaged on node patches (linear).
-const SETUPS: [(PlaneModel, VolumetricTreatment, bool); 5] = [
+/// on linear and quadratic triangles, and plane strain averaged on node patches (linear) or
+/// over elements (quadratic).
+const SETUPS: [(PlaneModel, VolumetricTreatment, bool); 6] = [
     (
         PlaneModel::PlaneStress,
         VolumetricTreatment::PerElement,
@@ -46,6 +47,11 @@ const SETUPS: [(PlaneModel, VolumetricTreatment, bool); 5] = [
     (
         PlaneModel::PlaneStrain,
         VolumetricTreatment::PerElement,
+        true,
+    ),
+    (
+        PlaneModel::PlaneStrain,
+        VolumetricTreatment::ElementAverage,
         true,
     ),
 ];

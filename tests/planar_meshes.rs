@@ -70,10 +70,7 @@ fn bad_outlines_are_typed_errors() {
             points(&[(0.0, 0.0), (1.0, 0.0), (1.0, 0.0), (0.0, 1.0)]),
             "outline edge",
         ),
-        (
-            points(&[(0.0, 0.0), (1.0, 0.0), (2.0, 0.0)]),
-            "outline",
-        ),
+        (points(&[(0.0, 0.0), (1.0, 0.0), (2.0, 0.0)]), "outline"),
         (
             points(&[(0.0, 0.0), (f64::NAN, 0.0), (0.0, 1.0)]),
             "outline vertex",
@@ -85,7 +82,9 @@ fn bad_outlines_are_typed_errors() {
     ];
     for (outline, named) in cases {
         match TriangleMesh::polygon(&outline, 0.1) {
-            Err(Error::InvalidGeneratorParameter { parameter, .. }) => assert_eq!(parameter, named, "{outline:?}"),
+            Err(Error::InvalidGeneratorParameter { parameter, .. }) => {
+                assert_eq!(parameter, named, "{outline:?}")
+            }
             other => panic!("{outline:?}: {other:?}"),
         }
     }

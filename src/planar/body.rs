@@ -3,8 +3,8 @@
 //! Contract: nodal masses are `ρ t A_i` (density, rest thickness, the node's control area of the
 //! chosen [`ControlVolumes`], or HRZ shares of quadratic triangles), summing to `ρ t A`;
 //! internal forces are those of the elements' integration points (for linear triangles the
-//! finite-volume forces of [`TriangleRest::forces`]) under the [`PlanarLaw`] of the body's material and
-//! [`PlaneModel`] (with the volumetric term averaged on node patches if asked, see
+//! finite-volume forces of [`TriangleRest::forces`]) under the [`PlanarLaw`] of the body's
+//! material and [`PlaneModel`] (with the volumetric term averaged if asked, see
 //! [`PlanarBodyBuilder::volumetric`]), and are minus the gradient of
 //! [`PlanarBody::elastic_energy`].
 
@@ -14,7 +14,7 @@ use super::evaluate::PlanarLawDyn;
 use super::mesh::TriangleMesh;
 use super::plane::{PlanarLaw, PlanarStress, PlaneModel};
 use super::points::{IntegrationPoints, QUADRATIC_MASS_FRACTIONS};
-use super::volumetric::NodalPatches;
+use super::volumetric::VolumeAveraging;
 use crate::Error;
 use crate::damping::RayleighDamping;
 use crate::fvm::VolumetricTreatment;
@@ -89,10 +89,11 @@ impl PlanarBodyBuilder {
         self
     }
 
-    /// How the volumetric term is evaluated: per triangle, or averaged on node patches
-    /// ([`VolumetricTreatment::NodalAverage`], plane strain only: locking-free for nearly
-    /// incompressible bodies). [`VolumetricTreatment::ElementAverage`] is the per-triangle term
-    /// for linear triangles, as for linear tetrahedra.
+    /// How the volumetric term is evaluated (plane strain only; see [`super::volumetric`]):
+    /// per element, averaged on node patches ([`VolumetricTreatment::NodalAverage`], linear
+    /// triangles) or over each element's points ([`VolumetricTreatment::ElementAverage`], mean
+    /// dilatation, quadratic triangles; for linear triangles, as for linear tetrahedra, it is
+    /// the per-element term): locking-free for nearly incompressible bodies.
     pub fn volumetric(mut self, volumetric: VolumetricTreatment) -> Self {
         self.volumetric = volumetric;
         self
@@ -137,10 +138,11 @@ impl PlanarBodyBuilder {
     /// [`Error::NonPositiveControlArea`] from [`ControlVolumes::nodal_areas`],
     /// [`Error::UnsupportedOption`] for nodal averaging in plane stress.
     pub fn build(self) -> Result<PlanarBody, Error> {
-        let averaged = self.volumetric == VolumetricTreatment::NodalAverage;
+        let averaged = self.volumetric == VolumetricTreatment::NodalAverage
+            || (self.volumetric == VolumetricTreatment::ElementAverage && self.quadratic);
         if averaged && self.plane == PlaneModel::PlaneStress {
             return Err(Error::UnsupportedOption {
-                option: "nodal averaging in plane stress",
+                option: "an averaged volumetric term in plane stress",
                 reason: "a sheet free across its thickness does not lock: nothing holds its volume",
             });
         }
@@ -161,14 +163,23 @@ impl PlanarBodyBuilder {
             axes[0] |= held[0];
             axes[1] |= held[1];
         }
-        let patches = if averaged {
-            let areas = self.control_volumes.nodal_areas(&self.mesh)?;
-            Some(NodalPatches::new(&points, &areas))
-        } else {
-            None
+        let averaging = match (self.volumetric, self.quadratic) {
+            (VolumetricTreatment::NodalAverage, _) => {
+                let areas = self.control_volumes.nodal_areas(&self.mesh)?;
+                Some(VolumeAveraging::nodal(&points, &areas))
+            }
+            (VolumetricTreatment::ElementAverage, true) => {
+                Some(VolumeAveraging::per_element(&points))
+            }
+            _ => None,
+        };
+        let volumetric = match averaging {
+            Some(_) => self.volumetric,
+            None => VolumetricTreatment::PerElement,
         };
         Ok(PlanarBody {
-            patches,
+            averaging,
+            volumetric,
             velocities: vec![DVec2::ZERO; node_count],
             damping: self.damping,
             positions: rest_positions.clone(),
@@ -206,7 +217,7 @@ impl PlanarBodyBuilder {
         if self.volumetric == VolumetricTreatment::NodalAverage {
             return unsupported(
                 "nodal averaging with quadratic triangles",
-                "nodal averaging is the locking-free option of linear triangles",
+                "quadratic triangles average over each element (ElementAverage)",
             );
         }
         let (positions, elements) = self.mesh.quadratic_nodes();
@@ -237,8 +248,10 @@ pub struct PlanarBody {
     masses: Vec<f64>,
     positions: Vec<DVec2>,
     pub(super) pinned: Vec<[bool; 2]>,
-    /// The node patches of nodal averaging, if the body averages its volumetric term.
-    pub(super) patches: Option<NodalPatches>,
+    /// The groups the volumetric term is averaged over, if it is.
+    pub(super) averaging: Option<VolumeAveraging>,
+    /// How the volumetric term is evaluated.
+    volumetric: VolumetricTreatment,
     velocities: Vec<DVec2>,
     damping: Option<RayleighDamping>,
 }
@@ -384,7 +397,7 @@ impl PlanarBody {
     }
 
     /// The stress at integration point `q` (see [`PlanarStress`]): the model's at its
-    /// deformation gradient, with nodal averaging its volumetric part averaged as the forces
+    /// deformation gradient, with an averaged volumetric term its volumetric part averaged as the forces
     /// take it.
     pub fn stress(&self, q: usize) -> PlanarStress {
         self.with_law(|law| {
@@ -397,13 +410,10 @@ impl PlanarBody {
         })
     }
 
-    /// How the volumetric term is evaluated.
+    /// How the volumetric term is evaluated ([`VolumetricTreatment::ElementAverage`] of
+    /// linear triangles is [`VolumetricTreatment::PerElement`]).
     pub fn volumetric(&self) -> VolumetricTreatment {
-        if self.patches.is_some() {
-            VolumetricTreatment::NodalAverage
-        } else {
-            VolumetricTreatment::PerElement
-        }
+        self.volumetric
     }
 
     /// Runs `body` with the body's [`PlanarLaw`] for its material model.

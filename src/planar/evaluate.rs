@@ -1,5 +1,5 @@
 //! What a 2D body's elasticity gives at some positions: its energy, the nodal forces and the
-//! tangent `K = −∂f/∂x`, with the volumetric term per triangle or averaged on node patches
+//! tangent `K = −∂f/∂x`, with the volumetric term per point or averaged over groups of points
 //! ([`super::volumetric`]).
 //!
 //! Per integration point `q` ([`super::points`]), with `F` its deformation gradient and `w` its
@@ -76,9 +76,9 @@ impl PlanarBody {
         let gradients: Vec<DMat2> = (0..points.len())
             .map(|q| points.gradient(q, positions))
             .collect();
-        let averages = self.patches.as_ref().map(|patches| {
+        let averages = self.averaging.as_ref().map(|averaging| {
             let measures = gradients.iter().map(|f| law.volume_measure(f)).collect();
-            patches.averages(points, measures)
+            averaging.averages(points, measures)
         });
         Evaluation {
             gradients,
@@ -96,9 +96,9 @@ impl PlanarBody {
         let elements: f64 = (evaluation.gradients.iter().enumerate())
             .map(|(q, f)| per_area(f) * points.weight(q))
             .sum();
-        let patches = (self.patches.as_ref().zip(evaluation.averages.as_ref()))
-            .map_or(0.0, |(p, a)| p.energy(a, law.bulk_modulus()));
-        (elements + patches) * self.thickness()
+        let averaged = (self.averaging.as_ref().zip(evaluation.averages.as_ref()))
+            .map_or(0.0, |(v, a)| v.energy(a, law.bulk_modulus()));
+        (elements + averaged) * self.thickness()
     }
 
     /// Point `q`'s stress (Pa) in `evaluation`: the model's, plus the averaged volumetric
@@ -113,7 +113,7 @@ impl PlanarBody {
         let p = law.stress(f).p;
         match &evaluation.averages {
             Some(a) => {
-                p + law.volume_gradient(f) * (law.bulk_modulus() * (a.element[q] - a.measure[q]))
+                p + law.volume_gradient(f) * (law.bulk_modulus() * (a.point[q] - a.measure[q]))
             }
             None => p,
         }
@@ -146,7 +146,7 @@ impl PlanarBody {
         let f = &evaluation.gradients[q];
         let (k, g) = (law.bulk_modulus(), law.volume_gradient(f));
         let dm = g.x_axis.dot(df.x_axis) + g.y_axis.dot(df.y_axis);
-        dp - g * (k * dm) + law.volume_differential(f, df) * (k * (a.element[q] - a.measure[q]))
+        dp - g * (k * dm) + law.volume_differential(f, df) * (k * (a.point[q] - a.measure[q]))
     }
 
     /// Adds the points' tangent blocks of `evaluation` to `triplets`, over the unknowns of
@@ -183,8 +183,8 @@ impl PlanarBody {
     }
 }
 
-/// Adds the patch term `Σ_a t W_a K g_a g_aᵀ` of nodal averaging to `triplets` (nothing
-/// without it).
+/// Adds the averaging's term `Σ_g t W_g K g_g g_gᵀ` to `triplets` (nothing without
+/// averaging).
 pub(super) fn patch_tangent(
     body: &PlanarBody,
     law: &dyn PlanarLawDyn,
@@ -192,7 +192,9 @@ pub(super) fn patch_tangent(
     index: &[[Option<usize>; 2]],
     triplets: &mut Vec<Triplet<usize, usize, f64>>,
 ) {
-    let Some(patches) = &body.patches else { return };
+    let Some(averaging) = &body.averaging else {
+        return;
+    };
     let points = body.points();
     // ∂m_q/∂x_a = ∂m/∂F ∇N_a.
     let measure_gradients: Vec<Vec<DVec2>> = (evaluation.gradients.iter().enumerate())
@@ -201,10 +203,10 @@ pub(super) fn patch_tangent(
             points.gradients(q).iter().map(|n| g * *n).collect()
         })
         .collect();
-    let gradients = patches.average_gradients(points, &measure_gradients);
+    let gradients = averaging.average_gradients(points, &measure_gradients);
     let k = law.bulk_modulus() * body.thickness();
     for (a, entries) in gradients.iter().enumerate() {
-        let weight = k * patches.control_area(a);
+        let weight = k * averaging.weight(a);
         for &(col_node, g_col) in entries {
             for (b, col) in index[col_node as usize].iter().enumerate() {
                 let Some(col) = col else { continue };
