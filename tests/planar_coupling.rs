@@ -133,3 +133,107 @@ fn a_collision_keeps_the_total_momentum() {
     );
     assert!(box_speed > 0.5, "the box was not struck: {box_speed} m/s");
 }
+
+/// A 0.3 m rubber strip glued by its top edge to a fixed rigid body hangs under gravity: after
+/// 3 s the glue carries its weight to 1 % (the tolerance for the ground reaction), the
+/// strip at rest.
+#[test]
+fn a_glued_strip_hangs_with_the_glue_carrying_its_weight() {
+    let mut world = PhysicsWorld::default();
+    let hook = world
+        .bodies
+        .insert(RigidBodyBuilder::fixed().translation([0.0, 0.3].into()));
+    let rubber = Material::new(MaterialModel::StableNeoHookean, 2e5, 0.3, 1000.0).unwrap();
+    let damping = RayleighDamping::stiffness_proportional(2e-3, rubber.lame()).unwrap();
+    let mesh = TriangleMesh::rectangle(DVec2::new(0.05, 0.3), [2, 12]).unwrap();
+    let strip = PlanarBodyBuilder::new(mesh, rubber)
+        .plane(PlaneModel::PlaneStress)
+        .thickness(0.02)
+        .damping(damping)
+        .build()
+        .unwrap();
+    let top = strip.nodes_on_line(DVec2::new(0.0, 0.3), DVec2::X, 1e-9);
+    let weight = strip.total_mass() * 9.81;
+    let mut bodies = vec![strip];
+    let mut coupling = PlanarCoupling::default();
+    coupling.glue(&world, &bodies, (0, &top), hook).unwrap();
+    for _ in 0..180 {
+        for report in coupling.step(&mut world, &mut bodies).unwrap() {
+            report.unwrap();
+        }
+    }
+    let held = coupling.glue_force(hook);
+    let speed = bodies[0]
+        .velocities()
+        .iter()
+        .map(|v| v.length())
+        .fold(0.0, f64::max);
+    println!(
+        "the glue carries {:.5} N against {weight:.5} N; fastest node {speed:.2e} m/s",
+        -held.y
+    );
+    assert!(
+        (-held.y / weight - 1.0).abs() < 1e-2,
+        "{held} against {weight}"
+    );
+    assert!(speed < 1e-3);
+}
+
+/// A free 0.2 kg rigid bar glued to a soft block, the pair thrown spinning without gravity:
+/// the glue's impulses are equal and opposite, so the total linear momentum is kept to 1e-5.
+#[test]
+fn a_glued_pair_keeps_its_momentum() {
+    let mut world = PhysicsWorld {
+        gravity: [0.0, 0.0].into(),
+        ..Default::default()
+    };
+    let bar = world
+        .bodies
+        .insert(RigidBodyBuilder::dynamic().translation([0.05, 0.11].into()));
+    world.colliders.insert_with_parent(
+        ColliderBuilder::cuboid(0.05, 0.01)
+            .density(200.0)
+            .sensor(true)
+            .build(),
+        bar,
+        &mut world.bodies,
+    );
+    let rubber = Material::new(MaterialModel::StableNeoHookean, 1e5, 0.3, 1000.0).unwrap();
+    let mut block = PlanarBodyBuilder::new(
+        TriangleMesh::rectangle(DVec2::new(0.1, 0.1), [4, 4]).unwrap(),
+        rubber,
+    )
+    .thickness(0.05)
+    .build()
+    .unwrap();
+    let positions = block.positions().to_vec();
+    for (v, x) in block.velocities_mut().iter_mut().zip(positions) {
+        *v = DVec2::new(1.0, 0.5) + (x - DVec2::splat(0.05)).perp() * 3.0;
+    }
+    let top = block.nodes_on_line(DVec2::new(0.0, 0.1), DVec2::X, 1e-9);
+    let mut bodies = vec![block];
+    let mut coupling = PlanarCoupling::default();
+    coupling.glue(&world, &bodies, (0, &top), bar).unwrap();
+    let momentum = |world: &PhysicsWorld, bodies: &[rapier_fvm::planar::PlanarBody]| {
+        let rigid = &world.bodies[bar];
+        rigid.linvel().as_dvec2() * f64::from(rigid.mass()) + bodies[0].linear_momentum()
+    };
+    let before = momentum(&world, &bodies);
+    for _ in 0..60 {
+        for report in coupling.step(&mut world, &mut bodies).unwrap() {
+            report.unwrap();
+        }
+    }
+    let after = momentum(&world, &bodies);
+    let bar_speed = world.bodies[bar].linvel().length();
+    println!("momentum {before} → {after}; the bar moves at {bar_speed:.3} m/s");
+    assert!(
+        (after - before).length() < 1e-5 * before.length(),
+        "{before} → {after}"
+    );
+    assert!(bar_speed > 0.5, "the bar was not carried: {bar_speed} m/s");
+    assert!(matches!(
+        coupling.glue(&world, &bodies, (1, &top), bar),
+        Err(rapier_fvm::Error::UnknownDeformableBody)
+    ));
+}

@@ -89,11 +89,12 @@ impl PlanarBodyBuilder {
         self
     }
 
-    /// How the volumetric term is evaluated (plane strain only; see [`super::volumetric`]):
-    /// per element, averaged on node patches ([`VolumetricTreatment::NodalAverage`], linear
-    /// triangles) or over each element's points ([`VolumetricTreatment::ElementAverage`], mean
-    /// dilatation, quadratic triangles; for linear triangles, as for linear tetrahedra, it is
-    /// the per-element term): locking-free for nearly incompressible bodies.
+    /// How the volumetric term `K/2 m²` is evaluated (plane strain only): per element, or
+    /// averaged over groups of integration points with their rest areas as weights, on node
+    /// patches ([`VolumetricTreatment::NodalAverage`], linear triangles) or over each
+    /// element's points ([`VolumetricTreatment::ElementAverage`], mean dilatation, quadratic
+    /// triangles; for linear triangles, as for linear tetrahedra, it is the per-element term):
+    /// locking-free for nearly incompressible bodies.
     pub fn volumetric(mut self, volumetric: VolumetricTreatment) -> Self {
         self.volumetric = volumetric;
         self

@@ -11,8 +11,11 @@
 //!    sliding velocity (regularized below [`STICKING_SPEED`]). The contact stiffness is
 //!    `k = (λ' + 2μ) t` of the body's material (`λ'` the plane model's), so that a node's
 //!    contact frequency is that of its elements.
+//!    Nodes glued to rigid bodies ([`PlanarCoupling::glue`]) are held to their anchors by
+//!    damped springs of the same stiffness, `f = k (a − x) + c (v_a − v)` to the anchor `a`.
 //! 3. **Exchange.** The opposite impulses, at the nodes, go to the dynamic rigid bodies, and
-//!    are summed per collider into the frame's mean forces ([`PlanarCoupling::collider_forces`]).
+//!    are summed per collider into the frame's mean forces ([`PlanarCoupling::collider_forces`];
+//!    the glue's per rigid body, [`PlanarCoupling::glue_force`]).
 //! 4. **Rigid step.** rapier2d steps its world over `h`.
 //!
 //! A dynamic rigid body pressed by `n` nodes feels a stiffness `n k` that its own step, which
@@ -56,6 +59,7 @@
 
 use super::body::PlanarBody;
 use super::dynamics::{PlanarStepReport, advance};
+use super::glue::{GlueView, GluedNode};
 use crate::Error;
 use rapier2d::dynamics::RigidBodyHandle;
 use rapier2d::geometry::{ColliderHandle, SharedShape};
@@ -83,6 +87,10 @@ pub struct PlanarCoupling {
     forces: Vec<(ColliderHandle, DVec2)>,
     /// The stiffest contact (N/m per kg of rigid body) of the last frame.
     stiffness_per_mass: f64,
+    /// Nodes glued to rigid bodies.
+    glued: Vec<GluedNode>,
+    /// The mean force (N) the glued nodes exerted on each rigid body over the last frame.
+    glue_forces: Vec<(RigidBodyHandle, DVec2)>,
 }
 
 impl Default for PlanarCoupling {
@@ -92,6 +100,8 @@ impl Default for PlanarCoupling {
             friction: 0.5,
             forces: Vec::new(),
             stiffness_per_mass: 0.0,
+            glued: Vec::new(),
+            glue_forces: Vec::new(),
         }
     }
 }
@@ -107,6 +117,8 @@ struct ColliderView {
     dynamic: bool,
     /// Its rigid body's mass (kg), infinite if not dynamic.
     mass: f64,
+    /// Its bounding box (m): nodes outside it are not tested.
+    bounds: (DVec2, DVec2),
 }
 
 impl ColliderView {
@@ -127,6 +139,10 @@ fn colliders_of(world: &PhysicsWorld) -> Vec<ColliderView> {
                 .and_then(|h| world.bodies.get(h).map(|b| (h, b)));
             ColliderView {
                 handle,
+                bounds: {
+                    let aabb = collider.compute_aabb();
+                    (aabb.mins.as_dvec2(), aabb.maxs.as_dvec2())
+                },
                 shape: collider.shared_shape().clone(),
                 pose: *collider.position(),
                 parent: body.map(|(h, b)| {
@@ -176,6 +192,10 @@ impl Exchange {
         let mut pressing = vec![0usize; colliders.len()];
         for (node, (x, v)) in body.positions().iter().zip(body.velocities()).enumerate() {
             for (c, view) in colliders.iter().enumerate() {
+                let (low, high) = view.bounds;
+                if x.cmplt(low).any() || x.cmpgt(high).any() {
+                    continue;
+                }
                 let projection = view.shape.project_point(&view.pose, x.as_vec2(), false);
                 let push = projection.point.as_dvec2() - *x;
                 let depth = push.length();
@@ -228,6 +248,35 @@ impl PlanarCoupling {
         &self.forces
     }
 
+    /// Glues `nodes` of `bodies[body]`, where they are, to the rigid body `rigid` of `world`
+    /// (each held to a point fixed in the rigid body by a damped spring of the body's contact
+    /// stiffness, the rigid body taking the opposite force); the glue holds while both exist (glue to a rigid body removed from
+    /// the world is dropped at the next step).
+    ///
+    /// # Errors
+    /// [`Error::UnknownDeformableBody`] for a body index out of range,
+    /// [`Error::UnknownRigidBody`], [`Error::NodeOutOfRange`]; nothing is glued then.
+    pub fn glue(
+        &mut self,
+        world: &PhysicsWorld,
+        bodies: &[PlanarBody],
+        (body, nodes): (usize, &[usize]),
+        rigid: RigidBodyHandle,
+    ) -> Result<(), Error> {
+        let planar = bodies.get(body).ok_or(Error::UnknownDeformableBody)?;
+        let glued = GluedNode::new_all(world, (body, planar), nodes, rigid)?;
+        self.glued.extend(glued);
+        Ok(())
+    }
+
+    /// The mean force (N) the glued nodes exerted on `rigid` over the last frame.
+    pub fn glue_force(&self, rigid: RigidBodyHandle) -> DVec2 {
+        (self.glue_forces.iter())
+            .filter(|(h, _)| *h == rigid)
+            .map(|(_, f)| *f)
+            .sum()
+    }
+
     /// The mean force (N) the bodies exerted on `collider` over the last frame.
     pub fn force_on(&self, collider: ColliderHandle) -> DVec2 {
         (self.forces.iter())
@@ -277,15 +326,27 @@ impl PlanarCoupling {
         let mut impulses: Vec<(ColliderHandle, DVec2)> = Vec::new();
         let mut stiffest = 0.0f64;
         world.integration_parameters.dt = h as f32;
+        self.glued
+            .retain(|g| world.bodies.get(g.rigid).is_some() && g.body < bodies.len());
+        let mut glue_impulses: Vec<(RigidBodyHandle, DVec2)> = Vec::new();
         for _ in 0..substeps {
             let colliders = colliders_of(world);
-            let total = self.soft_step(
+            let glue = GlueView::all(&self.glued, world);
+            let (total, glue_total) = self.soft_step(
                 bodies,
                 &mut reports,
-                &colliders,
+                (&colliders, &glue),
                 (h, gravity),
                 &mut stiffest,
             );
+            for (view, (impulse, angular)) in glue.iter().zip(glue_total) {
+                glue_impulses.push((view.rigid, impulse));
+                if view.dynamic {
+                    let rigid = &mut world.bodies[view.rigid];
+                    rigid.apply_impulse(impulse.as_vec2(), true);
+                    rigid.apply_torque_impulse(angular as f32, true);
+                }
+            }
             for (view, (impulse, angular)) in
                 colliders.iter().zip(total.force.iter().zip(&total.torque))
             {
@@ -301,23 +362,26 @@ impl PlanarCoupling {
         world.integration_parameters.dt = frame_dt;
         self.stiffness_per_mass = stiffest;
         self.forces = mean_forces(impulses, dt);
+        self.glue_forces = mean_forces(glue_impulses, dt);
         Ok(reports.into_iter().flatten().collect())
     }
 
     /// Steps each body of `bodies` not refused earlier in the frame (its `reports`) by `h` (s)
-    /// under `gravity` (m/s²) against `colliders`: the impulses (N s) and angular impulses
-    /// (N m s) the contacts gave each collider, and `stiffest` raised to the stiffest contact
-    /// per kilogram of dynamic rigid body (N/m/kg).
+    /// under `gravity` (m/s²) against `colliders` and held by its `glue`: the impulses (N s) and
+    /// angular impulses (N m s) the contacts gave each collider and the glue each glued node's
+    /// rigid body, and `stiffest` raised to the stiffest contact or glue per kilogram of dynamic
+    /// rigid body (N/m/kg).
     fn soft_step(
         &self,
         bodies: &mut [PlanarBody],
         reports: &mut [Option<Result<PlanarStepReport, Error>>],
-        colliders: &[ColliderView],
+        (colliders, glue): (&[ColliderView], &[GlueView]),
         (h, gravity): (f64, DVec2),
         stiffest: &mut f64,
-    ) -> Exchange {
+    ) -> (Exchange, Vec<(DVec2, f64)>) {
         let mut total = Exchange::new(colliders.len());
-        for (body, report) in bodies.iter_mut().zip(reports) {
+        let mut glue_total = vec![(DVec2::ZERO, 0.0); glue.len()];
+        for (index, (body, report)) in bodies.iter_mut().zip(reports).enumerate() {
             if matches!(report, Some(Err(_))) {
                 continue;
             }
@@ -325,30 +389,50 @@ impl PlanarCoupling {
             let lightest = body.masses().iter().copied().fold(f64::INFINITY, f64::min);
             let loads = vec![DVec2::ZERO; body.positions().len()];
             let mut exchange = Exchange::new(colliders.len());
-            let mut contacts =
-                |b: &PlanarBody| Some(exchange.contact_forces(b, colliders, (k, mu)));
-            let stepped = advance(body, h, (gravity, &loads), k / lightest, &mut contacts);
+            let mut glue_sums = vec![(DVec2::ZERO, 0.0); glue.len()];
+            let mut forces = |b: &PlanarBody| {
+                let mut forces = exchange.contact_forces(b, colliders, (k, mu));
+                for (view, sum) in glue
+                    .iter()
+                    .zip(&mut glue_sums)
+                    .filter(|(g, _)| g.body == index)
+                {
+                    let (force, at) = view.force(b, k);
+                    forces[view.node] += force;
+                    sum.0 -= force;
+                    sum.1 -= (at - view.centre).perp_dot(force);
+                }
+                Some(forces)
+            };
+            let stepped = advance(body, h, (gravity, &loads), k / lightest, &mut forces);
             let Ok(stepped) = report.insert(stepped) else {
                 continue;
             };
-            let pieces = exchange
-                .force
-                .iter()
+            let dt = stepped.substep_dt;
+            let pieces = (exchange.force.iter())
                 .zip(&exchange.torque)
                 .zip(&exchange.pressing);
             for (c, ((force, torque), pressing)) in pieces.enumerate() {
-                total.force[c] += *force * stepped.substep_dt;
-                total.torque[c] += torque * stepped.substep_dt;
+                total.force[c] += *force * dt;
+                total.torque[c] += torque * dt;
                 *stiffest = stiffest.max(*pressing as f64 * k / colliders[c].mass);
             }
+            for ((view, sum), impulse) in glue.iter().zip(&glue_sums).zip(&mut glue_total) {
+                if view.body == index {
+                    impulse.0 += sum.0 * dt;
+                    impulse.1 += sum.1 * dt;
+                    let glued = glue.iter().filter(|g| g.rigid == view.rigid).count();
+                    *stiffest = stiffest.max(glued as f64 * k / view.mass);
+                }
+            }
         }
-        total
+        (total, glue_total)
     }
 }
 
-/// The impulses (N s) per collider, summed and over `dt` (s): mean forces (N).
-fn mean_forces(impulses: Vec<(ColliderHandle, DVec2)>, dt: f64) -> Vec<(ColliderHandle, DVec2)> {
-    let mut forces: Vec<(ColliderHandle, DVec2)> = Vec::new();
+/// The impulses (N s) per key, summed and over `dt` (s): mean forces (N).
+fn mean_forces<K: PartialEq>(impulses: Vec<(K, DVec2)>, dt: f64) -> Vec<(K, DVec2)> {
+    let mut forces: Vec<(K, DVec2)> = Vec::new();
     for (handle, impulse) in impulses {
         match forces.iter_mut().find(|(h, _)| *h == handle) {
             Some((_, sum)) => *sum += impulse / dt,

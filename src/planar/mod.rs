@@ -39,6 +39,8 @@ pub mod coupling;
 mod dynamics;
 mod element;
 mod evaluate;
+#[cfg(feature = "dim2")]
+mod glue;
 mod implicit;
 mod mesh;
 mod outline;
