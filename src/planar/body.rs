@@ -154,7 +154,7 @@ impl PlanarBodyBuilder {
                 reason: "must be positive and finite (m)",
             });
         }
-        let (rest_positions, points, masses) = self.discretize()?;
+        let (rest_positions, points, masses, boundary) = self.discretize()?;
         let node_count = rest_positions.len();
         let mut pinned = vec![[false; 2]; node_count];
         for &(node, held) in &self.pinned {
@@ -179,6 +179,7 @@ impl PlanarBodyBuilder {
             None => VolumetricTreatment::PerElement,
         };
         Ok(PlanarBody {
+            boundary,
             averaging,
             volumetric,
             velocities: vec![DVec2::ZERO; node_count],
@@ -197,7 +198,7 @@ impl PlanarBodyBuilder {
     }
 
     /// The body's rest positions (m), integration points and nodal masses (kg).
-    fn discretize(&self) -> Result<(Vec<DVec2>, IntegrationPoints, Vec<f64>), Error> {
+    fn discretize(&self) -> Result<Discretized, Error> {
         let per_area = self.material.density() * self.thickness;
         let rest: Vec<TriangleRest> = (0..self.mesh.triangles().len())
             .map(|t| TriangleRest::new(self.mesh.corners(t)))
@@ -206,7 +207,13 @@ impl PlanarBodyBuilder {
             let areas = self.control_volumes.nodal_areas(&self.mesh)?;
             let masses = areas.iter().map(|a| a * per_area).collect();
             let points = IntegrationPoints::linear(self.mesh.triangles(), &rest);
-            return Ok((self.mesh.rest_positions().to_vec(), points, masses));
+            let boundary = self.mesh.boundary_edges();
+            return Ok((
+                self.mesh.rest_positions().to_vec(),
+                points,
+                masses,
+                boundary,
+            ));
         }
         let unsupported = |option, reason| Err(Error::UnsupportedOption { option, reason });
         if self.control_volumes != ControlVolumes::Median {
@@ -221,20 +228,20 @@ impl PlanarBodyBuilder {
                 "quadratic triangles average over each element (ElementAverage)",
             );
         }
-        let (positions, elements) = self.mesh.quadratic_nodes();
+        let (positions, elements, boundary) = self.mesh.quadratic_nodes();
         let mut masses = vec![0.0; positions.len()];
         for (nodes, rest) in elements.iter().zip(&rest) {
             for (n, fraction) in nodes.iter().zip(QUADRATIC_MASS_FRACTIONS) {
                 masses[*n as usize] += fraction * rest.area() * per_area;
             }
         }
-        Ok((
-            positions,
-            IntegrationPoints::quadratic(&elements, &rest),
-            masses,
-        ))
+        let points = IntegrationPoints::quadratic(&elements, &rest);
+        Ok((positions, points, masses, boundary))
     }
 }
+
+/// A body's rest positions (m), integration points, nodal masses (kg) and boundary segments.
+type Discretized = (Vec<DVec2>, IntegrationPoints, Vec<f64>, Vec<[u32; 2]>);
 
 /// A 2D soft body: its mesh, material and plane model, and where its nodes are.
 #[derive(Debug, Clone)]
@@ -255,6 +262,7 @@ pub struct PlanarBody {
     volumetric: VolumetricTreatment,
     velocities: Vec<DVec2>,
     damping: Option<RayleighDamping>,
+    boundary: Vec<[u32; 2]>,
 }
 
 impl PlanarBody {
@@ -300,6 +308,13 @@ impl PlanarBody {
         let along = |n: &usize| (self.rest_positions[*n] - point).dot(direction);
         nodes.sort_by(|a, b| along(a).total_cmp(&along(b)));
         nodes
+    }
+
+    /// The boundary as segments between nodes, the body to their left (see
+    /// [`TriangleMesh::boundary_edges`]; quadratic triangles' edges cut at their mid-edge
+    /// nodes).
+    pub fn boundary(&self) -> &[[u32; 2]] {
+        &self.boundary
     }
 
     /// Whether the elements are quadratic (6-node) triangles.

@@ -11,6 +11,8 @@
 //!    sliding velocity (regularized below [`STICKING_SPEED`]). The contact stiffness is
 //!    `k = (λ' + 2μ) t` of the body's material (`λ'` the plane model's), so that a node's
 //!    contact frequency is that of its elements.
+//!    Corners of polygonal colliders inside a body are pushed out through its boundary by the
+//!    same penalty, the boundary segment's nodes taking the opposite force.
 //!    Nodes glued to rigid bodies ([`PlanarCoupling::glue`]) are held to their anchors by
 //!    damped springs of the same stiffness, `f = k (a − x) + c (v_a − v)` to the anchor `a`.
 //! 3. **Exchange.** The opposite impulses, at the nodes, go to the dynamic rigid bodies, and
@@ -58,6 +60,7 @@
 //! ```
 
 use super::body::PlanarBody;
+use super::corners::{corner_inside, corners_of};
 use super::dynamics::{PlanarStepReport, advance};
 use super::glue::{GlueView, GluedNode};
 use crate::Error;
@@ -119,6 +122,8 @@ struct ColliderView {
     mass: f64,
     /// Its bounding box (m): nodes outside it are not tested.
     bounds: (DVec2, DVec2),
+    /// Its vertices (m) if it is polygonal ([`super::corners`]).
+    corners: Vec<DVec2>,
 }
 
 impl ColliderView {
@@ -143,6 +148,7 @@ fn colliders_of(world: &PhysicsWorld) -> Vec<ColliderView> {
                     let aabb = collider.compute_aabb();
                     (aabb.mins.as_dvec2(), aabb.maxs.as_dvec2())
                 },
+                corners: corners_of(collider.shared_shape(), collider.position()),
                 shape: collider.shared_shape().clone(),
                 pose: *collider.position(),
                 parent: body.map(|(h, b)| {
@@ -204,17 +210,8 @@ impl Exchange {
                 }
                 let normal = push / depth;
                 let relative = *v - view.velocity_at(*x);
-                let approach = relative.dot(normal);
                 let damping = 2.0 * (k * body.masses()[node]).sqrt();
-                let normal_force = (k * depth - damping * approach).max(0.0);
-                let sliding = relative - normal * approach;
-                let speed = sliding.length();
-                let friction = if speed > 0.0 {
-                    -sliding * (mu * normal_force * (speed / STICKING_SPEED).min(1.0) / speed)
-                } else {
-                    DVec2::ZERO
-                };
-                let force = normal * normal_force + friction;
+                let (force, normal_force) = penalty((k, damping, mu), depth, normal, relative);
                 forces[node] += force;
                 let arm = view.parent.map_or(DVec2::ZERO, |(_, com, ..)| *x - com);
                 self.force[c] -= force;
@@ -222,11 +219,78 @@ impl Exchange {
                 pressing[c] += usize::from(normal_force > 0.0);
             }
         }
+        self.corner_forces(body, colliders, (k, mu), (&mut forces, &mut pressing));
         for (most, now) in self.pressing.iter_mut().zip(pressing) {
             *most = (*most).max(now);
         }
         forces
     }
+
+    /// Adds the forces of the colliders' corners inside `body` to the nodes' `forces` (N), their
+    /// opposites to the colliders' sums, and counts the pressing ones in `pressing`.
+    fn corner_forces(
+        &mut self,
+        body: &PlanarBody,
+        colliders: &[ColliderView],
+        (k, mu): (f64, f64),
+        (forces, pressing): (&mut [DVec2], &mut [usize]),
+    ) {
+        let (x, v) = (body.positions(), body.velocities());
+        let (low, high) = bounds_of(x);
+        for (c, view) in colliders.iter().enumerate() {
+            for &p in &view.corners {
+                if p.cmplt(low).any() || p.cmpgt(high).any() {
+                    continue;
+                }
+                let Some(corner) = corner_inside(body, p) else {
+                    continue;
+                };
+                let [a, b] = corner.segment.map(|n| n as usize);
+                let s = corner.s;
+                let soft_velocity = v[a] * (1.0 - s) + v[b] * s;
+                let relative = view.velocity_at(p) - soft_velocity;
+                let mass = 0.5 * (body.masses()[a] + body.masses()[b]);
+                let damping = 2.0 * (k * mass).sqrt();
+                let (force, normal_force) =
+                    penalty((k, damping, mu), corner.depth, corner.normal, relative);
+                forces[a] -= force * (1.0 - s);
+                forces[b] -= force * s;
+                let arm = view.parent.map_or(DVec2::ZERO, |(_, com, ..)| p - com);
+                self.force[c] += force;
+                self.torque[c] += arm.perp_dot(force);
+                pressing[c] += usize::from(normal_force > 0.0);
+            }
+        }
+    }
+}
+
+/// The penalty force (N) on a point `depth` (m) inside along the outward `normal`, moving at
+/// `relative` (m/s) against what it presses on, with stiffness `k` (N/m), damping `c` (N s/m)
+/// and friction `mu`: `max(0, k d − c v_n)` along the normal, Coulomb friction against the
+/// sliding (viscous below [`STICKING_SPEED`]); and its normal part (N).
+fn penalty(
+    (k, damping, mu): (f64, f64, f64),
+    depth: f64,
+    normal: DVec2,
+    relative: DVec2,
+) -> (DVec2, f64) {
+    let approach = relative.dot(normal);
+    let normal_force = (k * depth - damping * approach).max(0.0);
+    let sliding = relative - normal * approach;
+    let speed = sliding.length();
+    let friction = if speed > 0.0 {
+        -sliding * (mu * normal_force * (speed / STICKING_SPEED).min(1.0) / speed)
+    } else {
+        DVec2::ZERO
+    };
+    (normal * normal_force + friction, normal_force)
+}
+
+/// The bounding box (m) of `points`.
+fn bounds_of(points: &[DVec2]) -> (DVec2, DVec2) {
+    (points.iter()).fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(low, high), p| {
+        (low.min(*p), high.max(*p))
+    })
 }
 
 /// The contact stiffness (N/m) of `body`'s nodes: `(λ' + 2μ) t`, the plane model's P-wave

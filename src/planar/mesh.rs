@@ -113,9 +113,10 @@ impl TriangleMesh {
 
 impl TriangleMesh {
     /// The nodes of the mesh's 6-node triangles: the corners (same indices), then a node at the
-    /// middle of each edge, shared by the triangles on it; and each triangle's six nodes,
-    /// corners then the mid-edge nodes of edges 01, 12, 20.
-    pub(super) fn quadratic_nodes(&self) -> (Vec<DVec2>, Vec<[u32; 6]>) {
+    /// middle of each edge, shared by the triangles on it; each triangle's six nodes, corners
+    /// then the mid-edge nodes of edges 01, 12, 20; and the boundary as segments (see
+    /// [`TriangleMesh::boundary_edges`]), each edge cut at its mid-edge node.
+    pub(super) fn quadratic_nodes(&self) -> (Vec<DVec2>, Vec<[u32; 6]>, Vec<[u32; 2]>) {
         let mut rest = self.rest.clone();
         let mut middle_of = std::collections::HashMap::new();
         let mut middle = |a: u32, b: u32, rest: &mut Vec<DVec2>| -> u32 {
@@ -134,7 +135,28 @@ impl TriangleMesh {
                 [a, b, c, ab, bc, ca]
             })
             .collect();
-        (rest, elements)
+        let boundary = (self.boundary_edges().into_iter())
+            .flat_map(|[a, b]| {
+                let m = middle(a, b, &mut rest);
+                [[a, m], [m, b]]
+            })
+            .collect();
+        (rest, elements, boundary)
+    }
+
+    /// The boundary: the edges of one triangle only, each oriented as its triangle has it
+    /// (counterclockwise), so that the mesh lies to its left and `(dy, −dx)` points out.
+    pub fn boundary_edges(&self) -> Vec<[u32; 2]> {
+        let mut count = std::collections::HashMap::new();
+        for &[a, b, c] in &self.triangles {
+            for (p, q) in [(a, b), (b, c), (c, a)] {
+                *count.entry((p.min(q), p.max(q))).or_insert(0u32) += 1;
+            }
+        }
+        (self.triangles.iter())
+            .flat_map(|&[a, b, c]| [[a, b], [b, c], [c, a]])
+            .filter(|[p, q]| count[&(*p.min(q), *p.max(q))] == 1)
+            .collect()
     }
 }
 

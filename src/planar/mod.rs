@@ -35,6 +35,8 @@
 mod body;
 mod control_volume;
 #[cfg(feature = "dim2")]
+mod corners;
+#[cfg(feature = "dim2")]
 pub mod coupling;
 mod dynamics;
 mod element;
