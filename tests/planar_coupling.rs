@@ -6,33 +6,23 @@ use rapier_fvm::damping::RayleighDamping;
 use rapier_fvm::glamx::DVec2;
 use rapier_fvm::material::{Material, MaterialModel};
 use rapier_fvm::planar::coupling::PlanarCoupling;
-use rapier_fvm::planar::{PlanarBodyBuilder, PlaneModel, TriangleMesh};
-use rapier2d::prelude::{ColliderBuilder, PhysicsWorld, RigidBodyBuilder};
+use rapier_fvm::planar::{PlanarBody, PlanarBodyBuilder, PlaneModel, TriangleMesh};
+use rapier2d::prelude::{ColliderBuilder, ColliderHandle, PhysicsWorld, RigidBodyBuilder};
 
-/// A 0.2 m × 0.1 m block of soft rubber (E = 100 kPa, 0.1 m thick, 2 kg) resting on the
-/// ground, a 0.5 kg rigid box dropped on it from 2 cm: after 3 s the ground carries the weight
-/// of both, to 1 % (the tolerance; the contacts' damping and the sticking friction
-/// leave only the creep of the regularized friction), the box rests on the block, and
-/// nothing has moved through anything.
-#[test]
-fn a_box_dropped_on_a_soft_block_rests_with_the_ground_carrying_both() {
-    let mut world = PhysicsWorld::default();
-    let ground_body = world
+/// The ground (a fixed 4 m × 1 m slab whose top is at y = 0) in `world`: its collider.
+fn ground(world: &mut PhysicsWorld) -> ColliderHandle {
+    let slab = world
         .bodies
         .insert(RigidBodyBuilder::fixed().translation([0.0, -0.5].into()));
-    let ground = world.colliders.insert_with_parent(
-        ColliderBuilder::cuboid(2.0, 0.5).build(),
-        ground_body,
-        &mut world.bodies,
-    );
-    let box_body = world
-        .bodies
-        .insert(RigidBodyBuilder::dynamic().translation([0.0, 0.145].into()));
-    world.colliders.insert_with_parent(
-        ColliderBuilder::cuboid(0.05, 0.025).density(100.0).build(),
-        box_body,
-        &mut world.bodies,
-    );
+    let shape = ColliderBuilder::cuboid(2.0, 0.5).build();
+    world
+        .colliders
+        .insert_with_parent(shape, slab, &mut world.bodies)
+}
+
+/// A 0.2 m × 0.1 m block of soft rubber (E = 100 kPa, 0.1 m thick, 2 kg, damped by a
+/// stiffness time of 1 ms) half a millimetre above the ground, and its material.
+fn rubber_block() -> (PlanarBody, Material) {
     let rubber = Material::new(MaterialModel::StableNeoHookean, 1e5, 0.3, 1000.0).unwrap();
     let damping = RayleighDamping::stiffness_proportional(1e-3, rubber.lame()).unwrap();
     let mesh = TriangleMesh::rectangle(DVec2::new(0.2, 0.1), [10, 5]).unwrap();
@@ -45,6 +35,27 @@ fn a_box_dropped_on_a_soft_block_rests_with_the_ground_carrying_both() {
     for x in block.positions_mut() {
         *x += DVec2::new(-0.1, 0.0005);
     }
+    (block, rubber)
+}
+
+/// A 0.2 m × 0.1 m block of soft rubber (E = 100 kPa, 0.1 m thick, 2 kg) resting on the
+/// ground, a 0.5 kg rigid box dropped on it from 2 cm: after 3 s the ground carries the weight
+/// of both, to 1 % (the tolerance; the contacts' damping and the sticking friction
+/// leave only the creep of the regularized friction), the box rests on the block, and
+/// nothing has moved through anything.
+#[test]
+fn a_box_dropped_on_a_soft_block_rests_with_the_ground_carrying_both() {
+    let mut world = PhysicsWorld::default();
+    let ground = ground(&mut world);
+    let box_body = world
+        .bodies
+        .insert(RigidBodyBuilder::dynamic().translation([0.0, 0.145].into()));
+    world.colliders.insert_with_parent(
+        ColliderBuilder::cuboid(0.05, 0.025).density(100.0).build(),
+        box_body,
+        &mut world.bodies,
+    );
+    let (block, _) = rubber_block();
     let block_mass = block.total_mass();
     let mut bodies = vec![block];
     let mut coupling = PlanarCoupling::default();
@@ -112,7 +123,7 @@ fn a_collision_keeps_the_total_momentum() {
         *v = DVec2::new(2.0, 0.0);
     }
     let mut bodies = vec![disk];
-    let momentum = |world: &PhysicsWorld, bodies: &[rapier_fvm::planar::PlanarBody]| {
+    let momentum = |world: &PhysicsWorld, bodies: &[PlanarBody]| {
         let rigid =
             world.bodies[box_body].linvel().as_dvec2() * f64::from(world.bodies[box_body].mass());
         rigid + bodies[0].linear_momentum()
@@ -214,7 +225,7 @@ fn a_glued_pair_keeps_its_momentum() {
     let mut bodies = vec![block];
     let mut coupling = PlanarCoupling::default();
     coupling.glue(&world, &bodies, (0, &top), bar).unwrap();
-    let momentum = |world: &PhysicsWorld, bodies: &[rapier_fvm::planar::PlanarBody]| {
+    let momentum = |world: &PhysicsWorld, bodies: &[PlanarBody]| {
         let rigid = &world.bodies[bar];
         rigid.linvel().as_dvec2() * f64::from(rigid.mass()) + bodies[0].linear_momentum()
     };
@@ -239,7 +250,7 @@ fn a_glued_pair_keeps_its_momentum() {
 }
 
 /// How deep (m) `p` lies inside `body`'s boundary where it is now, zero outside.
-fn depth_inside(body: &rapier_fvm::planar::PlanarBody, p: DVec2) -> f64 {
+fn depth_inside(body: &PlanarBody, p: DVec2) -> f64 {
     let x = body.positions();
     let mut crossings = 0;
     let mut nearest = f64::MAX;
@@ -264,14 +275,7 @@ fn depth_inside(body: &rapier_fvm::planar::PlanarBody, p: DVec2) -> f64 {
 #[test]
 fn a_box_landing_on_a_corner_does_not_pass_between_nodes() {
     let mut world = PhysicsWorld::default();
-    let ground_body = world
-        .bodies
-        .insert(RigidBodyBuilder::fixed().translation([0.0, -0.5].into()));
-    let ground = world.colliders.insert_with_parent(
-        ColliderBuilder::cuboid(2.0, 0.5).build(),
-        ground_body,
-        &mut world.bodies,
-    );
+    let ground = ground(&mut world);
     let half = 0.03f32;
     let start = 0.1 + 0.05 + half * 2f32.sqrt();
     let falling = RigidBodyBuilder::dynamic()
@@ -284,18 +288,7 @@ fn a_box_landing_on_a_corner_does_not_pass_between_nodes() {
     world
         .colliders
         .insert_with_parent(shape, box_body, &mut world.bodies);
-    let rubber = Material::new(MaterialModel::StableNeoHookean, 1e5, 0.3, 1000.0).unwrap();
-    let damping = RayleighDamping::stiffness_proportional(1e-3, rubber.lame()).unwrap();
-    let mesh = TriangleMesh::rectangle(DVec2::new(0.2, 0.1), [10, 5]).unwrap();
-    let mut block = PlanarBodyBuilder::new(mesh, rubber)
-        .plane(PlaneModel::PlaneStrain)
-        .thickness(0.1)
-        .damping(damping)
-        .build()
-        .unwrap();
-    for x in block.positions_mut() {
-        *x += DVec2::new(-0.1, 0.0005);
-    }
+    let (block, rubber) = rubber_block();
     let block_mass = block.total_mass();
     let mut bodies = vec![block];
     let mut coupling = PlanarCoupling::default();
@@ -368,7 +361,7 @@ fn a_corner_first_collision_keeps_the_momentum() {
         let mut bodies = vec![block];
         let mut coupling = PlanarCoupling::default();
         coupling.friction = friction;
-        let totals = |world: &PhysicsWorld, bodies: &[rapier_fvm::planar::PlanarBody]| {
+        let totals = |world: &PhysicsWorld, bodies: &[PlanarBody]| {
             let rigid = &world.bodies[box_body];
             let (m, c, v) = (
                 f64::from(rigid.mass()),

@@ -481,13 +481,19 @@ impl PlanarCoupling {
                 total.torque[c] += torque * dt;
                 *stiffest = stiffest.max(*pressing as f64 * k / colliders[c].mass);
             }
+            let mut glued_to: Vec<(RigidBodyHandle, usize, f64)> = Vec::new();
             for ((view, sum), impulse) in glue.iter().zip(&glue_sums).zip(&mut glue_total) {
                 if view.body == index {
                     impulse.0 += sum.0 * dt;
                     impulse.1 += sum.1 * dt;
-                    let glued = glue.iter().filter(|g| g.rigid == view.rigid).count();
-                    *stiffest = stiffest.max(glued as f64 * k / view.mass);
+                    match glued_to.iter_mut().find(|(rigid, ..)| *rigid == view.rigid) {
+                        Some((_, count, _)) => *count += 1,
+                        None => glued_to.push((view.rigid, 1, view.mass)),
+                    }
                 }
+            }
+            for (_, count, mass) in glued_to {
+                *stiffest = stiffest.max(count as f64 * k / mass);
             }
         }
         (total, glue_total)

@@ -92,6 +92,22 @@ pub fn step_explicit(
     gravity: DVec2,
     loads: &[DVec2],
 ) -> Result<PlanarStepReport, Error> {
+    check_step(body, dt, gravity, loads)?;
+    advance(body, dt, (gravity, loads), 0.0, &mut |_| None)
+}
+
+/// Checks a step of `dt` (s) of `body` under `gravity` (m/s²) and nodal `loads` (N).
+///
+/// # Errors
+/// [`Error::InvalidTimeStep`] for a `dt` that is not positive and finite,
+/// [`Error::NonFiniteInput`] for a non-finite gravity or load, [`Error::WrongNodeCount`] for
+/// loads of the wrong length.
+pub(super) fn check_step(
+    body: &PlanarBody,
+    dt: f64,
+    gravity: DVec2,
+    loads: &[DVec2],
+) -> Result<(), Error> {
     if !(dt.is_finite() && dt > 0.0) {
         return Err(Error::InvalidTimeStep {
             dt,
@@ -110,7 +126,7 @@ pub fn step_explicit(
             node_count,
         });
     }
-    advance(body, dt, (gravity, loads), 0.0, &mut |_| None)
+    Ok(())
 }
 
 /// Forces (N per node) a step adds at each substep, computed where the body is and as it

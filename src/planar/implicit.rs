@@ -24,14 +24,13 @@
 //! backward Euler's and is kept.
 
 use super::body::PlanarBody;
+use super::dynamics::check_step;
 use super::plane::{embed_change, embed_flat, in_plane_block};
-use super::unknowns::{Entry, Placed, Unknowns};
+use super::unknowns::{Entry, Minimized, Placed, Unknowns, minimize};
 use crate::Error;
 use crate::damping::RayleighDamping;
 use crate::material::green_strain;
-use crate::newton::{
-    ROUND_OFF_CEILING, Search, check_tolerance, descend, norm, stalled_at_round_off,
-};
+use crate::newton::{check_tolerance, norm};
 use crate::statics::StaticSettings;
 use faer::sparse::Triplet;
 use rapier3d::glamx::{DMat3, DVec2};
@@ -60,7 +59,7 @@ struct Step<'a> {
     body: &'a PlanarBody,
 }
 
-impl Step<'_> {
+impl Minimized for Step<'_> {
     /// `Φ` (J) where `placed` is.
     fn potential(&self, placed: &Placed<'_>) -> f64 {
         let body = self.body;
@@ -105,6 +104,26 @@ impl Step<'_> {
         self.unknowns.free_part(total)
     }
 
+    /// The Newton direction (m per node) for `residual` where `placed` is.
+    fn direction(
+        &self,
+        placed: &Placed<'_>,
+        residual: &[DVec2],
+        iteration: usize,
+    ) -> Result<Vec<DVec2>, Error> {
+        let mut entries = self.unknowns.elastic_entries(self.body, &placed.positions);
+        self.damping_entries(placed, &mut entries);
+        let inverse_h2 = 1.0 / (self.h * self.h);
+        for (slots, m) in self.unknowns.index.iter().zip(self.body.masses()) {
+            for k in slots.iter().flatten() {
+                entries.push(Triplet::new(*k, *k, m * inverse_h2));
+            }
+        }
+        self.unknowns.solve(&entries, residual, iteration)
+    }
+}
+
+impl Step<'_> {
     /// The damping's tangent entries where `placed` is.
     fn damping_entries(&self, placed: &Placed<'_>, entries: &mut Vec<Entry>) {
         let Some((damping, previous)) = &self.damping else {
@@ -138,24 +157,6 @@ impl Step<'_> {
             }
         }
     }
-
-    /// The Newton direction (m per node) for `residual` where `placed` is.
-    fn direction(
-        &self,
-        placed: &Placed<'_>,
-        residual: &[DVec2],
-        iteration: usize,
-    ) -> Result<Vec<DVec2>, Error> {
-        let mut entries = self.unknowns.elastic_entries(self.body, &placed.positions);
-        self.damping_entries(placed, &mut entries);
-        let inverse_h2 = 1.0 / (self.h * self.h);
-        for (slots, m) in self.unknowns.index.iter().zip(self.body.masses()) {
-            for k in slots.iter().flatten() {
-                entries.push(Triplet::new(*k, *k, m * inverse_h2));
-            }
-        }
-        self.unknowns.solve(&entries, residual, iteration)
-    }
 }
 
 /// Advances `body` by one backward Euler step of `dt` (s) under `gravity` (m/s²) and the nodal
@@ -174,24 +175,7 @@ pub fn step_implicit(
     loads: &[DVec2],
     settings: &StaticSettings,
 ) -> Result<PlanarImplicitReport, Error> {
-    if !(dt.is_finite() && dt > 0.0) {
-        return Err(Error::InvalidTimeStep {
-            dt,
-            reason: "a frame step must be positive and finite",
-        });
-    }
-    if !gravity.is_finite() || loads.iter().any(|f| !f.is_finite()) {
-        return Err(Error::NonFiniteInput {
-            parameter: "gravity or loads",
-        });
-    }
-    let node_count = body.positions().len();
-    if loads.len() != node_count {
-        return Err(Error::WrongNodeCount {
-            given: loads.len(),
-            node_count,
-        });
-    }
+    check_step(body, dt, gravity, loads)?;
     check_tolerance(settings.tolerance)?;
     let unknowns = Unknowns::new(body.pinned());
     let start = body.positions().to_vec();
@@ -248,62 +232,18 @@ pub fn step_implicit(
 /// Newton's iterations of a step from the better of the prediction and the start: the
 /// iterations, the final relative residual and the positions (m).
 fn newton(step: &Step<'_>, settings: &StaticSettings) -> Result<(usize, f64, Vec<DVec2>), Error> {
-    let mut placed = Placed {
+    let placed_at = |positions: &[DVec2]| Placed {
         body: step.body,
-        positions: step.predicted.clone(),
+        positions: positions.to_vec(),
     };
-    let from_start = Placed {
-        body: step.body,
-        positions: step.start.clone(),
+    let (predicted, start) = (placed_at(&step.predicted), placed_at(&step.start));
+    let mut placed = if step.potential(&start) < step.potential(&predicted) {
+        start
+    } else {
+        predicted
     };
-    if step.potential(&from_start) < step.potential(&placed) {
-        placed = from_start;
-    }
-    let mut residual = step.residual(&placed);
-    let reference = norm(&step.external).max(norm(&residual));
-    if reference == 0.0 {
-        return Ok((0, 0.0, placed.positions));
-    }
-    let mut history = Vec::new();
-    for iteration in 0..settings.max_iterations {
-        let relative = norm(&residual) / reference;
-        if relative <= settings.tolerance || stalled_at_round_off(&history, relative) {
-            return Ok((iteration, relative, placed.positions));
-        }
-        history.push(relative);
-        let direction = step.direction(&placed, &residual, iteration)?;
-        let energy = |placed: &Placed<'_>| step.potential(placed);
-        let potential = energy(&placed);
-        let next = descend(
-            &mut placed,
-            &residual,
-            potential,
-            &direction,
-            Search::Thorough,
-            energy,
-            |p| step.residual(p),
-        );
-        match next {
-            Some((next, _)) => residual = next,
-            None if relative <= ROUND_OFF_CEILING => {
-                return Ok((iteration, relative, placed.positions));
-            }
-            None => {
-                return Err(Error::StaticSolveDidNotConverge {
-                    iterations: iteration,
-                    residual: relative,
-                });
-            }
-        }
-    }
-    let relative = norm(&residual) / reference;
-    if relative <= settings.tolerance {
-        return Ok((settings.max_iterations, relative, placed.positions));
-    }
-    Err(Error::StaticSolveDidNotConverge {
-        iterations: settings.max_iterations,
-        residual: relative,
-    })
+    let (iterations, relative) = minimize(step, &mut placed, norm(&step.external), settings)?;
+    Ok((iterations, relative, placed.positions))
 }
 
 /// The rigid rotation's velocity field (m/s at a position) that gives back the angular

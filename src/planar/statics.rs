@@ -5,11 +5,9 @@
 //! law converges in one iteration.
 
 use super::body::PlanarBody;
-use super::unknowns::{Placed, Unknowns};
+use super::unknowns::{Minimized, Placed, Unknowns, minimize};
 use crate::Error;
-use crate::newton::{
-    ROUND_OFF_CEILING, Search, check_tolerance, descend, norm, stalled_at_round_off,
-};
+use crate::newton::{check_tolerance, norm};
 use crate::statics::{StaticReport, StaticSettings};
 use rapier3d::glamx::DVec2;
 
@@ -53,7 +51,7 @@ struct Problem<'a> {
     start: Vec<DVec2>,
 }
 
-impl Problem<'_> {
+impl Minimized for Problem<'_> {
     /// The out-of-balance force `f_int + f_ext` (N) per node where `placed` is, zero along
     /// held axes.
     fn residual(&self, placed: &Placed<'_>) -> Vec<DVec2> {
@@ -139,69 +137,11 @@ pub fn solve_planar_equilibrium(
         body,
         positions: start,
     };
-    let (report, positions) = newton(&problem, &mut placed, settings)?;
+    let (iterations, relative_residual) = minimize(&problem, &mut placed, norm(loads), settings)?;
+    let positions = placed.positions;
     body.positions_mut().copy_from_slice(&positions);
-    Ok(report)
-}
-
-/// Newton's iterations of [`solve_planar_equilibrium`]: the report and the positions (m)
-/// reached.
-fn newton(
-    problem: &Problem<'_>,
-    placed: &mut Placed<'_>,
-    settings: &StaticSettings,
-) -> Result<(StaticReport, Vec<DVec2>), Error> {
-    let mut residual = problem.residual(placed);
-    let reference = norm(problem.loads).max(norm(&residual));
-    let done = |iterations, relative_residual, placed: &Placed<'_>| {
-        Ok((
-            StaticReport {
-                iterations,
-                relative_residual,
-            },
-            placed.positions.clone(),
-        ))
-    };
-    if reference == 0.0 {
-        return done(0, 0.0, placed);
-    }
-    let mut history = Vec::new();
-    for iteration in 0..settings.max_iterations {
-        let relative = norm(&residual) / reference;
-        if relative <= settings.tolerance || stalled_at_round_off(&history, relative) {
-            return done(iteration, relative, placed);
-        }
-        history.push(relative);
-        let direction = problem.direction(placed, &residual, iteration)?;
-        let energy = |placed: &Placed<'_>| problem.potential(placed);
-        let potential = energy(placed);
-        let next = descend(
-            placed,
-            &residual,
-            potential,
-            &direction,
-            Search::Thorough,
-            energy,
-            |placed| problem.residual(placed),
-        );
-        match next {
-            Some((next, _)) => residual = next,
-            // No descent left above round-off: accept a tiny residual, refuse anything else.
-            None if relative <= ROUND_OFF_CEILING => return done(iteration, relative, placed),
-            None => {
-                return Err(Error::StaticSolveDidNotConverge {
-                    iterations: iteration,
-                    residual: relative,
-                });
-            }
-        }
-    }
-    let relative = norm(&residual) / reference;
-    if relative <= settings.tolerance {
-        return done(settings.max_iterations, relative, placed);
-    }
-    Err(Error::StaticSolveDidNotConverge {
-        iterations: settings.max_iterations,
-        residual: relative,
+    Ok(StaticReport {
+        iterations,
+        relative_residual,
     })
 }

@@ -1,12 +1,17 @@
 //! The Newton systems of 2D bodies: which coordinates are unknown (the held axes are not), the
-//! positions Newton moves ([`crate::newton::Configuration`]), and the solve of `K d = r` by
-//! faer's sparse Cholesky factorization, shared by the static and the implicit solvers.
+//! positions Newton moves ([`crate::newton::Configuration`]), the solve of `K d = r` by faer's
+//! sparse Cholesky factorization, and Newton's iterations on a potential ([`minimize`]), shared
+//! by the static and the implicit solvers, with the 3D solvers' line search, tolerance and
+//! round-off floor.
 
 use super::body::PlanarBody;
 use super::evaluate::patch_tangent;
 use crate::Error;
 use crate::assembly::{Factor, SymbolicFactor};
-use crate::newton::Configuration;
+use crate::newton::{
+    Configuration, ROUND_OFF_CEILING, Search, descend, norm, stalled_at_round_off,
+};
+use crate::statics::StaticSettings;
 use faer::Mat;
 use faer::sparse::{SparseColMat, Triplet};
 use rapier3d::glamx::DVec2;
@@ -115,4 +120,80 @@ impl Configuration for Placed<'_> {
             *x = *x0 + *d * alpha;
         }
     }
+}
+
+/// A potential Newton's method minimizes over a body's positions.
+pub(super) trait Minimized {
+    /// Minus its gradient (N per node) where `placed` is, zero along held axes.
+    fn residual(&self, placed: &Placed<'_>) -> Vec<DVec2>;
+    /// Its value (J) where `placed` is.
+    fn potential(&self, placed: &Placed<'_>) -> f64;
+    /// The Newton direction (m per node) for `residual` where `placed` is, at Newton's
+    /// `iteration`.
+    fn direction(
+        &self,
+        placed: &Placed<'_>,
+        residual: &[DVec2],
+        iteration: usize,
+    ) -> Result<Vec<DVec2>, Error>;
+}
+
+/// Newton's iterations on `problem` from `placed`, until the out-of-balance force is below
+/// `settings.tolerance` times the larger of `load` (N) and the first out-of-balance force, or
+/// sits at its round-off floor below 1e-6 of it: the iterations and the final relative
+/// residual, `placed` left where they end.
+///
+/// # Errors
+/// Those of [`Minimized::direction`]; [`Error::StaticSolveDidNotConverge`] when no step
+/// descends above round-off or the iterations run out.
+pub(super) fn minimize(
+    problem: &impl Minimized,
+    placed: &mut Placed<'_>,
+    load: f64,
+    settings: &StaticSettings,
+) -> Result<(usize, f64), Error> {
+    let mut residual = problem.residual(placed);
+    let reference = load.max(norm(&residual));
+    if reference == 0.0 {
+        return Ok((0, 0.0));
+    }
+    let mut history = Vec::new();
+    for iteration in 0..settings.max_iterations {
+        let relative = norm(&residual) / reference;
+        if relative <= settings.tolerance || stalled_at_round_off(&history, relative) {
+            return Ok((iteration, relative));
+        }
+        history.push(relative);
+        let direction = problem.direction(placed, &residual, iteration)?;
+        let energy = |placed: &Placed<'_>| problem.potential(placed);
+        let potential = energy(placed);
+        let residual_at = |placed: &mut Placed<'_>| problem.residual(placed);
+        match descend(
+            placed,
+            &residual,
+            potential,
+            &direction,
+            Search::Thorough,
+            energy,
+            residual_at,
+        ) {
+            Some((next, _)) => residual = next,
+            // No descent left above round-off: accept a tiny residual, refuse anything else.
+            None if relative <= ROUND_OFF_CEILING => return Ok((iteration, relative)),
+            None => {
+                return Err(Error::StaticSolveDidNotConverge {
+                    iterations: iteration,
+                    residual: relative,
+                });
+            }
+        }
+    }
+    let relative = norm(&residual) / reference;
+    if relative <= settings.tolerance {
+        return Ok((settings.max_iterations, relative));
+    }
+    Err(Error::StaticSolveDidNotConverge {
+        iterations: settings.max_iterations,
+        residual: relative,
+    })
 }
