@@ -5,7 +5,8 @@
 //!
 //! Contract: the outline is checked first (at least three vertices, finite and within
 //! ±[`MAX_COORDINATE`], no edge of zero length, no two edges crossing or touching but
-//! neighbours at their shared vertex, a non-zero area, either orientation): a bad one is an
+//! neighbours at their shared vertex, none folding back onto its neighbour, a non-zero area,
+//! either orientation; points collinear to round-off count as collinear): a bad one is an
 //! [`Error::InvalidGeneratorParameter`] naming the first offending vertex or edge, and spade,
 //! whose constraint insertion panics on crossing edges, never sees it.
 
@@ -30,23 +31,39 @@ fn invalid(parameter: &'static str, value: f64, reason: &'static str) -> Error {
     }
 }
 
+/// Relative size below which a cross product counts as zero: three points within
+/// `1e-12 |q − p| |r − p|` of a line are collinear (round-off of coordinates that are exactly
+/// collinear, such as `0.3` between `0.5` and `0.0`, is far smaller than that).
+const COLLINEAR: f64 = 1e-12;
+
+/// `(q − p) × (r − p)`, zero when the three points are collinear to round-off.
+fn side(p: DVec2, q: DVec2, r: DVec2) -> f64 {
+    let cross = (q - p).perp_dot(r - p);
+    if cross.abs() <= COLLINEAR * (q - p).length() * (r - p).length() {
+        0.0
+    } else {
+        cross
+    }
+}
+
 /// Whether the closed segments `a b` and `c d` share a point.
 fn segments_meet(a: DVec2, b: DVec2, c: DVec2, d: DVec2) -> bool {
-    let side = |p: DVec2, q: DVec2, r: DVec2| (q - p).perp_dot(r - p);
     let (d1, d2, d3, d4) = (side(c, d, a), side(c, d, b), side(a, b, c), side(a, b, d));
     let within = |p: DVec2, q: DVec2, r: DVec2| {
         r.x >= p.x.min(q.x) && r.x <= p.x.max(q.x) && r.y >= p.y.min(q.y) && r.y <= p.y.max(q.y)
     };
-    ((d1 > 0.0) != (d2 > 0.0)
-        && (d3 > 0.0) != (d4 > 0.0)
-        && d1 != 0.0
-        && d2 != 0.0
-        && d3 != 0.0
-        && d4 != 0.0)
+    let crossing = (d1 > 0.0) != (d2 > 0.0) && (d3 > 0.0) != (d4 > 0.0);
+    (crossing && d1 != 0.0 && d2 != 0.0 && d3 != 0.0 && d4 != 0.0)
         || (d1 == 0.0 && within(c, d, a))
         || (d2 == 0.0 && within(c, d, b))
         || (d3 == 0.0 && within(a, b, c))
         || (d4 == 0.0 && within(a, b, d))
+}
+
+/// Whether the outline turns back on itself at `b`, between `a` and `c`: the two edges lie
+/// along one line, overlapping.
+fn folds_back(a: DVec2, b: DVec2, c: DVec2) -> bool {
+    side(b, a, c) == 0.0 && (a - b).dot(c - b) > 0.0
 }
 
 /// Checks the `outline` (see the module's contract).
@@ -72,6 +89,16 @@ fn check_outline(outline: &[DVec2]) -> Result<(), Error> {
                 "outline edge",
                 i as f64,
                 "has zero length (a repeated vertex)",
+            ));
+        }
+    }
+    for i in 0..n {
+        let (previous, next) = (outline[(i + n - 1) % n], outline[(i + 1) % n]);
+        if folds_back(previous, outline[i], next) {
+            return Err(invalid(
+                "outline vertex",
+                i as f64,
+                "its two edges fold back onto each other",
             ));
         }
     }
