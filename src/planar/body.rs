@@ -387,6 +387,27 @@ impl PlanarBody {
         .sum()
     }
 
+    /// One symplectic Euler update over `h` (s): velocities kicked by `forces` (N per node) and
+    /// `gravity` (m/s²), held axes stopped, then positions drifted by the new velocities.
+    pub(super) fn kick_and_drift(&mut self, h: f64, forces: &[DVec2], gravity: DVec2) {
+        let nodes = self
+            .velocities
+            .iter_mut()
+            .zip(&self.masses)
+            .zip(&self.pinned);
+        for (((v, m), held), f) in nodes.zip(forces) {
+            *v += *f * (h / m) + gravity * h;
+            for axis in 0..2 {
+                if held[axis] {
+                    v[axis] = 0.0;
+                }
+            }
+        }
+        for (x, v) in self.positions.iter_mut().zip(&self.velocities) {
+            *x += *v * h;
+        }
+    }
+
     /// Holds node `node` along the axes set in `axes` (x, y), in addition to those it is
     /// held along; its velocity along them is zeroed by the next step. For nodes a builder
     /// cannot name, such as the mid-edge nodes of quadratic triangles.
@@ -417,6 +438,9 @@ impl PlanarBody {
     /// take it.
     pub fn stress(&self, q: usize) -> PlanarStress {
         self.with_law(|law| {
+            if self.averaging.is_none() {
+                return law.stress(&self.points.gradient(q, &self.positions));
+            }
             let evaluation = self.evaluate(law, &self.positions);
             let stress = law.stress(&evaluation.gradients[q]);
             PlanarStress {

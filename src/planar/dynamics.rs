@@ -193,18 +193,8 @@ fn substep(
             *f += *e;
         }
     }
-    let masses = body.masses().to_vec();
-    let pinned = body.pinned().to_vec();
-    for (n, v) in body.velocities_mut().iter_mut().enumerate() {
-        *v += (forces[n] + loads[n]) * (h / masses[n]) + gravity * h;
-        for axis in 0..2 {
-            if pinned[n][axis] {
-                v[axis] = 0.0;
-            }
-        }
+    for (f, load) in forces.iter_mut().zip(loads) {
+        *f += *load;
     }
-    let velocities = body.velocities().to_vec();
-    for (x, v) in body.positions_mut().iter_mut().zip(velocities) {
-        *x += v * h;
-    }
+    body.kick_and_drift(h, &forces, gravity);
 }
