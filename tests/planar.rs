@@ -195,6 +195,38 @@ fn uniaxial_tension_follows_the_plane_laws() {
     }
 }
 
+/// The Cauchy stress of the pulled sheet: the force over the deformed section,
+/// `σ₁₁ (H F₂₂) (t s) = F`, to 1e-9 relative (the solve reaches about 1e-12), the other
+/// in-plane components zero to 1e-9 of `σ₁₁`, and `σ₃₃` zero in plane stress and `ν σ₁₁` in
+/// plane strain to twice the strain `ε₁₁` (the linear law gives `P₃₃ = ν P₁₁`; Cauchy and
+/// nominal stresses differ at the order of the strain).
+#[test]
+fn cauchy_stress_is_the_force_over_the_deformed_section() {
+    let (nu, force) = (0.3, 100.0);
+    for plane in PLANES {
+        let body = pulled_sheet(plane, nu, force);
+        for (t, sigma) in body.cauchy_stresses().iter().enumerate() {
+            let f = body.deformation_gradient(t);
+            let stretch = body.stress(t).stretch;
+            let carried = sigma.x_axis.x * (1.0 * f.y_axis.y) * (0.1 * stretch);
+            assert!((carried / force - 1.0).abs() < 1e-9, "{plane:?} {carried}");
+            for off in [sigma.x_axis.y, sigma.y_axis.x, sigma.y_axis.y] {
+                assert!(off.abs() < 1e-9 * sigma.x_axis.x, "{plane:?} {sigma:?}");
+            }
+            let expected_33 = match plane {
+                PlaneModel::PlaneStress => 0.0,
+                PlaneModel::PlaneStrain => nu * sigma.x_axis.x,
+            };
+            let strain = f.x_axis.x - 1.0;
+            assert!(
+                (sigma.z_axis.z - expected_33).abs() <= 2.0 * strain * sigma.x_axis.x,
+                "{plane:?} σ₃₃ {}",
+                sigma.z_axis.z
+            );
+        }
+    }
+}
+
 /// The reduced linear law of plane stress is `λ* tr ε I + 2μ ε` with `λ* = 2λμ/(λ + 2μ)`, to
 /// round-off (1e-12 of the largest term cancelled, `(|λ| + 2μ) |ε|`), also at ν = 0.4999
 /// where `λ` is 2 500 times `μ` and `λ*` stays below `2μ`.

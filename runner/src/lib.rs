@@ -7,7 +7,8 @@
 //!   line and the key;
 //! - [`sim`]: a scene built into an [`rapier_fvm::world::FvmWorld`] and run frame by frame,
 //!   with its probes sampled and its output written;
-//! - [`output`]: the writers.
+//! - [`output`]: the writers;
+//! - [`planar`]: 2D scenes (`dimension = 2`), their runs and output through the same writers.
 //!
 //! Each saved frame, the runner fills a [`output::Snapshot`] (plain data: positions, velocities,
 //! tetrahedra, surfaces and stresses of the soft bodies, world-space triangle meshes of the rigid
@@ -22,5 +23,6 @@
 
 pub mod calibrate;
 pub mod output;
+pub mod planar;
 pub mod scene;
 pub mod sim;

@@ -6,7 +6,8 @@ use clap::{Parser, Subcommand};
 use rapier_fvm::integrate::SymplecticEuler;
 use rapier_fvm::material::{Material, MaterialModel};
 use rapier_fvm::mesh::import::{self, SurfaceOptions};
-use rapier_fvm_runner::scene::{MemoryBudget, Scene};
+use rapier_fvm_runner::planar::{self, PlanarScene};
+use rapier_fvm_runner::scene::{MemoryBudget, Scene, dimension_of};
 use rapier_fvm_runner::sim::{self, RunOptions};
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -37,6 +38,8 @@ enum Command {
     /// (every body's surface, for Blender); pictures/view_<frame>.png and
     /// pictures/stress_<frame>.png (rendered views coloured by material and by von Mises
     /// stress); plots/<probe>.png (each probe against time). Prints a summary on stdout.
+    /// A scene with `dimension = 2` in `[world]` is a 2D scene (soft bodies on triangles with
+    /// rapier2d's rigid bodies): the same files, triangles at z = 0, pictures from the front.
     Run {
         /// The scene file (TOML; format in assets/scenes/README.md).
         scene: PathBuf,
@@ -138,6 +141,43 @@ fn calibrate() -> Result<(), String> {
     Ok(())
 }
 
+/// `run` of a 2D scene (`dimension = 2`): runs it and prints a summary.
+fn run_planar(path: PathBuf, text: String, options: &RunOptions) -> Result<(), String> {
+    let scene = PlanarScene::parse(&path, text).map_err(|e| e.to_string())?;
+    let report = planar::run_planar(&scene, options).map_err(|e| e.to_string())?;
+    println!(
+        "{} (2D): {} frames, {:.3} s simulated in {:.2} s ({:.2} s stepping, {:.2} ms per frame, {:.2}x real time)",
+        report.scene,
+        report.frames,
+        report.simulated_time,
+        report.wall_time_s,
+        report.stepping_time_s,
+        report.ms_per_frame,
+        report.speed_vs_real_time
+    );
+    for body in &report.soft_bodies {
+        println!(
+            "  soft {:<16} {:>6} triangles {:>5} nodes, plane {}, {:.3} kg; at most {} explicit substeps per coupling substep; {} failed",
+            body.name,
+            body.triangles,
+            body.nodes,
+            body.plane,
+            body.mass,
+            body.max_explicit_substeps,
+            body.failed_frames
+        );
+    }
+    for probe in &report.probes {
+        println!(
+            "  probe {:<24} final {:.6e} {}",
+            probe.name, probe.final_value, probe.unit
+        );
+    }
+    println!("  state finite at the end: {}", report.final_state_finite);
+    println!("  written to {}", options.out.display());
+    Ok(())
+}
+
 /// `run`: runs the scene, its soft bodies within `memory_limit` GB if given, and prints a
 /// summary.
 fn run(
@@ -156,13 +196,24 @@ fn run(
             ));
         }
     };
-    let scene = Scene::load_within(&scene, budget).map_err(|e| e.to_string())?;
     let options = RunOptions {
         out: out.clone(),
         duration,
         progress: progress && std::io::stderr().is_terminal(),
     };
+    if let Ok(text) = std::fs::read_to_string(&scene)
+        && dimension_of(&text) == Some(2)
+    {
+        return run_planar(scene, text, &options);
+    }
+    let scene = Scene::load_within(&scene, budget).map_err(|e| e.to_string())?;
     let report = sim::run(&scene, &options).map_err(|e| e.to_string())?;
+    print_summary(&report, &out);
+    Ok(())
+}
+
+/// Prints the summary of a 3D run written into `out`.
+fn print_summary(report: &sim::Report, out: &std::path::Path) {
     println!(
         "{}: {} frames, {:.3} s simulated in {:.2} s ({:.2} s stepping, {:.2} ms per frame, {:.2}x real time)",
         report.scene,
@@ -244,7 +295,6 @@ fn run(
         );
     }
     println!("  written to {}", out.display());
-    Ok(())
 }
 
 /// A flag as the summary prints it: `-` when never raised, else its first frame, frame count and

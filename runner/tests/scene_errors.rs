@@ -318,3 +318,20 @@ fn a_damping_cost_factor_below_one_is_refused() {
         "at least 1",
     );
 }
+
+#[test]
+fn a_vector_with_more_elements_than_its_key_takes_is_refused() {
+    // Not truncated to its first three: refused at its line.
+    let e = error(broken(
+        "dt = 0.01",
+        "dt = 0.01\ngravity = [0.0, -9.81, 0.0, 7.0]",
+    ));
+    assert_names(&e, 6, "world.gravity", "more elements than the key takes");
+    let e = error(with_soft_body_key("angvel = [0.0, 3.0, 0.0, 1.0]"));
+    assert_names(
+        &e,
+        16,
+        "soft_body[0].angvel",
+        "more elements than the key takes",
+    );
+}

@@ -13,7 +13,7 @@ use super::plane::{PlanarLaw, PlanarStress, apply_tangent};
 use super::volumetric::Averages;
 use crate::material::VolumetricTerm;
 use faer::sparse::Triplet;
-use rapier3d::glamx::{DMat2, DVec2};
+use rapier3d::glamx::{DMat2, DMat3, DVec2};
 
 /// A [`PlanarLaw`] whatever its model, for the body's loops.
 pub(super) trait PlanarLawDyn {
@@ -117,6 +117,30 @@ impl PlanarBody {
             }
             None => p,
         }
+    }
+
+    /// The Cauchy stress (Pa, 3×3 with `σ₃₃` across the plane) of each element where the body
+    /// is: its integration point's for a linear triangle, the mean of its three points' for a
+    /// quadratic one, with an averaged volumetric term as the forces take it.
+    pub fn cauchy_stresses(&self) -> Vec<DMat3> {
+        self.with_law(|law| {
+            let evaluation = self.evaluate(law, self.positions());
+            let per_element = self.points().per_element();
+            let cauchy = |q: usize| {
+                let f = &evaluation.gradients[q];
+                let stress = PlanarStress {
+                    p: self.point_stress(law, &evaluation, q),
+                    ..law.stress(f)
+                };
+                stress.cauchy(f)
+            };
+            (0..self.points().len() / per_element)
+                .map(|e| {
+                    let sum: DMat3 = (0..per_element).map(|k| cauchy(e * per_element + k)).sum();
+                    sum * (1.0 / per_element as f64)
+                })
+                .collect()
+        })
     }
 
     /// The nodal forces (N) of `evaluation`.

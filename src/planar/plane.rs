@@ -47,6 +47,21 @@ pub struct PlanarStress {
     pub p33: f64,
 }
 
+impl PlanarStress {
+    /// The Cauchy (true) stress (Pa, world axes, `σ₃₃` across the plane) of this stress at the
+    /// in-plane deformation gradient `f` it was evaluated at: `σ = P₃ F₃ᵀ / det F₃` with
+    /// `F₃ = [[f, 0], [0, s]]`, so `σ₃₃ = P₃₃ / det f` (zero for plane stress).
+    pub fn cauchy(&self, f: &DMat2) -> DMat3 {
+        let j = f.determinant() * self.stretch;
+        let in_plane = self.p * f.transpose() * (1.0 / j);
+        DMat3::from_cols(
+            DVec3::new(in_plane.x_axis.x, in_plane.x_axis.y, 0.0),
+            DVec3::new(in_plane.y_axis.x, in_plane.y_axis.y, 0.0),
+            DVec3::new(0.0, 0.0, self.p33 * self.stretch / j),
+        )
+    }
+}
+
 /// A 3D hyperelastic model under a [`PlaneModel`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PlanarLaw<M> {

@@ -1,6 +1,7 @@
-//! A fixed oblique orthographic camera: looks down at the scene from the front right, about 27°
-//! above the horizon (y is up), and frames a given box with a margin in the left part of the
-//! picture, leaving a column on the right for the legend or colour bar.
+//! Orthographic cameras: the fixed oblique one of 3D scenes looks down at the scene from the
+//! front right, about 27° above the horizon (y is up); the front one of 2D scenes looks at the
+//! plane z = 0. Each frames a given box with a margin in the left part of the picture, leaving a
+//! column on the right for the legend or colour bar.
 
 use rapier_fvm::glamx::DVec3;
 
@@ -39,6 +40,23 @@ impl Camera {
     pub fn oblique(min: DVec3, max: DVec3, width: u32, height: u32) -> Self {
         let toward_eye = VIEW_FROM.normalize();
         let right = DVec3::Y.cross(toward_eye).normalize();
+        Self::framing(toward_eye, right, (min, max), (width, height))
+    }
+
+    /// The camera looking at the plane z = 0 from the front (x to the right, y up) that frames
+    /// the box `min`..`max` (m) in a `width` × `height` picture (pixels): the view of 2D scenes.
+    pub fn front(min: DVec3, max: DVec3, width: u32, height: u32) -> Self {
+        Self::framing(DVec3::Z, DVec3::X, (min, max), (width, height))
+    }
+
+    /// The camera looking along `-toward_eye` with `right` to the right that frames the box
+    /// `min`..`max` (m) in a `width` × `height` picture.
+    fn framing(
+        toward_eye: DVec3,
+        right: DVec3,
+        (min, max): (DVec3, DVec3),
+        (width, height): (u32, u32),
+    ) -> Self {
         let up = toward_eye.cross(right);
         let corners = (0..8).map(|i| {
             DVec3::new(

@@ -18,7 +18,7 @@ pub use obj::write_obj;
 pub use paraview::ParaViewSeries;
 pub use plot::{TimeSeries, plot_series};
 pub use render::{Coloring, render_png};
-pub use snapshot::{RigidBodySnapshot, Snapshot, SoftBodySnapshot};
+pub use snapshot::{Cells, RigidBodySnapshot, Snapshot, SoftBodySnapshot};
 
 /// `name` made safe as a file name and an OBJ object name: ASCII letters, digits, `-` and `_`
 /// kept, anything else replaced by `_`; `body` if nothing is left.

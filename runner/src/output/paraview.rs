@@ -2,7 +2,8 @@
 //! `.pvd` collection that lists them with their simulated times, each body as its own part, so
 //! that opening the `.pvd` shows every body moving over time.
 //!
-//! Each `.vtu` holds the world positions (m) as points, the tetrahedra as cells, the point data
+//! Each `.vtu` holds the world positions (m) as points, the tetrahedra (or a 2D body's
+//! triangles, at z = 0) as cells, the point data
 //! `displacement` (m) and `velocity` (m/s), and the cell data `cauchy_stress` (Pa, 9 components
 //! in row-major order, symmetric) and `von_mises` (Pa). The `.pvd` is rewritten after every frame,
 //! so a run stopped early still leaves a readable series.
@@ -99,14 +100,24 @@ fn write_vtu(path: &Path, body: &SoftBodySnapshot) -> Result<(), OutputError> {
         .iter()
         .flat_map(|s| s.transpose().to_cols_array())
         .collect();
+    let (cell_type, per_cell) = match body.cells {
+        super::Cells::Tetrahedra(_) => (CellType::Tetra, 4),
+        super::Cells::Triangles(_) => (CellType::Triangle, 3),
+    };
+    let count = body.cells.len() as u64;
     let piece = UnstructuredGridPiece {
         points: flat(&body.positions).into(),
         cells: Cells {
             cell_verts: VertexNumbers::XML {
-                connectivity: body.tets.iter().flatten().map(|&n| u64::from(n)).collect(),
-                offsets: (1..=body.tets.len() as u64).map(|t| 4 * t).collect(),
+                connectivity: body
+                    .cells
+                    .nodes()
+                    .flatten()
+                    .map(|&n| u64::from(n))
+                    .collect(),
+                offsets: (1..=count).map(|t| per_cell * t).collect(),
             },
-            types: vec![CellType::Tetra; body.tets.len()],
+            types: vec![cell_type; body.cells.len()],
         },
         data: Attributes {
             point: vec![

@@ -18,7 +18,39 @@ pub struct Snapshot {
     pub rigid_bodies: Vec<RigidBodySnapshot>,
 }
 
-/// One soft body at one frame. Node and tetrahedron order are the body's mesh order.
+/// The cells of a soft body: tetrahedra in 3D, triangles in the plane (z = 0).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Cells {
+    /// Tetrahedra (node indices).
+    Tetrahedra(Vec<[u32; 4]>),
+    /// Triangles (node indices) of a 2D body.
+    Triangles(Vec<[u32; 3]>),
+}
+
+impl Cells {
+    /// How many cells there are.
+    pub fn len(&self) -> usize {
+        match self {
+            Self::Tetrahedra(cells) => cells.len(),
+            Self::Triangles(cells) => cells.len(),
+        }
+    }
+
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Each cell's nodes, in order.
+    pub fn nodes(&self) -> Box<dyn Iterator<Item = &[u32]> + '_> {
+        match self {
+            Self::Tetrahedra(cells) => Box::new(cells.iter().map(|c| &c[..])),
+            Self::Triangles(cells) => Box::new(cells.iter().map(|c| &c[..])),
+        }
+    }
+}
+
+/// One soft body at one frame. Node and cell order are the body's mesh order.
 #[derive(Debug, Clone)]
 pub struct SoftBodySnapshot {
     /// The body's name (file names are made from it).
@@ -32,11 +64,13 @@ pub struct SoftBodySnapshot {
     pub positions: Vec<DVec3>,
     /// Node velocities (m/s).
     pub velocities: Vec<DVec3>,
-    /// Tetrahedra (node indices).
-    pub tets: Vec<[u32; 4]>,
-    /// Boundary triangles (node indices), normals `(b - a) × (c - a)` pointing out of the body.
+    /// The cells.
+    pub cells: Cells,
+    /// The triangles drawn (node indices): for a 3D body its boundary, normals
+    /// `(b - a) × (c - a)` pointing out of the body; for a 2D body its triangles.
     pub surface: Vec<[u32; 3]>,
-    /// Cauchy stress per tetrahedron (Pa), world axes: see [`DeformableBody::cauchy_stresses`].
+    /// Cauchy stress per cell (Pa), world axes: see [`DeformableBody::cauchy_stresses`] (and
+    /// `PlanarBody::cauchy_stresses`, with `σ₃₃` across the plane).
     pub cauchy_stress: Vec<DMat3>,
 }
 
@@ -79,7 +113,7 @@ impl SoftBodySnapshot {
                 rest_positions: embedding.positions(rest_positions),
                 positions: embedding.positions(body.positions()),
                 velocities: embedding.positions(body.velocities()),
-                tets: embedding.mesh().tets().to_vec(),
+                cells: Cells::Tetrahedra(embedding.mesh().tets().to_vec()),
                 surface: embedding.surface_triangles().to_vec(),
                 cauchy_stress: body.embedded_cauchy_stresses().unwrap_or_default(),
             };
@@ -90,7 +124,7 @@ impl SoftBodySnapshot {
             rest_positions: rest_positions.to_vec(),
             positions: body.positions().to_vec(),
             velocities: body.velocities().to_vec(),
-            tets: body.mesh().tets().to_vec(),
+            cells: Cells::Tetrahedra(body.mesh().tets().to_vec()),
             surface: body.mesh().surface_triangles(),
             cauchy_stress: body.cauchy_stresses(),
         }
@@ -105,7 +139,7 @@ impl SoftBodySnapshot {
             .collect()
     }
 
-    /// Von Mises equivalent stress per tetrahedron (Pa).
+    /// Von Mises equivalent stress per cell (Pa).
     pub fn von_mises(&self) -> Vec<f64> {
         self.cauchy_stress
             .iter()
@@ -113,12 +147,12 @@ impl SoftBodySnapshot {
             .collect()
     }
 
-    /// Von Mises stress per node (Pa): the mean over the node's tetrahedra, for smooth colouring.
+    /// Von Mises stress per node (Pa): the mean over the node's cells, for smooth colouring.
     pub fn nodal_von_mises(&self) -> Vec<f64> {
         let mut sum = vec![0.0; self.positions.len()];
         let mut count = vec![0u32; self.positions.len()];
-        for (tet, value) in self.tets.iter().zip(self.von_mises()) {
-            for &n in tet {
+        for (cell, value) in self.cells.nodes().zip(self.von_mises()) {
+            for &n in cell {
                 sum[n as usize] += value;
                 count[n as usize] += 1;
             }

@@ -22,7 +22,7 @@
 //! defaults; a key given a wrong value is never replaced by one.
 
 pub mod budget;
-mod check;
+pub(crate) mod check;
 mod error;
 pub mod load;
 pub mod material;
@@ -129,25 +129,7 @@ impl Scene {
             path: path.as_ref().to_path_buf(),
             text,
         };
-        let syntax_error = |error: toml::de::Error| SceneError {
-            file: source.path.clone(),
-            line: error.span().map(|span| source.line_of(span.start)),
-            key: None,
-            message: error.message().trim().to_owned(),
-        };
-        let table = toml::de::DeTable::parse(&source.text).map_err(syntax_error)?;
-        let deserializer = toml::de::Deserializer::from(table);
-        let mut scene: Self = serde_path_to_error::deserialize(deserializer).map_err(|error| {
-            let key = error.path().to_string();
-            let inner = error.into_inner();
-            let line = inner.span().map(|span| source.line_of(span.start));
-            SceneError {
-                file: source.path.clone(),
-                line,
-                key: (key != ".").then_some(key),
-                message: inner.message().trim().to_owned(),
-            }
-        })?;
+        let mut scene: Self = deserialize(&source)?;
         scene.source = source;
         scene.budget = budget;
         scene.check()?;
@@ -208,4 +190,62 @@ impl Scene {
         budget::check(&self.soft_body, &self.budget, &mut c);
         c.finish()
     }
+}
+
+/// The scene file `source` parsed as `T`, or a [`SceneError`] naming the file, the line and the
+/// key path of a syntax error, an unknown or missing key, a wrong type or an array longer than
+/// its key takes.
+///
+/// The text is read twice: through toml's spanned document, whose errors carry their line, then
+/// as a `toml::Value`, which (unlike the first) refuses arrays with more elements than a
+/// fixed-size array takes (`gravity = [0, -9.81, 0, 7]`), where the first reader drops the extra
+/// ones; its errors are placed by their key path.
+pub(crate) fn deserialize<T: serde::de::DeserializeOwned>(
+    source: &SceneSource,
+) -> Result<T, SceneError> {
+    let scene = deserialize_spanned(source)?;
+    let value: toml::Value = toml::from_str(&source.text)
+        .map_err(|e| source.error("", e.message().trim().to_owned()))?;
+    serde_path_to_error::deserialize::<_, T>(value).map_err(|error| {
+        let key = error.path().to_string();
+        let message = error.into_inner().message().trim().to_owned();
+        let message = message.replace(
+            "expected fewer elements in array",
+            "more elements than the key takes",
+        );
+        source.error(&key, message)
+    })?;
+    Ok(scene)
+}
+
+/// The first reading of [`deserialize`], whose errors carry their line.
+fn deserialize_spanned<T: serde::de::DeserializeOwned>(
+    source: &SceneSource,
+) -> Result<T, SceneError> {
+    let syntax_error = |error: toml::de::Error| SceneError {
+        file: source.path.clone(),
+        line: error.span().map(|span| source.line_of(span.start)),
+        key: None,
+        message: error.message().trim().to_owned(),
+    };
+    let table = toml::de::DeTable::parse(&source.text).map_err(syntax_error)?;
+    let deserializer = toml::de::Deserializer::from(table);
+    serde_path_to_error::deserialize(deserializer).map_err(|error| {
+        let key = error.path().to_string();
+        let inner = error.into_inner();
+        let line = inner.span().map(|span| source.line_of(span.start));
+        SceneError {
+            file: source.path.clone(),
+            line,
+            key: (key != ".").then_some(key),
+            message: inner.message().trim().to_owned(),
+        }
+    })
+}
+
+/// The `dimension` of `[world]` in the scene text `text` (2 for a 2D scene), or `None` when it
+/// is not given or the text does not parse (the 3D reader then reports what is wrong).
+pub fn dimension_of(text: &str) -> Option<i64> {
+    let table: toml::Table = toml::from_str(text).ok()?;
+    table.get("world")?.get("dimension")?.as_integer()
 }

@@ -2,6 +2,7 @@
 //!
 //! ```toml
 //! [world]
+//! dimension = 3               # default; 2 makes the file a 2D scene (`crate::planar`)
 //! gravity = [0.0, -9.81, 0.0] # m/s², default
 //! dt = 0.016666666666666666   # frame step (s), default 1/60
 //! duration = 2.0              # simulated time (s), required
@@ -20,6 +21,9 @@ pub const MAX_FRAMES: f64 = 1e7;
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct WorldSpec {
+    /// 3 if given (a scene with `dimension = 2` is a 2D scene, read by
+    /// [`crate::planar::PlanarScene`]).
+    pub dimension: Option<u8>,
     /// Gravity (m/s²); default `[0, -9.81, 0]`.
     #[serde(default = "default_gravity")]
     pub gravity: [f64; 3],
@@ -68,6 +72,9 @@ impl WorldSpec {
 
     /// Checks the values.
     pub(crate) fn check(&self, c: &mut Checker<'_>) {
+        if self.dimension.is_some_and(|d| d != 3) {
+            c.fail("world.dimension", "must be 2 (a 2D scene) or 3");
+        }
         c.finite_vector("world.gravity", self.gravity);
         c.positive("world.dt", self.dt, "s");
         // rapier steps in f32: a step that rounds to zero there would pause every frame.

@@ -6,6 +6,7 @@ use super::materials::{element_centroids, region_materials};
 use super::meshes::BodyMeshes;
 use super::probe::Probe;
 use super::regions::BodyRegions;
+use crate::output::{RigidBodySnapshot, Snapshot, SoftBodySnapshot};
 use crate::scene::budget::MemoryUse;
 use crate::scene::rigid_body::{RigidBodySpec, RigidKind, ShapeSpec};
 use crate::scene::soft_body::{SoftBodySpec, VolumetricSpec};
@@ -118,6 +119,30 @@ impl Simulation {
     /// The index of the rigid body named `name`.
     pub fn rigid_index(&self, name: &str) -> Option<usize> {
         self.rigid.iter().position(|r| r.name == name)
+    }
+
+    /// The world now as plain data at simulated time `time` (s), half-spaces and huge cuboids
+    /// drawn as patches of half size `patch` (m).
+    pub fn snapshot(&self, time: f64, patch: f64) -> Snapshot {
+        Snapshot {
+            time,
+            soft_bodies: (self.soft.iter())
+                .map(|entry| {
+                    let body = &self.world.soft_bodies[entry.handle];
+                    SoftBodySnapshot::capture(&entry.name, &entry.label, body, &entry.rest)
+                })
+                .collect(),
+            rigid_bodies: (self.rigid.iter())
+                .filter_map(|entry| {
+                    RigidBodySnapshot::of_body(
+                        &entry.name,
+                        &self.world.physics,
+                        entry.handle,
+                        patch,
+                    )
+                })
+                .collect(),
+        }
     }
 
     /// Samples every probe at time `t` (s).

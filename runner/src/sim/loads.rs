@@ -122,65 +122,78 @@ pub(super) fn build_loads(
                 tension: Some(s),
                 path: Some(points),
                 ..
-            } => {
-                let mut eyelets: Vec<u32> = points
-                    .iter()
-                    .map(|p| mesh.nearest_node(DVec3::from_array(*p)))
-                    .collect();
-                eyelets.dedup();
-                if eyelets.len() < 2 {
-                    return Err(
-                        source.error(&format!("{key}.path"), "its points all fall on one node")
-                    );
-                }
-                (
-                    Load::Cable {
-                        path: eyelets,
-                        tension: s.at(0.0),
-                    },
-                    LoadSchedule::Scalar(s.clone()),
-                )
-            }
+            } => cable(mesh, points, s, (&key, source))?,
             LoadSpec {
                 volume_ratio: Some(s),
                 bulk_modulus,
                 ..
-            } => {
-                let triangles = triangles()?;
-                let rest = match Load::enclosed_volume_of(&triangles, mesh.positions()) {
-                    Some(rest) if rest > 0.0 => rest,
-                    Some(_) => {
-                        return Err(source.error(
-                            &key,
-                            "its boundary triangles enclose no cavity (a chamber's face into \
-                             its cavity: select an inner surface, not the body's outside)",
-                        ));
-                    }
-                    None => {
-                        return Err(source.error(
-                            &key,
-                            "a chamber's walls must be a closed surface: its boundary \
-                             triangles leave holes",
-                        ));
-                    }
-                };
-                let schedule = LoadSchedule::Volume {
-                    ratio: s.clone(),
-                    rest,
-                };
-                let load = Load::Chamber {
-                    triangles,
-                    volume: s.at(0.0) * rest,
-                    bulk_modulus: bulk_modulus.unwrap_or(WATER_BULK_MODULUS),
-                };
-                (load, schedule)
-            }
+            } => chamber(triangles()?, mesh, (s, *bulk_modulus), (&key, source))?,
             // The scene's check asks for exactly one kind, a cable with its path.
             _ => return Err(source.error(&key, KINDS)),
         };
         loads.push((load, schedule, key));
     }
     Ok(loads)
+}
+
+/// A cable through the nodes nearest `points` (m, rest coordinates) pulled by the tension
+/// schedule `tension` (N), or an error at `key` if the points all fall on one node.
+fn cable(
+    mesh: &TetMesh,
+    points: &[[f64; 3]],
+    tension: &Schedule<f64>,
+    (key, source): (&str, &SceneSource),
+) -> Result<(Load, LoadSchedule), SceneError> {
+    let mut eyelets: Vec<u32> = (points.iter())
+        .map(|p| mesh.nearest_node(DVec3::from_array(*p)))
+        .collect();
+    eyelets.dedup();
+    if eyelets.len() < 2 {
+        return Err(source.error(&format!("{key}.path"), "its points all fall on one node"));
+    }
+    let load = Load::Cable {
+        path: eyelets,
+        tension: tension.at(0.0),
+    };
+    Ok((load, LoadSchedule::Scalar(tension.clone())))
+}
+
+/// A chamber whose walls are `triangles`, pumped to the volume ratios `ratio` of the volume it
+/// encloses at rest, of a liquid of bulk modulus `bulk_modulus` (Pa, default water's), or an
+/// error at `key` if the triangles enclose no cavity.
+fn chamber(
+    triangles: Vec<[u32; 3]>,
+    mesh: &TetMesh,
+    (ratio, bulk_modulus): (&Schedule<f64>, Option<f64>),
+    (key, source): (&str, &SceneSource),
+) -> Result<(Load, LoadSchedule), SceneError> {
+    let rest = match Load::enclosed_volume_of(&triangles, mesh.positions()) {
+        Some(rest) if rest > 0.0 => rest,
+        Some(_) => {
+            return Err(source.error(
+                key,
+                "its boundary triangles enclose no cavity (a chamber's face into \
+                 its cavity: select an inner surface, not the body's outside)",
+            ));
+        }
+        None => {
+            return Err(source.error(
+                key,
+                "a chamber's walls must be a closed surface: its boundary \
+                 triangles leave holes",
+            ));
+        }
+    };
+    let load = Load::Chamber {
+        triangles,
+        volume: ratio.at(0.0) * rest,
+        bulk_modulus: bulk_modulus.unwrap_or(WATER_BULK_MODULUS),
+    };
+    let schedule = LoadSchedule::Volume {
+        ratio: ratio.clone(),
+        rest,
+    };
+    Ok((load, schedule))
 }
 
 /// Adds `loads` to `body`; returns those whose value changes over time.

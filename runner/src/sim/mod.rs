@@ -18,7 +18,7 @@ mod probe;
 mod regions;
 mod report;
 mod run;
-mod writer;
+pub(crate) mod writer;
 
 pub use build::{RigidEntry, Simulation, SoftEntry};
 pub use loads::{DrivenLoad, LoadSchedule};

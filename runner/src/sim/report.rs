@@ -256,6 +256,21 @@ pub struct ProbeReport {
     pub values: Vec<f64>,
 }
 
+impl ProbeReport {
+    /// The report of the samples `series` of a probe of kind `kind` (its scene-file name).
+    pub fn of(series: &crate::output::TimeSeries, kind: &str) -> Self {
+        let (times, values): (Vec<f64>, Vec<f64>) = series.samples.iter().copied().unzip();
+        Self {
+            name: series.name.clone(),
+            kind: kind.to_owned(),
+            unit: series.unit.clone(),
+            final_value: values.last().copied().unwrap_or(f64::NAN),
+            times,
+            values,
+        }
+    }
+}
+
 /// The files written, relative to the output folder.
 #[derive(Debug, Clone, Default, Serialize)]
 pub struct Files {

@@ -4,7 +4,7 @@
 
 use super::build::Simulation;
 use super::report::{ProbeReport, Report, RigidBodyReport, Settings, SoftBodyReport, Stability};
-use super::writer::Writer;
+use super::writer::{View, Writer};
 use crate::output::OutputError;
 use crate::scene::rigid_body::RigidKind;
 use crate::scene::world::WorldSpec;
@@ -57,7 +57,13 @@ pub fn run(scene: &Scene, options: &RunOptions) -> Result<Report, RunError> {
     let mut sim = Simulation::build(scene)?;
     let frames = world_spec.frames();
     let dt = world_spec.dt;
-    let mut writer = Writer::new(scene, &options.out, frames, dt)?;
+    let output = (scene.display_name(), &scene.output);
+    let mut writer = Writer::new(
+        (&output.0, output.1),
+        &options.out,
+        (frames, dt),
+        View::Oblique,
+    )?;
     let mut bodies: Vec<SoftBodyReport> = (sim.soft.iter())
         .map(|entry| {
             let body = &sim.world.soft_bodies[entry.handle];
@@ -68,7 +74,7 @@ pub fn run(scene: &Scene, options: &RunOptions) -> Result<Report, RunError> {
     let mut audit = Audit::default();
     audit.restart_world(&sim.world);
     sim.sample_probes(0.0);
-    writer.frame(&sim, 0)?;
+    writer.frame(0, |time, patch| sim.snapshot(time, patch))?;
     let progress = progress_bar(frames, options.progress);
     let mut stepping = Duration::ZERO;
     for frame in 1..=frames {
@@ -94,13 +100,13 @@ pub fn run(scene: &Scene, options: &RunOptions) -> Result<Report, RunError> {
             }
         }
         sim.sample_probes(t);
-        writer.frame(&sim, frame)?;
+        writer.frame(frame, |time, patch| sim.snapshot(time, patch))?;
         progress.set_position(frame as u64);
         let speed = t / stepping.as_secs_f64().max(1e-9);
         progress.set_message(format!("t = {t:.3} s, {speed:.2}x real time"));
     }
     progress.finish_and_clear();
-    let files = writer.finish(&sim)?;
+    let files = writer.finish(sim.probes.iter().map(|p| &p.series))?;
     stability.final_state_finite = sim.soft.iter().all(|entry| {
         let body = &sim.world.soft_bodies[entry.handle];
         body.positions()
@@ -124,7 +130,9 @@ pub fn run(scene: &Scene, options: &RunOptions) -> Result<Report, RunError> {
         ms_per_frame: stepping_s * 1e3 / frames as f64,
         speed_vs_real_time: simulated / stepping_s.max(1e-9),
         stability,
-        probes: sim.probes.iter().map(probe_report).collect(),
+        probes: (sim.probes.iter())
+            .map(|p| ProbeReport::of(&p.series, p.kind.name()))
+            .collect(),
         files,
     };
     let path = options.out.join("report.json");
@@ -189,17 +197,4 @@ fn rigid_reports(sim: &Simulation) -> Vec<RigidBodyReport> {
                 .map_or(0.0, |b| f64::from(b.mass())),
         })
         .collect()
-}
-
-/// A probe's report.
-fn probe_report(probe: &super::Probe) -> ProbeReport {
-    let (times, values): (Vec<f64>, Vec<f64>) = probe.series.samples.iter().copied().unzip();
-    ProbeReport {
-        name: probe.series.name.clone(),
-        kind: probe.kind.name().to_owned(),
-        unit: probe.series.unit.clone(),
-        final_value: values.last().copied().unwrap_or(f64::NAN),
-        times,
-        values,
-    }
 }

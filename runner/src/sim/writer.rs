@@ -1,21 +1,30 @@
 //! The output folder of a run: ParaView and OBJ frames as they are saved, then the pictures
 //! and the probe plots.
 
-use super::build::Simulation;
 use super::report::Files;
 use crate::output::{
-    Camera, Coloring, OutputError, ParaViewSeries, RigidBodySnapshot, Snapshot, SoftBodySnapshot,
-    file_stem, plot_series, render_png, write_obj,
+    Camera, Coloring, OutputError, ParaViewSeries, Snapshot, TimeSeries, file_stem, plot_series,
+    render_png, write_obj,
 };
-use crate::scene::Scene;
+use crate::scene::settings::OutputSpec;
 use rapier_fvm::glamx::DVec3;
 use std::path::{Path, PathBuf};
 
 /// Size of the plots (pixels).
 const PLOT_SIZE: (u32, u32) = (900, 500);
 
+/// Where the pictures look from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum View {
+    /// [`Camera::oblique`], for 3D scenes.
+    Oblique,
+    /// [`Camera::front`], for 2D scenes.
+    Front,
+}
+
 /// Writes a run's output folder.
 pub(crate) struct Writer {
+    view: View,
     out: PathBuf,
     series: ParaViewSeries,
     files: Files,
@@ -34,13 +43,13 @@ pub(crate) struct Writer {
 }
 
 impl Writer {
-    /// A writer into `out` for `frames` frames of `dt` (s) of `scene`; removes the files an
-    /// earlier run left there.
+    /// A writer into `out` for `frames` frames of `dt` (s) of the scene `name` with output
+    /// settings `output`, pictured from `view`; removes the files an earlier run left there.
     pub(crate) fn new(
-        scene: &Scene,
+        (name, output): (&str, &OutputSpec),
         out: &Path,
-        frames: usize,
-        dt: f64,
+        (frames, dt): (usize, f64),
+        view: View,
     ) -> Result<Self, OutputError> {
         for (dir, extension) in [
             ("paraview", "vtu"),
@@ -51,34 +60,40 @@ impl Writer {
         ] {
             clear(&out.join(dir), extension)?;
         }
-        let series = ParaViewSeries::new(out.join("paraview"), &scene.display_name())?;
+        let series = ParaViewSeries::new(out.join("paraview"), name)?;
         let files = Files {
             pvd: relative(out, &series.pvd_path()),
             ..Files::default()
         };
         Ok(Self {
+            view,
             out: out.to_path_buf(),
             series,
             files,
-            save_every: scene.output.save_every,
+            save_every: output.save_every,
             frames,
             dt,
-            patch: scene.output.ground_patch,
-            picture_frames: picture_frames(scene, frames, dt),
+            patch: output.ground_patch,
+            picture_frames: picture_frames(output, frames, dt),
             pictured: Vec::new(),
             bounds: None,
-            picture_size: scene.output.picture_size,
+            picture_size: output.picture_size,
         })
     }
 
-    /// Saves frame `frame` of `sim` if it is a saved or pictured frame.
-    pub(crate) fn frame(&mut self, sim: &Simulation, frame: usize) -> Result<(), OutputError> {
+    /// Saves frame `frame` if it is a saved or pictured frame, as `capture(time (s), patch
+    /// half size (m))` gives it (called only then).
+    pub(crate) fn frame(
+        &mut self,
+        frame: usize,
+        capture: impl FnOnce(f64, f64) -> Snapshot,
+    ) -> Result<(), OutputError> {
         let saved = frame.is_multiple_of(self.save_every) || frame == self.frames;
         let pictured = self.picture_frames.contains(&frame);
         if !(saved || pictured) {
             return Ok(());
         }
-        let snapshot = capture(sim, frame as f64 * self.dt, self.patch);
+        let snapshot = capture(frame as f64 * self.dt, self.patch);
         if let Some((lo, hi)) = snapshot.bounds() {
             self.bounds = Some(
                 self.bounds
@@ -97,8 +112,11 @@ impl Writer {
         Ok(())
     }
 
-    /// Renders the pictures and plots the probes of `sim`; returns the files written.
-    pub(crate) fn finish(mut self, sim: &Simulation) -> Result<Files, OutputError> {
+    /// Renders the pictures and plots `probes`; returns the files written.
+    pub(crate) fn finish<'a>(
+        mut self,
+        probes: impl IntoIterator<Item = &'a TimeSeries>,
+    ) -> Result<Files, OutputError> {
         let (lo, hi) = self.bounds.unwrap_or_default();
         self.files.pictures = render_pictures(
             &self.out,
@@ -106,11 +124,12 @@ impl Writer {
             (lo, hi),
             self.picture_size,
             self.dt,
+            self.view,
         )?;
-        for probe in &sim.probes {
-            let name = format!("{}.png", file_stem(&probe.series.name));
+        for series in probes {
+            let name = format!("{}.png", file_stem(&series.name));
             let path = self.out.join("plots").join(name);
-            plot_series(&path, &probe.series, PLOT_SIZE)?;
+            plot_series(&path, series, PLOT_SIZE)?;
             self.files.plots.push(relative(&self.out, &path));
         }
         Ok(self.files)
@@ -119,8 +138,8 @@ impl Writer {
 
 /// The frames whose views are rendered: those nearest the scene's picture times, or the start,
 /// a third, two thirds and the end.
-fn picture_frames(scene: &Scene, frames: usize, dt: f64) -> Vec<usize> {
-    let mut chosen: Vec<usize> = match &scene.output.pictures {
+fn picture_frames(output: &OutputSpec, frames: usize, dt: f64) -> Vec<usize> {
+    let mut chosen: Vec<usize> = match &output.pictures {
         Some(times) => times
             .iter()
             .map(|t| ((t / dt).round().max(0.0) as usize).min(frames))
@@ -132,24 +151,6 @@ fn picture_frames(scene: &Scene, frames: usize, dt: f64) -> Vec<usize> {
     chosen
 }
 
-/// The world now as plain data.
-fn capture(sim: &Simulation, time: f64, patch: f64) -> Snapshot {
-    Snapshot {
-        time,
-        soft_bodies: (sim.soft.iter())
-            .map(|entry| {
-                let body = &sim.world.soft_bodies[entry.handle];
-                SoftBodySnapshot::capture(&entry.name, &entry.label, body, &entry.rest)
-            })
-            .collect(),
-        rigid_bodies: (sim.rigid.iter())
-            .filter_map(|entry| {
-                RigidBodySnapshot::of_body(&entry.name, &sim.world.physics, entry.handle, patch)
-            })
-            .collect(),
-    }
-}
-
 /// Renders each pictured frame by material and by stress from one camera framing the box
 /// `lo`..`hi` (m); returns `(time (s), file)` of each picture.
 fn render_pictures(
@@ -158,8 +159,12 @@ fn render_pictures(
     (lo, hi): (DVec3, DVec3),
     [width, height]: [u32; 2],
     dt: f64,
+    view: View,
 ) -> Result<Vec<(f64, String)>, OutputError> {
-    let camera = Camera::oblique(lo, hi, width, height);
+    let camera = match view {
+        View::Oblique => Camera::oblique(lo, hi, width, height),
+        View::Front => Camera::front(lo, hi, width, height),
+    };
     let max_stress = pictured
         .iter()
         .map(|(_, s)| stress_scale(s))

@@ -1,0 +1,303 @@
+//! A 2D scene built: its soft bodies ([`PlanarBody`]), its rapier2d world and the coupling
+//! between them ([`PlanarCoupling`]), its probes, and the world as plain data for the writers
+//! (the plane at z = 0).
+
+use super::probe::PlanarProbe;
+use super::scene::{
+    PlanarMeshSpec, PlanarRigidBodySpec, PlanarRigidKind, PlanarScene, PlanarShapeSpec,
+    PlanarSoftBodySpec, PlaneSpec,
+};
+use crate::output::{Cells, RigidBodySnapshot, Snapshot, SoftBodySnapshot};
+use crate::scene::SceneError;
+use rapier_fvm::glamx::{DVec2, DVec3};
+use rapier_fvm::planar::coupling::PlanarCoupling;
+use rapier_fvm::planar::{PlanarBody, PlanarBodyBuilder, PlaneModel, TriangleMesh};
+use rapier2d::prelude::{
+    ColliderBuilder, ColliderHandle, PhysicsWorld, RigidBodyBuilder, RigidBodyHandle,
+};
+
+/// Segments of a ball's drawn outline.
+const BALL_SEGMENTS: usize = 48;
+
+/// A soft body's name, material label and starting node positions (m).
+#[derive(Debug, Clone)]
+pub struct PlanarSoftEntry {
+    /// Its name.
+    pub name: String,
+    /// Its material's label (pictures).
+    pub label: String,
+    /// Where its nodes started (m): displacements are measured from there.
+    pub start: Vec<DVec2>,
+}
+
+/// A rigid body's name, handles and shape.
+#[derive(Debug, Clone)]
+pub struct PlanarRigidEntry {
+    /// Its name.
+    pub name: String,
+    /// Its handle in the rapier2d world.
+    pub handle: RigidBodyHandle,
+    /// Its collider.
+    pub collider: ColliderHandle,
+    /// Its shape as written.
+    pub shape: PlanarShapeSpec,
+}
+
+/// A 2D scene ready to run.
+pub struct PlanarSimulation {
+    /// The rapier2d world (rigid bodies, colliders, gravity, frame step).
+    pub physics: PhysicsWorld,
+    /// The soft bodies, in the scene's order.
+    pub bodies: Vec<PlanarBody>,
+    /// How they step with the rigid bodies.
+    pub coupling: PlanarCoupling,
+    /// The soft bodies' names, labels and starting positions.
+    pub soft: Vec<PlanarSoftEntry>,
+    /// The rigid bodies.
+    pub rigid: Vec<PlanarRigidEntry>,
+    /// Gravity (m/s²).
+    pub gravity: DVec2,
+    /// The probes.
+    pub probes: Vec<PlanarProbe>,
+}
+
+impl PlanarSimulation {
+    /// Builds `scene`.
+    ///
+    /// # Errors
+    /// A [`SceneError`] at the key of a mesh or material the library refuses (a polygon
+    /// outline that crosses itself, say).
+    pub fn build(scene: &PlanarScene) -> Result<Self, SceneError> {
+        let mut physics = PhysicsWorld::default();
+        let [gx, gy] = scene.world.gravity;
+        physics.gravity = [gx as f32, gy as f32].into();
+        physics.integration_parameters.dt = scene.world.dt as f32;
+        let rigid = (scene.rigid_body.iter())
+            .map(|spec| insert_rigid(&mut physics, spec))
+            .collect();
+        let mut bodies = Vec::new();
+        let mut soft = Vec::new();
+        for (i, spec) in scene.soft_body.iter().enumerate() {
+            let at = |(key, e): (&str, rapier_fvm::Error)| {
+                let key = format!("soft_body[{i}]{key}");
+                scene.source.error(&key, e.to_string())
+            };
+            let body = soft_body(spec).map_err(at)?;
+            soft.push(PlanarSoftEntry {
+                name: spec.name.clone(),
+                label: spec.material.label(),
+                start: body.positions().to_vec(),
+            });
+            bodies.push(body);
+        }
+        let mut coupling = PlanarCoupling::default();
+        coupling.substeps = scene.world.coupling_substeps;
+        coupling.friction = scene.world.friction;
+        let mut sim = Self {
+            physics,
+            bodies,
+            coupling,
+            soft,
+            rigid,
+            gravity: DVec2::new(gx, gy),
+            probes: Vec::new(),
+        };
+        sim.probes = scene
+            .probe
+            .iter()
+            .map(|p| PlanarProbe::new(p, &sim))
+            .collect();
+        Ok(sim)
+    }
+
+    /// Samples every probe at time `t` (s).
+    pub fn sample_probes(&mut self, t: f64) {
+        let mut probes = std::mem::take(&mut self.probes);
+        for probe in &mut probes {
+            probe.sample(t, self);
+        }
+        self.probes = probes;
+    }
+
+    /// The world now as plain data at simulated time `time` (s), in the plane z = 0; a
+    /// rectangle wider or taller than `2 patch` (m) (a ground slab) is drawn cut to a square of
+    /// half size `patch` about its point nearest the origin, and not framed by the camera.
+    pub fn snapshot(&self, time: f64, patch: f64) -> Snapshot {
+        let lift = |v: &DVec2| DVec3::new(v.x, v.y, 0.0);
+        let soft_bodies = (self.soft.iter().zip(&self.bodies))
+            .map(|(entry, body)| SoftBodySnapshot {
+                name: entry.name.clone(),
+                material: entry.label.clone(),
+                rest_positions: entry.start.iter().map(lift).collect(),
+                positions: body.positions().iter().map(lift).collect(),
+                velocities: body.velocities().iter().map(lift).collect(),
+                cells: Cells::Triangles(body.mesh().triangles().to_vec()),
+                surface: body.mesh().triangles().to_vec(),
+                cauchy_stress: body.cauchy_stresses(),
+            })
+            .collect();
+        let rigid_bodies = (self.rigid.iter())
+            .filter_map(|entry| {
+                let body = self.physics.bodies.get(entry.handle)?;
+                let angle = f64::from(body.rotation().angle());
+                let centre = body.translation().as_dvec2();
+                let (sin, cos) = angle.sin_cos();
+                let (outline, has_patch) = drawn_outline(entry.shape, centre, (sin, cos), patch);
+                let placed = outline.iter().map(|p| {
+                    let q = DVec2::new(cos * p.x - sin * p.y, sin * p.x + cos * p.y) + centre;
+                    DVec3::new(q.x, q.y, 0.0)
+                });
+                let triangles = (1..outline.len() as u32 - 1)
+                    .map(|k| [0, k, k + 1])
+                    .collect();
+                Some(RigidBodySnapshot {
+                    name: entry.name.clone(),
+                    vertices: placed.collect(),
+                    triangles,
+                    has_patch,
+                })
+            })
+            .collect();
+        Snapshot {
+            time,
+            soft_bodies,
+            rigid_bodies,
+        }
+    }
+}
+
+/// The soft body of `spec`, placed and moving as it says, or the library's error with the key
+/// (`.mesh`, `.material`, `.damping` or none, the body) it is about.
+fn soft_body(spec: &PlanarSoftBodySpec) -> Result<PlanarBody, (&'static str, rapier_fvm::Error)> {
+    let mesh = mesh(spec).map_err(|e| (".mesh", e))?;
+    let material = spec.material.material().map_err(|e| (".material", e))?;
+    let pinned: Vec<usize> = (mesh.rest_positions().iter().enumerate())
+        .filter(|(_, p)| {
+            (spec.pinned.iter()).any(|b| (0..2).all(|k| (b.min[k]..=b.max[k]).contains(&p[k])))
+        })
+        .map(|(i, _)| i)
+        .collect();
+    let mut builder = PlanarBodyBuilder::new(mesh, material)
+        .plane(match spec.plane {
+            PlaneSpec::Stress => PlaneModel::PlaneStress,
+            PlaneSpec::Strain => PlaneModel::PlaneStrain,
+        })
+        .thickness(spec.thickness)
+        .pinned_nodes(pinned);
+    if let Some(damping) = &spec.damping {
+        builder = builder.damping(damping.damping(&material).map_err(|e| (".damping", e))?);
+    }
+    let mut body = builder.build().map_err(|e| ("", e))?;
+    let offset = DVec2::from_array(spec.translation);
+    let velocity = DVec2::from_array(spec.velocity);
+    for x in body.positions_mut() {
+        *x += offset;
+    }
+    let pinned: Vec<[bool; 2]> = body.pinned().to_vec();
+    for (v, held) in body.velocities_mut().iter_mut().zip(pinned) {
+        if !held[0] && !held[1] {
+            *v = velocity;
+        }
+    }
+    Ok(body)
+}
+
+/// The triangle mesh of `spec`, in its own coordinates.
+fn mesh(spec: &PlanarSoftBodySpec) -> Result<TriangleMesh, rapier_fvm::Error> {
+    match &spec.mesh {
+        PlanarMeshSpec::Rectangle {
+            size: [w, h],
+            cells,
+        } => TriangleMesh::rectangle(DVec2::new(*w, *h), *cells),
+        PlanarMeshSpec::Disk { radius, rings } => TriangleMesh::disk(*radius, *rings),
+        PlanarMeshSpec::Polygon {
+            outline,
+            edge_length,
+        } => {
+            let outline: Vec<DVec2> = outline.iter().map(|&p| DVec2::from_array(p)).collect();
+            TriangleMesh::polygon(&outline, *edge_length)
+        }
+    }
+}
+
+/// Inserts the rigid body of `spec` with its collider into `physics`.
+fn insert_rigid(physics: &mut PhysicsWorld, spec: &PlanarRigidBodySpec) -> PlanarRigidEntry {
+    let builder = match spec.kind {
+        PlanarRigidKind::Fixed => RigidBodyBuilder::fixed(),
+        PlanarRigidKind::Dynamic => RigidBodyBuilder::dynamic(),
+    };
+    let [x, y] = spec.translation.map(|v| v as f32);
+    let [vx, vy] = spec.velocity.map(|v| v as f32);
+    let body = builder
+        .translation([x, y].into())
+        .rotation(spec.rotation as f32)
+        .linvel([vx, vy].into())
+        .angvel(spec.angular_velocity as f32);
+    let collider = match spec.shape {
+        PlanarShapeSpec::Cuboid {
+            half_extents: [a, b],
+        } => ColliderBuilder::cuboid(a as f32, b as f32),
+        PlanarShapeSpec::Ball { radius } => ColliderBuilder::ball(radius as f32),
+    }
+    .density(spec.density as f32);
+    let handle = physics.bodies.insert(body);
+    let collider =
+        physics
+            .colliders
+            .insert_with_parent(collider.build(), handle, &mut physics.bodies);
+    PlanarRigidEntry {
+        name: spec.name.clone(),
+        handle,
+        collider,
+        shape: spec.shape,
+    }
+}
+
+/// The outline drawn of `shape` (m, about its centre, counter-clockwise) placed at `centre` (m)
+/// and turned by the angle of sine and cosine `turn`: a rectangle cut to a square of half size
+/// `patch` (m) about its point nearest the origin, and whether it was cut.
+fn drawn_outline(
+    shape: PlanarShapeSpec,
+    centre: DVec2,
+    (sin, cos): (f64, f64),
+    patch: f64,
+) -> (Vec<DVec2>, bool) {
+    let PlanarShapeSpec::Cuboid {
+        half_extents: [a, b],
+    } = shape
+    else {
+        return (outline(shape), false);
+    };
+    let half = DVec2::new(a, b);
+    // The origin in the rectangle's frame, then the rectangle's point nearest it.
+    let origin = DVec2::new(
+        -cos * centre.x - sin * centre.y,
+        sin * centre.x - cos * centre.y,
+    );
+    let nearest = origin.clamp(-half, half);
+    let lo = (nearest - DVec2::splat(patch)).max(-half);
+    let hi = (nearest + DVec2::splat(patch)).min(half);
+    let cut = lo != -half || hi != half;
+    let corners = vec![lo, DVec2::new(hi.x, lo.y), hi, DVec2::new(lo.x, hi.y)];
+    (corners, cut)
+}
+
+/// The outline of `shape` about its centre (m), counter-clockwise.
+fn outline(shape: PlanarShapeSpec) -> Vec<DVec2> {
+    match shape {
+        PlanarShapeSpec::Cuboid {
+            half_extents: [a, b],
+        } => vec![
+            DVec2::new(-a, -b),
+            DVec2::new(a, -b),
+            DVec2::new(a, b),
+            DVec2::new(-a, b),
+        ],
+        PlanarShapeSpec::Ball { radius } => (0..BALL_SEGMENTS)
+            .map(|k| {
+                let angle = std::f64::consts::TAU * k as f64 / BALL_SEGMENTS as f64;
+                DVec2::new(angle.cos(), angle.sin()) * radius
+            })
+            .collect(),
+    }
+}

@@ -1,0 +1,369 @@
+//! 2D scene files: soft bodies on triangles and rapier2d rigid bodies in the plane (x right,
+//! y up), in SI units, read and checked with the same errors as 3D scenes (file, line, key).
+//!
+//! ```toml
+//! [world]
+//! dimension = 2               # required: this is a 2D scene
+//! gravity = [0.0, -9.81]      # m/s², default
+//! dt = 0.016666666666666666   # frame step (s), default 1/60
+//! duration = 3.0              # simulated time (s), required
+//! coupling_substeps = 4       # the fewest rapier steps per frame, default 4 (more are taken
+//!                             # when contacts with light rigid bodies need them)
+//! friction = 0.5              # between soft bodies and colliders, default 0.5
+//!
+//! [[soft_body]]
+//! name = "block"
+//! mesh = { rectangle = { size = [0.2, 0.1], cells = [10, 5] } }  # lower left corner at the origin
+//! # mesh = { disk = { radius = 0.05, rings = 4 } }                # centred at the origin
+//! # mesh = { polygon = { outline = [[0, 0], [1, 0], [0, 1]], edge_length = 0.05 } }
+//! plane = "strain"            # required: "strain" (a thick body) or "stress" (a thin sheet)
+//! thickness = 0.1             # m, required: masses and forces are per this thickness
+//! material = { model = "stable_neo_hookean", young = 1e5, poisson = 0.3, density = 1000.0 }
+//! damping = { stiffness_time = 1e-3 }  # as 3D scenes' (optional)
+//! translation = [-0.1, 0.0]   # m, added to the mesh's coordinates, default 0
+//! velocity = [0.0, 0.0]       # m/s, default 0
+//! pinned = [{ min = [-1.0, -1.0], max = [1.0, 0.001] }]  # nodes held where they start: those
+//!                             # whose rest position (m, mesh coordinates) lies in a box
+//!
+//! [[rigid_body]]
+//! name = "ground"
+//! kind = "fixed"              # or "dynamic" (default)
+//! shape = { cuboid = { half_extents = [2.0, 0.5] } }  # or { ball = { radius = 0.05 } }
+//! translation = [0.0, -0.5]   # m
+//! rotation = 0.0              # rad, counter-clockwise, default 0
+//! velocity = [0.0, 0.0]       # m/s, default 0
+//! angular_velocity = 0.0      # rad/s, default 0
+//! density = 1000.0            # kg/m² of the shape's area (rapier2d's), default 1000
+//! ```
+//! `[output]` is as in 3D scenes; `[[probe]]` entries are in [`super::probe`].
+
+use super::probe::PlanarProbeSpec;
+use crate::scene::check::Checker;
+use crate::scene::material::{DampingSpec, MaterialSpec};
+use crate::scene::settings::OutputSpec;
+use crate::scene::{SceneError, SceneSource};
+use serde::Deserialize;
+use std::path::Path;
+
+/// A 2D scene as written in its file.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlanarScene {
+    /// The scene's name (report and file names); default the file's stem.
+    pub name: Option<String>,
+    /// World settings.
+    pub world: PlanarWorldSpec,
+    /// The soft bodies.
+    #[serde(default)]
+    pub soft_body: Vec<PlanarSoftBodySpec>,
+    /// The rigid bodies.
+    #[serde(default)]
+    pub rigid_body: Vec<PlanarRigidBodySpec>,
+    /// Output settings (those of 3D scenes).
+    #[serde(default)]
+    pub output: OutputSpec,
+    /// The probes.
+    #[serde(default)]
+    pub probe: Vec<PlanarProbeSpec>,
+    /// The file and its text, to place later errors.
+    #[serde(skip)]
+    pub source: SceneSource,
+}
+
+/// `[world]` of a 2D scene.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlanarWorldSpec {
+    /// Must be 2.
+    pub dimension: u8,
+    /// Gravity (m/s²); default `[0, -9.81]`.
+    #[serde(default = "default_gravity")]
+    pub gravity: [f64; 2],
+    /// Frame step (s); default 1/60.
+    #[serde(default = "default_dt")]
+    pub dt: f64,
+    /// Simulated time (s), required.
+    pub duration: f64,
+    /// The fewest rapier steps per frame; default 4.
+    #[serde(default = "default_substeps")]
+    pub coupling_substeps: u32,
+    /// Friction coefficient between soft bodies and colliders; default 0.5.
+    #[serde(default = "default_friction")]
+    pub friction: f64,
+}
+
+fn default_gravity() -> [f64; 2] {
+    [0.0, -9.81]
+}
+
+fn default_dt() -> f64 {
+    1.0 / 60.0
+}
+
+fn default_substeps() -> u32 {
+    4
+}
+
+fn default_friction() -> f64 {
+    0.5
+}
+
+/// A 2D soft body.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlanarSoftBodySpec {
+    /// Its name, unique among bodies.
+    pub name: String,
+    /// Its triangle mesh.
+    pub mesh: PlanarMeshSpec,
+    /// Why it is flat.
+    pub plane: PlaneSpec,
+    /// Its thickness (m).
+    pub thickness: f64,
+    /// Its material.
+    pub material: MaterialSpec,
+    /// Rayleigh damping; default none.
+    pub damping: Option<DampingSpec>,
+    /// Added to the mesh's coordinates (m); default 0.
+    #[serde(default)]
+    pub translation: [f64; 2],
+    /// Initial velocity (m/s); default 0.
+    #[serde(default)]
+    pub velocity: [f64; 2],
+    /// Boxes of rest positions (m, mesh coordinates) whose nodes are pinned.
+    #[serde(default)]
+    pub pinned: Vec<PlanarBoxSpec>,
+}
+
+/// A triangle mesh generator.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum PlanarMeshSpec {
+    /// A rectangle of `size` (m) from the origin, `cells` along x and y.
+    Rectangle {
+        /// Width and height (m).
+        size: [f64; 2],
+        /// Cells along x and y (two triangles each).
+        cells: [usize; 2],
+    },
+    /// A disk of `radius` (m) centred at the origin, in `rings` rings of triangles.
+    Disk {
+        /// Radius (m).
+        radius: f64,
+        /// Rings of triangles.
+        rings: usize,
+    },
+    /// A polygon's inside, triangulated with edges of about `edge_length` (m).
+    Polygon {
+        /// The vertices (m), in order, either winding.
+        outline: Vec<[f64; 2]>,
+        /// The triangles' longest edge (m), about.
+        edge_length: f64,
+    },
+}
+
+/// The plane model, by its scene-file name.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PlaneSpec {
+    /// Plane stress (a thin sheet, `σ₃ⱼ = 0`).
+    Stress,
+    /// Plane strain (a thick body, `ε₃ⱼ = 0`).
+    Strain,
+}
+
+/// A box `min`..`max` (m).
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlanarBoxSpec {
+    /// Lower corner (m).
+    pub min: [f64; 2],
+    /// Upper corner (m).
+    pub max: [f64; 2],
+}
+
+/// A rigid body of rapier2d.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlanarRigidBodySpec {
+    /// Its name, unique among bodies.
+    pub name: String,
+    /// Fixed or dynamic; default dynamic.
+    #[serde(default)]
+    pub kind: PlanarRigidKind,
+    /// Its collider's shape.
+    pub shape: PlanarShapeSpec,
+    /// Position of its centre (m).
+    #[serde(default)]
+    pub translation: [f64; 2],
+    /// Rotation (rad, counter-clockwise); default 0.
+    #[serde(default)]
+    pub rotation: f64,
+    /// Initial velocity (m/s); default 0.
+    #[serde(default)]
+    pub velocity: [f64; 2],
+    /// Initial angular velocity (rad/s); default 0.
+    #[serde(default)]
+    pub angular_velocity: f64,
+    /// Density (kg/m² of the shape's area); default 1000.
+    #[serde(default = "default_density")]
+    pub density: f64,
+}
+
+fn default_density() -> f64 {
+    1000.0
+}
+
+/// How a rigid body moves.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PlanarRigidKind {
+    /// Never moves.
+    Fixed,
+    /// Moves under gravity and contacts.
+    #[default]
+    Dynamic,
+}
+
+/// A collider shape.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum PlanarShapeSpec {
+    /// A rectangle of half extents (m).
+    Cuboid {
+        /// Half width and half height (m).
+        half_extents: [f64; 2],
+    },
+    /// A disk of `radius` (m).
+    Ball {
+        /// Radius (m).
+        radius: f64,
+    },
+}
+
+impl PlanarScene {
+    /// Parses and checks `text`, the content of the 2D scene file `path`.
+    ///
+    /// # Errors
+    /// A [`SceneError`] naming the file, line and key of what is malformed.
+    pub fn parse(path: impl AsRef<Path>, text: String) -> Result<Self, SceneError> {
+        let source = SceneSource {
+            path: path.as_ref().to_path_buf(),
+            text,
+        };
+        let mut scene: Self = crate::scene::deserialize(&source)?;
+        scene.source = source;
+        scene.check()?;
+        Ok(scene)
+    }
+
+    /// The scene's name: `name`, or the file's stem.
+    pub fn display_name(&self) -> String {
+        self.name.clone().unwrap_or_else(|| {
+            self.source
+                .path
+                .file_stem()
+                .map_or_else(|| "scene".to_owned(), |s| s.to_string_lossy().into_owned())
+        })
+    }
+
+    /// The values and references a type cannot check.
+    fn check(&self) -> Result<(), SceneError> {
+        let mut c = Checker::new(&self.source);
+        let w = &self.world;
+        if w.dimension != 2 {
+            c.fail("world.dimension", "a 2D scene has dimension 2");
+        }
+        c.finite_vector("world.gravity", [w.gravity[0], w.gravity[1], 0.0]);
+        c.positive("world.dt", w.dt, "s");
+        c.positive("world.duration", w.duration, "s");
+        if w.duration / w.dt > crate::scene::world::MAX_FRAMES {
+            c.fail("world.duration", "needs more than ten million frames");
+        }
+        if !(1..=256).contains(&w.coupling_substeps) {
+            c.fail("world.coupling_substeps", "must lie in 1 to 256");
+        }
+        c.non_negative("world.friction", w.friction, "");
+        let soft: Vec<&str> = self.soft_body.iter().map(|b| b.name.as_str()).collect();
+        let rigid: Vec<&str> = self.rigid_body.iter().map(|b| b.name.as_str()).collect();
+        let names = (soft
+            .iter()
+            .enumerate()
+            .map(|(i, n)| (format!("soft_body[{i}].name"), *n)))
+        .chain((rigid.iter().enumerate()).map(|(i, n)| (format!("rigid_body[{i}].name"), *n)));
+        let mut seen: Vec<&str> = Vec::new();
+        for (key, name) in names {
+            if name.trim().is_empty() {
+                c.fail(&key, "must not be empty");
+            } else if seen.contains(&name) {
+                c.fail(&key, format!("another body is already named {name:?}"));
+            }
+            seen.push(name);
+        }
+        for (i, body) in self.soft_body.iter().enumerate() {
+            body.check(&format!("soft_body[{i}]"), &mut c);
+        }
+        for (i, body) in self.rigid_body.iter().enumerate() {
+            body.check(&format!("rigid_body[{i}]"), &mut c);
+        }
+        self.output.check(w.duration, &mut c);
+        let mut probes: Vec<&str> = Vec::new();
+        for (i, probe) in self.probe.iter().enumerate() {
+            if probes.contains(&probe.name.as_str()) {
+                let message = format!("another probe is already named {:?}", probe.name);
+                c.fail(&format!("probe[{i}].name"), message);
+            }
+            probes.push(&probe.name);
+            probe.check(&format!("probe[{i}]"), &soft, &rigid, &mut c);
+        }
+        c.finish()
+    }
+}
+
+impl PlanarSoftBodySpec {
+    fn check(&self, key: &str, c: &mut Checker<'_>) {
+        c.positive(&format!("{key}.thickness"), self.thickness, "m");
+        self.material.check(&format!("{key}.material"), c);
+        if let Some(damping) = &self.damping {
+            damping.check(&format!("{key}.damping"), c);
+        }
+        let [tx, ty] = self.translation;
+        c.finite_vector(&format!("{key}.translation"), [tx, ty, 0.0]);
+        let [vx, vy] = self.velocity;
+        c.speed(&format!("{key}.velocity"), [vx, vy, 0.0]);
+        for (i, pinned) in self.pinned.iter().enumerate() {
+            let key = format!("{key}.pinned[{i}]");
+            let ordered = (0..2).all(|k| pinned.min[k] <= pinned.max[k]);
+            let finite = pinned.min.iter().chain(&pinned.max).all(|v| v.is_finite());
+            if !(ordered && finite) {
+                c.fail(
+                    &key,
+                    "`min` must be finite and below `max` on each axis (m)",
+                );
+            }
+        }
+    }
+}
+
+impl PlanarRigidBodySpec {
+    fn check(&self, key: &str, c: &mut Checker<'_>) {
+        match self.shape {
+            PlanarShapeSpec::Cuboid {
+                half_extents: [a, b],
+            } => {
+                c.positive(&format!("{key}.shape.cuboid.half_extents"), a.min(b), "m");
+            }
+            PlanarShapeSpec::Ball { radius } => {
+                c.positive(&format!("{key}.shape.ball.radius"), radius, "m");
+            }
+        }
+        let [tx, ty] = self.translation;
+        c.finite_vector(&format!("{key}.translation"), [tx, ty, self.rotation]);
+        let [vx, vy] = self.velocity;
+        c.speed(&format!("{key}.velocity"), [vx, vy, 0.0]);
+        if !self.angular_velocity.is_finite() {
+            c.fail(&format!("{key}.angular_velocity"), "must be finite (rad/s)");
+        }
+        c.positive(&format!("{key}.density"), self.density, "kg/m²");
+    }
+}

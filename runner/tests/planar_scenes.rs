@@ -1,0 +1,204 @@
+//! 2D scenes through the runner: the shipped ones parse and build; the box dropped on a soft
+//! block comes to rest with the ground carrying both weights (the 2D issue's scene, now from a
+//! scene file); every output is written and the `.vtu` of triangles read back matches the
+//! bodies; malformed 2D scenes are refused with the file, line and key.
+
+use rapier_fvm_runner::planar::{PlanarScene, PlanarSimulation, run_planar};
+use rapier_fvm_runner::scene::{SceneError, dimension_of};
+use rapier_fvm_runner::sim::RunOptions;
+use std::path::{Path, PathBuf};
+use vtkio::model::{Attribute, CellType, DataSet, IOBuffer, Piece, VertexNumbers, Vtk};
+
+/// The 2D scenes shipped.
+const PLANAR_SCENES: [&str; 1] = ["planar_drop.toml"];
+
+/// The path of the shipped scene `file`.
+fn scene_path(file: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../assets/scenes")
+        .join(file)
+}
+
+/// The shipped 2D scene `file`, parsed.
+fn shipped(file: &str) -> PlanarScene {
+    let path = scene_path(file);
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert_eq!(dimension_of(&text), Some(2), "{file} is a 2D scene");
+    PlanarScene::parse(&path, text).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// A fresh output folder for `test`.
+fn out_dir(test: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(test);
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+#[test]
+fn every_shipped_2d_scene_parses_and_builds() {
+    for file in PLANAR_SCENES {
+        let scene = shipped(file);
+        let sim = PlanarSimulation::build(&scene).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(sim.bodies.len(), scene.soft_body.len(), "{file}");
+        assert_eq!(sim.probes.len(), scene.probe.len(), "{file}");
+    }
+}
+
+/// `planar_drop.toml`: a 0.5 kg box dropped from 2 cm on a 2 kg block of soft rubber on the
+/// ground. After its 3 s the mean force on the ground over the last frame is the weight of
+/// both, 24.525 N, to 1 % (the 2D issue's tolerance; `tests/planar_coupling.rs` measures
+/// 24.5250 N for the same bodies built in code), and the box rests on the block (its centre
+/// 2.5 cm above the block's top, 10 cm less the block's squash).
+#[test]
+fn the_dropped_box_rests_with_the_ground_carrying_both_weights() {
+    let scene = shipped("planar_drop.toml");
+    let out = out_dir("planar_drop");
+    let options = RunOptions {
+        out: out.clone(),
+        duration: None,
+        progress: false,
+    };
+    let report = run_planar(&scene, &options).unwrap();
+    assert_eq!(report.frames, 180);
+    assert!(report.final_state_finite);
+    let block = &report.soft_bodies[0];
+    assert_eq!(
+        (block.triangles, block.nodes, block.failed_frames),
+        (100, 66, 0)
+    );
+    let box_mass = report.rigid_bodies[1].2;
+    assert!((box_mass - 0.5).abs() < 1e-6, "box mass {box_mass}");
+    let weight = (block.mass + box_mass) * 9.81;
+    let reaction = -report.probes[0].final_value;
+    assert!(
+        (reaction / weight - 1.0).abs() < 0.01,
+        "ground reaction {reaction} N, weight {weight} N"
+    );
+    let box_height = report.probes[1].final_value;
+    assert!(
+        box_height > 0.1 && box_height < 0.125 + 0.0005,
+        "{box_height}"
+    );
+
+    // The series: frames 0, 4, …, 180 saved (46), a picture pair at 0, 1, 2 and 3 s, a plot
+    // per probe, the report.
+    let pvd = std::fs::read_to_string(out.join("paraview/planar_drop.pvd")).unwrap();
+    assert_eq!(pvd.matches("<DataSet").count(), 46);
+    assert_eq!(report.files.pictures.len(), 8);
+    for (_, file) in &report.files.pictures {
+        let png = std::fs::read(out.join(file)).unwrap();
+        assert_eq!(&png[1..4], b"PNG", "{file}");
+    }
+    for file in ["ground_reaction.png", "box_height.png", "block_energy.png"] {
+        assert!(out.join("plots").join(file).is_file(), "{file}");
+    }
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    assert_eq!(json["dimension"], 2);
+    assert_eq!(json["soft_bodies"][0]["plane"], "strain");
+
+    // The last .vtu: the mesh's triangles as cells, its nodes at z = 0, the displacements the
+    // points less where the nodes started.
+    let sim = PlanarSimulation::build(&scene).unwrap();
+    let vtk = Vtk::import(out.join("paraview/block_00045.vtu")).unwrap();
+    let DataSet::UnstructuredGrid { pieces, .. } = vtk.data else {
+        panic!("not an unstructured grid");
+    };
+    let Piece::Inline(piece) = &pieces[0] else {
+        panic!("not an inline piece");
+    };
+    assert!(piece.cells.types.iter().all(|t| *t == CellType::Triangle));
+    let VertexNumbers::XML { connectivity, .. } = &piece.cells.cell_verts else {
+        panic!("XML cells");
+    };
+    let triangles: Vec<u64> = (sim.bodies[0].mesh().triangles().iter())
+        .flatten()
+        .map(|&n| u64::from(n))
+        .collect();
+    assert_eq!(connectivity, &triangles);
+    let numbers = |buffer: &IOBuffer| buffer.clone().cast_into::<f64>().unwrap();
+    let points = numbers(&piece.points);
+    let displacement = (piece.data.point.iter())
+        .find_map(|a| match a {
+            Attribute::DataArray(array) if array.name == "displacement" => {
+                Some(numbers(&array.data))
+            }
+            _ => None,
+        })
+        .unwrap();
+    for (n, start) in sim.soft[0].start.iter().enumerate() {
+        assert_eq!(points[3 * n + 2], 0.0);
+        for axis in 0..2 {
+            let i = 3 * n + axis;
+            assert!((points[i] - start[axis] - displacement[i]).abs() < 1e-12);
+        }
+    }
+}
+
+/// `planar_drop.toml` with `from` replaced by `to` (which must occur once), parsed as
+/// `scenes/bad.toml`: its error.
+fn broken(from: &str, to: &str) -> SceneError {
+    let text = std::fs::read_to_string(scene_path("planar_drop.toml")).unwrap();
+    assert_eq!(text.matches(from).count(), 1, "{from:?} must occur once");
+    match PlanarScene::parse("scenes/bad.toml", text.replace(from, to)) {
+        Ok(_) => panic!("the scene should be refused: {to}"),
+        Err(error) => error,
+    }
+}
+
+/// Asserts the message names the file, the line and the key, and mentions `words`.
+fn assert_names(error: &SceneError, line: usize, key: &str, words: &str) {
+    let message = error.to_string();
+    assert!(
+        message.starts_with(&format!("scenes/bad.toml:{line}: ")),
+        "file and line {line} in {message:?}"
+    );
+    assert!(message.contains(key), "key {key} in {message:?}");
+    assert!(message.contains(words), "{words:?} in {message:?}");
+}
+
+#[test]
+fn malformed_2d_scenes_are_refused_with_file_line_and_key() {
+    let gravity = broken(
+        "duration = 3.0",
+        "duration = 3.0\ngravity = [0.0, -9.81, 0.0]",
+    );
+    assert_names(
+        &gravity,
+        10,
+        "world.gravity",
+        "more elements than the key takes",
+    );
+    let text = broken(
+        "duration = 3.0",
+        "duration = 3.0\ngravity = [0.0, \"down\"]",
+    );
+    assert_names(&text, 10, "world.gravity", "invalid type");
+    let plane = broken("plane = \"strain\"", "plane = \"flat\"");
+    assert_names(&plane, 26, "soft_body[0].plane", "unknown variant");
+    let thickness = broken("thickness = 0.1", "thickness = 0.0");
+    assert_names(&thickness, 27, "soft_body[0].thickness", "positive");
+    let component = broken(
+        "component = \"y\"\n\n[[probe]]\nname = \"box height\"",
+        "component = \"z\"\n\n[[probe]]\nname = \"box height\"",
+    );
+    assert_names(&component, 40, "probe[0].component", "x and y only");
+    let missing = broken("rigid = \"ground\"", "rigid = \"floor\"");
+    assert_names(
+        &missing,
+        39,
+        "probe[0].rigid",
+        "no rigid body is named \"floor\"",
+    );
+    // An outline crossing itself parses, and is refused by the library when the scene is
+    // built, at the body's line, with the edges named.
+    let text = std::fs::read_to_string(scene_path("planar_drop.toml")).unwrap().replace(
+        "mesh = { rectangle = { size = [0.2, 0.1], cells = [10, 5] } }",
+        "mesh = { polygon = { outline = [[0, 0], [1, 1], [1, 0], [0, 1]], edge_length = 0.1 } }",
+    );
+    let scene = PlanarScene::parse("scenes/bad.toml", text).unwrap();
+    let Err(crossing) = PlanarSimulation::build(&scene) else {
+        panic!("a crossing outline should be refused");
+    };
+    assert_names(&crossing, 25, "soft_body[0].mesh", "cross");
+}
