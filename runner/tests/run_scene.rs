@@ -41,7 +41,7 @@ fn every_shipped_scene_parses_and_builds() {
         .collect();
     found.sort();
     // The 2D scenes (tests/planar_scenes.rs).
-    let planar = ["planar_drop.toml"];
+    let planar = ["planar_drop.toml", "planar_rolling_disk.toml"];
     let mut expected: Vec<String> = (names.iter().chain(&planar))
         .map(|n| (*n).to_owned())
         .collect();

@@ -1,5 +1,5 @@
 //! A software z-buffer: triangles with per-vertex colours filled pixel by pixel, keeping the
-//! nearest surface at each pixel. Pixels are sampled at their centres; a triangle covers the
+//! nearest surface at each pixel; segments drawn over them (the edges of 2D meshes). Pixels are sampled at their centres; a triangle covers the
 //! pixels whose centre lies inside it (either winding).
 
 use rapier_fvm::glamx::DVec3;
@@ -67,6 +67,27 @@ impl Raster {
                     *byte = (value.clamp(0.0, 1.0) * 255.0).round() as u8;
                 }
             }
+        }
+    }
+}
+
+impl Raster {
+    /// Draws the segment between the screen points `a` and `b` (pixels) one pixel wide in
+    /// `color` (0 to 1 per channel), over whatever is drawn (no depth test).
+    pub(crate) fn segment(&mut self, a: DVec3, b: DVec3, color: [f64; 3]) {
+        let steps = (b - a).truncate().abs().max_element().ceil();
+        if !steps.is_finite() {
+            return;
+        }
+        let rgb = color.map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8);
+        for k in 0..=(steps as usize) {
+            let p = a.lerp(b, k as f64 / steps.max(1.0));
+            let (x, y) = (p.x.floor(), p.y.floor());
+            if x < 0.0 || y < 0.0 || x >= self.width as f64 || y >= self.height as f64 {
+                continue;
+            }
+            let i = y as usize * self.width + x as usize;
+            self.rgb[3 * i..3 * i + 3].copy_from_slice(&rgb);
         }
     }
 }

@@ -32,6 +32,8 @@ const VIRIDIS: [[f64; 3]; 5] = [
     [0.369, 0.789, 0.383],
     [0.993, 0.906, 0.144],
 ];
+/// Colour of the edges of 2D meshes (0 to 1 per channel).
+const EDGES: [f64; 3] = [0.25, 0.25, 0.25];
 /// Light factor on surfaces facing away from the light.
 const AMBIENT: f64 = 0.35;
 
@@ -82,6 +84,9 @@ pub fn render_png(
             let color = t.map(|n| colors[n as usize].map(|c| c * shade));
             raster.triangle(corners.map(|p| camera.project(p)), color);
         }
+        if let super::Cells::Triangles(triangles) = &body.cells {
+            draw_edges(&mut raster, camera, &body.positions, triangles);
+        }
     }
     for body in &snapshot.rigid_bodies {
         for t in &body.triangles {
@@ -102,6 +107,18 @@ pub fn render_png(
         &materials,
     )
     .map_err(OutputError::picture(path))
+}
+
+/// Draws the edges of the 2D mesh `triangles` with nodes at `positions` (m) in a dark grey, so
+/// that the mesh's deformation and turning show.
+fn draw_edges(raster: &mut Raster, camera: &Camera, positions: &[DVec3], triangles: &[[u32; 3]]) {
+    for t in triangles {
+        for k in 0..3 {
+            // An inner edge, shared by two triangles, is drawn twice, over itself.
+            let [p, q] = [t[k], t[(k + 1) % 3]].map(|n| camera.project(positions[n as usize]));
+            raster.segment(p, q, EDGES);
+        }
+    }
 }
 
 /// The material labels of the soft bodies, each once, in order of first appearance.

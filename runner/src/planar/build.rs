@@ -4,8 +4,8 @@
 
 use super::probe::PlanarProbe;
 use super::scene::{
-    PlanarMeshSpec, PlanarRigidBodySpec, PlanarRigidKind, PlanarScene, PlanarShapeSpec,
-    PlanarSoftBodySpec, PlaneSpec,
+    PlanarBoxSpec, PlanarMeshSpec, PlanarRigidBodySpec, PlanarRigidKind, PlanarScene,
+    PlanarShapeSpec, PlanarSoftBodySpec, PlaneSpec,
 };
 use crate::output::{Cells, RigidBodySnapshot, Snapshot, SoftBodySnapshot};
 use crate::scene::SceneError;
@@ -72,7 +72,7 @@ impl PlanarSimulation {
         let [gx, gy] = scene.world.gravity;
         physics.gravity = [gx as f32, gy as f32].into();
         physics.integration_parameters.dt = scene.world.dt as f32;
-        let rigid = (scene.rigid_body.iter())
+        let rigid: Vec<PlanarRigidEntry> = (scene.rigid_body.iter())
             .map(|spec| insert_rigid(&mut physics, spec))
             .collect();
         let mut bodies = Vec::new();
@@ -93,6 +93,7 @@ impl PlanarSimulation {
         let mut coupling = PlanarCoupling::default();
         coupling.substeps = scene.world.coupling_substeps;
         coupling.friction = scene.world.friction;
+        glue(scene, &rigid, &bodies, (&physics, &mut coupling))?;
         let mut sim = Self {
             physics,
             bodies,
@@ -166,17 +167,42 @@ impl PlanarSimulation {
     }
 }
 
+/// Glues the nodes each soft body's `attach` entries select to their rigid bodies.
+fn glue(
+    scene: &PlanarScene,
+    rigid: &[PlanarRigidEntry],
+    bodies: &[PlanarBody],
+    (physics, coupling): (&PhysicsWorld, &mut PlanarCoupling),
+) -> Result<(), SceneError> {
+    for (i, (spec, body)) in scene.soft_body.iter().zip(bodies).enumerate() {
+        for (k, glue) in spec.attach.iter().enumerate() {
+            let key = format!("soft_body[{i}].attach[{k}]");
+            let region = PlanarBoxSpec {
+                min: glue.min,
+                max: glue.max,
+            };
+            let nodes = nodes_in(body.mesh(), |p| region.contains(p));
+            if nodes.is_empty() {
+                return Err(scene.source.error(&key, "it selects no node of the body"));
+            }
+            // The scene's check has made sure the rigid body exists.
+            let Some(target) = rigid.iter().find(|r| r.name == glue.rigid) else {
+                continue;
+            };
+            coupling
+                .glue(physics, bodies, (i, &nodes), target.handle)
+                .map_err(|e| scene.source.error(&key, e.to_string()))?;
+        }
+    }
+    Ok(())
+}
+
 /// The soft body of `spec`, placed and moving as it says, or the library's error with the key
 /// (`.mesh`, `.material`, `.damping` or none, the body) it is about.
 fn soft_body(spec: &PlanarSoftBodySpec) -> Result<PlanarBody, (&'static str, rapier_fvm::Error)> {
     let mesh = mesh(spec).map_err(|e| (".mesh", e))?;
     let material = spec.material.material().map_err(|e| (".material", e))?;
-    let pinned: Vec<usize> = (mesh.rest_positions().iter().enumerate())
-        .filter(|(_, p)| {
-            (spec.pinned.iter()).any(|b| (0..2).all(|k| (b.min[k]..=b.max[k]).contains(&p[k])))
-        })
-        .map(|(i, _)| i)
-        .collect();
+    let pinned = nodes_in(&mesh, |p| spec.pinned.iter().any(|b| b.contains(p)));
     let mut builder = PlanarBodyBuilder::new(mesh, material)
         .plane(match spec.plane {
             PlaneSpec::Stress => PlaneModel::PlaneStress,
@@ -200,6 +226,14 @@ fn soft_body(spec: &PlanarSoftBodySpec) -> Result<PlanarBody, (&'static str, rap
         }
     }
     Ok(body)
+}
+
+/// The nodes of `mesh` whose rest position (m) `inside` accepts.
+fn nodes_in(mesh: &TriangleMesh, inside: impl Fn([f64; 2]) -> bool) -> Vec<usize> {
+    (mesh.rest_positions().iter().enumerate())
+        .filter(|(_, p)| inside(p.to_array()))
+        .map(|(i, _)| i)
+        .collect()
 }
 
 /// The triangle mesh of `spec`, in its own coordinates.

@@ -11,8 +11,8 @@
 //!
 //! [[probe]]
 //! name = "ground reaction"
-//! kind = "contact_force"  # mean force (N) the soft bodies exerted on rigid body `rigid`'s
-//! rigid = "ground"        # collider over the frame
+//! kind = "contact_force"  # mean force (N) the soft bodies' contacts and attachments exerted
+//! rigid = "ground"        # on rigid body `rigid` over the frame
 //! component = "y"
 //! ```
 //! Other kinds: `position` and `velocity` of rigid body `rigid` (m, m/s); `energy` of soft `body`
@@ -59,7 +59,7 @@ pub enum PlanarProbeKind {
     Position,
     /// A rigid body's linear velocity (m/s).
     Velocity,
-    /// The force soft bodies exert on a rigid body's collider (N).
+    /// The force soft bodies exert on a rigid body through contact and attachments (N).
     ContactForce,
     /// An energy of soft bodies (J).
     Energy,
@@ -225,7 +225,10 @@ impl PlanarProbe {
             }
             PlanarProbeKind::Velocity => rigid.map_or(f64::NAN, |r| vector(r.linvel().as_dvec2())),
             PlanarProbeKind::ContactForce => self.rigid.map_or(f64::NAN, |i| {
-                vector(sim.coupling.force_on(sim.rigid[i].collider))
+                let entry = &sim.rigid[i];
+                vector(
+                    sim.coupling.force_on(entry.collider) + sim.coupling.glue_force(entry.handle),
+                )
             }),
             PlanarProbeKind::Energy => (bodies.iter())
                 .map(|b| energy(b, self.spec.energy, sim.gravity))

@@ -24,6 +24,9 @@
 //! velocity = [0.0, 0.0]       # m/s, default 0
 //! pinned = [{ min = [-1.0, -1.0], max = [1.0, 0.001] }]  # nodes held where they start: those
 //!                             # whose rest position (m, mesh coordinates) lies in a box
+//! attach = [{ min = [0.19, 0.0], max = [0.2, 0.1], rigid = "handle" }]  # nodes in a box glued
+//!                             # where they start to a rigid body (damped springs of the body's
+//!                             # contact stiffness, `PlanarCoupling::glue`)
 //!
 //! [[rigid_body]]
 //! name = "ground"
@@ -133,6 +136,37 @@ pub struct PlanarSoftBodySpec {
     /// Boxes of rest positions (m, mesh coordinates) whose nodes are pinned.
     #[serde(default)]
     pub pinned: Vec<PlanarBoxSpec>,
+    /// Nodes glued to rigid bodies.
+    #[serde(default)]
+    pub attach: Vec<PlanarAttachSpec>,
+}
+
+/// The nodes whose rest position (m, mesh coordinates) lies in the box `min`..`max`, glued
+/// where they start to the rigid body `rigid`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlanarAttachSpec {
+    /// Lower corner (m).
+    pub min: [f64; 2],
+    /// Upper corner (m).
+    pub max: [f64; 2],
+    /// The rigid body's name.
+    pub rigid: String,
+}
+
+impl PlanarBoxSpec {
+    /// Whether `p` (m) lies in the box, bounds included.
+    pub fn contains(&self, p: [f64; 2]) -> bool {
+        (0..2).all(|k| (self.min[k]..=self.max[k]).contains(&p[k]))
+    }
+
+    fn check(&self, key: &str, c: &mut Checker<'_>) {
+        let ordered = (0..2).all(|k| self.min[k] <= self.max[k]);
+        let finite = self.min.iter().chain(&self.max).all(|v| v.is_finite());
+        if !(ordered && finite) {
+            c.fail(key, "`min` must be finite and below `max` on each axis (m)");
+        }
+    }
 }
 
 /// A triangle mesh generator.
@@ -301,7 +335,7 @@ impl PlanarScene {
             seen.push(name);
         }
         for (i, body) in self.soft_body.iter().enumerate() {
-            body.check(&format!("soft_body[{i}]"), &mut c);
+            body.check(&format!("soft_body[{i}]"), &rigid, &mut c);
         }
         for (i, body) in self.rigid_body.iter().enumerate() {
             body.check(&format!("rigid_body[{i}]"), &mut c);
@@ -321,7 +355,7 @@ impl PlanarScene {
 }
 
 impl PlanarSoftBodySpec {
-    fn check(&self, key: &str, c: &mut Checker<'_>) {
+    fn check(&self, key: &str, rigid: &[&str], c: &mut Checker<'_>) {
         c.positive(&format!("{key}.thickness"), self.thickness, "m");
         self.material.check(&format!("{key}.material"), c);
         if let Some(damping) = &self.damping {
@@ -332,13 +366,19 @@ impl PlanarSoftBodySpec {
         let [vx, vy] = self.velocity;
         c.speed(&format!("{key}.velocity"), [vx, vy, 0.0]);
         for (i, pinned) in self.pinned.iter().enumerate() {
-            let key = format!("{key}.pinned[{i}]");
-            let ordered = (0..2).all(|k| pinned.min[k] <= pinned.max[k]);
-            let finite = pinned.min.iter().chain(&pinned.max).all(|v| v.is_finite());
-            if !(ordered && finite) {
+            pinned.check(&format!("{key}.pinned[{i}]"), c);
+        }
+        for (i, glue) in self.attach.iter().enumerate() {
+            let key = format!("{key}.attach[{i}]");
+            let region = PlanarBoxSpec {
+                min: glue.min,
+                max: glue.max,
+            };
+            region.check(&key, c);
+            if !rigid.contains(&glue.rigid.as_str()) {
                 c.fail(
-                    &key,
-                    "`min` must be finite and below `max` on each axis (m)",
+                    &format!("{key}.rigid"),
+                    format!("no rigid body is named {:?}", glue.rigid),
                 );
             }
         }
