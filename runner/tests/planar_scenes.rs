@@ -364,3 +364,53 @@ component = "y"
     };
     assert_names(&error, 19, "soft_body[0].attach[0]", "selects no node");
 }
+
+/// `planar_drop.toml` with quadratic (6-node) triangles averaged per element: the ground
+/// carries both weights to 1 % as with linear triangles, and each element is written as its
+/// four sub-triangles, every node (corners and mid-edge nodes) in one.
+#[test]
+fn the_drop_with_quadratic_triangles_carries_both_weights() {
+    let text = std::fs::read_to_string(scene_path("planar_drop.toml"))
+        .unwrap()
+        .replace(
+            "plane = \"strain\"",
+            "plane = \"strain\"\nelements = \"quadratic\"\nvolumetric = \"element_average\"",
+        );
+    let scene = PlanarScene::parse(scene_path("planar_drop_quadratic.toml"), text).unwrap();
+    let out = out_dir("planar_drop_quadratic");
+    let options = RunOptions {
+        out: out.clone(),
+        duration: None,
+        progress: false,
+    };
+    let report = run_planar(&scene, &options).unwrap();
+    let block = &report.soft_bodies[0];
+    // 10 x 5 cells: 66 corners and 165 edges.
+    assert_eq!(
+        (block.triangles, block.nodes, block.failed_frames),
+        (100, 231, 0)
+    );
+    let weight = (block.mass + report.rigid_bodies[1].2) * 9.81;
+    let reaction = -report.probes[0].final_value;
+    println!("quadratic: the ground carries {reaction:.5} N of {weight:.5} N");
+    assert!(
+        (reaction / weight - 1.0).abs() < 0.01,
+        "{reaction} N against {weight} N"
+    );
+    let vtk = Vtk::import(out.join("paraview/block_00045.vtu")).unwrap();
+    let DataSet::UnstructuredGrid { pieces, .. } = vtk.data else {
+        panic!("not an unstructured grid");
+    };
+    let Piece::Inline(piece) = &pieces[0] else {
+        panic!("not an inline piece");
+    };
+    assert_eq!(piece.cells.types.len(), 400);
+    let VertexNumbers::XML { connectivity, .. } = &piece.cells.cell_verts else {
+        panic!("XML cells");
+    };
+    let mut used = vec![false; 231];
+    for &n in connectivity {
+        used[n as usize] = true;
+    }
+    assert!(used.iter().all(|u| *u));
+}

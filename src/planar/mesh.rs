@@ -115,8 +115,10 @@ impl TriangleMesh {
     /// The nodes of the mesh's 6-node triangles: the corners (same indices), then a node at the
     /// middle of each edge, shared by the triangles on it; each triangle's six nodes, corners
     /// then the mid-edge nodes of edges 01, 12, 20; and the boundary as segments (see
-    /// [`TriangleMesh::boundary_edges`]), each edge cut at its mid-edge node.
-    pub(super) fn quadratic_nodes(&self) -> (Vec<DVec2>, Vec<[u32; 6]>, Vec<[u32; 2]>) {
+    /// [`TriangleMesh::boundary_edges`]), each edge cut at its mid-edge node. A body built
+    /// with [`PlanarBodyBuilder::quadratic`](super::PlanarBodyBuilder::quadratic) has these
+    /// nodes, in this order.
+    pub fn quadratic_nodes(&self) -> (Vec<DVec2>, Vec<[u32; 6]>, Vec<[u32; 2]>) {
         let mut rest = self.rest.clone();
         let mut middle_of = std::collections::HashMap::new();
         let mut middle = |a: u32, b: u32, rest: &mut Vec<DVec2>| -> u32 {

@@ -4,8 +4,8 @@
 
 use super::probe::PlanarProbe;
 use super::scene::{
-    PlanarBoxSpec, PlanarMeshSpec, PlanarRigidBodySpec, PlanarRigidKind, PlanarScene,
-    PlanarShapeSpec, PlanarSoftBodySpec, PlaneSpec,
+    PlanarBoxSpec, PlanarElementsSpec, PlanarMeshSpec, PlanarRigidBodySpec, PlanarRigidKind,
+    PlanarScene, PlanarShapeSpec, PlanarSoftBodySpec, PlaneSpec,
 };
 use crate::output::{Cells, RigidBodySnapshot, Snapshot, SoftBodySnapshot};
 use crate::scene::SceneError;
@@ -132,9 +132,9 @@ impl PlanarSimulation {
                 rest_positions: entry.start.iter().map(lift).collect(),
                 positions: body.positions().iter().map(lift).collect(),
                 velocities: body.velocities().iter().map(lift).collect(),
-                cells: Cells::Triangles(body.mesh().triangles().to_vec()),
-                surface: body.mesh().triangles().to_vec(),
-                cauchy_stress: body.cauchy_stresses(),
+                cells: Cells::Triangles(drawn_triangles(body)),
+                surface: drawn_triangles(body),
+                cauchy_stress: drawn_stresses(body),
             })
             .collect();
         let rigid_bodies = (self.rigid.iter())
@@ -165,6 +165,35 @@ impl PlanarSimulation {
             rigid_bodies,
         }
     }
+}
+
+/// The triangles `body` is drawn and written as: its mesh's, or each 6-node triangle's four
+/// corner and mid-edge sub-triangles (nodes ordered corners then the mid-edge nodes of edges
+/// 01, 12, 20).
+fn drawn_triangles(body: &PlanarBody) -> Vec<[u32; 3]> {
+    if !body.is_quadratic() {
+        return body.mesh().triangles().to_vec();
+    }
+    let (_, elements, _) = body.mesh().quadratic_nodes();
+    (elements.iter())
+        .flat_map(|[a, b, c, ab, bc, ca]| {
+            [
+                [*a, *ab, *ca],
+                [*ab, *b, *bc],
+                [*ca, *bc, *c],
+                [*ab, *bc, *ca],
+            ]
+        })
+        .collect()
+}
+
+/// The Cauchy stress (Pa) of each triangle of [`drawn_triangles`]: its element's.
+fn drawn_stresses(body: &PlanarBody) -> Vec<rapier_fvm::glamx::DMat3> {
+    let per_element = body.cauchy_stresses();
+    if !body.is_quadratic() {
+        return per_element;
+    }
+    per_element.into_iter().flat_map(|s| [s; 4]).collect()
 }
 
 /// Glues the nodes each soft body's `attach` entries select to their rigid bodies.
@@ -209,7 +238,11 @@ fn soft_body(spec: &PlanarSoftBodySpec) -> Result<PlanarBody, (&'static str, rap
             PlaneSpec::Strain => PlaneModel::PlaneStrain,
         })
         .thickness(spec.thickness)
+        .volumetric(spec.volumetric.treatment())
         .pinned_nodes(pinned);
+    if spec.elements == PlanarElementsSpec::Quadratic {
+        builder = builder.quadratic();
+    }
     if let Some(damping) = &spec.damping {
         builder = builder.damping(damping.damping(&material).map_err(|e| (".damping", e))?);
     }

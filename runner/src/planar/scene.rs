@@ -20,6 +20,8 @@
 //! thickness = 0.1             # m, required: masses and forces are per this thickness
 //! material = { model = "stable_neo_hookean", young = 1e5, poisson = 0.3, density = 1000.0 }
 //! damping = { stiffness_time = 1e-3 }  # as 3D scenes' (optional)
+//! elements = "linear"         # or "quadratic" (6-node triangles), default linear
+//! volumetric = "per_element"  # or "nodal_average", "element_average" (quadratic), as in 3D
 //! translation = [-0.1, 0.0]   # m, added to the mesh's coordinates, default 0
 //! velocity = [0.0, 0.0]       # m/s, default 0
 //! pinned = [{ min = [-1.0, -1.0], max = [1.0, 0.001] }]  # nodes held where they start: those
@@ -44,6 +46,7 @@ use super::probe::PlanarProbeSpec;
 use crate::scene::check::Checker;
 use crate::scene::material::{DampingSpec, MaterialSpec};
 use crate::scene::settings::OutputSpec;
+use crate::scene::soft_body::VolumetricSpec;
 use crate::scene::{SceneError, SceneSource};
 use serde::Deserialize;
 use std::path::Path;
@@ -136,6 +139,12 @@ pub struct PlanarSoftBodySpec {
     /// Boxes of rest positions (m, mesh coordinates) whose nodes are pinned.
     #[serde(default)]
     pub pinned: Vec<PlanarBoxSpec>,
+    /// Linear (3-node) or quadratic (6-node) triangles; default linear.
+    #[serde(default)]
+    pub elements: PlanarElementsSpec,
+    /// How the volumetric energy is evaluated (as in 3D scenes); default per element.
+    #[serde(default)]
+    pub volumetric: VolumetricSpec,
     /// Nodes glued to rigid bodies.
     #[serde(default)]
     pub attach: Vec<PlanarAttachSpec>,
@@ -194,6 +203,17 @@ pub enum PlanarMeshSpec {
         /// The triangles' longest edge (m), about.
         edge_length: f64,
     },
+}
+
+/// The triangles of a 2D body.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PlanarElementsSpec {
+    /// 3-node triangles.
+    #[default]
+    Linear,
+    /// 6-node triangles: mid-edge nodes added to the mesh.
+    Quadratic,
 }
 
 /// The plane model, by its scene-file name.

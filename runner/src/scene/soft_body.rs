@@ -123,6 +123,18 @@ pub enum VolumetricSpec {
     ElementAverage,
 }
 
+impl VolumetricSpec {
+    /// The library's treatment.
+    pub fn treatment(self) -> rapier_fvm::fvm::VolumetricTreatment {
+        use rapier_fvm::fvm::VolumetricTreatment;
+        match self {
+            Self::PerElement => VolumetricTreatment::PerElement,
+            Self::NodalAverage => VolumetricTreatment::NodalAverage,
+            Self::ElementAverage => VolumetricTreatment::ElementAverage,
+        }
+    }
+}
+
 /// The elements of a soft body.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "snake_case")]

@@ -9,11 +9,10 @@ use super::regions::BodyRegions;
 use crate::output::{RigidBodySnapshot, Snapshot, SoftBodySnapshot};
 use crate::scene::budget::MemoryUse;
 use crate::scene::rigid_body::{RigidBodySpec, RigidKind, ShapeSpec};
-use crate::scene::soft_body::{SoftBodySpec, VolumetricSpec};
+use crate::scene::soft_body::SoftBodySpec;
 use crate::scene::{Scene, SceneError, SceneSource};
 use rapier_fvm::body::{DeformableBodyBuilder, DeformableBodyHandle};
 use rapier_fvm::coupling::SleepSettings;
-use rapier_fvm::fvm::VolumetricTreatment;
 use rapier_fvm::glamx::{DVec3, Vec3};
 use rapier_fvm::mesh::import::surface;
 use rapier_fvm::world::FvmWorld;
@@ -303,11 +302,7 @@ fn insert_soft(
         .pinned_nodes(pinned)
         .friction(spec.friction)
         .self_contact(spec.self_contact)
-        .volumetric(match spec.volumetric {
-            VolumetricSpec::PerElement => VolumetricTreatment::PerElement,
-            VolumetricSpec::NodalAverage => VolumetricTreatment::NodalAverage,
-            VolumetricSpec::ElementAverage => VolumetricTreatment::ElementAverage,
-        });
+        .volumetric(spec.volumetric.treatment());
     for (nodes, linvel) in velocities {
         builder = builder.nodes_linvel(nodes, linvel);
     }
