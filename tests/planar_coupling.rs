@@ -1,11 +1,12 @@
 //! 2D bodies coupled with rapier2d (feature `dim2`): a rigid box dropped on a soft block on
-//! the ground comes to rest with the ground carrying the weight of both.
+//! the ground comes to rest with the ground carrying the weight of both, explicitly or (a
+//! stiff block alone) implicitly.
 #![cfg(feature = "dim2")]
 
 use rapier_fvm::damping::RayleighDamping;
 use rapier_fvm::glamx::DVec2;
 use rapier_fvm::material::{Material, MaterialModel};
-use rapier_fvm::planar::coupling::PlanarCoupling;
+use rapier_fvm::planar::coupling::{PlanarCoupling, PlanarIntegrator};
 use rapier_fvm::planar::{PlanarBody, PlanarBodyBuilder, PlaneModel, TriangleMesh};
 use rapier2d::prelude::{ColliderBuilder, ColliderHandle, PhysicsWorld, RigidBodyBuilder};
 
@@ -392,4 +393,82 @@ fn a_corner_first_collision_keeps_the_momentum() {
         assert!((l1 - l0).abs() < tolerance * l0.abs(), "{l0} → {l1}");
         assert!(block_speed > 0.3, "the block was not struck");
     }
+}
+
+/// A stiff block (E = 10⁸ Pa damped by a 1 ms stiffness time, 0.2 m × 0.1 m, 10 cm thick,
+/// 2 kg) dropped from 1 mm on the ground under the default integrator
+/// (`PlanarIntegrator::Automatic`): its explicit step would need about 17 000 substeps, so it
+/// steps implicitly (one backward Euler step per coupling substep, its contacts with the ground
+/// in it; no dynamic body, corner or glue in reach), every frame; after 1 s the ground carries
+/// the block's weight to 1 % (the 2D issue's tolerance), the block at rest on it.
+#[test]
+fn an_implicit_block_rests_on_the_ground_carrying_its_weight() {
+    let mut world = PhysicsWorld::default();
+    let ground = ground(&mut world);
+    let stiff = Material::new(MaterialModel::StableNeoHookean, 1e8, 0.3, 1000.0).unwrap();
+    let mesh = TriangleMesh::rectangle(DVec2::new(0.2, 0.1), [10, 5]).unwrap();
+    let damping = RayleighDamping::stiffness_proportional(1e-3, stiff.lame()).unwrap();
+    let mut block = PlanarBodyBuilder::new(mesh, stiff)
+        .plane(PlaneModel::PlaneStrain)
+        .thickness(0.1)
+        .damping(damping)
+        .build()
+        .unwrap();
+    for x in block.positions_mut() {
+        *x += DVec2::new(-0.1, 0.001);
+    }
+    let weight = block.total_mass() * 9.81;
+    let mut bodies = vec![block];
+    let mut coupling = PlanarCoupling::default();
+    assert_eq!(coupling.integrator, PlanarIntegrator::Automatic);
+    let mut implicit = 0;
+    for _ in 0..60 {
+        for report in coupling.step(&mut world, &mut bodies).unwrap() {
+            implicit += usize::from(report.unwrap().implicit);
+        }
+    }
+    let reaction = -coupling.force_on(ground).y;
+    let speed = (bodies[0].velocities().iter()).fold(0.0f64, |m, v| m.max(v.length()));
+    println!(
+        "implicit: the ground carries {reaction:.5} N of {weight:.5} N; fastest node {speed:.2e} m/s"
+    );
+    assert_eq!(implicit, 60);
+    assert!(
+        (reaction / weight - 1.0).abs() < 0.01,
+        "{reaction} N against {weight} N"
+    );
+    assert!(speed < 1e-3, "{speed} m/s");
+}
+
+/// With the implicit integrator, the block under a dynamic box steps explicitly (a staggered
+/// implicit step would freeze the box during it), and the box still rests on it with the
+/// ground carrying both.
+#[test]
+fn a_block_under_a_dynamic_box_steps_explicitly_under_the_implicit_integrator() {
+    let mut world = PhysicsWorld::default();
+    let ground = ground(&mut world);
+    let box_body = world
+        .bodies
+        .insert(RigidBodyBuilder::dynamic().translation([0.0, 0.145].into()));
+    world.colliders.insert_with_parent(
+        ColliderBuilder::cuboid(0.05, 0.025).density(100.0).build(),
+        box_body,
+        &mut world.bodies,
+    );
+    let (block, _) = rubber_block();
+    let block_mass = block.total_mass();
+    let mut bodies = vec![block];
+    let mut coupling = PlanarCoupling::default();
+    coupling.integrator = PlanarIntegrator::Implicit;
+    for _ in 0..180 {
+        for report in coupling.step(&mut world, &mut bodies).unwrap() {
+            assert!(!report.unwrap().implicit);
+        }
+    }
+    let weight = (block_mass + f64::from(world.bodies[box_body].mass())) * 9.81;
+    let reaction = -coupling.force_on(ground).y;
+    assert!(
+        (reaction / weight - 1.0).abs() < 0.01,
+        "{reaction} N against {weight} N"
+    );
 }

@@ -157,12 +157,13 @@ fn run_planar(path: PathBuf, text: String, options: &RunOptions) -> Result<(), S
     );
     for body in &report.soft_bodies {
         println!(
-            "  soft {:<16} {:>6} triangles {:>5} nodes, plane {}, {:.3} kg; at most {} explicit substeps per coupling substep; {} failed",
+            "  soft {:<16} {:>6} triangles {:>5} nodes, plane {}, {:.3} kg; {} implicit frames, at most {} explicit substeps per coupling substep; {} failed",
             body.name,
             body.triangles,
             body.nodes,
             body.plane,
             body.mass,
+            body.implicit_frames,
             body.max_explicit_substeps,
             body.failed_frames
         );

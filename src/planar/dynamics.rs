@@ -31,6 +31,9 @@ pub struct PlanarStepReport {
     pub substeps: u32,
     /// Their length (s).
     pub substep_dt: f64,
+    /// Whether the step was implicit (one backward Euler step, `planar::coupling`'s
+    /// `PlanarIntegrator::Implicit`, feature `dim2`).
+    pub implicit: bool,
 }
 
 impl PlanarBody {
@@ -176,6 +179,7 @@ pub(super) fn advance(
     Ok(PlanarStepReport {
         substeps,
         substep_dt: h,
+        implicit: false,
     })
 }
 

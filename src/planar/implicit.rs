@@ -33,7 +33,7 @@ use crate::material::green_strain;
 use crate::newton::{check_tolerance, norm};
 use crate::statics::StaticSettings;
 use faer::sparse::Triplet;
-use rapier3d::glamx::{DMat3, DVec2};
+use rapier3d::glamx::{DMat2, DMat3, DVec2};
 
 /// What [`step_implicit`] did.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -46,8 +46,23 @@ pub struct PlanarImplicitReport {
     pub angular_momentum_given_back: f64,
 }
 
+/// Terms of `Φ` that act on nodes one at a time, such as contacts with colliders
+/// (`planar::coupling`, feature `dim2`): at positions `x` (m), their energy (J), the forces
+/// they put on the nodes (N, `−∂/∂x`) and each touched node's 2×2 stiffness (N/m, `∂²/∂x²`,
+/// symmetric and positive semi-definite).
+pub(super) trait NodePotential {
+    /// The energy (J) at `x`.
+    fn energy(&self, x: &[DVec2]) -> f64;
+    /// Adds the forces (N) at `x` to `forces`.
+    fn add_forces(&self, x: &[DVec2], forces: &mut [DVec2]);
+    /// The nodes the terms touch at `x`, with their stiffness (N/m).
+    fn stiffness(&self, x: &[DVec2]) -> Vec<(usize, DMat2)>;
+}
+
 /// One backward Euler step: where it starts, what it predicts, what acts.
 struct Step<'a> {
+    /// Per-node terms besides the body's own (contacts).
+    nodal: Option<&'a dyn NodePotential>,
     h: f64,
     start: Vec<DVec2>,
     predicted: Vec<DVec2>,
@@ -81,7 +96,8 @@ impl Minimized for Step<'_> {
                 .sum::<f64>()
                 * body.thickness()
         });
-        inertia + body.elastic_energy_at(x) + dissipation - work
+        let nodal = self.nodal.map_or(0.0, |n| n.energy(x));
+        inertia + body.elastic_energy_at(x) + dissipation + nodal - work
     }
 
     /// `−∂Φ/∂x` (N per node) where `placed` is, zero along held axes.
@@ -96,6 +112,9 @@ impl Minimized for Step<'_> {
                 let p = in_plane_block(&damping.step_first_piola(&f, previous, self.h));
                 points.add_forces(q, &p, body.thickness(), &mut forces);
             }
+        }
+        if let Some(nodal) = self.nodal {
+            nodal.add_forces(x, &mut forces);
         }
         let inverse_h2 = 1.0 / (self.h * self.h);
         let total = (forces.iter().enumerate()).map(|(i, f)| {
@@ -113,6 +132,7 @@ impl Minimized for Step<'_> {
     ) -> Result<Vec<DVec2>, Error> {
         let mut entries = self.unknowns.elastic_entries(self.body, &placed.positions);
         self.damping_entries(placed, &mut entries);
+        self.nodal_entries(placed, &mut entries);
         let inverse_h2 = 1.0 / (self.h * self.h);
         for (slots, m) in self.unknowns.index.iter().zip(self.body.masses()) {
             for k in slots.iter().flatten() {
@@ -124,6 +144,23 @@ impl Minimized for Step<'_> {
 }
 
 impl Step<'_> {
+    /// The per-node terms' tangent entries where `placed` is.
+    fn nodal_entries(&self, placed: &Placed<'_>, entries: &mut Vec<Entry>) {
+        let Some(nodal) = self.nodal else {
+            return;
+        };
+        for (node, k) in nodal.stiffness(&placed.positions) {
+            let slots = self.unknowns.index[node];
+            for (a, row) in slots.iter().enumerate() {
+                for (b, col) in slots.iter().enumerate() {
+                    if let (Some(row), Some(col)) = (row, col) {
+                        entries.push(Triplet::new(*row, *col, k.col(b)[a]));
+                    }
+                }
+            }
+        }
+    }
+
     /// The damping's tangent entries where `placed` is.
     fn damping_entries(&self, placed: &Placed<'_>, entries: &mut Vec<Entry>) {
         let Some((damping, previous)) = &self.damping else {
@@ -175,6 +212,20 @@ pub fn step_implicit(
     loads: &[DVec2],
     settings: &StaticSettings,
 ) -> Result<PlanarImplicitReport, Error> {
+    step_implicit_with(body, (dt, gravity, loads), settings, None)
+}
+
+/// [`step_implicit`] with the per-node terms `nodal` in `Φ` (their forces at the step's end
+/// count as external loads where the angular momentum is given back).
+///
+/// # Errors
+/// Those of [`step_implicit`].
+pub(super) fn step_implicit_with(
+    body: &mut PlanarBody,
+    (dt, gravity, loads): (f64, DVec2, &[DVec2]),
+    settings: &StaticSettings,
+    nodal: Option<&dyn NodePotential>,
+) -> Result<PlanarImplicitReport, Error> {
     check_step(body, dt, gravity, loads)?;
     check_tolerance(settings.tolerance)?;
     let unknowns = Unknowns::new(body.pinned());
@@ -196,6 +247,7 @@ pub fn step_implicit(
         (body.plane().in_plane_damping(d), previous)
     });
     let step = Step {
+        nodal,
         h: dt,
         start,
         predicted,
@@ -210,8 +262,12 @@ pub fn step_implicit(
         .zip(&step.start)
         .map(|(x, x0)| (*x - *x0) / dt)
         .collect();
+    let mut acting = loads.to_vec();
+    if let Some(nodal) = nodal {
+        nodal.add_forces(&positions, &mut acting);
+    }
     let (rotation, given) =
-        angular_give_back(&step, loads, &velocities, &positions, &new_velocities);
+        angular_give_back(&step, &acting, &velocities, &positions, &new_velocities);
     let velocities: Vec<DVec2> = (new_velocities.iter().zip(&positions))
         .map(|(v, x)| *v + rotation(*x))
         .collect();

@@ -33,6 +33,8 @@
 //! ```
 
 mod body;
+#[cfg(feature = "dim2")]
+mod colliders;
 mod control_volume;
 #[cfg(feature = "dim2")]
 mod corners;
@@ -44,6 +46,8 @@ mod evaluate;
 #[cfg(feature = "dim2")]
 mod glue;
 mod implicit;
+#[cfg(feature = "dim2")]
+mod implicit_contact;
 mod mesh;
 mod outline;
 mod plane;

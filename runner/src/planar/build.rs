@@ -4,13 +4,13 @@
 
 use super::probe::PlanarProbe;
 use super::scene::{
-    PlanarBoxSpec, PlanarElementsSpec, PlanarMeshSpec, PlanarRigidBodySpec, PlanarRigidKind,
-    PlanarScene, PlanarShapeSpec, PlanarSoftBodySpec, PlaneSpec,
+    PlanarBoxSpec, PlanarElementsSpec, PlanarIntegratorSpec, PlanarMeshSpec, PlanarRigidBodySpec,
+    PlanarRigidKind, PlanarScene, PlanarShapeSpec, PlanarSoftBodySpec, PlaneSpec,
 };
 use crate::output::{Cells, RigidBodySnapshot, Snapshot, SoftBodySnapshot};
 use crate::scene::SceneError;
 use rapier_fvm::glamx::{DVec2, DVec3};
-use rapier_fvm::planar::coupling::PlanarCoupling;
+use rapier_fvm::planar::coupling::{PlanarCoupling, PlanarIntegrator};
 use rapier_fvm::planar::{PlanarBody, PlanarBodyBuilder, PlaneModel, TriangleMesh};
 use rapier2d::prelude::{
     ColliderBuilder, ColliderHandle, PhysicsWorld, RigidBodyBuilder, RigidBodyHandle,
@@ -93,6 +93,11 @@ impl PlanarSimulation {
         let mut coupling = PlanarCoupling::default();
         coupling.substeps = scene.world.coupling_substeps;
         coupling.friction = scene.world.friction;
+        coupling.integrator = match scene.world.integrator {
+            PlanarIntegratorSpec::Explicit => PlanarIntegrator::Explicit,
+            PlanarIntegratorSpec::Implicit => PlanarIntegrator::Implicit,
+            PlanarIntegratorSpec::Automatic => PlanarIntegrator::Automatic,
+        };
         glue(scene, &rigid, &bodies, (&physics, &mut coupling))?;
         let mut sim = Self {
             physics,

@@ -31,6 +31,8 @@ pub struct PlanarReport {
     pub coupling_substeps: u32,
     /// Soft–rigid friction coefficient.
     pub friction: f64,
+    /// `"explicit"` or `"implicit"`.
+    pub integrator: String,
     /// The soft bodies.
     pub soft_bodies: Vec<PlanarBodyReport>,
     /// The rigid bodies: name, kind and mass (kg per unit thickness of rapier2d's shapes).
@@ -75,6 +77,8 @@ pub struct PlanarBodyReport {
     pub mass: f64,
     /// The most explicit substeps one coupling substep took.
     pub max_explicit_substeps: u32,
+    /// Frames whose last coupling substep stepped the body implicitly.
+    pub implicit_frames: usize,
     /// Frames whose step failed (the body then stays where the failing step left it).
     pub failed_frames: usize,
     /// The first failure's message.
@@ -116,6 +120,7 @@ pub fn run_planar(scene: &PlanarScene, options: &RunOptions) -> Result<PlanarRep
         let outcomes = outcomes.map_err(|e| scene.source.error("world.dt", e.to_string()))?;
         for (report, outcome) in bodies.iter_mut().zip(outcomes) {
             match outcome {
+                Ok(step) if step.implicit => report.implicit_frames += 1,
                 Ok(step) => {
                     report.max_explicit_substeps = report.max_explicit_substeps.max(step.substeps)
                 }
@@ -147,6 +152,7 @@ pub fn run_planar(scene: &PlanarScene, options: &RunOptions) -> Result<PlanarRep
         gravity: scene.world.gravity,
         coupling_substeps: scene.world.coupling_substeps,
         friction: scene.world.friction,
+        integrator: format!("{:?}", scene.world.integrator).to_lowercase(),
         soft_bodies: bodies,
         rigid_bodies: rigid_reports(scene, &sim),
         frames,
@@ -190,6 +196,7 @@ fn body_reports(scene: &PlanarScene, sim: &PlanarSimulation) -> Vec<PlanarBodyRe
             nodes: body.positions().len(),
             mass: body.total_mass(),
             max_explicit_substeps: 0,
+            implicit_frames: 0,
             failed_frames: 0,
             first_failure: None,
         })

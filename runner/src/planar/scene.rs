@@ -10,6 +10,11 @@
 //! coupling_substeps = 4       # the fewest rapier steps per frame, default 4 (more are taken
 //!                             # when contacts with light rigid bodies need them)
 //! friction = 0.5              # between soft bodies and colliders, default 0.5
+//! integrator = "automatic"    # default; "implicit": backward Euler, one step per coupling
+//!                             # substep, for bodies within reach of no dynamic rigid body,
+//!                             # collider corner or attachment (the others step explicitly);
+//!                             # "automatic": implicit there when the explicit step would
+//!                             # need more than 400 substeps; "explicit"
 //!
 //! [[soft_body]]
 //! name = "block"
@@ -96,6 +101,23 @@ pub struct PlanarWorldSpec {
     /// Friction coefficient between soft bodies and colliders; default 0.5.
     #[serde(default = "default_friction")]
     pub friction: f64,
+    /// How the soft bodies step; default automatic.
+    #[serde(default)]
+    pub integrator: PlanarIntegratorSpec,
+}
+
+/// How a 2D scene's soft bodies step, by its scene-file name.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PlanarIntegratorSpec {
+    /// Symplectic Euler substeps.
+    Explicit,
+    /// Backward Euler, one step per coupling substep, where no dynamic rigid body, collider
+    /// corner or attachment is within reach (explicit there).
+    Implicit,
+    /// Implicit where it may be and the explicit step would need more than 400 substeps.
+    #[default]
+    Automatic,
 }
 
 fn default_gravity() -> [f64; 2] {
