@@ -204,3 +204,50 @@ fn quadratic_triangles_converge_sooner() {
     assert!(coarse_error.abs() < 0.01 && finer_error.abs() < 0.002);
     assert_eq!(iterations, 1);
 }
+
+/// The averaged volumetric term carries the same pressure across the plane as in it: for the
+/// linear law with `ε₃₃ = 0` and the volumetric part `K θ̄` averaged, `P = K θ̄ I + 2μ dev ε`,
+/// so `P₃₃ − (P₁₁ + P₂₂)/2 = −μ tr ε` at every point, whatever `θ̄`, to round-off (1e-8 of the
+/// largest stress; the pressure is λ/μ = 20 000 times the shear stiffness). The nearly
+/// incompressible membrane, averaged on node patches on the locking parallel diagonals, where
+/// `θ̄` and `tr ε` differ most.
+#[test]
+fn an_averaged_volumetric_term_gives_the_same_pressure_across_the_plane() {
+    let (lambda, mu) = (7500.0, 0.375);
+    let material = Material::new(
+        MaterialModel::Linear,
+        mu * (3.0 * lambda + 2.0 * mu) / (lambda + mu),
+        lambda / (2.0 * (lambda + mu)),
+        1.0,
+    )
+    .unwrap();
+    let mesh = TriangleMesh::quadrilateral_with(CORNERS, [16, 16], Diagonals::Parallel).unwrap();
+    let mut body = PlanarBodyBuilder::new(mesh, material)
+        .plane(PlaneModel::PlaneStrain)
+        .volumetric(VolumetricTreatment::NodalAverage)
+        .build()
+        .unwrap();
+    for node in body.nodes_on_line(DVec2::ZERO, DVec2::Y, 1e-9) {
+        body.pin(node, [true, true]).unwrap();
+    }
+    let loaded = body.nodes_on_line(DVec2::new(48.0, 0.0), DVec2::Y, 1e-9);
+    let loads = edge_loads(&body, &loaded, DVec2::new(0.0, 1.0), true);
+    solve_planar_equilibrium(&mut body, &loads, &StaticSettings::default()).unwrap();
+    let stresses: Vec<_> = (0..body.mesh().triangles().len())
+        .map(|q| (body.stress(q), body.deformation_gradient(q)))
+        .collect();
+    let largest = (stresses.iter())
+        .map(|(s, _)| {
+            let p = s.p.to_cols_array();
+            p.iter().fold(s.p33.abs(), |m, v| m.max(v.abs()))
+        })
+        .fold(0.0, f64::max);
+    let mut worst = 0.0f64;
+    for (stress, f) in &stresses {
+        let trace = f.x_axis.x + f.y_axis.y - 2.0;
+        let across = stress.p33 - 0.5 * (stress.p.x_axis.x + stress.p.y_axis.y);
+        worst = worst.max((across + mu * trace).abs());
+    }
+    println!("largest stress {largest:.4e}, worst mismatch {worst:.3e}");
+    assert!(worst < 1e-8 * largest, "{worst} against {largest}");
+}

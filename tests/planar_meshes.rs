@@ -198,3 +198,26 @@ proptest::proptest! {
         }
     }
 }
+
+/// A generator asked for more than ten million triangles refuses with a typed error naming
+/// what sets the count, before allocating anything (16 384 × 16 384 cells would be 537 million
+/// triangles, about half a terabyte once built).
+#[test]
+fn generators_refuse_more_than_ten_million_triangles() {
+    for mesh in [
+        TriangleMesh::rectangle(DVec2::ONE, [16384, 16384]),
+        TriangleMesh::disk(1.0, 16384),
+    ] {
+        match mesh {
+            Err(Error::InvalidGeneratorParameter { reason, .. }) => {
+                assert!(reason.contains("ten million"), "{reason}");
+            }
+            other => panic!(
+                "expected a refusal, got {:?}",
+                other.map(|m| m.triangles().len())
+            ),
+        }
+    }
+    // At the limit's scale but below it: 2 × 2 000 × 2 000 = 8 million triangles are made.
+    assert!(TriangleMesh::rectangle(DVec2::ONE, [2000, 2000]).is_ok());
+}

@@ -55,6 +55,7 @@ enum Command {
         /// The most memory the soft bodies may need, in GB (10⁹ bytes); default the memory
         /// available (`MemAvailable` in `/proc/meminfo`, 8 GB where that is unknown). A scene whose
         /// meshes are estimated to need more is refused, with the estimate, before any is built.
+        /// For 3D scenes; a 2D scene's generators make at most ten million triangles each.
         #[arg(long, value_name = "GB")]
         memory_limit: Option<f64>,
     },
@@ -145,15 +146,14 @@ fn calibrate() -> Result<(), String> {
 fn run_planar(path: PathBuf, text: String, options: &RunOptions) -> Result<(), String> {
     let scene = PlanarScene::parse(&path, text).map_err(|e| e.to_string())?;
     let report = planar::run_planar(&scene, options).map_err(|e| e.to_string())?;
-    println!(
-        "{} (2D): {} frames, {:.3} s simulated in {:.2} s ({:.2} s stepping, {:.2} ms per frame, {:.2}x real time)",
-        report.scene,
+    print_timing(
+        &format!("{} (2D)", report.scene),
         report.frames,
-        report.simulated_time,
-        report.wall_time_s,
-        report.stepping_time_s,
-        report.ms_per_frame,
-        report.speed_vs_real_time
+        [
+            report.simulated_time,
+            report.wall_time_s,
+            report.stepping_time_s,
+        ],
     );
     for body in &report.soft_bodies {
         println!(
@@ -213,55 +213,29 @@ fn run(
     Ok(())
 }
 
+/// Prints the first line of a run's summary: `label`, the frames, the simulated, wall and
+/// stepping times (s), the time per frame and the speed against real time.
+fn print_timing(label: &str, frames: usize, [simulated, wall, stepping]: [f64; 3]) {
+    println!(
+        "{label}: {frames} frames, {simulated:.3} s simulated in {wall:.2} s ({stepping:.2} s stepping, {:.2} ms per frame, {:.2}x real time)",
+        stepping * 1e3 / frames.max(1) as f64,
+        simulated / stepping.max(1e-9),
+    );
+}
+
 /// Prints the summary of a 3D run written into `out`.
 fn print_summary(report: &sim::Report, out: &std::path::Path) {
-    println!(
-        "{}: {} frames, {:.3} s simulated in {:.2} s ({:.2} s stepping, {:.2} ms per frame, {:.2}x real time)",
-        report.scene,
+    print_timing(
+        &report.scene,
         report.frames,
-        report.simulated_time,
-        report.wall_time_s,
-        report.stepping_time_s,
-        report.ms_per_frame,
-        report.speed_vs_real_time
+        [
+            report.simulated_time,
+            report.wall_time_s,
+            report.stepping_time_s,
+        ],
     );
     for body in &report.soft_bodies {
-        let embedded = body
-            .embedded_tets
-            .map_or(String::new(), |tets| format!(", carrying {tets} tets"));
-        println!(
-            "  soft {:<16} {:>6} {} {:>5} nodes{embedded}; {} explicit / {} implicit / {} asleep frames; {} failed; max inverted {}",
-            body.name,
-            body.elements,
-            body.element_kind,
-            body.nodes,
-            body.explicit_frames,
-            body.implicit_frames,
-            body.asleep_frames,
-            body.failed_frames,
-            body.max_inverted_elements
-        );
-        let c = &body.cost;
-        println!(
-            "       {:<16} per step: predicted explicit {:.3} ms, implicit {:.3} ms; used {:.3} ms predicted, {:.3} ms measured ({:.2}x; explicit steps {:.2}x, median {:.2}x; implicit {:.2}x, median {:.2}x)",
-            "",
-            c.predicted_explicit_ms,
-            c.predicted_implicit_ms,
-            c.predicted_ms,
-            c.measured_ms,
-            c.measured_over_predicted,
-            c.explicit.measured_over_predicted,
-            c.explicit.median_measured_over_predicted,
-            c.implicit.measured_over_predicted,
-            c.implicit.median_measured_over_predicted,
-        );
-        if c.implicit.steps > 0 {
-            let w = &c.implicit_work;
-            println!(
-                "       {:<16} implicit step: {:.2} Newton iterations, {:.2} factorizations, {:.2} energy evaluations",
-                "", w.newton_iterations, w.factorizations, w.energy_evaluations
-            );
-        }
+        print_soft_body(body);
     }
     for probe in &report.probes {
         println!(
@@ -296,6 +270,47 @@ fn print_summary(report: &sim::Report, out: &std::path::Path) {
         );
     }
     println!("  written to {}", out.display());
+}
+
+/// Prints a 3D soft body's line of the summary: its elements, frames, failures and the cost
+/// of its steps.
+fn print_soft_body(body: &sim::SoftBodyReport) {
+    let embedded = body
+        .embedded_tets
+        .map_or(String::new(), |tets| format!(", carrying {tets} tets"));
+    println!(
+        "  soft {:<16} {:>6} {} {:>5} nodes{embedded}; {} explicit / {} implicit / {} asleep frames; {} failed; max inverted {}",
+        body.name,
+        body.elements,
+        body.element_kind,
+        body.nodes,
+        body.explicit_frames,
+        body.implicit_frames,
+        body.asleep_frames,
+        body.failed_frames,
+        body.max_inverted_elements
+    );
+    let c = &body.cost;
+    println!(
+        "       {:<16} per step: predicted explicit {:.3} ms, implicit {:.3} ms; used {:.3} ms predicted, {:.3} ms measured ({:.2}x; explicit steps {:.2}x, median {:.2}x; implicit {:.2}x, median {:.2}x)",
+        "",
+        c.predicted_explicit_ms,
+        c.predicted_implicit_ms,
+        c.predicted_ms,
+        c.measured_ms,
+        c.measured_over_predicted,
+        c.explicit.measured_over_predicted,
+        c.explicit.median_measured_over_predicted,
+        c.implicit.measured_over_predicted,
+        c.implicit.median_measured_over_predicted,
+    );
+    if c.implicit.steps > 0 {
+        let w = &c.implicit_work;
+        println!(
+            "       {:<16} implicit step: {:.2} Newton iterations, {:.2} factorizations, {:.2} energy evaluations",
+            "", w.newton_iterations, w.factorizations, w.energy_evaluations
+        );
+    }
 }
 
 /// A flag as the summary prints it: `-` when never raised, else its first frame, frame count and

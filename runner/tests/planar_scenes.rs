@@ -47,7 +47,7 @@ fn every_shipped_2d_scene_parses_and_builds() {
 /// `planar_drop.toml`: a 0.5 kg box dropped from 2 cm on a 2 kg block of soft rubber on the
 /// ground. After its 3 s the mean force on the ground over the last frame is the weight of
 /// both, 24.525 N, to 1 % (the 2D issue's tolerance; `tests/planar_coupling.rs` measures
-/// 24.5250 N for the same bodies built in code), and the box rests on the block (its centre
+/// 24.5247 N for the same bodies built in code), and the box rests on the block (its centre
 /// 2.5 cm above the block's top, 10 cm less the block's squash).
 #[test]
 fn the_dropped_box_rests_with_the_ground_carrying_both_weights() {
@@ -97,10 +97,15 @@ fn the_dropped_box_rests_with_the_ground_carrying_both_weights() {
     assert_eq!(json["dimension"], 2);
     assert_eq!(json["soft_bodies"][0]["plane"], "strain");
 
-    // The last .vtu: the mesh's triangles as cells, its nodes at z = 0, the displacements the
-    // points less where the nodes started.
-    let sim = PlanarSimulation::build(&scene).unwrap();
-    let vtk = Vtk::import(out.join("paraview/block_00045.vtu")).unwrap();
+    assert_last_vtu_matches(&scene, &out.join("paraview/block_00045.vtu"));
+}
+
+/// Asserts the `.vtu` at `path` holds the first soft body of `scene` as its run left it: the
+/// mesh's triangles as cells, its nodes at z = 0, the displacements the points less where the
+/// nodes started.
+fn assert_last_vtu_matches(scene: &PlanarScene, path: &Path) {
+    let sim = PlanarSimulation::build(scene).unwrap();
+    let vtk = Vtk::import(path).unwrap();
     let DataSet::UnstructuredGrid { pieces, .. } = vtk.data else {
         panic!("not an unstructured grid");
     };
@@ -163,12 +168,7 @@ fn malformed_2d_scenes_are_refused_with_file_line_and_key() {
         "duration = 3.0",
         "duration = 3.0\ngravity = [0.0, -9.81, 0.0]",
     );
-    assert_names(
-        &gravity,
-        10,
-        "world.gravity",
-        "more elements than the key takes",
-    );
+    assert_names(&gravity, 10, "world.gravity", "more than the key takes");
     let text = broken(
         "duration = 3.0",
         "duration = 3.0\ngravity = [0.0, \"down\"]",
@@ -425,4 +425,62 @@ fn the_drop_with_quadratic_triangles_carries_both_weights() {
         used[n as usize] = true;
     }
     assert!(used.iter().all(|u| *u));
+}
+
+/// What the checks catch beyond types: a non-finite half extent or rotation at its own key, a
+/// pin box selecting no node (boxes are in mesh coordinates) at its key when the scene is
+/// built, and a 2D scene given to the 3D reader named as one.
+#[test]
+fn non_finite_shapes_empty_pin_boxes_and_misread_2d_scenes_are_refused() {
+    let extent = broken(
+        "half_extents = [0.05, 0.025]",
+        "half_extents = [nan, 0.025]",
+    );
+    assert_names(
+        &extent,
+        19,
+        "rigid_body[1].shape.cuboid.half_extents[0]",
+        "positive",
+    );
+    let rotation = broken(
+        "translation = [0.0, 0.145]",
+        "translation = [0.0, 0.145]\nrotation = nan",
+    );
+    assert_names(&rotation, 21, "rigid_body[1].rotation", "finite");
+    let text = std::fs::read_to_string(scene_path("planar_drop.toml")).unwrap();
+    let far = text.replace(
+        "translation = [-0.1, 0.0005]",
+        "translation = [-0.1, 0.0005]\npinned = [{ min = [5.0, 5.0], max = [6.0, 6.0] }]",
+    );
+    let scene = PlanarScene::parse("scenes/bad.toml", far).unwrap();
+    let Err(error) = PlanarSimulation::build(&scene) else {
+        panic!("a pin box selecting no node should be refused");
+    };
+    assert_names(&error, 31, "soft_body[0].pinned[0]", "selects no node");
+    let error = rapier_fvm_runner::scene::Scene::parse("scenes/bad.toml", text).unwrap_err();
+    assert!(error.to_string().contains("a 2D scene"), "{error}");
+}
+
+/// A pin box on a quadratic body holds the mid-edge nodes inside it too, not only the corners:
+/// every node on the left edge of the block, corners and mid-edge nodes, is held.
+#[test]
+fn a_pin_box_holds_the_mid_edge_nodes_of_quadratic_triangles() {
+    let text = std::fs::read_to_string(scene_path("planar_drop.toml"))
+        .unwrap()
+        .replace(
+            "plane = \"strain\"",
+            "plane = \"strain\"\nelements = \"quadratic\"\npinned = [{ min = [-0.001, -1.0], max = [0.001, 1.0] }]",
+        );
+    let scene = PlanarScene::parse(scene_path("planar_drop.toml"), text).unwrap();
+    let sim = PlanarSimulation::build(&scene).unwrap();
+    let block = &sim.bodies[0];
+    let left: Vec<usize> = (block.rest_positions().iter().enumerate())
+        .filter(|(_, p)| p.x.abs() < 1e-9)
+        .map(|(i, _)| i)
+        .collect();
+    // 5 cells up the edge: 6 corners and 5 mid-edge nodes.
+    assert_eq!(left.len(), 11);
+    assert!(left.iter().all(|&n| block.pinned()[n] == [true, true]));
+    let held = block.pinned().iter().filter(|p| p[0] || p[1]).count();
+    assert_eq!(held, 11);
 }

@@ -326,12 +326,7 @@ fn a_vector_with_more_elements_than_its_key_takes_is_refused() {
         "dt = 0.01",
         "dt = 0.01\ngravity = [0.0, -9.81, 0.0, 7.0]",
     ));
-    assert_names(&e, 6, "world.gravity", "more elements than the key takes");
+    assert_names(&e, 6, "world.gravity", "more than the key takes");
     let e = error(with_soft_body_key("angvel = [0.0, 3.0, 0.0, 1.0]"));
-    assert_names(
-        &e,
-        16,
-        "soft_body[0].angvel",
-        "more elements than the key takes",
-    );
+    assert_names(&e, 16, "soft_body[0].angvel", "more than the key takes");
 }

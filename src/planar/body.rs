@@ -434,19 +434,14 @@ impl PlanarBody {
     }
 
     /// The stress at integration point `q` (see [`PlanarStress`]): the model's at its
-    /// deformation gradient, with an averaged volumetric term its volumetric part averaged as the forces
-    /// take it.
+    /// deformation gradient, with an averaged volumetric term its volumetric part (in `P` and
+    /// `P₃₃`) averaged as the forces take it.
     pub fn stress(&self, q: usize) -> PlanarStress {
         self.with_law(|law| {
             if self.averaging.is_none() {
                 return law.stress(&self.points.gradient(q, &self.positions));
             }
-            let evaluation = self.evaluate(law, &self.positions);
-            let stress = law.stress(&evaluation.gradients[q]);
-            PlanarStress {
-                p: self.point_stress(law, &evaluation, q),
-                ..stress
-            }
+            self.point_planar_stress(law, &self.evaluate(law, &self.positions), q)
         })
     }
 

@@ -136,6 +136,20 @@ pub(super) fn check_step(
 /// moves, or `None` for none: contacts with colliders (`planar::coupling`, feature `dim2`).
 pub(super) type ExtraForces<'a> = dyn FnMut(&PlanarBody) -> Option<Vec<DVec2>> + 'a;
 
+/// How many explicit substeps (not rounded) a step of `dt` (s) of `body` needs: `dt` over
+/// [`SAFETY_FACTOR`] times its stability limit, lowered for a frequency `ω_extra²` (1/s²) that
+/// extra forces (contacts) add to its highest.
+pub(super) fn explicit_substeps(body: &PlanarBody, dt: f64, extra_frequency_squared: f64) -> f64 {
+    let undamped = body.critical_time_step();
+    let limit = if extra_frequency_squared > 0.0 {
+        let omega = 2.0 / undamped;
+        SAFETY_FACTOR * undamped * omega / (omega * omega + extra_frequency_squared).sqrt()
+    } else {
+        SAFETY_FACTOR * undamped
+    };
+    dt / limit
+}
+
 /// [`step_explicit`]'s substeps, with `extra` forces added at each and the stability limit
 /// lowered for a frequency `ω_extra²` (1/s²) they add to the highest.
 pub(super) fn advance(
@@ -145,14 +159,7 @@ pub(super) fn advance(
     extra_frequency_squared: f64,
     extra: &mut ExtraForces<'_>,
 ) -> Result<PlanarStepReport, Error> {
-    let undamped = body.critical_time_step();
-    let limit = if extra_frequency_squared > 0.0 {
-        let omega = 2.0 / undamped;
-        SAFETY_FACTOR * undamped * omega / (omega * omega + extra_frequency_squared).sqrt()
-    } else {
-        SAFETY_FACTOR * undamped
-    };
-    let needed = (dt / limit).ceil();
+    let needed = explicit_substeps(body, dt, extra_frequency_squared).ceil();
     if needed.is_nan() || needed > f64::from(MAX_SUBSTEPS) {
         return Err(Error::TooManySubsteps {
             frame_dt: dt,

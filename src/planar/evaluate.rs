@@ -31,6 +31,8 @@ pub(super) trait PlanarLawDyn {
     fn volume_gradient(&self, f: &DMat2) -> DMat2;
     /// See [`PlanarLaw::volume_differential`].
     fn volume_differential(&self, f: &DMat2, df: &DMat2) -> DMat2;
+    /// See [`PlanarLaw::volume_gradient_across`].
+    fn volume_gradient_across(&self, f: &DMat2) -> f64;
     /// See [`PlanarLaw::energy_without_volumetric`].
     fn energy_without_volumetric(&self, f: &DMat2) -> f64;
 }
@@ -56,6 +58,9 @@ impl<M: VolumetricTerm> PlanarLawDyn for PlanarLaw<M> {
     }
     fn volume_differential(&self, f: &DMat2, df: &DMat2) -> DMat2 {
         PlanarLaw::volume_differential(self, f, df)
+    }
+    fn volume_gradient_across(&self, f: &DMat2) -> f64 {
+        PlanarLaw::volume_gradient_across(self, f)
     }
     fn energy_without_volumetric(&self, f: &DMat2) -> f64 {
         PlanarLaw::energy_without_volumetric(self, f)
@@ -119,6 +124,30 @@ impl PlanarBody {
         }
     }
 
+    /// Point `q`'s stress in `evaluation` (see [`PlanarStress`]): the model's, with an averaged
+    /// volumetric term's correction `K (θ̄ − m) ∂m/∂F₃` in both `P` and `P₃₃` (averaging is
+    /// plane strain's, at unit stretch).
+    pub(super) fn point_planar_stress(
+        &self,
+        law: &dyn PlanarLawDyn,
+        evaluation: &Evaluation,
+        q: usize,
+    ) -> PlanarStress {
+        let f = &evaluation.gradients[q];
+        let stress = law.stress(f);
+        match &evaluation.averages {
+            Some(a) => {
+                let shift = law.bulk_modulus() * (a.point[q] - a.measure[q]);
+                PlanarStress {
+                    p: stress.p + law.volume_gradient(f) * shift,
+                    p33: stress.p33 + law.volume_gradient_across(f) * shift,
+                    ..stress
+                }
+            }
+            None => stress,
+        }
+    }
+
     /// The Cauchy stress (Pa, 3×3 with `σ₃₃` across the plane) of each element where the body
     /// is: its integration point's for a linear triangle, the mean of its three points' for a
     /// quadratic one, with an averaged volumetric term as the forces take it.
@@ -127,12 +156,7 @@ impl PlanarBody {
             let evaluation = self.evaluate(law, self.positions());
             let per_element = self.points().per_element();
             let cauchy = |q: usize| {
-                let f = &evaluation.gradients[q];
-                let stress = PlanarStress {
-                    p: self.point_stress(law, &evaluation, q),
-                    ..law.stress(f)
-                };
-                stress.cauchy(f)
+                (self.point_planar_stress(law, &evaluation, q)).cauchy(&evaluation.gradients[q])
             };
             (0..self.points().len() / per_element)
                 .map(|e| {

@@ -215,8 +215,9 @@ pub fn step_implicit(
     step_implicit_with(body, (dt, gravity, loads), settings, None)
 }
 
-/// [`step_implicit`] with the per-node terms `nodal` in `Φ` (their forces at the step's end
-/// count as external loads where the angular momentum is given back).
+/// [`step_implicit`] with the per-node terms `nodal` in `Φ`: where the angular momentum is
+/// given back, their forces at the step's end count with the external loads, their torque
+/// about the centre of mass or about the hinge.
 ///
 /// # Errors
 /// Those of [`step_implicit`].
@@ -262,12 +263,17 @@ pub(super) fn step_implicit_with(
         .zip(&step.start)
         .map(|(x, x0)| (*x - *x0) / dt)
         .collect();
-    let mut acting = loads.to_vec();
+    let mut contact = vec![DVec2::ZERO; positions.len()];
     if let Some(nodal) = nodal {
-        nodal.add_forces(&positions, &mut acting);
+        nodal.add_forces(&positions, &mut contact);
     }
-    let (rotation, given) =
-        angular_give_back(&step, &acting, &velocities, &positions, &new_velocities);
+    let (rotation, given) = angular_give_back(
+        &step,
+        (loads, &contact),
+        &velocities,
+        &positions,
+        &new_velocities,
+    );
     let velocities: Vec<DVec2> = (new_velocities.iter().zip(&positions))
         .map(|(v, x)| *v + rotation(*x))
         .collect();
@@ -305,10 +311,10 @@ fn newton(step: &Step<'_>, settings: &StaticSettings) -> Result<(usize, f64, Vec
 /// The rigid rotation's velocity field (m/s at a position) that gives back the angular
 /// momentum the step took, and that angular momentum (kg m²/s); see the module's documentation.
 /// `before` and `after` are the velocities (m/s) at the step's start and end, `positions` its
-/// end.
+/// end; `loads` the nodal loads (N) and `contact` the per-node terms' forces (N) at the end.
 fn angular_give_back(
     step: &Step<'_>,
-    loads: &[DVec2],
+    (loads, contact): (&[DVec2], &[DVec2]),
     before: &[DVec2],
     positions: &[DVec2],
     after: &[DVec2],
@@ -336,10 +342,8 @@ fn angular_give_back(
                     .map(|((m, x), v)| m * (*x - c).perp_dot(*v - vc))
                     .sum()
             };
-            let torque: f64 = positions
-                .iter()
-                .zip(loads)
-                .map(|(x, f)| (*x - c1).perp_dot(*f))
+            let torque: f64 = (positions.iter().zip(loads).zip(contact))
+                .map(|((x, f), c)| (*x - c1).perp_dot(*f + *c))
                 .sum();
             (
                 c1,
@@ -356,7 +360,10 @@ fn angular_give_back(
             };
             let torque: f64 = (step.start.iter().zip(&step.external))
                 .map(|(x, f)| (*x - p).perp_dot(*f))
-                .sum();
+                .sum::<f64>()
+                + (positions.iter().zip(contact))
+                    .map(|(x, c)| (*x - p).perp_dot(*c))
+                    .sum::<f64>();
             (
                 p,
                 about(&step.start, before) + step.h * torque,

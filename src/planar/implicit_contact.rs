@@ -10,8 +10,9 @@
 //!   `u = (x − x₀ − h v_c)·t₀` (`t₀ = n₀⊥`, `v_c` the collider's velocity there), with the
 //!   potential `μ λ F(u)`, `F(u) = u²/ε − |u|³/(3ε²) + ε/3` below `ε = STICKING_SPEED h` and
 //!   `|u|` above: the friction force `μ λ min(1, 2|u|/ε − u²/ε²)` is Coulomb's above the sliding
-//!   speed [`STICKING_SPEED`], as in the explicit step, and its stiffness
-//!   `μ λ (2/ε − 2|u|/ε²) t₀ t₀ᵀ` below it.
+//!   speed [`STICKING_SPEED`], as in the explicit step (below it the explicit step's viscous
+//!   law has half this one's slope at rest), and its stiffness `μ λ (2/ε − 2|u|/ε²) t₀ t₀ᵀ`
+//!   below it.
 //!
 //! No damping term: backward Euler damps the contact's own vibration (frequency `√(k/m)`,
 //! far above `1/h`) by itself.

@@ -188,6 +188,24 @@ fn check_triangle(triangle: usize, nodes: [u32; 3], rest: &[DVec2]) -> Result<()
     Ok(())
 }
 
+/// The most triangles a generator makes (as [`TriangleMesh::polygon`]'s), so that a mistyped
+/// cell count is refused rather than exhausting memory (about 1 kB per triangle once a body is
+/// built).
+const MAX_GENERATED_TRIANGLES: f64 = 1e7;
+
+/// Checks that a generator making `triangles` triangles stays within
+/// [`MAX_GENERATED_TRIANGLES`]; `parameter` and `value` name what sets it.
+fn check_triangle_count(parameter: &'static str, value: f64, triangles: f64) -> Result<(), Error> {
+    if triangles > MAX_GENERATED_TRIANGLES {
+        return Err(Error::InvalidGeneratorParameter {
+            parameter,
+            value,
+            reason: "would make more than ten million triangles",
+        });
+    }
+    Ok(())
+}
+
 /// Checks that a generator's `cells` count is at least one.
 fn check_cells(parameter: &'static str, cells: usize) -> Result<(), Error> {
     if cells == 0 || cells > 1 << 14 {
@@ -208,8 +226,9 @@ impl TriangleMesh {
     /// `[(0,0), (48,44), (48,60), (0,44)]`.
     ///
     /// # Errors
-    /// [`Error::InvalidGeneratorParameter`] for zero cells or more than 16 384 along a side;
-    /// the errors of [`TriangleMesh::new`] for corners that fold the quadrilateral.
+    /// [`Error::InvalidGeneratorParameter`] for zero cells, more than 16 384 along a side or more
+    /// than ten million triangles; the errors of [`TriangleMesh::new`] for corners that fold the
+    /// quadrilateral.
     pub fn quadrilateral(corners: [DVec2; 4], cells: [usize; 2]) -> Result<Self, Error> {
         Self::quadrilateral_with(corners, cells, Diagonals::Alternating)
     }
@@ -225,6 +244,8 @@ impl TriangleMesh {
     ) -> Result<Self, Error> {
         check_cells("cells[0]", cells[0])?;
         check_cells("cells[1]", cells[1])?;
+        let triangles = 2.0 * cells[0] as f64 * cells[1] as f64;
+        check_triangle_count("cells[0] × cells[1]", triangles / 2.0, triangles)?;
         let [nx, ny] = cells;
         let [p0, p1, p2, p3] = corners;
         let mut rest = Vec::with_capacity((nx + 1) * (ny + 1));
@@ -263,7 +284,8 @@ impl TriangleMesh {
     /// y (see [`TriangleMesh::quadrilateral`]).
     ///
     /// # Errors
-    /// [`Error::InvalidGeneratorParameter`] for a non-positive or non-finite size or bad cells.
+    /// [`Error::InvalidGeneratorParameter`] for a non-positive or non-finite size, bad cells or
+    /// more than ten million triangles.
     pub fn rectangle(size: DVec2, cells: [usize; 2]) -> Result<Self, Error> {
         for (parameter, value) in [("size.x", size.x), ("size.y", size.y)] {
             if !(value.is_finite() && value > 0.0) {
@@ -287,7 +309,8 @@ impl TriangleMesh {
     /// centre node, ring `k` holding `6 k` nodes on its circle (nearly equilateral triangles).
     ///
     /// # Errors
-    /// [`Error::InvalidGeneratorParameter`] for a non-positive radius or bad rings.
+    /// [`Error::InvalidGeneratorParameter`] for a non-positive radius, bad rings or more than
+    /// ten million triangles.
     pub fn disk(radius: f64, rings: usize) -> Result<Self, Error> {
         if !(radius.is_finite() && radius > 0.0) {
             return Err(Error::InvalidGeneratorParameter {
@@ -297,6 +320,7 @@ impl TriangleMesh {
             });
         }
         check_cells("rings", rings)?;
+        check_triangle_count("rings", rings as f64, 6.0 * (rings as f64).powi(2))?;
         let mut rest = vec![DVec2::ZERO];
         for k in 1..=rings {
             let r = radius * k as f64 / rings as f64;

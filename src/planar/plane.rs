@@ -176,6 +176,12 @@ impl<M: VolumetricTerm> PlanarLaw<M> {
         in_plane(&self.model.volume_measure_gradient(&embed(f, 1.0)))
     }
 
+    /// The component of `∂m/∂F₃` across the plane (dimensionless), at the unit stretch of plane
+    /// strain: what an averaged volumetric term adds to `P₃₃` per unit of pressure shift.
+    pub fn volume_gradient_across(&self, f: &DMat2) -> f64 {
+        self.model.volume_measure_gradient(&embed(f, 1.0)).z_axis.z
+    }
+
     /// The differential of the gradient for an in-plane change `df`.
     pub fn volume_differential(&self, f: &DMat2, df: &DMat2) -> DMat2 {
         in_plane(&(self.model).volume_measure_differential(&embed(f, 1.0), &embed(df, 0.0)))

@@ -1,6 +1,7 @@
 //! A software z-buffer: triangles with per-vertex colours filled pixel by pixel, keeping the
-//! nearest surface at each pixel; segments drawn over them (the edges of 2D meshes). Pixels are sampled at their centres; a triangle covers the
-//! pixels whose centre lies inside it (either winding).
+//! nearest surface at each pixel; segments drawn over them (the edges of 2D meshes). Pixels are
+//! sampled at their centres; a triangle covers the pixels whose centre lies inside it (either
+//! winding).
 
 use rapier_fvm::glamx::DVec3;
 

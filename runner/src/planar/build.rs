@@ -78,9 +78,8 @@ impl PlanarSimulation {
         let mut bodies = Vec::new();
         let mut soft = Vec::new();
         for (i, spec) in scene.soft_body.iter().enumerate() {
-            let at = |(key, e): (&str, rapier_fvm::Error)| {
-                let key = format!("soft_body[{i}]{key}");
-                scene.source.error(&key, e.to_string())
+            let at = |(key, message): (String, String)| {
+                scene.source.error(&format!("soft_body[{i}]{key}"), message)
             };
             let body = soft_body(spec).map_err(at)?;
             soft.push(PlanarSoftEntry {
@@ -215,7 +214,7 @@ fn glue(
                 min: glue.min,
                 max: glue.max,
             };
-            let nodes = nodes_in(body.mesh(), |p| region.contains(p));
+            let nodes = nodes_in(body.rest_positions(), |p| region.contains(p));
             if nodes.is_empty() {
                 return Err(scene.source.error(&key, "it selects no node of the body"));
             }
@@ -231,12 +230,28 @@ fn glue(
     Ok(())
 }
 
-/// The soft body of `spec`, placed and moving as it says, or the library's error with the key
-/// (`.mesh`, `.material`, `.damping` or none, the body) it is about.
-fn soft_body(spec: &PlanarSoftBodySpec) -> Result<PlanarBody, (&'static str, rapier_fvm::Error)> {
-    let mesh = mesh(spec).map_err(|e| (".mesh", e))?;
-    let material = spec.material.material().map_err(|e| (".material", e))?;
-    let pinned = nodes_in(&mesh, |p| spec.pinned.iter().any(|b| b.contains(p)));
+/// The soft body of `spec`, placed and moving as it says, or an error (the library's, or a pin
+/// box selecting no node) with the key it is about (`.mesh`, `.material`, `.pinned[i]`,
+/// `.damping` or `.volumetric`).
+fn soft_body(spec: &PlanarSoftBodySpec) -> Result<PlanarBody, (String, String)> {
+    let at = |key: &'static str| move |e: rapier_fvm::Error| (key.to_owned(), e.to_string());
+    let mesh = mesh(spec).map_err(at(".mesh"))?;
+    let material = spec.material.material().map_err(at(".material"))?;
+    // The body's nodes in its order: the mesh's, then the mid-edge nodes of quadratic triangles.
+    let nodes = match spec.elements {
+        PlanarElementsSpec::Linear => mesh.rest_positions().to_vec(),
+        PlanarElementsSpec::Quadratic => mesh.quadratic_nodes().0,
+    };
+    let mut pinned = Vec::new();
+    for (i, region) in spec.pinned.iter().enumerate() {
+        let selected = nodes_in(&nodes, |p| region.contains(p));
+        if selected.is_empty() {
+            let message = "it selects no node of the body (its box is in mesh coordinates, \
+                           before `translation`)";
+            return Err((format!(".pinned[{i}]"), message.to_owned()));
+        }
+        pinned.extend(selected);
+    }
     let mut builder = PlanarBodyBuilder::new(mesh, material)
         .plane(match spec.plane {
             PlaneSpec::Stress => PlaneModel::PlaneStress,
@@ -249,9 +264,10 @@ fn soft_body(spec: &PlanarSoftBodySpec) -> Result<PlanarBody, (&'static str, rap
         builder = builder.quadratic();
     }
     if let Some(damping) = &spec.damping {
-        builder = builder.damping(damping.damping(&material).map_err(|e| (".damping", e))?);
+        builder = builder.damping(damping.damping(&material).map_err(at(".damping"))?);
     }
-    let mut body = builder.build().map_err(|e| ("", e))?;
+    // The builder refuses only the averaged volumetric terms it cannot take.
+    let mut body = builder.build().map_err(at(".volumetric"))?;
     let offset = DVec2::from_array(spec.translation);
     let velocity = DVec2::from_array(spec.velocity);
     for x in body.positions_mut() {
@@ -266,9 +282,9 @@ fn soft_body(spec: &PlanarSoftBodySpec) -> Result<PlanarBody, (&'static str, rap
     Ok(body)
 }
 
-/// The nodes of `mesh` whose rest position (m) `inside` accepts.
-fn nodes_in(mesh: &TriangleMesh, inside: impl Fn([f64; 2]) -> bool) -> Vec<usize> {
-    (mesh.rest_positions().iter().enumerate())
+/// The indices of the `positions` (m) that `inside` accepts.
+fn nodes_in(positions: &[DVec2], inside: impl Fn([f64; 2]) -> bool) -> Vec<usize> {
+    (positions.iter().enumerate())
         .filter(|(_, p)| inside(p.to_array()))
         .map(|(i, _)| i)
         .collect()
@@ -326,21 +342,24 @@ fn insert_rigid(physics: &mut PhysicsWorld, spec: &PlanarRigidBodySpec) -> Plana
 }
 
 /// The outline drawn of `shape` (m, about its centre, counter-clockwise) placed at `centre` (m)
-/// and turned by the angle of sine and cosine `turn`: a rectangle cut to a square of half size
-/// `patch` (m) about its point nearest the origin, and whether it was cut.
+/// and turned by the angle of sine and cosine `turn`: a disk as a polygon, a rectangle cut to a
+/// square of half size `patch` (m) about its point nearest the origin; and whether it was cut.
 fn drawn_outline(
     shape: PlanarShapeSpec,
     centre: DVec2,
     (sin, cos): (f64, f64),
     patch: f64,
 ) -> (Vec<DVec2>, bool) {
-    let PlanarShapeSpec::Cuboid {
-        half_extents: [a, b],
-    } = shape
-    else {
-        return (outline(shape), false);
+    let half = match shape {
+        PlanarShapeSpec::Cuboid { half_extents } => DVec2::from_array(half_extents),
+        PlanarShapeSpec::Ball { radius } => {
+            let polygon = (0..BALL_SEGMENTS).map(|k| {
+                let angle = std::f64::consts::TAU * k as f64 / BALL_SEGMENTS as f64;
+                DVec2::new(angle.cos(), angle.sin()) * radius
+            });
+            return (polygon.collect(), false);
+        }
     };
-    let half = DVec2::new(a, b);
     // The origin in the rectangle's frame, then the rectangle's point nearest it.
     let origin = DVec2::new(
         -cos * centre.x - sin * centre.y,
@@ -352,24 +371,4 @@ fn drawn_outline(
     let cut = lo != -half || hi != half;
     let corners = vec![lo, DVec2::new(hi.x, lo.y), hi, DVec2::new(lo.x, hi.y)];
     (corners, cut)
-}
-
-/// The outline of `shape` about its centre (m), counter-clockwise.
-fn outline(shape: PlanarShapeSpec) -> Vec<DVec2> {
-    match shape {
-        PlanarShapeSpec::Cuboid {
-            half_extents: [a, b],
-        } => vec![
-            DVec2::new(-a, -b),
-            DVec2::new(a, -b),
-            DVec2::new(a, b),
-            DVec2::new(-a, b),
-        ],
-        PlanarShapeSpec::Ball { radius } => (0..BALL_SEGMENTS)
-            .map(|k| {
-                let angle = std::f64::consts::TAU * k as f64 / BALL_SEGMENTS as f64;
-                DVec2::new(angle.cos(), angle.sin()) * radius
-            })
-            .collect(),
-    }
 }

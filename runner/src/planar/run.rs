@@ -4,24 +4,24 @@
 
 use super::build::PlanarSimulation;
 use super::scene::{PlanarRigidKind, PlanarScene, PlaneSpec};
-use crate::output::OutputError;
+use crate::sim::report::write_report;
 use crate::sim::writer::{View, Writer};
 use crate::sim::{Files, ProbeReport, RunError, RunOptions};
 use rapier_fvm::glamx::DVec2;
+use rapier_fvm::planar::PlanarStepReport;
 use serde::Serialize;
 use std::time::{Duration, Instant};
 
 /// What a 2D run did (written as `report.json`).
 #[derive(Debug, Clone, Serialize)]
 pub struct PlanarReport {
-    /// The scene's name and file.
+    /// The scene's name.
     pub scene: String,
     /// The scene file.
     pub scene_file: String,
     /// Always 2.
     pub dimension: u8,
-    /// The frame step (s), the simulated time (s), gravity (m/s²), the fewest coupling
-    /// substeps, the friction coefficient.
+    /// The frame step (s).
     pub dt: f64,
     /// Simulated time (s).
     pub simulated_time: f64,
@@ -31,15 +31,17 @@ pub struct PlanarReport {
     pub coupling_substeps: u32,
     /// Soft–rigid friction coefficient.
     pub friction: f64,
-    /// `"explicit"` or `"implicit"`.
+    /// The scene's integrator setting: `"explicit"`, `"implicit"` or `"automatic"` (what each
+    /// body took: [`PlanarBodyReport::implicit_frames`]).
     pub integrator: String,
     /// The soft bodies.
     pub soft_bodies: Vec<PlanarBodyReport>,
-    /// The rigid bodies: name, kind and mass (kg per unit thickness of rapier2d's shapes).
+    /// The rigid bodies: name, kind and mass (kg: rapier2d's, the shape's area times its
+    /// density in kg/m²).
     pub rigid_bodies: Vec<(String, String, f64)>,
     /// Frames run.
     pub frames: usize,
-    /// Wall time of the run (s), of the stepping alone (s), per frame (ms).
+    /// Wall time of the run (s).
     pub wall_time_s: f64,
     /// Time spent stepping (s).
     pub stepping_time_s: f64,
@@ -69,7 +71,7 @@ pub struct PlanarBodyReport {
     pub plane: String,
     /// Thickness (m).
     pub thickness: f64,
-    /// Triangles and nodes.
+    /// Triangles (of a quadratic body, its 6-node triangles).
     pub triangles: usize,
     /// Nodes.
     pub nodes: usize,
@@ -119,18 +121,7 @@ pub fn run_planar(scene: &PlanarScene, options: &RunOptions) -> Result<PlanarRep
         stepping += step_start.elapsed();
         let outcomes = outcomes.map_err(|e| scene.source.error("world.dt", e.to_string()))?;
         for (report, outcome) in bodies.iter_mut().zip(outcomes) {
-            match outcome {
-                Ok(step) if step.implicit => report.implicit_frames += 1,
-                Ok(step) => {
-                    report.max_explicit_substeps = report.max_explicit_substeps.max(step.substeps)
-                }
-                Err(error) => {
-                    report.failed_frames += 1;
-                    report
-                        .first_failure
-                        .get_or_insert_with(|| format!("frame {frame}: {error}"));
-                }
-            }
+            report.record(frame, outcome);
         }
         let now = mechanical_energy(&sim);
         if now - energy > largest_rise.0 {
@@ -141,44 +132,70 @@ pub fn run_planar(scene: &PlanarScene, options: &RunOptions) -> Result<PlanarRep
         writer.frame(frame, |time, patch| sim.snapshot(time, patch))?;
     }
     let files = writer.finish(sim.probes.iter().map(|p| &p.series))?;
-    let stepping_s = stepping.as_secs_f64();
-    let simulated = frames as f64 * dt;
     let report = PlanarReport {
-        scene: name,
-        scene_file: scene.source.path.display().to_string(),
-        dimension: 2,
-        dt,
-        simulated_time: simulated,
-        gravity: scene.world.gravity,
-        coupling_substeps: scene.world.coupling_substeps,
-        friction: scene.world.friction,
-        integrator: format!("{:?}", scene.world.integrator).to_lowercase(),
         soft_bodies: bodies,
-        rigid_bodies: rigid_reports(scene, &sim),
-        frames,
-        wall_time_s: started.elapsed().as_secs_f64(),
-        stepping_time_s: stepping_s,
-        ms_per_frame: stepping_s * 1e3 / frames as f64,
-        speed_vs_real_time: simulated / stepping_s.max(1e-9),
-        final_state_finite: (sim.bodies.iter()).all(|b| {
-            b.positions()
-                .iter()
-                .chain(b.velocities())
-                .all(|v| v.is_finite())
-        }),
         largest_energy_rise: largest_rise,
-        probes: (sim.probes.iter())
-            .map(|p| ProbeReport::of(&p.series, p.kind()))
-            .collect(),
         files,
+        ..PlanarReport::of(scene, &sim, (frames, started.elapsed(), stepping))
     };
-    let path = options.out.join("report.json");
-    let json = serde_json::to_string_pretty(&report).map_err(|e| OutputError::Io {
-        path: path.clone(),
-        source: std::io::Error::other(e),
-    })?;
-    std::fs::write(&path, json).map_err(OutputError::io(&path))?;
+    write_report(&options.out, &report)?;
     Ok(report)
+}
+
+impl PlanarReport {
+    /// The report of `scene` run in `sim` for `frames` frames, taking `wall` and `stepping`
+    /// time, with no soft body, energy rise or file yet.
+    fn of(
+        scene: &PlanarScene,
+        sim: &PlanarSimulation,
+        (frames, wall, stepping): (usize, Duration, Duration),
+    ) -> Self {
+        let stepping_s = stepping.as_secs_f64();
+        let simulated = frames as f64 * scene.world.dt;
+        Self {
+            scene: scene.display_name(),
+            scene_file: scene.source.path.display().to_string(),
+            dimension: 2,
+            dt: scene.world.dt,
+            simulated_time: simulated,
+            gravity: scene.world.gravity,
+            coupling_substeps: scene.world.coupling_substeps,
+            friction: scene.world.friction,
+            integrator: format!("{:?}", scene.world.integrator).to_lowercase(),
+            soft_bodies: Vec::new(),
+            rigid_bodies: rigid_reports(scene, sim),
+            frames,
+            wall_time_s: wall.as_secs_f64(),
+            stepping_time_s: stepping_s,
+            ms_per_frame: stepping_s * 1e3 / frames as f64,
+            speed_vs_real_time: simulated / stepping_s.max(1e-9),
+            final_state_finite: (sim.bodies.iter()).all(|b| {
+                b.positions()
+                    .iter()
+                    .chain(b.velocities())
+                    .all(|v| v.is_finite())
+            }),
+            largest_energy_rise: (f64::NEG_INFINITY, 0),
+            probes: (sim.probes.iter())
+                .map(|p| ProbeReport::of(&p.series, p.kind()))
+                .collect(),
+            files: Files::default(),
+        }
+    }
+}
+
+impl PlanarBodyReport {
+    /// Records the outcome of frame `frame`'s last coupling substep.
+    fn record(&mut self, frame: usize, outcome: Result<PlanarStepReport, rapier_fvm::Error>) {
+        match outcome {
+            Ok(step) if step.implicit => self.implicit_frames += 1,
+            Ok(step) => self.max_explicit_substeps = self.max_explicit_substeps.max(step.substeps),
+            Err(error) => {
+                self.failed_frames += 1;
+                (self.first_failure).get_or_insert_with(|| format!("frame {frame}: {error}"));
+            }
+        }
+    }
 }
 
 /// The soft bodies' reports before the first step.

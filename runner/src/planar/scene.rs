@@ -48,7 +48,7 @@
 //! `[output]` is as in 3D scenes; `[[probe]]` entries are in [`super::probe`].
 
 use super::probe::PlanarProbeSpec;
-use crate::scene::check::Checker;
+use crate::scene::check::{Checker, check_body_names, check_probe_names};
 use crate::scene::material::{DampingSpec, MaterialSpec};
 use crate::scene::settings::OutputSpec;
 use crate::scene::soft_body::VolumetricSpec;
@@ -335,12 +335,7 @@ impl PlanarScene {
 
     /// The scene's name: `name`, or the file's stem.
     pub fn display_name(&self) -> String {
-        self.name.clone().unwrap_or_else(|| {
-            self.source
-                .path
-                .file_stem()
-                .map_or_else(|| "scene".to_owned(), |s| s.to_string_lossy().into_owned())
-        })
+        self.source.name_or_stem(self.name.as_deref())
     }
 
     /// The values and references a type cannot check.
@@ -359,23 +354,10 @@ impl PlanarScene {
         if !(1..=256).contains(&w.coupling_substeps) {
             c.fail("world.coupling_substeps", "must lie in 1 to 256");
         }
-        c.non_negative("world.friction", w.friction, "");
+        c.non_negative("world.friction", w.friction, "dimensionless");
         let soft: Vec<&str> = self.soft_body.iter().map(|b| b.name.as_str()).collect();
         let rigid: Vec<&str> = self.rigid_body.iter().map(|b| b.name.as_str()).collect();
-        let names = (soft
-            .iter()
-            .enumerate()
-            .map(|(i, n)| (format!("soft_body[{i}].name"), *n)))
-        .chain((rigid.iter().enumerate()).map(|(i, n)| (format!("rigid_body[{i}].name"), *n)));
-        let mut seen: Vec<&str> = Vec::new();
-        for (key, name) in names {
-            if name.trim().is_empty() {
-                c.fail(&key, "must not be empty");
-            } else if seen.contains(&name) {
-                c.fail(&key, format!("another body is already named {name:?}"));
-            }
-            seen.push(name);
-        }
+        check_body_names(&soft, &rigid, &mut c);
         for (i, body) in self.soft_body.iter().enumerate() {
             body.check(&format!("soft_body[{i}]"), &rigid, &mut c);
         }
@@ -383,13 +365,8 @@ impl PlanarScene {
             body.check(&format!("rigid_body[{i}]"), &mut c);
         }
         self.output.check(w.duration, &mut c);
-        let mut probes: Vec<&str> = Vec::new();
+        check_probe_names(self.probe.iter().map(|p| p.name.as_str()), &mut c);
         for (i, probe) in self.probe.iter().enumerate() {
-            if probes.contains(&probe.name.as_str()) {
-                let message = format!("another probe is already named {:?}", probe.name);
-                c.fail(&format!("probe[{i}].name"), message);
-            }
-            probes.push(&probe.name);
             probe.check(&format!("probe[{i}]"), &soft, &rigid, &mut c);
         }
         c.finish()
@@ -430,17 +407,20 @@ impl PlanarSoftBodySpec {
 impl PlanarRigidBodySpec {
     fn check(&self, key: &str, c: &mut Checker<'_>) {
         match self.shape {
-            PlanarShapeSpec::Cuboid {
-                half_extents: [a, b],
-            } => {
-                c.positive(&format!("{key}.shape.cuboid.half_extents"), a.min(b), "m");
+            PlanarShapeSpec::Cuboid { half_extents } => {
+                for (k, half) in half_extents.iter().enumerate() {
+                    c.positive(&format!("{key}.shape.cuboid.half_extents[{k}]"), *half, "m");
+                }
             }
             PlanarShapeSpec::Ball { radius } => {
                 c.positive(&format!("{key}.shape.ball.radius"), radius, "m");
             }
         }
         let [tx, ty] = self.translation;
-        c.finite_vector(&format!("{key}.translation"), [tx, ty, self.rotation]);
+        c.finite_vector(&format!("{key}.translation"), [tx, ty, 0.0]);
+        if !self.rotation.is_finite() {
+            c.fail(&format!("{key}.rotation"), "must be finite (rad)");
+        }
         let [vx, vy] = self.velocity;
         c.speed(&format!("{key}.velocity"), [vx, vy, 0.0]);
         if !self.angular_velocity.is_finite() {

@@ -73,3 +73,33 @@ impl<'a> Checker<'a> {
         self.first.map_or(Ok(()), Err)
     }
 }
+
+/// Checks the bodies' names (`soft`, then `rigid`, in the scene's order): none empty, none
+/// repeated.
+pub(crate) fn check_body_names(soft: &[&str], rigid: &[&str], c: &mut Checker<'_>) {
+    let soft_keys = (soft.iter().enumerate()).map(|(i, n)| (format!("soft_body[{i}].name"), *n));
+    let rigid_keys = (rigid.iter().enumerate()).map(|(i, n)| (format!("rigid_body[{i}].name"), *n));
+    let mut seen: Vec<&str> = Vec::new();
+    for (key, name) in soft_keys.chain(rigid_keys) {
+        if name.trim().is_empty() {
+            c.fail(&key, "must not be empty");
+        } else if seen.contains(&name) {
+            c.fail(&key, format!("another body is already named {name:?}"));
+        }
+        seen.push(name);
+    }
+}
+
+/// Checks the probes' names, `names` in the scene's order: none repeated.
+pub(crate) fn check_probe_names<'a>(names: impl IntoIterator<Item = &'a str>, c: &mut Checker<'_>) {
+    let mut seen: Vec<&str> = Vec::new();
+    for (i, name) in names.into_iter().enumerate() {
+        if seen.contains(&name) {
+            c.fail(
+                &format!("probe[{i}].name"),
+                format!("another probe is already named {name:?}"),
+            );
+        }
+        seen.push(name);
+    }
+}

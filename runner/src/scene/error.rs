@@ -91,6 +91,18 @@ impl SceneSource {
         Some(self.line_of(span))
     }
 
+    /// `name`, or the file's stem (`scene` if it has none).
+    pub fn name_or_stem(&self, name: Option<&str>) -> String {
+        name.map_or_else(
+            || {
+                self.path
+                    .file_stem()
+                    .map_or_else(|| "scene".to_owned(), |s| s.to_string_lossy().into_owned())
+            },
+            str::to_owned,
+        )
+    }
+
     /// The path of the folder holding the scene, to resolve the files it names.
     pub fn folder(&self) -> &Path {
         self.path.parent().unwrap_or_else(|| Path::new(""))

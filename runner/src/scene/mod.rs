@@ -129,6 +129,12 @@ impl Scene {
             path: path.as_ref().to_path_buf(),
             text,
         };
+        if dimension_of(&source.text) == Some(2) {
+            return Err(source.error(
+                "world.dimension",
+                "a 2D scene: read it as one (`planar::PlanarScene`; `rapier-fvm run` does)",
+            ));
+        }
         let mut scene: Self = deserialize(&source)?;
         scene.source = source;
         scene.budget = budget;
@@ -138,12 +144,7 @@ impl Scene {
 
     /// The scene's name: `name`, or the file's stem.
     pub fn display_name(&self) -> String {
-        self.name.clone().unwrap_or_else(|| {
-            self.source
-                .path
-                .file_stem()
-                .map_or_else(|| "scene".to_owned(), |s| s.to_string_lossy().into_owned())
-        })
+        self.source.name_or_stem(self.name.as_deref())
     }
 
     /// The values and references a type cannot check.
@@ -152,21 +153,7 @@ impl Scene {
         self.world.check(&mut c);
         let soft: Vec<&str> = self.soft_body.iter().map(|b| b.name.as_str()).collect();
         let rigid: Vec<&str> = self.rigid_body.iter().map(|b| b.name.as_str()).collect();
-        let mut seen: Vec<&str> = Vec::new();
-        let names = (self.soft_body.iter().enumerate())
-            .map(|(i, b)| (format!("soft_body[{i}].name"), b.name.as_str()))
-            .chain(
-                (self.rigid_body.iter().enumerate())
-                    .map(|(i, b)| (format!("rigid_body[{i}].name"), b.name.as_str())),
-            );
-        for (key, name) in names {
-            if name.trim().is_empty() {
-                c.fail(&key, "must not be empty");
-            } else if seen.contains(&name) {
-                c.fail(&key, format!("another body is already named {name:?}"));
-            }
-            seen.push(name);
-        }
+        check::check_body_names(&soft, &rigid, &mut c);
         for (i, body) in self.soft_body.iter().enumerate() {
             body.check(&format!("soft_body[{i}]"), &rigid, &mut c);
         }
@@ -176,15 +163,8 @@ impl Scene {
         self.contact.check(&mut c);
         self.integrator.check(&mut c);
         self.output.check(self.world.duration, &mut c);
-        let mut probe_names: Vec<&str> = Vec::new();
+        check::check_probe_names(self.probe.iter().map(|p| p.name.as_str()), &mut c);
         for (i, probe) in self.probe.iter().enumerate() {
-            if probe_names.contains(&probe.name.as_str()) {
-                c.fail(
-                    &format!("probe[{i}].name"),
-                    format!("another probe is already named {:?}", probe.name),
-                );
-            }
-            probe_names.push(&probe.name);
             probe.check(&format!("probe[{i}]"), &soft, &rigid, &mut c);
         }
         budget::check(&self.soft_body, &self.budget, &mut c);
@@ -209,10 +189,14 @@ pub(crate) fn deserialize<T: serde::de::DeserializeOwned>(
     serde_path_to_error::deserialize::<_, T>(value).map_err(|error| {
         let key = error.path().to_string();
         let message = error.into_inner().message().trim().to_owned();
-        let message = message.replace(
-            "expected fewer elements in array",
-            "more elements than the key takes",
-        );
+        // toml's "invalid length 4, expected fewer elements in array".
+        let message = match message.strip_suffix(", expected fewer elements in array") {
+            Some(length) => format!(
+                "an array of {} elements, more than the key takes",
+                length.trim_start_matches("invalid length ")
+            ),
+            None => message,
+        };
         source.error(&key, message)
     })?;
     Ok(scene)

@@ -72,6 +72,7 @@ impl WorldSpec {
 
     /// Checks the values.
     pub(crate) fn check(&self, c: &mut Checker<'_>) {
+        // A 2D scene is refused before it is read as a 3D one (`Scene::parse`).
         if self.dimension.is_some_and(|d| d != 3) {
             c.fail("world.dimension", "must be 2 (a 2D scene) or 3");
         }

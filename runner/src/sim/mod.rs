@@ -16,7 +16,7 @@ mod materials;
 mod meshes;
 mod probe;
 mod regions;
-mod report;
+pub(crate) mod report;
 mod run;
 pub(crate) mod writer;
 

@@ -377,3 +377,20 @@ impl SoftBodyReport {
         }
     }
 }
+
+/// Writes `report` as pretty JSON into `report.json` of the folder `out`.
+///
+/// # Errors
+/// [`OutputError::Io`] if it cannot be serialized or written.
+pub(crate) fn write_report(
+    out: &std::path::Path,
+    report: &impl Serialize,
+) -> Result<(), crate::output::OutputError> {
+    use crate::output::OutputError;
+    let path = out.join("report.json");
+    let json = serde_json::to_string_pretty(report).map_err(|e| OutputError::Io {
+        path: path.clone(),
+        source: std::io::Error::other(e),
+    })?;
+    std::fs::write(&path, json).map_err(OutputError::io(&path))
+}

@@ -3,14 +3,17 @@
 //! write the report with its stability verdict.
 
 use super::build::Simulation;
-use super::report::{ProbeReport, Report, RigidBodyReport, Settings, SoftBodyReport, Stability};
+use super::report::{
+    ProbeReport, Report, RigidBodyReport, Settings, SoftBodyReport, Stability, write_report,
+};
 use super::writer::{View, Writer};
 use crate::output::OutputError;
 use crate::scene::rigid_body::RigidKind;
 use crate::scene::world::WorldSpec;
 use crate::scene::{Scene, SceneError};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use rapier_fvm::coupling::Audit;
+use rapier_fvm::body::DeformableBodyHandle;
+use rapier_fvm::coupling::{Audit, SoftStepResults};
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
@@ -57,13 +60,9 @@ pub fn run(scene: &Scene, options: &RunOptions) -> Result<Report, RunError> {
     let mut sim = Simulation::build(scene)?;
     let frames = world_spec.frames();
     let dt = world_spec.dt;
-    let output = (scene.display_name(), &scene.output);
-    let mut writer = Writer::new(
-        (&output.0, output.1),
-        &options.out,
-        (frames, dt),
-        View::Oblique,
-    )?;
+    let name = scene.display_name();
+    let output = (name.as_str(), &scene.output);
+    let mut writer = Writer::new(output, &options.out, (frames, dt), View::Oblique)?;
     let mut bodies: Vec<SoftBodyReport> = (sim.soft.iter())
         .map(|entry| {
             let body = &sim.world.soft_bodies[entry.handle];
@@ -84,21 +83,11 @@ pub fn run(scene: &Scene, options: &RunOptions) -> Result<Report, RunError> {
         sim.drive_loads(t, &scene.source)?;
         let outcomes = sim.world.step();
         stepping += step_start.elapsed();
-        for (handle, outcome) in &outcomes {
-            if let Some(i) = sim.soft.iter().position(|e| e.handle == *handle) {
-                bodies[i].record(outcome, &mut stability);
-            }
-        }
-        for (entry, body) in sim.soft.iter().zip(&mut bodies) {
-            body.asleep_frames += usize::from(sim.world.coupling.is_sleeping(entry.handle));
-        }
-        let found = audit.check_world(&sim.world, &outcomes);
-        stability.record_system(frame, found.system);
-        for (handle, body_audit) in &found.bodies {
-            if let Some(i) = sim.soft.iter().position(|e| e.handle == *handle) {
-                bodies[i].record_audit(frame, body_audit);
-            }
-        }
+        record_frame(
+            &sim,
+            (frame, &outcomes),
+            (&mut bodies, &mut stability, &mut audit),
+        );
         sim.sample_probes(t);
         writer.frame(frame, |time, patch| sim.snapshot(time, patch))?;
         progress.set_position(frame as u64);
@@ -107,13 +96,14 @@ pub fn run(scene: &Scene, options: &RunOptions) -> Result<Report, RunError> {
     }
     progress.finish_and_clear();
     let files = writer.finish(sim.probes.iter().map(|p| &p.series))?;
-    stability.final_state_finite = sim.soft.iter().all(|entry| {
-        let body = &sim.world.soft_bodies[entry.handle];
-        body.positions()
-            .iter()
-            .chain(body.velocities())
-            .all(|v| v.is_finite())
-    });
+    stability.final_state_finite = (sim.soft.iter())
+        .map(|entry| &sim.world.soft_bodies[entry.handle])
+        .all(|b| {
+            b.positions()
+                .iter()
+                .chain(b.velocities())
+                .all(|v| v.is_finite())
+        });
     stability.conclude(&mut bodies);
     let stepping_s = stepping.as_secs_f64();
     let simulated = frames as f64 * dt;
@@ -135,13 +125,33 @@ pub fn run(scene: &Scene, options: &RunOptions) -> Result<Report, RunError> {
             .collect(),
         files,
     };
-    let path = options.out.join("report.json");
-    let json = serde_json::to_string_pretty(&report).map_err(|e| OutputError::Io {
-        path: path.clone(),
-        source: std::io::Error::other(e),
-    })?;
-    std::fs::write(&path, json).map_err(OutputError::io(&path))?;
+    write_report(&options.out, &report)?;
     Ok(report)
+}
+
+/// Records what frame `frame`'s step `outcomes` were in each soft body's report, the bodies
+/// asleep, and what the `audit` of the frame finds, in the reports and the `stability`.
+fn record_frame(
+    sim: &Simulation,
+    (frame, outcomes): (usize, &SoftStepResults),
+    (bodies, stability, audit): (&mut [SoftBodyReport], &mut Stability, &mut Audit),
+) {
+    let report_of = |handle: DeformableBodyHandle| sim.soft.iter().position(|e| e.handle == handle);
+    for (handle, outcome) in outcomes {
+        if let Some(i) = report_of(*handle) {
+            bodies[i].record(outcome, stability);
+        }
+    }
+    for (entry, body) in sim.soft.iter().zip(bodies.iter_mut()) {
+        body.asleep_frames += usize::from(sim.world.coupling.is_sleeping(entry.handle));
+    }
+    let found = audit.check_world(&sim.world, outcomes);
+    stability.record_system(frame, found.system);
+    for (handle, body_audit) in &found.bodies {
+        if let Some(i) = report_of(*handle) {
+            bodies[i].record_audit(frame, body_audit);
+        }
+    }
 }
 
 /// A progress bar over `frames`, drawn on stderr only when it is a terminal and `show` is set.
