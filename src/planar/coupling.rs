@@ -19,7 +19,8 @@
 //!    one backward Euler step over `h` with its contacts in it ([`PlanarIntegrator`]; by
 //!    default where the explicit step would need more than [`AUTOMATIC_SUBSTEPS`] substeps): a
 //!    stiff 2 kg block (E = 10⁸ Pa, damped) resting on the ground takes 0.45 ms per frame
-//!    (automatic) against 408 ms explicitly, the ground carrying its weight to the fifth digit both ways.
+//!    (automatic) against 408 ms explicitly, the ground carrying its weight to the fifth digit
+//!    both ways.
 //! 3. **Exchange.** The opposite impulses, at the nodes, go to the dynamic rigid bodies, and
 //!    are summed per collider into the frame's mean forces ([`PlanarCoupling::collider_forces`];
 //!    the glue's per rigid body, [`PlanarCoupling::glue_force`]).
@@ -281,8 +282,8 @@ impl PlanarCoupling {
 
     /// Glues `nodes` of `bodies[body]`, where they are, to the rigid body `rigid` of `world`
     /// (each held to a point fixed in the rigid body by a damped spring of the body's contact
-    /// stiffness, the rigid body taking the opposite force); the glue holds while both exist (glue to a rigid body removed from
-    /// the world is dropped at the next step).
+    /// stiffness, the rigid body taking the opposite force); the glue holds while both exist
+    /// (glue to a rigid body removed from the world is dropped at the next step).
     ///
     /// # Errors
     /// [`Error::UnknownDeformableBody`] for a body index out of range,

@@ -1,7 +1,8 @@
 //! Per-triangle rest data and the finite-volume force: with the deformation gradient `F`
 //! constant in a linear triangle (so the stress `P`), `f_i = t P b_i`, the traction of `P`
-//! integrated over the part of node `i`'s control-volume boundary inside the triangle (`b_i` half the outward length-weighted
-//! normal of the edge opposite `i`, whatever the control volumes, see
+//! integrated over the part of node `i`'s control-volume boundary inside the triangle (`b_i`
+//! half the outward length-weighted normal of the edge opposite `i`, whatever the control
+//! volumes, see
 //! [`super::ControlVolumes`]), times the rest thickness `t`. The forces sum to zero and their
 //! torque vanishes when `P Fᵀ` is symmetric, as every model's is.
 
