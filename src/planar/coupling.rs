@@ -15,8 +15,9 @@
 //!    same penalty, the boundary segment's nodes taking the opposite force.
 //!    Nodes glued to rigid bodies ([`PlanarCoupling::glue`]) are held to their anchors by
 //!    damped springs of the same stiffness, `f = k (a − x) + c (v_a − v)` to the anchor `a`.
-//!    A body within reach of no dynamic rigid body, collider corner or glue may instead take
-//!    one backward Euler step over `h` with its contacts in it ([`PlanarIntegrator`]; by
+//!    A body within reach of no dynamic rigid body or collider corner, and glued to no dynamic
+//!    rigid body, may instead take one backward Euler step over `h` with its contacts and glue
+//!    in it ([`PlanarIntegrator`]; by
 //!    default where the explicit step would need more than [`AUTOMATIC_SUBSTEPS`] substeps): a
 //!    stiff 2 kg block (E = 10⁸ Pa, damped) resting on the ground takes 0.45 ms per frame
 //!    (automatic) against 408 ms explicitly, the ground carrying its weight to the fifth digit
@@ -96,9 +97,10 @@ pub const AUTOMATIC_SUBSTEPS: f64 = 400.0;
 pub enum PlanarIntegrator {
     /// Symplectic Euler in substeps below the stability limit, with every contact kind.
     Explicit,
-    /// One backward Euler step per coupling substep, contacts with colliders in it
-    /// (the penalty as a potential, friction lagged), for a body whose reach over the substep
-    /// meets no dynamic rigid body, no collider's corner and no glue; any other body steps
+    /// One backward Euler step per coupling substep, contacts with colliders and glue to
+    /// fixed or kinematic rigid bodies in it (the penalty and the glue's springs as potentials,
+    /// friction lagged), for a body whose reach over the substep meets no dynamic rigid body and
+    /// no collider's corner and which is glued to no dynamic rigid body; any other body steps
     /// explicitly (the step's report says which).
     Implicit,
     /// Implicit where [`PlanarIntegrator::Implicit`] would be and the explicit step would
@@ -424,7 +426,7 @@ impl PlanarCoupling {
                 (colliders, glue),
                 (k, mu, lightest),
                 (h, gravity),
-                &mut total,
+                (&mut total, &mut glue_total),
             ) {
                 *report = Some(stepped);
                 continue;
@@ -491,7 +493,7 @@ impl PlanarCoupling {
         (colliders, glue): (&[ColliderView], &[GlueView]),
         (k, mu, lightest): (f64, f64, f64),
         (h, gravity): (f64, DVec2),
-        total: &mut Exchange,
+        (total, glue_total): (&mut Exchange, &mut [(DVec2, f64)]),
     ) -> Option<Result<PlanarStepReport, Error>> {
         let wanted = match self.integrator {
             PlanarIntegrator::Explicit => false,
@@ -503,10 +505,16 @@ impl PlanarCoupling {
         if !(wanted && steps_alone(body, index, (colliders, glue), h)) {
             return None;
         }
-        match step_in_contact(body, colliders, (k, mu), (h, gravity)) {
-            Ok((stepped, impulses)) => {
+        let anchored: Vec<(usize, &GlueView)> = (glue.iter().enumerate())
+            .filter(|(_, g)| g.body == index)
+            .collect();
+        match step_in_contact(body, (colliders, &anchored), (k, mu), (h, gravity)) {
+            Ok((stepped, impulses, glue_impulses)) => {
                 for (sum, impulse) in total.force.iter_mut().zip(impulses) {
                     *sum += impulse;
+                }
+                for (g, impulse) in glue_impulses {
+                    glue_total[g].0 += impulse;
                 }
                 Some(Ok(stepped))
             }
@@ -518,14 +526,14 @@ impl PlanarCoupling {
 
 /// Whether `body` (number `index`) can step implicitly over `h` (s): within its reach (its
 /// bounding box grown by its fastest node's travel over `h` and a tenth of its size) lies no
-/// dynamic collider and no collider corner, and no node of it is glued.
+/// dynamic collider and no collider corner, and no node of it is glued to a dynamic rigid body.
 fn steps_alone(
     body: &PlanarBody,
     index: usize,
     (colliders, glue): (&[ColliderView], &[GlueView]),
     h: f64,
 ) -> bool {
-    if glue.iter().any(|g| g.body == index) {
+    if glue.iter().any(|g| g.body == index && g.dynamic) {
         return false;
     }
     let (low, high) = bounds_of(body.positions());

@@ -102,6 +102,11 @@ impl GlueView {
             .collect()
     }
 
+    /// Where the anchor will be (m) after `h` (s), moving as it moves now.
+    pub(super) fn anchor_after(&self, h: f64) -> DVec2 {
+        self.anchor + self.velocity * h
+    }
+
     /// The force (N) on the node of `body` with stiffness `k` (N/m), and the point where the
     /// rigid body takes its opposite.
     pub(super) fn force(&self, body: &PlanarBody, k: f64) -> (DVec2, DVec2) {

@@ -14,44 +14,62 @@
 //!   law has half this one's slope at rest), and its stiffness `μ λ (2/ε − 2|u|/ε²) t₀ t₀ᵀ`
 //!   below it.
 //!
-//! No damping term: backward Euler damps the contact's own vibration (frequency `√(k/m)`,
-//! far above `1/h`) by itself.
+//! - **Glue** to fixed and kinematic rigid bodies: a glued node is held to where its anchor
+//!   will be at the step's end by a spring of the same `k`, `k |x − a|²/2`.
+//!
+//! No damping term: backward Euler damps the contact's and the glue's own vibration (frequency
+//! `√(k/m)`, far above `1/h`) by itself.
 
 use super::body::PlanarBody;
 use super::colliders::ColliderView;
 use super::coupling::STICKING_SPEED;
 use super::dynamics::PlanarStepReport;
+use super::glue::GlueView;
 use super::implicit::{NodePotential, step_implicit_with};
 use crate::Error;
 use crate::statics::StaticSettings;
 use rapier2d::glamx::{DMat2, DVec2};
 
+/// What an implicit step did: its report, and the impulses (N s) it gave each collider
+/// (indexed as the step's colliders) and the rigid body of each glued node (by the glue's
+/// index).
+type SteppedInContact = (PlanarStepReport, Vec<DVec2>, Vec<(usize, DVec2)>);
+
 /// One backward Euler step of `body` over `h` (s) under `gravity` (m/s²) against `colliders`
-/// (frozen where they are) with contact stiffness `k` (N/m) and friction `mu`: its report, and
-/// the impulse (N s) the body's contacts gave each collider (indexed as `colliders`).
+/// (frozen where they are) and held by the `glued` nodes (each with its glue's index; their
+/// anchors where they will be at the step's end), with contact and glue stiffness `k` (N/m)
+/// and friction `mu`: its report, and the impulses it gave the colliders and glued rigid
+/// bodies.
 ///
 /// # Errors
 /// Those of [`super::step_implicit`]; the body is left as it was.
 pub(super) fn step_in_contact(
     body: &mut PlanarBody,
-    colliders: &[ColliderView],
+    (colliders, glued): (&[ColliderView], &[(usize, &GlueView)]),
     (k, mu): (f64, f64),
     (h, gravity): (f64, DVec2),
-) -> Result<(PlanarStepReport, Vec<DVec2>), Error> {
-    let potential = ContactPotential::new(colliders, body.positions(), (k, mu), h);
+) -> Result<SteppedInContact, Error> {
+    let mut potential = ContactPotential::new(colliders, body.positions(), (k, mu), h);
+    potential.anchors = (glued.iter())
+        .map(|(_, g)| (g.node, g.anchor_after(h)))
+        .collect();
     let loads = vec![DVec2::ZERO; body.positions().len()];
     let settings = StaticSettings::default();
     step_implicit_with(body, (h, gravity, &loads), &settings, Some(&potential))?;
+    let x = body.positions();
     let mut impulses = vec![DVec2::ZERO; colliders.len()];
-    for (c, _, force) in potential.forces_by_collider(body.positions()) {
+    for (c, _, force) in potential.forces_by_collider(x) {
         impulses[c] -= force * h;
     }
+    let glue_impulses = (glued.iter().zip(&potential.anchors))
+        .map(|((g, _), (node, anchor))| (*g, (x[*node] - *anchor) * (k * h)))
+        .collect();
     let report = PlanarStepReport {
         substeps: 1,
         substep_dt: h,
         implicit: true,
     };
-    Ok((report, impulses))
+    Ok((report, impulses, glue_impulses))
 }
 
 /// A node pressing on a collider at the step's start, for the lagged friction.
@@ -77,6 +95,9 @@ pub(super) struct ContactPotential<'a> {
     start: Vec<DVec2>,
     smoothing: f64,
     pressing: Vec<Pressing>,
+    /// Glued nodes and where their anchors are at the step's end (m), held by springs of the
+    /// contact stiffness.
+    anchors: Vec<(usize, DVec2)>,
 }
 
 impl<'a> ContactPotential<'a> {
@@ -110,6 +131,7 @@ impl<'a> ContactPotential<'a> {
             start: start.to_vec(),
             smoothing: STICKING_SPEED * h,
             pressing,
+            anchors: Vec::new(),
         }
     }
 
@@ -171,7 +193,10 @@ impl NodePotential for ContactPotential<'_> {
                 self.friction * p.normal_force * f
             })
             .sum();
-        normal + friction
+        let glue: f64 = (self.anchors.iter())
+            .map(|(node, anchor)| 0.5 * self.stiffness * x[*node].distance_squared(*anchor))
+            .sum();
+        normal + friction + glue
     }
 
     fn add_forces(&self, x: &[DVec2], forces: &mut [DVec2]) {
@@ -180,6 +205,9 @@ impl NodePotential for ContactPotential<'_> {
         }
         for p in &self.pressing {
             forces[p.node] += self.friction_force(p, x);
+        }
+        for (node, anchor) in &self.anchors {
+            forces[*node] += (*anchor - x[*node]) * self.stiffness;
         }
     }
 
@@ -198,6 +226,8 @@ impl NodePotential for ContactPotential<'_> {
                 blocks.push((p.node, outer(p.tangent) * k));
             }
         }
+        let glue = DMat2::IDENTITY * self.stiffness;
+        blocks.extend(self.anchors.iter().map(|(node, _)| (*node, glue)));
         blocks
     }
 }

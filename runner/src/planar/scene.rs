@@ -11,8 +11,9 @@
 //!                             # when contacts with light rigid bodies need them)
 //! friction = 0.5              # between soft bodies and colliders, default 0.5
 //! integrator = "automatic"    # default; "implicit": backward Euler, one step per coupling
-//!                             # substep, for bodies within reach of no dynamic rigid body,
-//!                             # collider corner or attachment (the others step explicitly);
+//!                             # substep, for bodies within reach of no dynamic rigid body
+//!                             # or collider corner and attached to no dynamic rigid body
+//!                             # (the others step explicitly);
 //!                             # "automatic": implicit there when the explicit step would
 //!                             # need more than 400 substeps; "explicit"
 //!
@@ -112,8 +113,9 @@ pub struct PlanarWorldSpec {
 pub enum PlanarIntegratorSpec {
     /// Symplectic Euler substeps.
     Explicit,
-    /// Backward Euler, one step per coupling substep, where no dynamic rigid body, collider
-    /// corner or attachment is within reach (explicit there).
+    /// Backward Euler, one step per coupling substep, where no dynamic rigid body or collider
+    /// corner is within reach and no attachment to a dynamic rigid body holds the body
+    /// (explicit there).
     Implicit,
     /// Implicit where it may be and the explicit step would need more than 400 substeps.
     #[default]
