@@ -149,6 +149,43 @@ pub(crate) fn stalled_at_round_off(history: &[f64], relative: f64) -> bool {
     }
 }
 
+/// How a Newton loop ends when its line search finds no descent at `iteration` with the
+/// relative residual `relative`: a tiny residual (at most [`ROUND_OFF_CEILING`]) is accepted as
+/// round-off (`(iterations, relative residual)`), anything else refused.
+///
+/// # Errors
+/// [`Error::StaticSolveDidNotConverge`] above the ceiling.
+pub(crate) fn without_descent(iteration: usize, relative: f64) -> Result<(usize, f64), Error> {
+    if relative <= ROUND_OFF_CEILING {
+        Ok((iteration, relative))
+    } else {
+        Err(Error::StaticSolveDidNotConverge {
+            iterations: iteration,
+            residual: relative,
+        })
+    }
+}
+
+/// How a Newton loop ends after its `max_iterations` with the relative residual `relative`:
+/// accepted (`(iterations, relative residual)`) if it meets `tolerance`.
+///
+/// # Errors
+/// [`Error::StaticSolveDidNotConverge`] otherwise.
+pub(crate) fn after_last_iteration(
+    relative: f64,
+    tolerance: f64,
+    max_iterations: usize,
+) -> Result<(usize, f64), Error> {
+    if relative <= tolerance {
+        Ok((max_iterations, relative))
+    } else {
+        Err(Error::StaticSolveDidNotConverge {
+            iterations: max_iterations,
+            residual: relative,
+        })
+    }
+}
+
 /// Euclidean norm of a field of per-node vectors.
 pub(crate) fn norm<V: NodeVector>(v: &[V]) -> f64 {
     v.iter().map(|x| x.length_squared()).sum::<f64>().sqrt()

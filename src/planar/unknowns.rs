@@ -9,7 +9,8 @@ use super::evaluate::patch_tangent;
 use crate::Error;
 use crate::assembly::{Factor, SymbolicFactor};
 use crate::newton::{
-    Configuration, ROUND_OFF_CEILING, Search, descend, norm, stalled_at_round_off,
+    Configuration, Search, after_last_iteration, descend, norm, stalled_at_round_off,
+    without_descent,
 };
 use crate::statics::StaticSettings;
 use faer::Mat;
@@ -178,22 +179,9 @@ pub(super) fn minimize(
             residual_at,
         ) {
             Some((next, _)) => residual = next,
-            // No descent left above round-off: accept a tiny residual, refuse anything else.
-            None if relative <= ROUND_OFF_CEILING => return Ok((iteration, relative)),
-            None => {
-                return Err(Error::StaticSolveDidNotConverge {
-                    iterations: iteration,
-                    residual: relative,
-                });
-            }
+            None => return without_descent(iteration, relative),
         }
     }
     let relative = norm(&residual) / reference;
-    if relative <= settings.tolerance {
-        return Ok((settings.max_iterations, relative));
-    }
-    Err(Error::StaticSolveDidNotConverge {
-        iterations: settings.max_iterations,
-        residual: relative,
-    })
+    after_last_iteration(relative, settings.tolerance, settings.max_iterations)
 }

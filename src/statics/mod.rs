@@ -19,8 +19,8 @@ use crate::integrate::SolverWorkspace;
 use crate::linear_solver::{Method, solve_newton_system};
 use crate::load::ChamberSolve;
 use crate::newton::{
-    ROUND_OFF_CEILING, Search, check_tolerance, descend, norm, round_off_floor,
-    stalled_at_round_off,
+    Search, after_last_iteration, check_tolerance, descend, norm, round_off_floor,
+    stalled_at_round_off, without_descent,
 };
 use rapier3d::glamx::{DMat3, DVec3};
 
@@ -134,32 +134,18 @@ fn newton(
             |body| out_of_balance(body, &load),
         ) {
             Some((next, _)) => residual = next,
-            // No descent left above round-off: accept a tiny residual, refuse anything else.
-            None if relative <= ROUND_OFF_CEILING => {
-                return Ok(StaticReport {
-                    iterations: iteration,
-                    relative_residual: relative,
-                });
-            }
-            None => {
-                return Err(Error::StaticSolveDidNotConverge {
-                    iterations: iteration,
-                    residual: relative,
-                });
-            }
+            None => return without_descent(iteration, relative).map(report),
         }
     }
     let relative = norm(&residual) / reference;
-    if relative <= settings.tolerance {
-        Ok(StaticReport {
-            iterations: settings.max_iterations,
-            relative_residual: relative,
-        })
-    } else {
-        Err(Error::StaticSolveDidNotConverge {
-            iterations: settings.max_iterations,
-            residual: relative,
-        })
+    after_last_iteration(relative, settings.tolerance, settings.max_iterations).map(report)
+}
+
+/// The report of Newton's `(iterations, relative residual)`.
+fn report((iterations, relative_residual): (usize, f64)) -> StaticReport {
+    StaticReport {
+        iterations,
+        relative_residual,
     }
 }
 
