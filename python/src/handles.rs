@@ -1,0 +1,90 @@
+//! Handles to a world's bodies and colliders, as rapier gives them: generational indices that
+//! stay valid while the body lives, compared and hashed by value.
+
+use pyo3::prelude::*;
+use rapier_fvm::body::DeformableBodyHandle;
+use rapier3d::prelude::{ColliderHandle, RigidBodyHandle};
+
+/// A soft (deformable) body of a `World`.
+#[pyclass(module = "rapier_fvm", frozen, eq, hash, from_py_object)]
+#[derive(Clone, Copy, PartialEq, Eq, Hash)]
+pub struct SoftBody {
+    index: u32,
+    generation: u32,
+}
+
+/// A rigid body of a `World`.
+#[pyclass(module = "rapier_fvm", frozen, eq, hash, from_py_object)]
+#[derive(Clone, Copy, PartialEq, Eq, Hash)]
+pub struct RigidBody {
+    index: u32,
+    generation: u32,
+}
+
+/// A collider of a `World` (the ground, or a rigid body's shape).
+#[pyclass(module = "rapier_fvm", frozen, eq, hash, from_py_object)]
+#[derive(Clone, Copy, PartialEq, Eq, Hash)]
+pub struct Collider {
+    index: u32,
+    generation: u32,
+}
+
+impl SoftBody {
+    /// The handle of the library's handle `handle`.
+    pub fn of(handle: DeformableBodyHandle) -> Self {
+        let (index, generation) = handle.into_raw_parts();
+        Self { index, generation }
+    }
+
+    /// The library's handle.
+    pub fn handle(self) -> DeformableBodyHandle {
+        DeformableBodyHandle::from_raw_parts(self.index, self.generation)
+    }
+}
+
+impl RigidBody {
+    /// The handle of rapier's handle `handle`.
+    pub fn of(handle: RigidBodyHandle) -> Self {
+        let (index, generation) = handle.into_raw_parts();
+        Self { index, generation }
+    }
+
+    /// rapier's handle.
+    pub fn handle(self) -> RigidBodyHandle {
+        RigidBodyHandle::from_raw_parts(self.index, self.generation)
+    }
+}
+
+impl Collider {
+    /// The handle of rapier's handle `handle`.
+    pub fn of(handle: ColliderHandle) -> Self {
+        let (index, generation) = handle.into_raw_parts();
+        Self { index, generation }
+    }
+
+    /// rapier's handle.
+    pub fn handle(self) -> ColliderHandle {
+        ColliderHandle::from_raw_parts(self.index, self.generation)
+    }
+}
+
+#[pymethods]
+impl SoftBody {
+    fn __repr__(&self) -> String {
+        format!("SoftBody({}, {})", self.index, self.generation)
+    }
+}
+
+#[pymethods]
+impl RigidBody {
+    fn __repr__(&self) -> String {
+        format!("RigidBody({}, {})", self.index, self.generation)
+    }
+}
+
+#[pymethods]
+impl Collider {
+    fn __repr__(&self) -> String {
+        format!("Collider({}, {})", self.index, self.generation)
+    }
+}

@@ -1,0 +1,268 @@
+//! A world's rigid bodies and colliders from Python: the ground, boxes and balls (fixed,
+//! dynamic or kinematic), their poses and velocities read, kinematic bodies driven.
+//!
+//! rapier stores poses and velocities in `f32`; they are handed over as float64 arrays of
+//! those values.
+
+use crate::arrays::{rows_out, vector3};
+use crate::errors::{argument, unknown};
+use crate::handles::{Collider, RigidBody};
+use crate::world::World;
+use numpy::PyArray2;
+use pyo3::prelude::*;
+use rapier_fvm::glamx::DQuat;
+use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder, SharedShape};
+
+impl std::fmt::Debug for RigidBody {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let (index, generation) = self.handle().into_raw_parts();
+        write!(f, "RigidBody({index}, {generation})")
+    }
+}
+
+/// How a rigid body is placed, moved and made, as Python gives it.
+struct RigidOptions {
+    kind: String,
+    translation: [f64; 3],
+    rotation: [f64; 3],
+    linvel: [f64; 3],
+    angvel: [f64; 3],
+    density: f64,
+    friction: f64,
+    restitution: f64,
+}
+
+impl World {
+    /// The rigid body `body` of rapier's set, or a `KeyError`.
+    pub fn rigid(&self, body: RigidBody) -> PyResult<&rapier3d::dynamics::RigidBody> {
+        (self.sim.world.physics.bodies.get(body.handle()))
+            .ok_or_else(|| unknown("rigid body", body))
+    }
+
+    /// Inserts a rigid body of shape `shape` made and placed by `options`.
+    fn insert_rigid(&mut self, shape: SharedShape, options: &RigidOptions) -> PyResult<RigidBody> {
+        let builder = match options.kind.as_str() {
+            "dynamic" => RigidBodyBuilder::dynamic(),
+            "fixed" => RigidBodyBuilder::fixed(),
+            "kinematic" => RigidBodyBuilder::kinematic_position_based(),
+            other => {
+                return Err(argument(
+                    "kind",
+                    format!("{other:?} is not \"dynamic\", \"fixed\" or \"kinematic\""),
+                ));
+            }
+        };
+        let positive = |name: &str, value: f64| {
+            if value.is_finite() && value >= 0.0 {
+                Ok(value as f32)
+            } else {
+                Err(argument(
+                    name,
+                    format!("must be finite and not negative, got {value}"),
+                ))
+            }
+        };
+        if !(options.density.is_finite() && options.density > 0.0) {
+            return Err(argument(
+                "density",
+                format!("must be positive (kg/m³), got {}", options.density),
+            ));
+        }
+        let body = builder
+            .translation(vector3("translation", options.translation)?.as_vec3())
+            .rotation(vector3("rotation", options.rotation)?.as_vec3())
+            .linvel(vector3("linvel", options.linvel)?.as_vec3())
+            .angvel(vector3("angvel", options.angvel)?.as_vec3());
+        let collider = ColliderBuilder::new(shape)
+            .density(options.density as f32)
+            .friction(positive("friction", options.friction)?)
+            .restitution(positive("restitution", options.restitution)?);
+        Ok(RigidBody::of(
+            self.sim.world.physics.insert(body, collider).0,
+        ))
+    }
+}
+
+/// A length given from Python, positive and finite (argument `name`).
+fn length(name: &str, value: f64) -> PyResult<f32> {
+    if value.is_finite() && value > 0.0 {
+        Ok(value as f32)
+    } else {
+        Err(argument(
+            name,
+            format!("must be positive and finite (m), got {value}"),
+        ))
+    }
+}
+
+#[pymethods]
+impl World {
+    /// Adds the ground: a fixed half-space whose surface passes through `normal * height` (m),
+    /// solid below it, with Coulomb friction `friction`.
+    #[pyo3(signature = (*, height = 0.0, normal = [0.0, 1.0, 0.0], friction = 0.5))]
+    fn add_ground(&mut self, height: f64, normal: [f64; 3], friction: f64) -> PyResult<Collider> {
+        let normal = vector3("normal", normal)?;
+        if normal.length() < 1e-12
+            || !height.is_finite()
+            || !(friction.is_finite() && friction >= 0.0)
+        {
+            return Err(argument(
+                "ground",
+                "needs a non-zero normal, a finite height and friction >= 0",
+            ));
+        }
+        let normal = normal.normalize();
+        let collider = ColliderBuilder::new(SharedShape::halfspace(normal.as_vec3()))
+            .translation((normal * height).as_vec3())
+            .friction(friction as f32);
+        Ok(Collider::of(
+            self.sim.world.physics.insert_collider(collider, None),
+        ))
+    }
+
+    /// Adds a box of half extents `half_extents` (m): `kind` is `"dynamic"`, `"fixed"` or
+    /// `"kinematic"`; placed by `translation` (m) and `rotation` (scaled axis, rad), moving at
+    /// `linvel` (m/s) and `angvel` (rad/s), of density `density` (kg/m³).
+    #[pyo3(signature = (half_extents, *, kind = "dynamic".to_owned(), translation = [0.0; 3],
+        rotation = [0.0; 3], linvel = [0.0; 3], angvel = [0.0; 3], density = 1000.0,
+        friction = 0.5, restitution = 0.0))]
+    #[allow(clippy::too_many_arguments)]
+    fn add_box(
+        &mut self,
+        half_extents: [f64; 3],
+        kind: String,
+        translation: [f64; 3],
+        rotation: [f64; 3],
+        linvel: [f64; 3],
+        angvel: [f64; 3],
+        density: f64,
+        friction: f64,
+        restitution: f64,
+    ) -> PyResult<RigidBody> {
+        let [x, y, z] = [0, 1, 2].map(|i| length("half_extents", half_extents[i]));
+        let shape = SharedShape::cuboid(x?, y?, z?);
+        let options = RigidOptions {
+            kind,
+            translation,
+            rotation,
+            linvel,
+            angvel,
+            density,
+            friction,
+            restitution,
+        };
+        self.insert_rigid(shape, &options)
+    }
+
+    /// Adds a ball of radius `radius` (m), with the options of `add_box`.
+    #[pyo3(signature = (radius, *, kind = "dynamic".to_owned(), translation = [0.0; 3],
+        rotation = [0.0; 3], linvel = [0.0; 3], angvel = [0.0; 3], density = 1000.0,
+        friction = 0.5, restitution = 0.0))]
+    #[allow(clippy::too_many_arguments)]
+    fn add_ball(
+        &mut self,
+        radius: f64,
+        kind: String,
+        translation: [f64; 3],
+        rotation: [f64; 3],
+        linvel: [f64; 3],
+        angvel: [f64; 3],
+        density: f64,
+        friction: f64,
+        restitution: f64,
+    ) -> PyResult<RigidBody> {
+        let shape = SharedShape::ball(length("radius", radius)?);
+        let options = RigidOptions {
+            kind,
+            translation,
+            rotation,
+            linvel,
+            angvel,
+            density,
+            friction,
+            restitution,
+        };
+        self.insert_rigid(shape, &options)
+    }
+
+    /// The rigid bodies, in the order of their handles.
+    #[getter]
+    fn rigid_bodies(&self) -> Vec<RigidBody> {
+        (self.sim.world.physics.bodies.iter())
+            .map(|(handle, _)| RigidBody::of(handle))
+            .collect()
+    }
+
+    /// The colliders of `body` (a rigid body's shapes, as `contact_force` takes them).
+    fn colliders_of(&self, body: RigidBody) -> PyResult<Vec<Collider>> {
+        Ok(self
+            .rigid(body)?
+            .colliders()
+            .iter()
+            .map(|c| Collider::of(*c))
+            .collect())
+    }
+
+    /// The pose of `body`: its translation (m) and its rotation as a unit quaternion
+    /// `(x, y, z, w)`.
+    fn rigid_pose(&self, body: RigidBody) -> PyResult<([f64; 3], [f64; 4])> {
+        let b = self.rigid(body)?;
+        let q = b.rotation().as_dquat();
+        Ok((b.translation().as_dvec3().to_array(), q.to_array()))
+    }
+
+    /// The linear (m/s) and angular (rad/s) velocity of `body`.
+    fn rigid_velocity(&self, body: RigidBody) -> PyResult<([f64; 3], [f64; 3])> {
+        let b = self.rigid(body)?;
+        Ok((
+            b.linvel().as_dvec3().to_array(),
+            b.angvel().as_dvec3().to_array(),
+        ))
+    }
+
+    /// Every rigid body's pose in the order of `rigid_bodies`: an `(n, 7)` array of the
+    /// translation (m) then the rotation quaternion `(x, y, z, w)`.
+    fn rigid_poses<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        let flat: Vec<f64> = (self.sim.world.physics.bodies.iter())
+            .flat_map(|(_, b)| {
+                let [x, y, z] = b.translation().as_dvec3().to_array();
+                let [qx, qy, qz, qw] = b.rotation().as_dquat().to_array();
+                [x, y, z, qx, qy, qz, qw]
+            })
+            .collect();
+        rows_out(py, flat, 7)
+    }
+
+    /// Tells the kinematic body `body` where to be at the end of the next frame: `translation`
+    /// (m) and, if given, `rotation` as a unit quaternion `(x, y, z, w)`; rapier moves it there
+    /// over the frame and the soft bodies it touches feel it.
+    #[pyo3(signature = (body, translation, rotation = None))]
+    fn set_kinematic_target(
+        &mut self,
+        body: RigidBody,
+        translation: [f64; 3],
+        rotation: Option<[f64; 4]>,
+    ) -> PyResult<()> {
+        let translation = vector3("translation", translation)?;
+        let rotation = match rotation {
+            None => None,
+            Some(q) => {
+                let q = DQuat::from_array(q);
+                if !(q.is_finite() && (q.length() - 1.0).abs() < 1e-6) {
+                    return Err(argument("rotation", format!("not a unit quaternion: {q}")));
+                }
+                Some(q)
+            }
+        };
+        self.rigid(body)?;
+        let b = &mut self.sim.world.physics.bodies[body.handle()];
+        if !b.is_kinematic() {
+            return Err(argument("body", format!("{body:?} is not kinematic")));
+        }
+        b.set_next_kinematic_translation(translation.as_vec3());
+        if let Some(q) = rotation {
+            b.set_next_kinematic_rotation(q.as_quat());
+        }
+        Ok(())
+    }
+}
