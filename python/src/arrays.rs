@@ -70,3 +70,36 @@ pub fn vector3(name: &str, v: [f64; 3]) -> PyResult<DVec3> {
         Err(argument(name, format!("not finite: {v}")))
     }
 }
+
+/// A 3-vector for rapier, which stores it in `f32` (argument `name`): each value finite in
+/// `f32` (below 3.4e38 in magnitude).
+///
+/// # Errors
+/// A `ValueError` naming `name` if a value is not finite in `f32`.
+pub fn vector3_f32(name: &str, v: [f64; 3]) -> PyResult<rapier_fvm::glamx::Vec3> {
+    let single = DVec3::from_array(v).as_vec3();
+    if single.is_finite() {
+        Ok(single)
+    } else {
+        Err(argument(
+            name,
+            format!("not finite in float32, as rapier stores it: {:?}", v),
+        ))
+    }
+}
+
+/// A number for rapier (argument `name`), finite in `f32`.
+///
+/// # Errors
+/// A `ValueError` naming `name` if it is not finite in `f32`.
+pub fn scalar_f32(name: &str, value: f64) -> PyResult<f32> {
+    let single = value as f32;
+    if single.is_finite() {
+        Ok(single)
+    } else {
+        Err(argument(
+            name,
+            format!("not finite in float32, as rapier stores it: {value}"),
+        ))
+    }
+}

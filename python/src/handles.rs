@@ -68,23 +68,35 @@ impl Collider {
     }
 }
 
+/// Each handle prints as Python shows it, `SoftBody(index, generation)`.
+macro_rules! debug_as_repr {
+    ($($handle:ident),*) => {$(
+        impl std::fmt::Debug for $handle {
+            fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                write!(f, "{}({}, {})", stringify!($handle), self.index, self.generation)
+            }
+        }
+    )*};
+}
+debug_as_repr!(SoftBody, RigidBody, Collider);
+
 #[pymethods]
 impl SoftBody {
     fn __repr__(&self) -> String {
-        format!("SoftBody({}, {})", self.index, self.generation)
+        format!("{self:?}")
     }
 }
 
 #[pymethods]
 impl RigidBody {
     fn __repr__(&self) -> String {
-        format!("RigidBody({}, {})", self.index, self.generation)
+        format!("{self:?}")
     }
 }
 
 #[pymethods]
 impl Collider {
     fn __repr__(&self) -> String {
-        format!("Collider({}, {})", self.index, self.generation)
+        format!("{self:?}")
     }
 }

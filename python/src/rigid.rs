@@ -4,7 +4,7 @@
 //! rapier stores poses and velocities in `f32`; they are handed over as float64 arrays of
 //! those values.
 
-use crate::arrays::{rows_out, vector3};
+use crate::arrays::{rows_out, scalar_f32, vector3, vector3_f32};
 use crate::errors::{argument, unknown};
 use crate::handles::{Collider, RigidBody};
 use crate::world::World;
@@ -12,13 +12,6 @@ use numpy::PyArray2;
 use pyo3::prelude::*;
 use rapier_fvm::glamx::DQuat;
 use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder, SharedShape};
-
-impl std::fmt::Debug for RigidBody {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let (index, generation) = self.handle().into_raw_parts();
-        write!(f, "RigidBody({index}, {generation})")
-    }
-}
 
 /// How a rigid body is placed, moved and made, as Python gives it.
 struct RigidOptions {
@@ -52,46 +45,43 @@ impl World {
                 ));
             }
         };
-        let positive = |name: &str, value: f64| {
-            if value.is_finite() && value >= 0.0 {
-                Ok(value as f32)
+        let not_negative = |name: &str, value: f64| {
+            let single = scalar_f32(name, value)?;
+            if single >= 0.0 {
+                Ok(single)
             } else {
-                Err(argument(
-                    name,
-                    format!("must be finite and not negative, got {value}"),
-                ))
+                Err(argument(name, format!("must not be negative, got {value}")))
             }
         };
-        if !(options.density.is_finite() && options.density > 0.0) {
+        let density = scalar_f32("density", options.density)?;
+        if density <= 0.0 {
             return Err(argument(
                 "density",
                 format!("must be positive (kg/m³), got {}", options.density),
             ));
         }
         let body = builder
-            .translation(vector3("translation", options.translation)?.as_vec3())
-            .rotation(vector3("rotation", options.rotation)?.as_vec3())
-            .linvel(vector3("linvel", options.linvel)?.as_vec3())
-            .angvel(vector3("angvel", options.angvel)?.as_vec3());
+            .translation(vector3_f32("translation", options.translation)?)
+            .rotation(vector3_f32("rotation", options.rotation)?)
+            .linvel(vector3_f32("linvel", options.linvel)?)
+            .angvel(vector3_f32("angvel", options.angvel)?);
         let collider = ColliderBuilder::new(shape)
-            .density(options.density as f32)
-            .friction(positive("friction", options.friction)?)
-            .restitution(positive("restitution", options.restitution)?);
+            .density(density)
+            .friction(not_negative("friction", options.friction)?)
+            .restitution(not_negative("restitution", options.restitution)?);
         Ok(RigidBody::of(
             self.sim.world.physics.insert(body, collider).0,
         ))
     }
 }
 
-/// A length given from Python, positive and finite (argument `name`).
+/// A length given from Python (argument `name`), positive and finite in `f32`.
 fn length(name: &str, value: f64) -> PyResult<f32> {
-    if value.is_finite() && value > 0.0 {
-        Ok(value as f32)
+    let single = scalar_f32(name, value)?;
+    if single > 0.0 {
+        Ok(single)
     } else {
-        Err(argument(
-            name,
-            format!("must be positive and finite (m), got {value}"),
-        ))
+        Err(argument(name, format!("must be positive (m), got {value}")))
     }
 }
 
@@ -102,19 +92,21 @@ impl World {
     #[pyo3(signature = (*, height = 0.0, normal = [0.0, 1.0, 0.0], friction = 0.5))]
     fn add_ground(&mut self, height: f64, normal: [f64; 3], friction: f64) -> PyResult<Collider> {
         let normal = vector3("normal", normal)?;
-        if normal.length() < 1e-12
-            || !height.is_finite()
-            || !(friction.is_finite() && friction >= 0.0)
-        {
+        if normal.length() < 1e-12 {
+            return Err(argument("normal", "must not be zero"));
+        }
+        let height = scalar_f32("height", height)?;
+        let friction = scalar_f32("friction", friction)?;
+        if friction < 0.0 {
             return Err(argument(
-                "ground",
-                "needs a non-zero normal, a finite height and friction >= 0",
+                "friction",
+                format!("must not be negative, got {friction}"),
             ));
         }
-        let normal = normal.normalize();
-        let collider = ColliderBuilder::new(SharedShape::halfspace(normal.as_vec3()))
-            .translation((normal * height).as_vec3())
-            .friction(friction as f32);
+        let normal = normal.normalize().as_vec3();
+        let collider = ColliderBuilder::new(SharedShape::halfspace(normal))
+            .translation(normal * height)
+            .friction(friction);
         Ok(Collider::of(
             self.sim.world.physics.insert_collider(collider, None),
         ))
@@ -243,7 +235,7 @@ impl World {
         translation: [f64; 3],
         rotation: Option<[f64; 4]>,
     ) -> PyResult<()> {
-        let translation = vector3("translation", translation)?;
+        let translation = vector3_f32("translation", translation)?;
         let rotation = match rotation {
             None => None,
             Some(q) => {
@@ -259,7 +251,7 @@ impl World {
         if !b.is_kinematic() {
             return Err(argument("body", format!("{body:?} is not kinematic")));
         }
-        b.set_next_kinematic_translation(translation.as_vec3());
+        b.set_next_kinematic_translation(translation);
         if let Some(q) = rotation {
             b.set_next_kinematic_rotation(q.as_quat());
         }

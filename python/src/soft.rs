@@ -27,13 +27,6 @@ impl World {
     }
 }
 
-impl std::fmt::Debug for SoftBody {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let (index, generation) = self.handle().into_raw_parts();
-        write!(f, "SoftBody({index}, {generation})")
-    }
-}
-
 /// Node indices given from Python, each below `count` (argument `name`).
 fn node_indices(name: &str, nodes: &[i64], count: usize) -> PyResult<Vec<u32>> {
     (nodes.iter())

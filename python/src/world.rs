@@ -63,9 +63,13 @@ impl World {
         }
         for (handle, outcome) in outcomes {
             if let Err(error) = outcome {
-                let (index, _) = handle.into_raw_parts();
+                let name = match self.sim.soft.iter().find(|s| s.handle == handle) {
+                    Some(entry) => format!("soft body {:?}", entry.name),
+                    None => format!("{:?}", crate::handles::SoftBody::of(handle)),
+                };
                 return Err(Error::new_err(format!(
-                    "soft body {index}: its step failed and it kept its state: {error}"
+                    "frame {}: the step of {name} failed and it kept its state: {error}",
+                    self.frame
                 )));
             }
         }
@@ -78,14 +82,15 @@ impl World {
     #[new]
     #[pyo3(signature = (dt = 1.0 / 60.0, gravity = [0.0, -9.81, 0.0]))]
     fn new(dt: f64, gravity: [f64; 3]) -> PyResult<Self> {
-        if !(dt.is_finite() && dt > 0.0) {
+        let single = crate::arrays::scalar_f32("dt", dt)?;
+        if !(dt > 0.0 && single > 0.0) {
             return Err(argument(
                 "dt",
-                format!("must be positive and finite (s), got {dt}"),
+                format!("must be positive (s), also in float32 as rapier holds it, got {dt}"),
             ));
         }
-        let gravity = crate::arrays::vector3("gravity", gravity)?;
-        Ok(Self::empty(dt, gravity))
+        let gravity = crate::arrays::vector3_f32("gravity", gravity)?;
+        Ok(Self::empty(dt, gravity.as_dvec3()))
     }
 
     /// Advances the world by `frames` frames of `dt` (s each), with the GIL released.

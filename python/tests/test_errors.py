@@ -74,3 +74,24 @@ def test_a_file_the_reader_cannot_take_is_refused_naming_file_and_line():
 
     with pytest.raises(rf.Error, match=r"cube_lzma.vtu: line 7: .*vtkLZMADataCompressor"):
         rf.Mesh.load(ROOT / "assets" / "meshes" / "cube_lzma.vtu")
+
+
+def test_values_rapier_cannot_hold_in_float32_are_refused_by_name():
+    # rapier stores poses, velocities, densities and the frame step in float32: 1e-300 rounds
+    # to 0 and 1e300 to infinity there, which would stop the step or poison the world.
+    with pytest.raises(ValueError, match="dt"):
+        rf.World(dt=1e-300)
+    with pytest.raises(ValueError, match="dt"):
+        rf.World(dt=1e300)
+    with pytest.raises(ValueError, match="gravity"):
+        rf.World(gravity=(0.0, -1e300, 0.0))
+    world = rf.World()
+    with pytest.raises(ValueError, match="density"):
+        world.add_box((0.1, 0.1, 0.1), density=1e300)
+    with pytest.raises(ValueError, match="translation"):
+        world.add_ball(0.1, translation=(1e300, 0.0, 0.0))
+    with pytest.raises(ValueError, match="radius"):
+        world.add_ball(1e-60)
+    with pytest.raises(ValueError, match="height"):
+        world.add_ground(height=1e300)
+    assert world.rigid_bodies == []
