@@ -14,6 +14,7 @@ mod cost;
 mod loads;
 mod materials;
 mod meshes;
+mod needs;
 mod probe;
 mod regions;
 pub(crate) mod report;
@@ -22,6 +23,7 @@ pub(crate) mod writer;
 
 pub use build::{RigidEntry, Simulation, SoftEntry};
 pub use loads::{DrivenLoad, LoadSchedule};
+pub use needs::BodyNeeds;
 pub use probe::Probe;
 pub use report::{
     BodyFlags, Files, Flag, ProbeReport, Report, RigidBodyReport, Settings, SoftBodyReport,

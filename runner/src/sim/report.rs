@@ -116,6 +116,8 @@ pub struct SoftBodyReport {
     pub stable: bool,
     /// What its steps cost: the automatic choice's predictions beside the measured time.
     pub cost: StepCost,
+    /// What its motion asked of its model: peak strain and rotation, frames in contact.
+    pub needs: super::needs::BodyNeeds,
     #[serde(skip)]
     explicit_substeps_sum: u64,
 }

@@ -14,6 +14,7 @@ use crate::scene::{Scene, SceneError};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rapier_fvm::body::DeformableBodyHandle;
 use rapier_fvm::coupling::{Audit, SoftStepResults};
+use rapier_fvm::glamx::DVec3;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
@@ -130,7 +131,8 @@ pub fn run(scene: &Scene, options: &RunOptions) -> Result<Report, RunError> {
 }
 
 /// Records what frame `frame`'s step `outcomes` were in each soft body's report, the bodies
-/// asleep, and what the `audit` of the frame finds, in the reports and the `stability`.
+/// asleep, their strain, rotation and contacts, and what the `audit` of the frame finds, in
+/// the reports and the `stability`.
 fn record_frame(
     sim: &Simulation,
     (frame, outcomes): (usize, &SoftStepResults),
@@ -142,8 +144,12 @@ fn record_frame(
             bodies[i].record(outcome, stability);
         }
     }
-    for (entry, body) in sim.soft.iter().zip(bodies.iter_mut()) {
-        body.asleep_frames += usize::from(sim.world.coupling.is_sleeping(entry.handle));
+    for (entry, report) in sim.soft.iter().zip(bodies.iter_mut()) {
+        report.asleep_frames += usize::from(sim.world.coupling.is_sleeping(entry.handle));
+        let touching = (sim.world.coupling.contacts(entry.handle).iter())
+            .any(|contact| contact.impulse != DVec3::ZERO);
+        let body = &sim.world.soft_bodies[entry.handle];
+        report.needs.record(body, &entry.rest, touching);
     }
     let found = audit.check_world(&sim.world, outcomes);
     stability.record_system(frame, found.system);
