@@ -49,7 +49,10 @@ def run_job(scene: str, out: str, index: int, overrides: Mapping[str, Any],
 
     folder = Path(out) / "runs" / f"{index:04d}"
     started = time.perf_counter()
-    report = run_scene(scene, folder, duration=duration, overrides=dict(overrides))
+    try:
+        report = run_scene(scene, folder, duration=duration, overrides=dict(overrides))
+    except ValueError as error:  # rapier_fvm.Error and SceneError, a malformed override
+        return {"run": index, **overrides, "error": str(error), "exception": error}
     (folder / "overrides.json").write_text(json.dumps(overrides))
     return row_of(index, overrides, report, time.perf_counter() - started)
 
@@ -73,8 +76,10 @@ def sweep(scene: Union[str, os.PathLike], parameters: Union[Mapping[str, Sequenc
           address: Optional[str] = None) -> list[dict[str, Any]]:
     """Runs `scene` once per combination of `parameters` (a dict of key paths to value lists,
     or a list of override dicts) and writes the table and plot into `out`; returns the rows in
-    run order. Each job's solver runs on one thread (``RAYON_NUM_THREADS=1``), so `workers`
-    jobs use `workers` cores."""
+    run order. A pool's or Ray's job runs its solver on one thread (``RAYON_NUM_THREADS=1``),
+    so `workers` jobs use `workers` cores; the serial loop runs in this process, on its threads.
+    A run that fails is a row with its ``error``; if every run fails, the first error is
+    raised."""
     if backend not in BACKENDS:
         raise ValueError(f"backend: {backend!r} is not one of {BACKENDS}")
     if workers < 1:
@@ -82,7 +87,9 @@ def sweep(scene: Union[str, os.PathLike], parameters: Union[Mapping[str, Sequenc
     jobs = grid(parameters) if isinstance(parameters, Mapping) else [dict(p) for p in parameters]
     if not jobs:
         raise ValueError("parameters: no run to make")
-    scene, out = str(Path(scene).resolve()), str(Path(out))
+    # Absolute, so that jobs on other machines' workers (whose working folder differs) find
+    # them on a shared file system.
+    scene, out = str(Path(scene).resolve()), str(Path(out).resolve())
     Path(out).mkdir(parents=True, exist_ok=True)
     args = [(scene, out, i, job, duration) for i, job in enumerate(jobs)]
     if backend == "serial":
@@ -91,7 +98,10 @@ def sweep(scene: Union[str, os.PathLike], parameters: Union[Mapping[str, Sequenc
         rows = run_pool(args, workers)
     else:
         rows = run_ray(args, workers, address)
+    errors = [row.pop("exception") for row in rows if "exception" in row]
     write_table(rows, Path(out))
+    if len(errors) == len(rows):
+        raise errors[0]
     return rows
 
 
@@ -114,13 +124,13 @@ def run_ray(args: list[tuple], workers: int, address: Optional[str]) -> list[dic
 
     started_here = not ray.is_initialized()
     if started_here:
-        options: dict[str, Any] = {"address": address, "include_dashboard": False,
-                                   "runtime_env": {"env_vars": {"RAYON_NUM_THREADS": "1"}}}
+        options: dict[str, Any] = {"address": address, "include_dashboard": False}
         if address is None:
             options["num_cpus"] = workers
         ray.init(**options)
     try:
-        task = ray.remote(num_cpus=1)(run_job)
+        one_thread_env = {"env_vars": {"RAYON_NUM_THREADS": "1"}}
+        task = ray.remote(num_cpus=1, runtime_env=one_thread_env)(run_job)
         return ray.get([task.remote(*a) for a in args])
     finally:
         if started_here:
@@ -148,6 +158,9 @@ def plot(rows: list[dict[str, Any]], path: Path) -> bool:
         import matplotlib.pyplot as plt
     except ImportError:
         return False
+    rows = [row for row in rows if "error" not in row]
+    if not rows:
+        return False
     fixed = {"run", "wall_time_s", "ms_per_frame", "stable"}
     keys = [k for k in rows[0] if k not in fixed and " (" not in k]
     probes = [k for k in rows[0] if " (" in k]
@@ -173,9 +186,13 @@ def plot(rows: list[dict[str, Any]], path: Path) -> bool:
 
 
 def gather(out: Path) -> list[dict[str, Any]]:
-    """The rows of the finished runs under `out/runs` (a Slurm job array's), and the table."""
+    """The rows of the finished runs under `out/runs` (a Slurm job array's), and the table;
+    a folder without a finished run is named on stderr and left out."""
     rows = []
     for folder in sorted((out / "runs").iterdir()):
+        if not ((folder / "report.json").is_file() and (folder / "overrides.json").is_file()):
+            print(f"{folder}: no finished run, left out", file=sys.stderr)
+            continue
         report = json.loads((folder / "report.json").read_text())
         overrides = json.loads((folder / "overrides.json").read_text())
         rows.append(row_of(int(folder.name), overrides, report, report["wall_time_s"]))
@@ -203,10 +220,11 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--address", default=None, help="a Ray cluster's address")
     parser.add_argument("--duration", type=float, default=None)
-    parser.add_argument("--only", type=int, default=None,
-                        help="runs only this job index (one task of a Slurm job array)")
-    parser.add_argument("--gather", action="store_true",
-                        help="gathers the table of the runs already under --out")
+    one = parser.add_mutually_exclusive_group()
+    one.add_argument("--only", type=int, default=None,
+                     help="runs only this job index (one task of a Slurm job array)")
+    one.add_argument("--gather", action="store_true",
+                     help="gathers the table of the runs already under --out")
     args = parser.parse_args(argv)
     out = Path(args.out)
     if args.gather:
@@ -216,16 +234,20 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         if not 0 <= args.only < len(jobs):
             parser.error(f"--only {args.only}: the grid has jobs 0..{len(jobs) - 1}")
         one_thread()
-        rows = [run_job(str(Path(args.scene).resolve()), str(out), args.only, jobs[args.only],
-                        args.duration)]
+        rows = [run_job(str(Path(args.scene).resolve()), str(out.resolve()), args.only,
+                        jobs[args.only], args.duration)]
+        rows[0].pop("exception", None)
     else:
         rows = sweep(args.scene, dict(args.sets), out, backend=args.backend,
                      workers=args.workers, duration=args.duration, address=args.address)
+    failed = [row for row in rows if "error" in row]
+    for row in failed:
+        print(f"run {row['run']} failed: {row['error']}", file=sys.stderr)
     if args.only is None:
-        print(f"{len(rows)} runs; table in {out / 'sweep.csv'}")
+        print(f"{len(rows)} runs ({len(failed)} failed); table in {out / 'sweep.csv'}")
     else:
         print(f"run {args.only} in {out / 'runs'}")
-    return 0
+    return 1 if failed else 0
 
 
 if __name__ == "__main__":

@@ -34,19 +34,60 @@ pub fn vector_out<T: numpy::Element>(py: Python<'_>, values: Vec<T>) -> Bound<'_
     values.into_pyarray(py)
 }
 
-/// The rows of the `(n, 3)` array `array` (argument `name`) as vectors, each finite.
-///
-/// # Errors
-/// A `ValueError` naming `name` and the row for a wrong shape or a value that is not finite.
-pub fn vectors_in(name: &str, array: &PyReadonlyArray2<'_, f64>) -> PyResult<Vec<DVec3>> {
-    let view = array.as_array();
-    if view.ncols() != 3 {
+/// `object` (argument `name`: a numpy array or nested sequences of numbers) as a 2D numpy
+/// array of `columns` columns, cast to `dtype` (a numpy type name), with the shape it had.
+fn rows_in<'py>(
+    name: &str,
+    object: &Bound<'py, PyAny>,
+    columns: usize,
+    dtype: &str,
+) -> PyResult<Bound<'py, PyAny>> {
+    let numpy = object.py().import("numpy")?;
+    let array = numpy.call_method1("asarray", (object,))?;
+    let shape: Vec<usize> = array.getattr("shape")?.extract()?;
+    let size: usize = array.getattr("size")?.extract()?;
+    if size == 0 {
+        return numpy.call_method1("zeros", ((0, columns), dtype));
+    }
+    if shape.len() != 2 || shape[1] != columns {
         return Err(argument(
             name,
-            format!("expected an (n, 3) array, got {:?}", view.shape()),
+            format!("expected an (n, {columns}) array, got the shape {shape:?}"),
         ));
     }
-    (view.rows().into_iter().enumerate())
+    let kind: String = array.getattr("dtype")?.getattr("kind")?.extract()?;
+    let allowed = if dtype == "float64" { "iuf" } else { "iu" };
+    if !allowed.contains(kind.as_str()) {
+        let given = array.getattr("dtype")?.str()?;
+        return Err(argument(
+            name,
+            format!(
+                "expected {} values, got the dtype {given}",
+                kind_name(dtype)
+            ),
+        ));
+    }
+    array.call_method1("astype", (dtype,))
+}
+
+/// What values of the numpy type `dtype` are, for messages.
+fn kind_name(dtype: &str) -> &'static str {
+    if dtype == "float64" {
+        "numeric"
+    } else {
+        "integer"
+    }
+}
+
+/// The rows of `object` (argument `name`, an `(n, 3)` array-like of numbers) as vectors, each
+/// finite.
+///
+/// # Errors
+/// A `ValueError` naming `name` (and the row) for a wrong shape, a dtype that is not numeric or
+/// a value that is not finite.
+pub fn vectors_in(name: &str, object: &Bound<'_, PyAny>) -> PyResult<Vec<DVec3>> {
+    let array: PyReadonlyArray2<'_, f64> = rows_in(name, object, 3, "float64")?.extract()?;
+    (array.as_array().rows().into_iter().enumerate())
         .map(|(i, row)| {
             let v = DVec3::new(row[0], row[1], row[2]);
             if v.is_finite() {
@@ -54,6 +95,30 @@ pub fn vectors_in(name: &str, array: &PyReadonlyArray2<'_, f64>) -> PyResult<Vec
             } else {
                 Err(argument(name, format!("row {i} is not finite: {v}")))
             }
+        })
+        .collect()
+}
+
+/// The rows of `object` (argument `name`, an `(n, K)` array-like of integers) as node
+/// indices.
+///
+/// # Errors
+/// A `ValueError` naming `name` (and the row) for a wrong shape, values that are not integers
+/// or an index below 0 or past `u32`.
+pub fn indices_in<const K: usize>(
+    name: &str,
+    object: &Bound<'_, PyAny>,
+) -> PyResult<Vec<[u32; K]>> {
+    let array: PyReadonlyArray2<'_, i64> = rows_in(name, object, K, "int64")?.extract()?;
+    (array.as_array().rows().into_iter().enumerate())
+        .map(|(i, row)| {
+            let mut indices = [0u32; K];
+            for (slot, &index) in indices.iter_mut().zip(row.iter()) {
+                *slot = u32::try_from(index).map_err(|_| {
+                    argument(name, format!("row {i}: node index {index} out of range"))
+                })?;
+            }
+            Ok(indices)
         })
         .collect()
 }

@@ -3,8 +3,9 @@
 //! `rapier_fvm.Error` (a `ValueError`) is what the library refuses: a mesh, material, setting
 //! or state, or a step that failed; `rapier_fvm.SceneError` (a subclass) is a scene file that
 //! cannot be read, naming the file, line and key as `rapier-fvm run` does. Arguments of the
-//! wrong shape or kind raise `ValueError`/`TypeError` naming the argument, and a handle of
-//! another world or of a removed body raises `KeyError`.
+//! wrong shape or kind raise `ValueError`/`TypeError` naming the argument, and a handle this
+//! world holds no body or collider for raises `KeyError`. Handles are indices into a world's
+//! sets, as rapier's are: a handle of another world names whatever this world holds there.
 
 use pyo3::exceptions::{PyKeyError, PyValueError};
 use pyo3::{PyErr, create_exception};

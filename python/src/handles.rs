@@ -82,6 +82,17 @@ debug_as_repr!(SoftBody, RigidBody, Collider);
 
 #[pymethods]
 impl SoftBody {
+    /// The handle of raw parts `index` and `generation` (as `__getnewargs__` gives them, for
+    /// pickling).
+    #[new]
+    fn new(index: u32, generation: u32) -> Self {
+        Self { index, generation }
+    }
+
+    fn __getnewargs__(&self) -> (u32, u32) {
+        (self.index, self.generation)
+    }
+
     fn __repr__(&self) -> String {
         format!("{self:?}")
     }
@@ -89,6 +100,17 @@ impl SoftBody {
 
 #[pymethods]
 impl RigidBody {
+    /// The handle of raw parts `index` and `generation` (as `__getnewargs__` gives them, for
+    /// pickling).
+    #[new]
+    fn new(index: u32, generation: u32) -> Self {
+        Self { index, generation }
+    }
+
+    fn __getnewargs__(&self) -> (u32, u32) {
+        (self.index, self.generation)
+    }
+
     fn __repr__(&self) -> String {
         format!("{self:?}")
     }
@@ -96,6 +118,17 @@ impl RigidBody {
 
 #[pymethods]
 impl Collider {
+    /// The handle of raw parts `index` and `generation` (as `__getnewargs__` gives them, for
+    /// pickling).
+    #[new]
+    fn new(index: u32, generation: u32) -> Self {
+        Self { index, generation }
+    }
+
+    fn __getnewargs__(&self) -> (u32, u32) {
+        (self.index, self.generation)
+    }
+
     fn __repr__(&self) -> String {
         format!("{self:?}")
     }

@@ -15,6 +15,7 @@ mod errors;
 mod handles;
 mod loads;
 mod model;
+mod overrides;
 mod rigid;
 mod scene;
 mod soft;

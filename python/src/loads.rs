@@ -3,35 +3,12 @@
 //! through nodes (N). `add_*` returns the load's index on its body; `set_load` changes its
 //! magnitude (see the library's `load` module for each load's law).
 
-use crate::arrays::vector3;
-use crate::errors::{argument, library};
+use crate::arrays::{indices_in, vector3};
+use crate::errors::library;
 use crate::handles::SoftBody;
 use crate::world::World;
-use numpy::PyReadonlyArray2;
 use pyo3::prelude::*;
 use rapier_fvm::load::{Load, LoadHandle, LoadValue};
-
-/// Triangles given as an `(k, 3)` integer array of node indices (argument `triangles`).
-fn triangles_in(triangles: &PyReadonlyArray2<'_, i64>) -> PyResult<Vec<[u32; 3]>> {
-    let view = triangles.as_array();
-    if view.ncols() != 3 {
-        return Err(argument(
-            "triangles",
-            format!("expected a (k, 3) array, got {:?}", view.shape()),
-        ));
-    }
-    (view.rows().into_iter().enumerate())
-        .map(|(i, row)| {
-            let mut triangle = [0u32; 3];
-            for (slot, &n) in triangle.iter_mut().zip(row.iter()) {
-                *slot = u32::try_from(n).map_err(|_| {
-                    argument("triangles", format!("row {i}: node {n} out of range"))
-                })?;
-            }
-            Ok(triangle)
-        })
-        .collect()
-}
 
 impl World {
     /// Adds `load` to `body`; its index on the body.
@@ -48,10 +25,10 @@ impl World {
     fn add_pressure(
         &mut self,
         body: SoftBody,
-        triangles: PyReadonlyArray2<'_, i64>,
+        triangles: &Bound<'_, PyAny>,
         pressure: f64,
     ) -> PyResult<u32> {
-        let triangles = triangles_in(&triangles)?;
+        let triangles = indices_in::<3>("triangles", triangles)?;
         self.add_load(
             body,
             Load::Pressure {
@@ -66,10 +43,10 @@ impl World {
     fn add_traction(
         &mut self,
         body: SoftBody,
-        triangles: PyReadonlyArray2<'_, i64>,
+        triangles: &Bound<'_, PyAny>,
         traction: [f64; 3],
     ) -> PyResult<u32> {
-        let triangles = triangles_in(&triangles)?;
+        let triangles = indices_in::<3>("triangles", triangles)?;
         let traction = vector3("traction", traction)?;
         self.add_load(
             body,

@@ -1,9 +1,9 @@
 //! What a body is made of, on the Python side: `Material` (model and constants in SI units)
 //! and `Mesh` (a checked tetrahedral mesh, generated, read from a file or given as arrays).
 
-use crate::arrays::{rows_out, vectors_in, vectors_out};
+use crate::arrays::{indices_in, rows_out, vectors_in, vectors_out};
 use crate::errors::{argument, library};
-use numpy::{PyArray2, PyReadonlyArray2};
+use numpy::PyArray2;
 use pyo3::prelude::*;
 use rapier_fvm::glamx::DVec3;
 use rapier_fvm::material::{Material as LibraryMaterial, MaterialModel};
@@ -28,6 +28,15 @@ const MODELS: [(&str, MaterialModel); 4] = [
 pub struct Material {
     /// The library's material.
     pub inner: LibraryMaterial,
+}
+
+impl Material {
+    /// The model's name as Python gives it.
+    fn model_name(&self) -> &'static str {
+        (MODELS.iter())
+            .find(|(_, model)| *model == self.inner.model())
+            .map_or("?", |(name, _)| name)
+    }
 }
 
 #[pymethods]
@@ -64,10 +73,18 @@ impl Material {
         self.inner.density()
     }
 
+    /// The arguments that make this material again (for pickling).
+    fn __getnewargs__(&self) -> (&'static str, f64, f64, f64) {
+        (
+            self.model_name(),
+            self.young(),
+            self.poisson(),
+            self.density(),
+        )
+    }
+
     fn __repr__(&self) -> String {
-        let name = (MODELS.iter())
-            .find(|(_, model)| *model == self.inner.model())
-            .map_or("?", |(name, _)| name);
+        let name = self.model_name();
         format!(
             "Material({name:?}, young={}, poisson={}, density={})",
             self.young(),
@@ -91,26 +108,9 @@ impl Mesh {
     /// A mesh of the nodes `nodes` (an `(n, 3)` float array, m) and tetrahedra `tets` (an
     /// `(m, 4)` integer array of node indices, positively oriented).
     #[new]
-    fn new(nodes: PyReadonlyArray2<'_, f64>, tets: PyReadonlyArray2<'_, i64>) -> PyResult<Self> {
-        let nodes = vectors_in("nodes", &nodes)?;
-        let view = tets.as_array();
-        if view.ncols() != 4 {
-            return Err(argument(
-                "tets",
-                format!("expected an (m, 4) array, got {:?}", view.shape()),
-            ));
-        }
-        let tets = (view.rows().into_iter().enumerate())
-            .map(|(i, row)| {
-                let mut tet = [0u32; 4];
-                for (slot, &index) in tet.iter_mut().zip(row.iter()) {
-                    *slot = u32::try_from(index).map_err(|_| {
-                        argument("tets", format!("row {i}: node index {index} out of range"))
-                    })?;
-                }
-                Ok(tet)
-            })
-            .collect::<PyResult<Vec<_>>>()?;
+    fn new(nodes: &Bound<'_, PyAny>, tets: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let nodes = vectors_in("nodes", nodes)?;
+        let tets = indices_in::<4>("tets", tets)?;
         let inner = TetMesh::new(nodes, tets).map_err(library)?;
         Ok(Self { inner })
     }
@@ -152,6 +152,15 @@ impl Mesh {
         let options = import::SurfaceOptions::default();
         let inner = import::load(path, scale, &options).map_err(library)?;
         Ok(Self { inner })
+    }
+
+    /// The arguments that make this mesh again (for pickling): its nodes and tetrahedra.
+    #[allow(clippy::type_complexity)]
+    fn __getnewargs__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<u32>>) {
+        (self.nodes(py), self.tets(py))
     }
 
     /// The node positions, an `(n, 3)` array (m).

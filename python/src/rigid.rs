@@ -65,6 +65,13 @@ impl World {
             .rotation(vector3_f32("rotation", options.rotation)?)
             .linvel(vector3_f32("linvel", options.linvel)?)
             .angvel(vector3_f32("angvel", options.angvel)?);
+        let mass = shape.mass_properties(density).mass();
+        if !(mass.is_finite() && mass > 0.0) {
+            return Err(argument(
+                "density",
+                format!("with this size the body's mass is {mass} kg in float32, not positive"),
+            ));
+        }
         let collider = ColliderBuilder::new(shape)
             .density(density)
             .friction(not_negative("friction", options.friction)?)
@@ -92,9 +99,10 @@ impl World {
     #[pyo3(signature = (*, height = 0.0, normal = [0.0, 1.0, 0.0], friction = 0.5))]
     fn add_ground(&mut self, height: f64, normal: [f64; 3], friction: f64) -> PyResult<Collider> {
         let normal = vector3("normal", normal)?;
-        if normal.length() < 1e-12 {
-            return Err(argument("normal", "must not be zero"));
-        }
+        let largest = normal.abs().max_element();
+        let normal = (normal / largest)
+            .try_normalize()
+            .ok_or_else(|| argument("normal", "must be a non-zero direction"))?;
         let height = scalar_f32("height", height)?;
         let friction = scalar_f32("friction", friction)?;
         if friction < 0.0 {
@@ -103,7 +111,7 @@ impl World {
                 format!("must not be negative, got {friction}"),
             ));
         }
-        let normal = normal.normalize().as_vec3();
+        let normal = normal.as_vec3();
         let collider = ColliderBuilder::new(SharedShape::halfspace(normal))
             .translation(normal * height)
             .friction(friction);

@@ -7,7 +7,7 @@ use crate::errors::{argument, library, unknown};
 use crate::handles::{Collider, RigidBody, SoftBody};
 use crate::model::{Material, Mesh};
 use crate::world::World;
-use numpy::{PyArray1, PyArray2, PyArray3, PyReadonlyArray2};
+use numpy::{PyArray1, PyArray2, PyArray3};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rapier_fvm::body::{DeformableBody, DeformableBodyBuilder};
@@ -147,7 +147,7 @@ impl World {
             .flat_map(|s| s.transpose().to_cols_array())
             .collect();
         let array = numpy::ndarray::Array3::from_shape_vec((stresses.len(), 3, 3), flat)
-            .map_err(|e| argument("stresses", e))?;
+            .expect("nine values per element by construction");
         Ok(numpy::IntoPyArray::into_pyarray(array, py))
     }
 
@@ -155,11 +155,12 @@ impl World {
     /// `collider` over its last step.
     fn contact_force(&self, soft: SoftBody, collider: Collider) -> PyResult<([f64; 3], [f64; 3])> {
         self.soft(soft)?;
-        let (force, torque) = (self
-            .sim
-            .world
-            .contact_force_on(soft.handle(), collider.handle()))
-        .map_err(library)?;
+        if !self.sim.world.physics.colliders.contains(collider.handle()) {
+            return Err(unknown("collider", collider));
+        }
+        let (force, torque) = (self.sim.world)
+            .contact_force_on(soft.handle(), collider.handle())
+            .map_err(library)?;
         Ok((force.to_array(), torque.to_array()))
     }
 
@@ -167,6 +168,7 @@ impl World {
     /// `rigid` over the last frame, through contacts and glue.
     fn load_on(&self, soft: SoftBody, rigid: RigidBody) -> PyResult<([f64; 3], [f64; 3])> {
         self.soft(soft)?;
+        self.rigid(rigid)?;
         let (force, torque) = self.sim.world.load_on(soft.handle(), rigid.handle());
         Ok((force.to_array(), torque.to_array()))
     }
@@ -177,10 +179,10 @@ impl World {
     fn set_positions(
         &mut self,
         body: SoftBody,
-        positions: PyReadonlyArray2<'_, f64>,
+        positions: &Bound<'_, PyAny>,
         nodes: Option<Vec<i64>>,
     ) -> PyResult<()> {
-        let values = vectors_in("positions", &positions)?;
+        let values = vectors_in("positions", positions)?;
         self.set_node_vectors(
             body,
             values,
@@ -195,10 +197,10 @@ impl World {
     fn set_velocities(
         &mut self,
         body: SoftBody,
-        velocities: PyReadonlyArray2<'_, f64>,
+        velocities: &Bound<'_, PyAny>,
         nodes: Option<Vec<i64>>,
     ) -> PyResult<()> {
-        let values = vectors_in("velocities", &velocities)?;
+        let values = vectors_in("velocities", velocities)?;
         self.set_node_vectors(
             body,
             values,

@@ -2,10 +2,12 @@
 //! (to hand a world to another process: a process pool's or a Ray worker's).
 //!
 //! The bytes are CBOR (the format the library's serialization is tested with; rapier's state
-//! holds infinities, which JSON cannot carry) of the frame count and the whole `FvmWorld`:
-//! rigid and soft bodies, contacts, attachments, sleep and solver caches. A pickle adds the frame
-//! step, the scene the world was read from (its path and text: its keyframes drive the world,
-//! and its mesh files are read again where the pickle is loaded) and the probes' samples.
+//! holds infinities, which JSON cannot carry) of a [`Saved`]: the frame count and step, the
+//! probes' samples and the whole `FvmWorld` (rigid and soft bodies, contacts, attachments,
+//! sleep and solver caches). A state is put back only into a world of the same bodies (handles,
+//! and each soft body's node count), so that every handle the caller holds names the same body
+//! after it. A pickle adds the scene the world was read from (its path and text: its
+//! keyframes drive the world, and its mesh files are read again where the pickle is loaded).
 
 use crate::errors::{Error, argument, scene as scene_error};
 use crate::world::World;
@@ -15,40 +17,92 @@ use rapier_fvm::glamx::DVec3;
 use rapier_fvm::world::FvmWorld;
 use rapier_fvm_runner::scene::Scene;
 use rapier_fvm_runner::sim::Simulation;
+use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
 
 /// The scene a pickled world was read from: its path and text.
 type PickledScene = Option<(PathBuf, String)>;
-/// Each probe's `(time (s), value)` samples, in scene order.
-type ProbeSamples = Vec<Vec<(f64, f64)>>;
+
+/// A world's state as saved (`W` the world, borrowed to save and owned when read).
+#[derive(Serialize, Deserialize)]
+struct Saved<W> {
+    /// Frames stepped.
+    frame: u64,
+    /// The frame step (s).
+    dt: f64,
+    /// Each probe's `(time (s), value)` samples, in scene order.
+    probes: Vec<Vec<(f64, f64)>>,
+    /// The world.
+    world: W,
+}
+
+/// A world's bodies, to compare two worlds: each soft body's handle (raw parts) and node
+/// count, each rigid body's handle.
+#[derive(Serialize, Deserialize, PartialEq, Debug)]
+struct Bodies {
+    soft: Vec<((u32, u32), usize)>,
+    rigid: Vec<(u32, u32)>,
+}
+
+impl Bodies {
+    /// The bodies of `world`.
+    fn of(world: &FvmWorld) -> Self {
+        Self {
+            soft: (world.soft_bodies.iter())
+                .map(|(h, b)| (h.into_raw_parts(), b.node_count()))
+                .collect(),
+            rigid: (world.physics.bodies.iter())
+                .map(|(h, _)| h.into_raw_parts())
+                .collect(),
+        }
+    }
+}
 
 impl World {
-    /// The world's state as CBOR bytes: the frame count and the whole `FvmWorld`.
+    /// The world's state as CBOR bytes (a [`Saved`]).
     fn state_bytes(&self) -> PyResult<Vec<u8>> {
+        let saved = Saved {
+            frame: self.frame,
+            dt: self.dt,
+            probes: (self.sim.probes.iter())
+                .map(|p| p.series.samples.clone())
+                .collect(),
+            world: &self.sim.world,
+        };
         let mut bytes = Vec::new();
-        ciborium::into_writer(&(self.frame, &self.sim.world), &mut bytes)
+        ciborium::into_writer(&saved, &mut bytes)
             .map_err(|e| Error::new_err(format!("the world could not be saved: {e}")))?;
         Ok(bytes)
     }
 
-    /// Puts back the state `bytes` of [`World::state_bytes`]; the probes keep their samples up
-    /// to the restored frame.
+    /// Puts back the state `bytes` of [`World::state_bytes`], if it is a state of a world of
+    /// the same bodies and probes.
     fn restore_bytes(&mut self, bytes: &[u8]) -> PyResult<()> {
-        let (frame, world): (u64, FvmWorld) = ciborium::from_reader(bytes)
+        let saved: Saved<FvmWorld> = ciborium::from_reader(bytes)
             .map_err(|e| argument("state", format!("not a saved world: {e}")))?;
-        let names_kept = (self.sim.soft.iter()).all(|s| world.soft_bodies.contains(s.handle))
-            && (self.sim.rigid.iter()).all(|r| world.physics.bodies.contains(r.handle));
-        if !names_kept {
+        if Bodies::of(&saved.world) != Bodies::of(&self.sim.world) {
             return Err(argument(
                 "state",
-                "saved from another scene: its bodies are not this world's",
+                "saved from a world of other bodies: this world's handles would name other \
+                 bodies in it",
             ));
         }
-        self.sim.world = world;
-        self.frame = frame;
-        for probe in &mut self.sim.probes {
-            probe.series.samples.truncate(frame as usize + 1);
+        if saved.probes.len() != self.sim.probes.len() {
+            return Err(argument(
+                "state",
+                format!(
+                    "saved from a world of {} probes, this one has {}",
+                    saved.probes.len(),
+                    self.sim.probes.len()
+                ),
+            ));
         }
+        for (probe, samples) in self.sim.probes.iter_mut().zip(saved.probes) {
+            probe.series.samples = samples;
+        }
+        self.sim.world = saved.world;
+        self.frame = saved.frame;
+        self.dt = saved.dt;
         Ok(())
     }
 }
@@ -66,8 +120,7 @@ impl World {
         self.restore_bytes(state)
     }
 
-    /// Pickling: the world rebuilt by `_unpickle_world` from its frame step, scene, state and
-    /// probes' samples.
+    /// Pickling: the world rebuilt by `_unpickle_world` from its scene and state.
     fn __reduce__<'py>(
         &self,
         py: Python<'py>,
@@ -77,28 +130,22 @@ impl World {
             .getattr("_unpickle_world")?;
         let scene: PickledScene =
             (self.scene.as_ref()).map(|s| (s.source.path.clone(), s.source.text.clone()));
-        let samples: ProbeSamples = (self.sim.probes.iter())
-            .map(|p| p.series.samples.clone())
-            .collect();
         let state = PyBytes::new(py, &self.state_bytes()?);
-        let args = (self.dt, scene, state, samples).into_pyobject(py)?;
+        let args = (scene, state).into_pyobject(py)?;
         Ok((rebuild, args))
     }
 }
 
-/// A pickled world rebuilt (see [`World::__reduce__`]).
+/// A pickled world rebuilt (see [`World::__reduce__`]): its scene's world, or an empty one,
+/// given its state.
 #[pyfunction]
-pub fn _unpickle_world(
-    dt: f64,
-    scene: PickledScene,
-    state: &[u8],
-    samples: ProbeSamples,
-) -> PyResult<World> {
+pub fn _unpickle_world(scene: PickledScene, state: &[u8]) -> PyResult<World> {
     let mut world = match scene {
-        None => World::empty(dt, DVec3::ZERO),
+        None => World::empty(1.0 / 60.0, DVec3::ZERO),
         Some((path, text)) => {
             let scene = Scene::parse(&path, text).map_err(scene_error)?;
             let sim = Simulation::build(&scene).map_err(scene_error)?;
+            let dt = scene.world.dt;
             World {
                 sim,
                 scene: Some(scene),
@@ -107,9 +154,15 @@ pub fn _unpickle_world(
             }
         }
     };
-    world.restore_bytes(state)?;
-    for (probe, samples) in world.sim.probes.iter_mut().zip(samples) {
-        probe.series.samples = samples;
+    if world.scene.is_none() {
+        // An empty world takes its bodies from the state.
+        let saved: Saved<FvmWorld> = ciborium::from_reader(state)
+            .map_err(|e| argument("state", format!("not a saved world: {e}")))?;
+        world.sim.world = saved.world;
+        world.frame = saved.frame;
+        world.dt = saved.dt;
+        return Ok(world);
     }
+    world.restore_bytes(state)?;
     Ok(world)
 }

@@ -96,11 +96,15 @@ impl World {
     /// Advances the world by `frames` frames of `dt` (s each), with the GIL released.
     ///
     /// Raises `rapier_fvm.Error` after the first frame in which a soft body's step failed
-    /// (that body kept its state; the others and the rigid bodies moved on).
+    /// (that body kept its state; the others and the rigid bodies moved on). Signals (Ctrl-C)
+    /// are handled between frames. While it steps, another thread's call on the same world
+    /// raises `RuntimeError` (the world is borrowed); other worlds step in parallel.
     #[pyo3(signature = (frames = 1))]
     fn step(&mut self, py: Python<'_>, frames: u64) -> PyResult<()> {
         for _ in 0..frames {
             py.detach(|| self.advance())?;
+            // Ctrl-C (or another signal's handler) stops a long run between frames.
+            py.check_signals()?;
         }
         Ok(())
     }

@@ -95,3 +95,36 @@ def test_values_rapier_cannot_hold_in_float32_are_refused_by_name():
     with pytest.raises(ValueError, match="height"):
         world.add_ground(height=1e300)
     assert world.rigid_bodies == []
+
+
+def test_arrays_come_as_numpy_gives_them_and_are_checked_by_name():
+    world = rf.World(gravity=(0.0, 0.0, 0.0))
+    body = world.add_soft_body(rf.Mesh.cuboid((0.1, 0.1, 0.1), (1, 1, 1)),
+                               rf.Material("linear", 1e6, 0.3, 1000.0))
+    # surface_triangles' uint32 rows go straight back in; float32 and lists are taken.
+    world.add_pressure(body, world.surface_triangles(body), 10.0)
+    x = world.positions(body)
+    world.set_positions(body, x.astype(np.float32))
+    world.set_positions(body, x.tolist())
+    mesh = rf.Mesh.cuboid((0.1, 0.1, 0.1), (1, 1, 1))
+    assert rf.Mesh(mesh.nodes.astype(np.float32), mesh.tets).tet_count == mesh.tet_count
+    with pytest.raises(ValueError, match="triangles: expected integer values"):
+        world.add_pressure(body, world.surface_triangles(body).astype(float), 10.0)
+    with pytest.raises(ValueError, match=r"positions: expected an \(n, 3\) array"):
+        world.set_positions(body, x.ravel())
+    with pytest.raises(KeyError):
+        world.contact_force(body, rf.Collider(7, 0))
+    with pytest.raises(KeyError):
+        world.load_on(body, rf.RigidBody(7, 0))
+
+
+def test_a_state_goes_back_only_into_a_world_of_the_same_bodies():
+    one = rf.World()
+    one.add_soft_body(rf.Mesh.cuboid((0.1, 0.1, 0.1), (1, 1, 1)), rf.Material("linear", 1e6, 0.3, 1e3))
+    other = rf.World()
+    other.add_soft_body(rf.Mesh.cuboid((0.1, 0.1, 0.1), (2, 2, 2)), rf.Material("linear", 1e6, 0.3, 1e3))
+    with pytest.raises(ValueError, match="other bodies"):
+        one.restore(other.save())
+    empty = rf.World()
+    with pytest.raises(ValueError, match="other bodies"):
+        empty.restore(one.save())

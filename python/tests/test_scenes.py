@@ -57,3 +57,55 @@ def test_a_pickled_scene_world_keeps_its_keyframes_and_probes(scenes):
     for name, samples in world.probes().items():
         np.testing.assert_array_equal(copy.probes()[name], samples)
     assert copy.probes()["cube centre rise"].shape == (21, 2)  # frames 0 to 20
+
+
+def test_a_state_of_another_scene_is_refused_and_a_later_one_brings_its_probes(scenes):
+    drop = rf.World.from_scene(scenes / "drop.toml")
+    beam = rf.World.from_scene(scenes / "cage_beam.toml")
+    with pytest.raises(ValueError, match="other bodies"):
+        beam.restore(drop.save())
+    start = drop.save()
+    drop.step(5)
+    later, probes = drop.save(), drop.probes()
+    drop.restore(start)
+    assert drop.frame == 0 and all(p.shape[0] == 1 for p in drop.probes().values())
+    drop.restore(later)
+    assert drop.frame == 5
+    for name, samples in probes.items():
+        np.testing.assert_array_equal(drop.probes()[name], samples)
+
+
+def test_override_paths_are_strict_and_create_missing_tables(scenes):
+    path = scenes / "rigid_on_soft.toml"
+    for bad in ["soft_body[[0].material.young", "soft_body[", "a..b", "soft_body[x]"]:
+        with pytest.raises(ValueError, match="a key path is keys"):
+            rf.World.from_scene(path, {bad: 1.0})
+    # [contact] is not in the scene: the override makes it, and its value is checked.
+    rf.World.from_scene(path, {"contact.margin": 2e-3})
+    with pytest.raises(rf.SceneError, match="margin"):
+        rf.World.from_scene(path, {"contact.margin": -1.0})
+    # numpy scalars and tuples are values too.
+    rf.World.from_scene(path, {"soft_body[0].material.young": np.float64(2e6),
+                               "world.gravity": (0.0, np.float32(-9.0), 0.0)})
+
+
+def test_an_error_elsewhere_in_an_overridden_scene_names_the_files_own_line(scenes, tmp_path):
+    text = (scenes / "rigid_on_soft.toml").read_text().replace("poisson = 0.3", "poisson = 0.7")
+    bad = tmp_path / "rigid_on_soft.toml"
+    bad.write_text(text)
+    line = next(i + 1 for i, l in enumerate(text.splitlines()) if "poisson = 0.7" in l)
+    with pytest.raises(rf.SceneError, match=f"rigid_on_soft.toml:{line}:"):
+        rf.World.from_scene(bad, {"rigid_body[1].density": 500.0})
+
+
+def test_handles_materials_and_meshes_pickle():
+    import pickle
+
+    material = rf.Material("corotated", 2e6, 0.25, 900.0)
+    mesh = rf.Mesh.cuboid((0.1, 0.2, 0.3), (1, 2, 3))
+    for value in [rf.SoftBody(1, 2), rf.RigidBody(3, 0), rf.Collider(0, 4)]:
+        assert pickle.loads(pickle.dumps(value)) == value
+    assert repr(pickle.loads(pickle.dumps(material))) == repr(material)
+    copy = pickle.loads(pickle.dumps(mesh))
+    np.testing.assert_array_equal(copy.nodes, mesh.nodes)
+    np.testing.assert_array_equal(copy.tets, mesh.tets)

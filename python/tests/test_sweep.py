@@ -51,6 +51,16 @@ def test_a_job_array_runs_one_job_each_then_gathers(scenes, tmp_path):
 
 
 def test_a_bad_key_fails_the_sweep_with_the_scenes_error(scenes, tmp_path):
-    with pytest.raises(ValueError, match="no key"):
+    import rapier_fvm as rf
+
+    with pytest.raises(rf.SceneError, match="unknown field `nothing`"):
         sweep(scenes / "rigid_on_soft.toml", {"soft_body[0].nothing.young": [1.0]},
               tmp_path, backend="serial", duration=0.1)
+
+
+def test_a_failed_run_is_a_row_with_its_error_and_the_others_go_on(scenes, tmp_path):
+    rows = sweep(scenes / "rigid_on_soft.toml", {"soft_body[0].material.young": [1e6, -1.0]},
+                 tmp_path, backend="pool", workers=2, duration=0.1)
+    assert "error" not in rows[0] and "young" in rows[1]["error"]
+    with open(tmp_path / "sweep.csv") as f:
+        assert [r["error"] for r in csv.DictReader(f)] == ["", rows[1]["error"]]
