@@ -5,10 +5,11 @@
 //! read and driven through numpy arrays, saved and restored bit for bit; scene runs as
 //! `rapier-fvm run` does them. SI units throughout (m, s, kg, Pa, N).
 //!
-//! One module per concept: `model` (materials and meshes), `world` (a world and its steps), `state` (saved, restored and
-//! pickled), `rigid` and `soft` (bodies of each kind), `loads` (loads on soft bodies),
-//! `scene` (scene files and runs), `handles`, `arrays` (numpy in and out) and
-//! `errors` (the library's errors as Python exceptions).
+//! One module per concept: `model` (materials and meshes), `world` (a world and its steps), `state`
+//! (saved, restored and pickled), `rigid` and `soft` (bodies of each kind), `loads` (loads on soft
+//! bodies), `scene` (scene files and runs), `overrides` (a scene's values set at key paths),
+//! `handles`, `arrays` (numpy in and out) and `errors` (the library's errors as Python
+//! exceptions).
 
 mod arrays;
 mod errors;

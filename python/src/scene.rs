@@ -74,8 +74,8 @@ impl World {
 }
 
 /// Runs the scene file `path` (3D or 2D) as `rapier-fvm run` does, writing its output into
-/// `out` (`report.json`, the `.vtu` series, pictures, plots), for `duration` (s) if given instead of
-/// the scene's, with `overrides` applied; returns the report as a dict. The GIL is released
+/// `out` (`report.json`, the `.vtu` series, pictures, plots), for `duration` (s) if given instead
+/// of the scene's, with `overrides` applied; returns the report as a dict. The GIL is released
 /// during the run.
 #[pyfunction]
 #[pyo3(signature = (path, out, *, duration = None, overrides = None))]

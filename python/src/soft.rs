@@ -42,9 +42,9 @@ impl World {
     /// Adds a soft body of `mesh` and `material`, placed by `translation` (m) and `rotation`
     /// (a scaled axis, rad), moving at `linvel` (m/s) and spinning at `angvel` (rad/s) about its
     /// centre of mass; `stiffness_time` is the stiffness-proportional Rayleigh damping's time
-    /// constant β (s; the viscosities are β λ and β μ; a scene's `damping.stiffness_time`), `pinned` node indices held in place
-    /// (move them with `set_positions`), `friction` its Coulomb coefficient (default the
-    /// library's), `self_contact` whether it collides with itself.
+    /// constant β (s; the viscosities are β λ and β μ; a scene's `damping.stiffness_time`),
+    /// `pinned` node indices held in place (move them with `set_positions`), `friction` its Coulomb
+    /// coefficient (default the library's), `self_contact` whether it collides with itself.
     #[pyo3(signature = (mesh, material, *, translation = [0.0; 3], rotation = [0.0; 3],
         linvel = [0.0; 3], angvel = [0.0; 3], stiffness_time = None, pinned = Vec::new(),
         friction = None, self_contact = false))]

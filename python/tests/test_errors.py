@@ -120,9 +120,10 @@ def test_arrays_come_as_numpy_gives_them_and_are_checked_by_name():
 
 def test_a_state_goes_back_only_into_a_world_of_the_same_bodies():
     one = rf.World()
-    one.add_soft_body(rf.Mesh.cuboid((0.1, 0.1, 0.1), (1, 1, 1)), rf.Material("linear", 1e6, 0.3, 1e3))
+    linear = rf.Material("linear", 1e6, 0.3, 1e3)
+    one.add_soft_body(rf.Mesh.cuboid((0.1, 0.1, 0.1), (1, 1, 1)), linear)
     other = rf.World()
-    other.add_soft_body(rf.Mesh.cuboid((0.1, 0.1, 0.1), (2, 2, 2)), rf.Material("linear", 1e6, 0.3, 1e3))
+    other.add_soft_body(rf.Mesh.cuboid((0.1, 0.1, 0.1), (2, 2, 2)), linear)
     with pytest.raises(ValueError, match="other bodies"):
         one.restore(other.save())
     empty = rf.World()
