@@ -48,7 +48,8 @@ class SoftPusherEnv(gym.Env):
         self.finger = self.world.add_soft_body(mesh, rubber, translation=(0.0, 0.05, 0.0),
                                                stiffness_time=None, pinned=self.held,
                                                friction=0.5)
-        self.box = self.world.add_box((0.04, 0.04, 0.04), translation=(0.08, 0.04, 0.0),
+        self.box = self.world.add_rigid_body(rf.Shape.cuboid((0.04, 0.04, 0.04)),
+                                             translation=(0.08, 0.04, 0.0),
                                       density=300.0, friction=0.4)
         self.initial = self.world.save()
         self.target = np.zeros(2)

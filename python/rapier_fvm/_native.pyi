@@ -63,6 +63,19 @@ class Mesh:
     def volume(self) -> float: ...
 
 @final
+class Shape:
+    """A rigid body's collision shape (m); y is the axis of capsules and cylinders."""
+
+    @staticmethod
+    def cuboid(half_extents: _Vec3) -> Shape: ...
+    @staticmethod
+    def ball(radius: float) -> Shape: ...
+    @staticmethod
+    def capsule(half_height: float, radius: float) -> Shape: ...
+    @staticmethod
+    def cylinder(half_height: float, radius: float) -> Shape: ...
+
+@final
 class SoftBody:
     """A soft body's handle (hashable, compared by value)."""
 
@@ -113,14 +126,11 @@ class World:
     # Rigid bodies
     def add_ground(self, *, height: float = ..., normal: _Vec3 = ...,
                    friction: float = ...) -> Collider: ...
-    def add_box(self, half_extents: _Vec3, *, kind: str = ..., translation: _Vec3 = ...,
-                rotation: _Vec3 = ..., linvel: _Vec3 = ..., angvel: _Vec3 = ...,
-                density: float = ..., friction: float = ...,
-                restitution: float = ...) -> RigidBody: ...
-    def add_ball(self, radius: float, *, kind: str = ..., translation: _Vec3 = ...,
-                 rotation: _Vec3 = ..., linvel: _Vec3 = ..., angvel: _Vec3 = ...,
-                 density: float = ..., friction: float = ...,
-                 restitution: float = ...) -> RigidBody: ...
+    def add_rigid_body(self, shape: Shape, *, kind: str = ..., translation: _Vec3 = ...,
+                       rotation: _Vec3 = ..., linvel: _Vec3 = ..., angvel: _Vec3 = ...,
+                       density: float = ..., friction: float = ...,
+                       restitution: float = ...) -> RigidBody:
+        """kind: "dynamic", "fixed" or "kinematic"; rotation a scaled axis (rad)."""
     @property
     def rigid_bodies(self) -> list[RigidBody]: ...
     def colliders_of(self, body: RigidBody) -> list[Collider]: ...
@@ -180,6 +190,7 @@ __all__ = [
     "Mesh",
     "RigidBody",
     "SceneError",
+    "Shape",
     "SoftBody",
     "World",
     "run_scene",

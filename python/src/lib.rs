@@ -5,7 +5,7 @@
 //! read and driven through numpy arrays, saved and restored bit for bit; scene runs as
 //! `rapier-fvm run` does them. SI units throughout (m, s, kg, Pa, N).
 //!
-//! One module per concept: `model` (materials and meshes), `world` (a world and its steps), `state`
+//! One module per concept: `model` (materials, meshes, shapes), `world` (a world and its steps), `state`
 //! (saved, restored and pickled), `rigid` and `soft` (bodies of each kind), `loads` (loads on soft
 //! bodies), `scene` (scene files and runs), `overrides` (a scene's values set at key paths),
 //! `handles`, `arrays` (numpy in and out) and `errors` (the library's errors as Python
@@ -33,6 +33,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("SceneError", py.get_type::<errors::SceneError>())?;
     m.add_class::<model::Material>()?;
     m.add_class::<model::Mesh>()?;
+    m.add_class::<model::Shape>()?;
     m.add_class::<handles::SoftBody>()?;
     m.add_class::<handles::RigidBody>()?;
     m.add_class::<handles::Collider>()?;

@@ -1,13 +1,16 @@
-//! What a body is made of, on the Python side: `Material` (model and constants in SI units)
-//! and `Mesh` (a checked tetrahedral mesh, generated, read from a file or given as arrays).
+//! What a body is made of, on the Python side: `Material` (model and constants in SI units),
+//! `Mesh` (a checked tetrahedral mesh, generated, read from a file or given as arrays) and a
+//! rigid body's `Shape`.
 
-use crate::arrays::{indices_in, rows_out, vectors_in, vectors_out};
+use crate::arrays::{indices_in, rows_out, scalar_f32, vectors_in, vectors_out};
 use crate::errors::{argument, library};
 use numpy::PyArray2;
 use pyo3::prelude::*;
+use pyo3::types::PyTuple;
 use rapier_fvm::glamx::DVec3;
 use rapier_fvm::material::{Material as LibraryMaterial, MaterialModel};
 use rapier_fvm::mesh::{self, TetMesh, import};
+use rapier3d::prelude::SharedShape;
 
 /// The material model names Python takes (those of scene files), and the models they stand for.
 const MODELS: [(&str, MaterialModel); 4] = [
@@ -199,5 +202,96 @@ impl Mesh {
             self.inner.node_count(),
             self.inner.tet_count()
         )
+    }
+}
+
+/// A rigid body's collision shape (m), as rapier's `SharedShape`: `Shape.cuboid((hx, hy, hz))`
+/// by half extents, `Shape.ball(radius)`, `Shape.capsule(half_height, radius)` and
+/// `Shape.cylinder(half_height, radius)` along y. Lengths must be positive and finite in
+/// float32, as rapier holds them.
+#[pyclass(module = "rapier_fvm", frozen)]
+pub struct Shape {
+    /// rapier's shape.
+    pub inner: SharedShape,
+    /// How it was made, for `repr` and pickling: the constructor's name and lengths (m).
+    made: (&'static str, Vec<f64>),
+}
+
+/// A length given from Python (argument `name`), positive and finite in `f32`.
+fn length(name: &str, value: f64) -> PyResult<f32> {
+    let single = scalar_f32(name, value)?;
+    if single > 0.0 {
+        Ok(single)
+    } else {
+        Err(argument(name, format!("must be positive (m), got {value}")))
+    }
+}
+
+#[pymethods]
+impl Shape {
+    /// A box of half extents `half_extents` (m).
+    #[staticmethod]
+    fn cuboid(half_extents: [f64; 3]) -> PyResult<Self> {
+        let [x, y, z] = half_extents.map(|h| length("half_extents", h));
+        Ok(Self {
+            inner: SharedShape::cuboid(x?, y?, z?),
+            made: ("cuboid", half_extents.to_vec()),
+        })
+    }
+
+    /// A ball of radius `radius` (m).
+    #[staticmethod]
+    fn ball(radius: f64) -> PyResult<Self> {
+        Ok(Self {
+            inner: SharedShape::ball(length("radius", radius)?),
+            made: ("ball", vec![radius]),
+        })
+    }
+
+    /// A capsule along y: a cylinder of half height `half_height` (m) capped by half balls of
+    /// radius `radius` (m).
+    #[staticmethod]
+    fn capsule(half_height: f64, radius: f64) -> PyResult<Self> {
+        let shape = SharedShape::capsule_y(
+            length("half_height", half_height)?,
+            length("radius", radius)?,
+        );
+        Ok(Self {
+            inner: shape,
+            made: ("capsule", vec![half_height, radius]),
+        })
+    }
+
+    /// A cylinder along y of half height `half_height` and radius `radius` (m).
+    #[staticmethod]
+    fn cylinder(half_height: f64, radius: f64) -> PyResult<Self> {
+        let shape = SharedShape::cylinder(
+            length("half_height", half_height)?,
+            length("radius", radius)?,
+        );
+        Ok(Self {
+            inner: shape,
+            made: ("cylinder", vec![half_height, radius]),
+        })
+    }
+
+    /// Pickling: the constructor and its lengths.
+    fn __reduce__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
+        let (name, lengths) = &self.made;
+        let made = py.get_type::<Shape>().getattr(*name)?;
+        let args = if *name == "cuboid" {
+            PyTuple::new(py, [lengths.clone()])?
+        } else {
+            PyTuple::new(py, lengths)?
+        };
+        Ok((made, args))
+    }
+
+    fn __repr__(&self) -> String {
+        let (name, lengths) = &self.made;
+        format!("Shape.{name}{lengths:?}")
     }
 }

@@ -1,5 +1,6 @@
-//! A world's rigid bodies and colliders from Python: the ground, boxes and balls (fixed,
-//! dynamic or kinematic), their poses and velocities read, kinematic bodies driven.
+//! A world's rigid bodies and colliders from Python: the ground and rigid bodies of any
+//! `Shape` (fixed, dynamic or kinematic), their poses and velocities read, kinematic bodies
+//! driven.
 //!
 //! rapier stores poses and velocities in `f32`; they are handed over as float64 arrays of
 //! those values.
@@ -7,23 +8,12 @@
 use crate::arrays::{rows_out, scalar_f32, vector3, vector3_f32};
 use crate::errors::{argument, unknown};
 use crate::handles::{Collider, RigidBody};
+use crate::model::Shape;
 use crate::world::World;
 use numpy::PyArray2;
 use pyo3::prelude::*;
 use rapier_fvm::glamx::DQuat;
 use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder, SharedShape};
-
-/// How a rigid body is placed, moved and made, as Python gives it.
-struct RigidOptions {
-    kind: String,
-    translation: [f64; 3],
-    rotation: [f64; 3],
-    linvel: [f64; 3],
-    angvel: [f64; 3],
-    density: f64,
-    friction: f64,
-    restitution: f64,
-}
 
 impl World {
     /// The rigid body `body` of rapier's set, or a `KeyError`.
@@ -31,65 +21,60 @@ impl World {
         (self.sim.world.physics.bodies.get(body.handle()))
             .ok_or_else(|| unknown("rigid body", body))
     }
-
-    /// Inserts a rigid body of shape `shape` made and placed by `options`.
-    fn insert_rigid(&mut self, shape: SharedShape, options: &RigidOptions) -> PyResult<RigidBody> {
-        let builder = match options.kind.as_str() {
-            "dynamic" => RigidBodyBuilder::dynamic(),
-            "fixed" => RigidBodyBuilder::fixed(),
-            "kinematic" => RigidBodyBuilder::kinematic_position_based(),
-            other => {
-                return Err(argument(
-                    "kind",
-                    format!("{other:?} is not \"dynamic\", \"fixed\" or \"kinematic\""),
-                ));
-            }
-        };
-        let not_negative = |name: &str, value: f64| {
-            let single = scalar_f32(name, value)?;
-            if single >= 0.0 {
-                Ok(single)
-            } else {
-                Err(argument(name, format!("must not be negative, got {value}")))
-            }
-        };
-        let density = scalar_f32("density", options.density)?;
-        if density <= 0.0 {
-            return Err(argument(
-                "density",
-                format!("must be positive (kg/m³), got {}", options.density),
-            ));
-        }
-        let body = builder
-            .translation(vector3_f32("translation", options.translation)?)
-            .rotation(vector3_f32("rotation", options.rotation)?)
-            .linvel(vector3_f32("linvel", options.linvel)?)
-            .angvel(vector3_f32("angvel", options.angvel)?);
-        let mass = shape.mass_properties(density).mass();
-        if !(mass.is_finite() && mass > 0.0) {
-            return Err(argument(
-                "density",
-                format!("with this size the body's mass is {mass} kg in float32, not positive"),
-            ));
-        }
-        let collider = ColliderBuilder::new(shape)
-            .density(density)
-            .friction(not_negative("friction", options.friction)?)
-            .restitution(not_negative("restitution", options.restitution)?);
-        Ok(RigidBody::of(
-            self.sim.world.physics.insert(body, collider).0,
-        ))
-    }
 }
 
-/// A length given from Python (argument `name`), positive and finite in `f32`.
-fn length(name: &str, value: f64) -> PyResult<f32> {
-    let single = scalar_f32(name, value)?;
-    if single > 0.0 {
-        Ok(single)
-    } else {
-        Err(argument(name, format!("must be positive (m), got {value}")))
+/// A rigid body of kind `kind`, placed by `translation` (m) and `rotation` (scaled axis, rad),
+/// moving at `linvel` (m/s) and `angvel` (rad/s).
+fn body_builder(
+    kind: &str,
+    [translation, rotation, linvel, angvel]: [[f64; 3]; 4],
+) -> PyResult<RigidBodyBuilder> {
+    let builder = match kind {
+        "dynamic" => RigidBodyBuilder::dynamic(),
+        "fixed" => RigidBodyBuilder::fixed(),
+        "kinematic" => RigidBodyBuilder::kinematic_position_based(),
+        other => {
+            return Err(argument(
+                "kind",
+                format!("{other:?} is not \"dynamic\", \"fixed\" or \"kinematic\""),
+            ));
+        }
+    };
+    Ok(builder
+        .translation(vector3_f32("translation", translation)?)
+        .rotation(vector3_f32("rotation", rotation)?)
+        .linvel(vector3_f32("linvel", linvel)?)
+        .angvel(vector3_f32("angvel", angvel)?))
+}
+
+/// A collider of `shape` and `density` (kg/m³), of positive mass in `f32`, with `friction`
+/// and `restitution`.
+fn collider_builder(
+    shape: SharedShape,
+    [density, friction, restitution]: [f64; 3],
+) -> PyResult<ColliderBuilder> {
+    let not_negative = |name: &str, value: f64| {
+        let single = scalar_f32(name, value)?;
+        if single >= 0.0 {
+            Ok(single)
+        } else {
+            Err(argument(name, format!("must not be negative, got {value}")))
+        }
+    };
+    let density_f32 = scalar_f32("density", density)?;
+    let mass = shape.mass_properties(density_f32).mass();
+    if !(density_f32 > 0.0 && mass.is_finite() && mass > 0.0) {
+        return Err(argument(
+            "density",
+            format!(
+                "{density} kg/m³ gives this shape a mass of {mass} kg in float32, not positive"
+            ),
+        ));
     }
+    Ok(ColliderBuilder::new(shape)
+        .density(density_f32)
+        .friction(not_negative("friction", friction)?)
+        .restitution(not_negative("restitution", restitution)?))
 }
 
 #[pymethods]
@@ -120,16 +105,17 @@ impl World {
         ))
     }
 
-    /// Adds a box of half extents `half_extents` (m): `kind` is `"dynamic"`, `"fixed"` or
+    /// Adds a rigid body of shape `shape` (a `Shape`): `kind` is `"dynamic"`, `"fixed"` or
     /// `"kinematic"`; placed by `translation` (m) and `rotation` (scaled axis, rad), moving at
-    /// `linvel` (m/s) and `angvel` (rad/s), of density `density` (kg/m³).
-    #[pyo3(signature = (half_extents, *, kind = "dynamic".to_owned(), translation = [0.0; 3],
+    /// `linvel` (m/s) and `angvel` (rad/s), of density `density` (kg/m³), with Coulomb friction
+    /// `friction` and restitution `restitution`.
+    #[pyo3(signature = (shape, *, kind = "dynamic".to_owned(), translation = [0.0; 3],
         rotation = [0.0; 3], linvel = [0.0; 3], angvel = [0.0; 3], density = 1000.0,
         friction = 0.5, restitution = 0.0))]
     #[allow(clippy::too_many_arguments)]
-    fn add_box(
+    fn add_rigid_body(
         &mut self,
-        half_extents: [f64; 3],
+        shape: &Shape,
         kind: String,
         translation: [f64; 3],
         rotation: [f64; 3],
@@ -139,50 +125,11 @@ impl World {
         friction: f64,
         restitution: f64,
     ) -> PyResult<RigidBody> {
-        let [x, y, z] = [0, 1, 2].map(|i| length("half_extents", half_extents[i]));
-        let shape = SharedShape::cuboid(x?, y?, z?);
-        let options = RigidOptions {
-            kind,
-            translation,
-            rotation,
-            linvel,
-            angvel,
-            density,
-            friction,
-            restitution,
-        };
-        self.insert_rigid(shape, &options)
-    }
-
-    /// Adds a ball of radius `radius` (m), with the options of `add_box`.
-    #[pyo3(signature = (radius, *, kind = "dynamic".to_owned(), translation = [0.0; 3],
-        rotation = [0.0; 3], linvel = [0.0; 3], angvel = [0.0; 3], density = 1000.0,
-        friction = 0.5, restitution = 0.0))]
-    #[allow(clippy::too_many_arguments)]
-    fn add_ball(
-        &mut self,
-        radius: f64,
-        kind: String,
-        translation: [f64; 3],
-        rotation: [f64; 3],
-        linvel: [f64; 3],
-        angvel: [f64; 3],
-        density: f64,
-        friction: f64,
-        restitution: f64,
-    ) -> PyResult<RigidBody> {
-        let shape = SharedShape::ball(length("radius", radius)?);
-        let options = RigidOptions {
-            kind,
-            translation,
-            rotation,
-            linvel,
-            angvel,
-            density,
-            friction,
-            restitution,
-        };
-        self.insert_rigid(shape, &options)
+        let body = body_builder(&kind, [translation, rotation, linvel, angvel])?;
+        let collider = collider_builder(shape.inner.clone(), [density, friction, restitution])?;
+        Ok(RigidBody::of(
+            self.sim.world.physics.insert(body, collider).0,
+        ))
     }
 
     /// The rigid bodies, in the order of their handles.

@@ -49,7 +49,7 @@ def test_handles_arguments_and_state_are_checked():
     with pytest.raises(rf.Error):
         other.set_positions(body, np.full((other.positions(body).shape[0], 3), 1e300))
     with pytest.raises(ValueError, match="kind"):
-        world.add_box((0.1, 0.1, 0.1), kind="floating")
+        world.add_rigid_body(rf.Shape.ball(0.1), kind="floating")
     with pytest.raises(ValueError, match="not a saved world"):
         world.restore(b"not a world")
     with pytest.raises(ValueError, match="dt"):
@@ -87,11 +87,11 @@ def test_values_rapier_cannot_hold_in_float32_are_refused_by_name():
         rf.World(gravity=(0.0, -1e300, 0.0))
     world = rf.World()
     with pytest.raises(ValueError, match="density"):
-        world.add_box((0.1, 0.1, 0.1), density=1e300)
+        world.add_rigid_body(rf.Shape.cuboid((0.1, 0.1, 0.1)), density=1e300)
     with pytest.raises(ValueError, match="translation"):
-        world.add_ball(0.1, translation=(1e300, 0.0, 0.0))
+        world.add_rigid_body(rf.Shape.ball(0.1), translation=(1e300, 0.0, 0.0))
     with pytest.raises(ValueError, match="radius"):
-        world.add_ball(1e-60)
+        rf.Shape.ball(1e-60)
     with pytest.raises(ValueError, match="height"):
         world.add_ground(height=1e300)
     assert world.rigid_bodies == []

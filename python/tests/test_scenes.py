@@ -98,13 +98,16 @@ def test_an_error_elsewhere_in_an_overridden_scene_names_the_files_own_line(scen
         rf.World.from_scene(bad, {"rigid_body[1].density": 500.0})
 
 
-def test_handles_materials_and_meshes_pickle():
+def test_handles_materials_meshes_and_shapes_pickle():
     import pickle
 
     material = rf.Material("corotated", 2e6, 0.25, 900.0)
     mesh = rf.Mesh.cuboid((0.1, 0.2, 0.3), (1, 2, 3))
     for value in [rf.SoftBody(1, 2), rf.RigidBody(3, 0), rf.Collider(0, 4)]:
         assert pickle.loads(pickle.dumps(value)) == value
+    for shape in [rf.Shape.cuboid((0.1, 0.2, 0.3)), rf.Shape.ball(0.1),
+                  rf.Shape.capsule(0.2, 0.05), rf.Shape.cylinder(0.2, 0.05)]:
+        assert repr(pickle.loads(pickle.dumps(shape))) == repr(shape)
     assert repr(pickle.loads(pickle.dumps(material))) == repr(material)
     copy = pickle.loads(pickle.dumps(mesh))
     np.testing.assert_array_equal(copy.nodes, mesh.nodes)

@@ -69,7 +69,8 @@ def test_a_body_force_changes_momentum_at_its_resultant():
 
 def test_a_restored_world_steps_on_bit_for_bit():
     world, _, cube = cube_on_ground()
-    box = world.add_box((0.05, 0.05, 0.05), translation=(0.02, 0.55, 0.0), angvel=(1.0, 0.0, 0.0))
+    box = world.add_rigid_body(rf.Shape.cuboid((0.05, 0.05, 0.05)), translation=(0.02, 0.55, 0.0),
+                               angvel=(1.0, 0.0, 0.0))
     world.step(20)
     state = world.save()
     world.step(25)
@@ -121,7 +122,7 @@ def test_worlds_step_in_threads_as_they_do_alone():
 
 def test_a_kinematic_box_goes_where_it_is_told_and_pins_move_when_set():
     world = rf.World(dt=1 / 60)
-    mover = world.add_box((0.05, 0.05, 0.05), kind="kinematic")
+    mover = world.add_rigid_body(rf.Shape.cuboid((0.05, 0.05, 0.05)), kind="kinematic")
     world.set_kinematic_target(mover, (0.0, 0.1, 0.0))
     world.step()
     assert world.rigid_pose(mover)[0] == pytest.approx((0.0, 0.1, 0.0), abs=1e-7)
