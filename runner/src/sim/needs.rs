@@ -31,6 +31,9 @@ pub struct BodyNeeds {
     /// Frames whose last substep a collider's contact pushed the body in (an impulse, not a
     /// contact merely within reach).
     pub contact_frames: usize,
+    /// Whether the body ended the last frame asleep (its nodes have not moved since).
+    #[serde(skip)]
+    was_asleep: bool,
 }
 
 /// An element's principal Green strain of largest magnitude and rotation angle (rad) for the
@@ -55,8 +58,21 @@ pub fn strain_and_rotation(f: DMat3) -> (f64, f64) {
 
 impl BodyNeeds {
     /// Takes in the frame's state of `body`, placed at `placement` (the node positions before
-    /// the first step, m), pushed by a collider in the frame if `touching`.
-    pub fn record(&mut self, body: &DeformableBody, placement: &[DVec3], touching: bool) {
+    /// the first step, m), pushed by a collider in the frame if `touching`, ending it `asleep`
+    /// or not (a body asleep at both ends of the frame has not moved: its elements are not
+    /// measured again).
+    pub fn record(
+        &mut self,
+        body: &DeformableBody,
+        placement: &[DVec3],
+        (touching, asleep): (bool, bool),
+    ) {
+        self.contact_frames += usize::from(touching);
+        let unmoved = asleep && self.was_asleep;
+        self.was_asleep = asleep;
+        if unmoved {
+            return;
+        }
         let x = body.positions();
         let mut peak_rotation = self.peak_rotation_deg.to_radians();
         for tet in body.mesh().tets() {
@@ -70,7 +86,6 @@ impl BodyNeeds {
         self.peak_rotation_deg = peak_rotation.to_degrees();
         let poisson = body.material().elasticity().poisson_ratio;
         self.linear_spurious_stress_over_e = (1.0 - peak_rotation.cos()) / (1.0 + poisson);
-        self.contact_frames += usize::from(touching);
     }
 }
 

@@ -145,11 +145,12 @@ fn record_frame(
         }
     }
     for (entry, report) in sim.soft.iter().zip(bodies.iter_mut()) {
-        report.asleep_frames += usize::from(sim.world.coupling.is_sleeping(entry.handle));
+        let asleep = sim.world.coupling.is_sleeping(entry.handle);
+        report.asleep_frames += usize::from(asleep);
         let touching = (sim.world.coupling.contacts(entry.handle).iter())
             .any(|contact| contact.impulse != DVec3::ZERO);
         let body = &sim.world.soft_bodies[entry.handle];
-        report.needs.record(body, &entry.rest, touching);
+        report.needs.record(body, &entry.rest, (touching, asleep));
     }
     let found = audit.check_world(&sim.world, outcomes);
     stability.record_system(frame, found.system);
