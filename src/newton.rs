@@ -151,36 +151,30 @@ pub(crate) fn stalled_at_round_off(history: &[f64], relative: f64) -> bool {
 
 /// How a Newton loop ends when its line search finds no descent at `iteration` with the
 /// relative residual `relative`: a tiny residual (at most [`ROUND_OFF_CEILING`]) is accepted as
-/// round-off (`(iterations, relative residual)`), anything else refused.
+/// round-off, anything else refused ([`accepted_within`]).
 ///
 /// # Errors
 /// [`Error::StaticSolveDidNotConverge`] above the ceiling.
 pub(crate) fn without_descent(iteration: usize, relative: f64) -> Result<(usize, f64), Error> {
-    if relative <= ROUND_OFF_CEILING {
-        Ok((iteration, relative))
-    } else {
-        Err(Error::StaticSolveDidNotConverge {
-            iterations: iteration,
-            residual: relative,
-        })
-    }
+    accepted_within(iteration, relative, ROUND_OFF_CEILING)
 }
 
-/// How a Newton loop ends after its `max_iterations` with the relative residual `relative`:
-/// accepted (`(iterations, relative residual)`) if it meets `tolerance`.
+/// How a Newton loop ends after `iterations` with the relative residual `relative`: accepted
+/// (`(iterations, relative residual)`) if it is at most `limit` (the tolerance after the last
+/// iteration).
 ///
 /// # Errors
 /// [`Error::StaticSolveDidNotConverge`] otherwise.
-pub(crate) fn after_last_iteration(
+pub(crate) fn accepted_within(
+    iterations: usize,
     relative: f64,
-    tolerance: f64,
-    max_iterations: usize,
+    limit: f64,
 ) -> Result<(usize, f64), Error> {
-    if relative <= tolerance {
-        Ok((max_iterations, relative))
+    if relative <= limit {
+        Ok((iterations, relative))
     } else {
         Err(Error::StaticSolveDidNotConverge {
-            iterations: max_iterations,
+            iterations,
             residual: relative,
         })
     }

@@ -78,8 +78,14 @@ impl World {
     /// Puts back the state `bytes` of [`World::state_bytes`], if it is a state of a world of
     /// the same bodies and probes.
     fn restore_bytes(&mut self, bytes: &[u8]) -> PyResult<()> {
-        let saved: Saved<FvmWorld> = ciborium::from_reader(bytes)
-            .map_err(|e| argument("state", format!("not a saved world: {e}")))?;
+        let saved = read_saved(bytes)?;
+        self.check_same_bodies(&saved)?;
+        self.put_back(saved);
+        Ok(())
+    }
+
+    /// Whether `saved` is a state of a world of this world's bodies and probes.
+    fn check_same_bodies(&self, saved: &Saved<FvmWorld>) -> PyResult<()> {
         if Bodies::of(&saved.world) != Bodies::of(&self.sim.world) {
             return Err(argument(
                 "state",
@@ -97,14 +103,23 @@ impl World {
                 ),
             ));
         }
+        Ok(())
+    }
+
+    /// Takes the world, frame, step and probes' samples of `saved`.
+    fn put_back(&mut self, saved: Saved<FvmWorld>) {
         for (probe, samples) in self.sim.probes.iter_mut().zip(saved.probes) {
             probe.series.samples = samples;
         }
         self.sim.world = saved.world;
         self.frame = saved.frame;
         self.dt = saved.dt;
-        Ok(())
     }
+}
+
+/// The state in `bytes` (of [`World::state_bytes`]).
+fn read_saved(bytes: &[u8]) -> PyResult<Saved<FvmWorld>> {
+    ciborium::from_reader(bytes).map_err(|e| argument("state", format!("not a saved world: {e}")))
 }
 
 #[pymethods]
@@ -136,33 +151,26 @@ impl World {
     }
 }
 
-/// A pickled world rebuilt (see [`World::__reduce__`]): its scene's world, or an empty one,
-/// given its state.
+/// A pickled world rebuilt (see [`World::__reduce__`]): its scene's world given its state, or
+/// a world made of the state alone.
 #[pyfunction]
 pub fn _unpickle_world(scene: PickledScene, state: &[u8]) -> PyResult<World> {
+    let saved = read_saved(state)?;
     let mut world = match scene {
-        None => World::empty(1.0 / 60.0, DVec3::ZERO),
+        None => World::empty(saved.dt, DVec3::ZERO),
         Some((path, text)) => {
             let scene = Scene::parse(&path, text).map_err(scene_error)?;
             let sim = Simulation::build(&scene).map_err(scene_error)?;
-            let dt = scene.world.dt;
-            World {
+            let world = World {
                 sim,
                 scene: Some(scene),
                 frame: 0,
-                dt,
-            }
+                dt: saved.dt,
+            };
+            world.check_same_bodies(&saved)?;
+            world
         }
     };
-    if world.scene.is_none() {
-        // An empty world takes its bodies from the state.
-        let saved: Saved<FvmWorld> = ciborium::from_reader(state)
-            .map_err(|e| argument("state", format!("not a saved world: {e}")))?;
-        world.sim.world = saved.world;
-        world.frame = saved.frame;
-        world.dt = saved.dt;
-        return Ok(world);
-    }
-    world.restore_bytes(state)?;
+    world.put_back(saved);
     Ok(world)
 }

@@ -9,8 +9,7 @@ use super::evaluate::patch_tangent;
 use crate::Error;
 use crate::assembly::{Factor, SymbolicFactor};
 use crate::newton::{
-    Configuration, Search, after_last_iteration, descend, norm, stalled_at_round_off,
-    without_descent,
+    Configuration, Search, accepted_within, descend, norm, stalled_at_round_off, without_descent,
 };
 use crate::statics::StaticSettings;
 use faer::Mat;
@@ -183,5 +182,5 @@ pub(super) fn minimize(
         }
     }
     let relative = norm(&residual) / reference;
-    after_last_iteration(relative, settings.tolerance, settings.max_iterations)
+    accepted_within(settings.max_iterations, relative, settings.tolerance)
 }

@@ -19,8 +19,8 @@ use crate::integrate::SolverWorkspace;
 use crate::linear_solver::{Method, solve_newton_system};
 use crate::load::ChamberSolve;
 use crate::newton::{
-    Search, after_last_iteration, check_tolerance, descend, norm, round_off_floor,
-    stalled_at_round_off, without_descent,
+    Search, accepted_within, check_tolerance, descend, norm, round_off_floor, stalled_at_round_off,
+    without_descent,
 };
 use rapier3d::glamx::{DMat3, DVec3};
 
@@ -138,7 +138,7 @@ fn newton(
         }
     }
     let relative = norm(&residual) / reference;
-    after_last_iteration(relative, settings.tolerance, settings.max_iterations).map(report)
+    accepted_within(settings.max_iterations, relative, settings.tolerance).map(report)
 }
 
 /// The report of Newton's `(iterations, relative residual)`.
