@@ -15,8 +15,9 @@ restored bit for bit::
     world.step(60)
     print(world.positions(cube)[:, 1].min())   # the cube's lowest point (m)
 
-`run_scene` runs a scene file as ``rapier-fvm run`` does and returns its report; `sweep`
-runs a scene over a grid of values, locally or on Ray.
+`run_scene` runs a scene file as ``rapier-fvm run`` does and returns its report; `advise`
+finds the cheapest scene within a target error as ``rapier-fvm advise`` does; `sweep` runs a
+scene over a grid of values, locally or on Ray.
 """
 
 from ._native import (
@@ -29,6 +30,7 @@ from ._native import (
     Shape,
     SoftBody,
     World,
+    advise,
     run_scene,
 )
 
@@ -42,5 +44,6 @@ __all__ = [
     "Shape",
     "SoftBody",
     "World",
+    "advise",
     "run_scene",
 ]

@@ -180,6 +180,10 @@ def run_scene(path: _Path, out: _Path, *, duration: Optional[float] = None,
               overrides: Optional[Mapping[str, Any]] = None) -> dict[str, Any]:
     """Runs a scene file (3D or 2D) as `rapier-fvm run` does; returns its report."""
 
+def advise(path: _Path, out: _Path, *, target: float = 0.05,
+           duration: Optional[float] = None) -> dict[str, Any]:
+    """Advises on a 3D scene file as `rapier-fvm advise` does; returns the advice."""
+
 def _unpickle_world(scene: Optional[Tuple[str, str]], state: bytes) -> World:
     """A pickled world rebuilt (`World.__reduce__`)."""
 
@@ -193,6 +197,7 @@ __all__ = [
     "Shape",
     "SoftBody",
     "World",
+    "advise",
     "run_scene",
     "_unpickle_world",
 ]

@@ -39,6 +39,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<handles::Collider>()?;
     m.add_class::<world::World>()?;
     m.add_function(wrap_pyfunction!(scene::run_scene, m)?)?;
+    m.add_function(wrap_pyfunction!(scene::advise, m)?)?;
     m.add_function(wrap_pyfunction!(state::_unpickle_world, m)?)?;
     Ok(())
 }

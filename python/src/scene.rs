@@ -1,16 +1,18 @@
 //! Scene files from Python: a world read from a scene (`World.from_scene`), with values
 //! overridden at key paths (`{"soft_body[0].material.young": 2e6}`, see `overrides`), its
-//! bodies found by name and its probes read; and a whole run (`run_scene`) as `rapier-fvm run`
-//! does it, returning the report.
+//! bodies found by name and its probes read; a whole run (`run_scene`) as `rapier-fvm run`
+//! does it, returning the report; and the advisor (`advise`) as `rapier-fvm advise` runs it,
+//! returning the advice.
 
 use crate::arrays::rows_out;
-use crate::errors::{Error, scene as scene_error};
+use crate::errors::{Error, argument, scene as scene_error};
 use crate::handles::{RigidBody, SoftBody};
 use crate::overrides::scene_text;
 use crate::world::World;
 use numpy::PyArray2;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use rapier_fvm_runner::advise::{self as advisor, AdviseError, AdviseOptions};
 use rapier_fvm_runner::planar::{self, PlanarScene};
 use rapier_fvm_runner::scene::{Scene, dimension_of};
 use rapier_fvm_runner::sim::{self, RunError, RunOptions, Simulation};
@@ -103,6 +105,36 @@ pub fn run_scene<'py>(
         json.map_err(|e| Error::new_err(format!("the report could not be written: {e}")))
     })?;
     py.import("json")?.call_method1("loads", (report,))
+}
+
+/// Advises on the 3D scene file `path` as `rapier-fvm advise` does: runs it, each alternative
+/// (another model, linear elements, half the cells per soft body; another integrator) and the
+/// cheapest set of changes whose probe errors add up to at most `target` (relative), each for
+/// `duration` (s) if given instead of the scene's; writes `recommended.toml`, `advice.json` and
+/// `trials/` into `out`, and returns the advice as a dict. The GIL is released during the runs.
+#[pyfunction]
+#[pyo3(signature = (path, out, *, target = 0.05, duration = None))]
+pub fn advise<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+    out: PathBuf,
+    target: f64,
+    duration: Option<f64>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let options = AdviseOptions {
+        target,
+        window: duration,
+        out,
+    };
+    let advice = py.detach(|| -> PyResult<String> {
+        let advice = advisor::advise(&path, &options, |_| {}).map_err(|e| match e {
+            AdviseError::Target(_) => argument("target", e),
+            other => Error::new_err(other.to_string()),
+        })?;
+        serde_json::to_string(&advice)
+            .map_err(|e| Error::new_err(format!("the advice could not be written: {e}")))
+    })?;
+    py.import("json")?.call_method1("loads", (advice,))
 }
 
 /// A run's error: a scene's as `rapier_fvm.SceneError`, an output file's or a duration's as

@@ -112,3 +112,16 @@ def test_handles_materials_meshes_and_shapes_pickle():
     copy = pickle.loads(pickle.dumps(mesh))
     np.testing.assert_array_equal(copy.nodes, mesh.nodes)
     np.testing.assert_array_equal(copy.tets, mesh.tets)
+
+
+def test_advise_returns_the_advice_and_writes_a_scene_that_runs(scenes, tmp_path):
+    # The cantilever over 0.2 s: the same advice as `rapier-fvm advise`; the recommendation's
+    # measured error is within the target and its file runs.
+    advice = rf.advise(scenes / "cantilever.toml", tmp_path / "advice", target=0.05, duration=0.2)
+    recommendation = advice["recommendation"]
+    assert recommendation["within_target"] and recommendation["measured_error"] <= 0.05
+    assert [a["label"] for a in advice["soft_bodies"][0]["alternatives"]][0] == "beam: model linear"
+    report = rf.run_scene(recommendation["file"], tmp_path / "run", duration=0.05)
+    assert report["frames"] == 3
+    with pytest.raises(ValueError, match="target"):
+        rf.advise(scenes / "cantilever.toml", tmp_path / "no", target=2.0)

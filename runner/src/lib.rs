@@ -2,13 +2,14 @@
 //!
 //! The headless runner for [`rapier_fvm`] scenes, in its own crate so that users of the library
 //! do not build the command line, the scene format and the plotting and file-format
-//! dependencies. The binary `rapier-fvm` (`src/main.rs`) is a thin layer over three modules:
+//! dependencies. The binary `rapier-fvm` (`src/main.rs`) is a thin layer over these modules:
 //! - [`scene`]: the TOML scene format, read and checked with errors that name the file, the
 //!   line and the key;
 //! - [`sim`]: a scene built into an [`rapier_fvm::world::FvmWorld`] and run frame by frame,
 //!   with its probes sampled and its output written;
 //! - [`output`]: the writers;
-//! - [`planar`]: 2D scenes (`dimension = 2`), their runs and output through the same writers.
+//! - [`planar`]: 2D scenes (`dimension = 2`), their runs and output through the same writers;
+//! - [`advise`]: the cheapest scene within a target error of the scene as written.
 //!
 //! Each saved frame, the runner fills a [`output::Snapshot`] (plain data: positions, velocities,
 //! tetrahedra, surfaces and stresses of the soft bodies, world-space triangle meshes of the rigid
@@ -21,6 +22,7 @@
 //!
 //! All lengths are in m, times in s, velocities in m/s and stresses in Pa.
 
+pub mod advise;
 pub mod calibrate;
 pub mod output;
 pub mod planar;

@@ -1,4 +1,5 @@
-//! `rapier-fvm`: runs `rapier_fvm` scenes headless and checks meshes.
+//! `rapier-fvm`: runs `rapier_fvm` scenes headless, checks meshes, advises on the cheapest
+//! scene within a target error and measures the cost model.
 //!
 //! See `rapier-fvm --help`, and `assets/scenes/README.md` for the scene format.
 
@@ -6,6 +7,7 @@ use clap::{Parser, Subcommand};
 use rapier_fvm::integrate::SymplecticEuler;
 use rapier_fvm::material::{Material, MaterialModel};
 use rapier_fvm::mesh::import::{self, SurfaceOptions};
+use rapier_fvm_runner::advise;
 use rapier_fvm_runner::planar::{self, PlanarScene};
 use rapier_fvm_runner::scene::{MemoryBudget, Scene, dimension_of};
 use rapier_fvm_runner::sim::{self, RunOptions};
@@ -14,7 +16,8 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 /// Runs scenes of finite-volume soft bodies and rapier rigid bodies (described in TOML)
-/// headless, checks meshes, and measures the automatic integrator's costs on this machine.
+/// headless, checks meshes, finds the cheapest scene within a target error, and measures the
+/// automatic integrator's costs on this machine.
 ///
 /// Errors (a missing file, a malformed scene or mesh) print one line on stderr and exit with
 /// status 1; wrong command-line arguments exit with status 2.
@@ -87,6 +90,33 @@ enum Command {
         #[arg(long, default_value_t = 16)]
         cells_across: usize,
     },
+    /// Finds the cheapest scene whose probes stay within a target error of the scene as written.
+    ///
+    /// Runs the scene (the reference: each soft body's peak strain, rotation and contact
+    /// frames, the time per frame), then each alternative alone (per soft body another material
+    /// model, linear elements for quadratic ones, half the cells; another integrator), each
+    /// measured by its largest probe error (relative L2 distance over the frames' samples) and
+    /// its time per frame; then runs the cheapest set whose errors add up to at most the
+    /// target, dropping changes until its own error is within it. Writes into the output
+    /// folder: recommended.toml (ready for `rapier-fvm run`), advice.json (every
+    /// alternative's error, cost and verdict; predicted and measured error and cost of the
+    /// recommendation) and trials/ (each run's output folder). Prints the table.
+    Advise {
+        /// The scene file (3D).
+        scene: PathBuf,
+        /// The output folder (created if needed; files in it are overwritten).
+        #[arg(long, short)]
+        out: PathBuf,
+        /// The largest probe error allowed, relative (0.05 for 5 %).
+        #[arg(long, default_value_t = 0.05)]
+        target: f64,
+        /// Runs each trial this long (s) instead of the scene's duration.
+        #[arg(long)]
+        duration: Option<f64>,
+        /// Prints no line per trial on stderr.
+        #[arg(long)]
+        quiet: bool,
+    },
     /// Measures the automatic integrator's cost model on this machine.
     ///
     /// Steps a soft cube free and dropped on the ground with each integrator forced (about half
@@ -123,6 +153,13 @@ fn main() -> ExitCode {
             density,
             cells_across,
         } => check(mesh, scale, [young, poisson, density], cells_across),
+        Command::Advise {
+            scene,
+            out,
+            target,
+            duration,
+            quiet,
+        } => advise(&scene, out, target, duration, quiet),
         Command::Calibrate => calibrate(),
     };
     match result {
@@ -131,6 +168,89 @@ fn main() -> ExitCode {
             eprintln!("error: {message}");
             ExitCode::FAILURE
         }
+    }
+}
+
+/// `advise`: advises on `scene` for `target` over `duration` (s) into `out`; prints the table.
+fn advise(
+    scene: &std::path::Path,
+    out: PathBuf,
+    target: f64,
+    duration: Option<f64>,
+    quiet: bool,
+) -> Result<(), String> {
+    let options = advise::AdviseOptions {
+        target,
+        window: duration,
+        out,
+    };
+    let advice = advise::advise(scene, &options, |line| {
+        if !quiet {
+            eprintln!("{line}");
+        }
+    })
+    .map_err(|e| e.to_string())?;
+    print_advice(&advice);
+    Ok(())
+}
+
+/// Prints `advice`: each body's needs and alternatives, then the recommendation.
+fn print_advice(advice: &advise::Advice) {
+    println!(
+        "{}: target {:.2} %, {:.3} s per run; as written {:.3} ms per frame (two runs {:.1} % apart)",
+        advice.scene_file,
+        advice.target * 100.0,
+        advice.window_s,
+        advice.reference_ms_per_frame,
+        advice.reference_spread * 100.0
+    );
+    let print_alternative = |a: &advise::Alternative| match (a.error, a.ms_per_frame) {
+        (Some(error), Some(ms)) => println!(
+            "    {:<44} error {:>10} {:>9.3} ms/frame  {}",
+            a.label,
+            percent(error),
+            ms,
+            a.verdict
+        ),
+        _ => println!("    {:<44} {}", a.label, a.verdict),
+    };
+    for body in &advice.soft_bodies {
+        let n = &body.needs;
+        println!(
+            "  {} ({}, {}): peak strain {:.4}, peak rotation {:.1} deg, {} contact frames",
+            body.name,
+            body.model,
+            body.elements,
+            n.peak_green_strain,
+            n.peak_rotation_deg,
+            n.contact_frames
+        );
+        body.alternatives.iter().for_each(print_alternative);
+    }
+    println!("  the scene:");
+    advice.integrators.iter().for_each(print_alternative);
+    let r = &advice.recommendation;
+    println!(
+        "recommended: {}
+  error predicted {:.3} %, measured {:.3} % ({}); {:.3} ms per frame predicted, {:.3} measured: {:.2}x faster; {}
+  written to {}",
+        if r.changes.is_empty() { "the scene as written".to_owned() } else { r.changes.join("; ") },
+        r.predicted_error * 100.0,
+        r.measured_error * 100.0,
+        if r.worst_probe.is_empty() { "-" } else { &r.worst_probe },
+        r.predicted_ms_per_frame,
+        r.measured_ms_per_frame,
+        r.speed_up,
+        if r.within_target { "within the target" } else { "NOT within the target" },
+        r.file
+    );
+}
+
+/// A relative error in percent, to three significant figures.
+fn percent(error: f64) -> String {
+    match error * 100.0 {
+        p if p == 0.0 || p >= 0.01 => format!("{p:.3} %"),
+        p => format!("{p:.2e} %"),
     }
 }
 

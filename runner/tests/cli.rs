@@ -17,11 +17,13 @@ fn assert_one_line_error(output: &Output, words: &str) {
 }
 
 #[test]
-fn help_documents_both_subcommands() {
+fn help_documents_the_subcommands() {
     let output = rapier_fvm(&["--help"]);
     assert!(output.status.success());
     let help = String::from_utf8_lossy(&output.stdout);
-    assert!(help.contains("run") && help.contains("check"), "{help}");
+    for word in ["run", "check", "advise", "calibrate"] {
+        assert!(help.contains(word), "{word} in {help}");
+    }
     let output = rapier_fvm(&["run", "--help"]);
     let help = String::from_utf8_lossy(&output.stdout);
     for word in ["--out", "--duration", "report.json", ".pvd", "pictures"] {
@@ -207,4 +209,61 @@ fn calibrate_prints_a_cost_table_a_scene_reads() {
         assert!(value.is_finite() && value >= least, "{key} = {value}");
         assert_eq!(value, printed(key), "{key}");
     }
+}
+
+#[test]
+fn advise_prints_its_table_and_writes_a_scene_that_runs() {
+    // The cantilever over 0.2 s (12 frames), 5 % allowed: every alternative is listed with its
+    // verdict, and the recommended file is a scene `run` takes.
+    let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("cli_advise");
+    let _ = std::fs::remove_dir_all(&out);
+    let output = rapier_fvm(&[
+        "advise",
+        "assets/scenes/cantilever.toml",
+        "--out",
+        out.to_str().unwrap(),
+        "--duration",
+        "0.2",
+        "--quiet",
+    ]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success() && stderr.is_empty(), "{stderr}");
+    let text = String::from_utf8_lossy(&output.stdout);
+    for words in [
+        "target 5.00 %",
+        "beam: model linear",
+        "beam: cells [10, 1, 1]",
+        "integrator explicit",
+        "recommended: ",
+        "within the target",
+    ] {
+        assert!(text.contains(words), "{words:?} in {text}");
+    }
+    assert!(out.join("advice.json").is_file());
+    let recommended = out.join("recommended.toml");
+    let run = rapier_fvm(&[
+        "run",
+        recommended.to_str().unwrap(),
+        "--out",
+        out.join("run").to_str().unwrap(),
+        "--duration",
+        "0.05",
+    ]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let output = rapier_fvm(&[
+        "advise",
+        "assets/scenes/cantilever.toml",
+        "--out",
+        "unused",
+        "--target",
+        "0",
+    ]);
+    assert_one_line_error(
+        &output,
+        "the target must be a relative error in (0, 1), got 0",
+    );
 }

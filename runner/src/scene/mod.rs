@@ -11,6 +11,9 @@
 //! - [`settings`]: `[contact]`, `[integrator]` and `[output]`;
 //! - [`probe`]: `[[probe]]` entries sampled every frame.
 //!
+//! [`edit`] sets values at key paths in a scene's text before it is read (overrides,
+//! the advisor's alternatives).
+//!
 //! Its soft bodies must fit in memory: [`budget`] estimates what their meshes need from their
 //! cell counts and refuses a scene that would need more than there is.
 //!
@@ -23,6 +26,7 @@
 
 pub mod budget;
 pub(crate) mod check;
+pub mod edit;
 mod error;
 pub mod load;
 pub mod material;

@@ -29,4 +29,4 @@ pub use report::{
     BodyFlags, Files, Flag, ProbeReport, Report, RigidBodyReport, Settings, SoftBodyReport,
     Stability,
 };
-pub use run::{RunError, RunOptions, run};
+pub use run::{RunError, RunOptions, run, run_within};

@@ -41,6 +41,16 @@ pub enum RunError {
     /// The duration override is not positive.
     #[error("the duration must be positive and finite (s), got {0}")]
     Duration(f64),
+    /// The stepping took longer than the limit given to [`run_within`].
+    #[error("stopped at frame {frame} of {frames}: {stepping_s:.2} s of stepping, over the limit")]
+    OverTime {
+        /// The last frame stepped.
+        frame: usize,
+        /// The frames of the run.
+        frames: usize,
+        /// The stepping time so far (s).
+        stepping_s: f64,
+    },
 }
 
 /// Runs `scene` and writes its output into `options.out`; returns the report (also written as
@@ -50,6 +60,19 @@ pub enum RunError {
 /// [`RunError`] if the scene cannot be built or a file cannot be written. A body whose step
 /// fails does not stop the run: it keeps its state, and the report records the failure.
 pub fn run(scene: &Scene, options: &RunOptions) -> Result<Report, RunError> {
+    run_within(scene, options, None)
+}
+
+/// [`run`], stopped once its stepping has taken longer than `limit` (the advisor's trials: an
+/// alternative slower than the scene as written is not waited for).
+///
+/// # Errors
+/// Those of [`run`], and [`RunError::OverTime`] past the limit.
+pub fn run_within(
+    scene: &Scene,
+    options: &RunOptions,
+    limit: Option<Duration>,
+) -> Result<Report, RunError> {
     let started = Instant::now();
     let mut world_spec = scene.world.clone();
     if let Some(duration) = options.duration {
@@ -84,6 +107,13 @@ pub fn run(scene: &Scene, options: &RunOptions) -> Result<Report, RunError> {
         sim.drive_loads(t, &scene.source)?;
         let outcomes = sim.world.step();
         stepping += step_start.elapsed();
+        if limit.is_some_and(|limit| stepping > limit) {
+            return Err(RunError::OverTime {
+                frame,
+                frames,
+                stepping_s: stepping.as_secs_f64(),
+            });
+        }
         record_frame(
             &sim,
             (frame, &outcomes),

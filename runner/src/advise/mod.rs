@@ -1,0 +1,144 @@
+//! The advisor (`rapier-fvm advise`): the cheapest scene whose probes stay within a target
+//! error of the scene as written.
+//!
+//! It runs the scene as written over a window (the reference: what each soft body needed, its
+//! peak strain, rotation and contact frames, and the time per frame), then each alternative of
+//! [`candidates`] alone (another model, linear elements, half the cells, another integrator),
+//! measuring its error (the largest over the probes of the relative L2 distance of their samples
+//! from the reference's) and its time per frame (stopped past twice the reference's stepping
+//! time: it could not be chosen); then chooses the cheapest set of changes whose errors add up
+//! to at most the target, runs that set, and keeps it only once its measured error is within
+//! the target. The reference runs three times: first for its probes (a process's first run
+//! also pays for its thread pool's start), then before and after the alternatives for its
+//! time; the spread of those two times per frame (at least 3 %) is the smallest saving counted.
+//!
+//! The coarser mesh's error is also the estimate of the scene's own discretization error: with
+//! the errors of linear elements `O(hᵖ)`, Richardson's `|q_h − q_2h| / (2ᵖ − 1)` with the lowest
+//! order `p = 1`.
+//!
+//! Written into the output folder: `recommended.toml` (the scene's text with the chosen edits,
+//! mesh files named by absolute paths), `advice.json` (the [`Advice`]) and `trials/<n>/`, each
+//! run's own output folder.
+
+mod advisor;
+mod candidates;
+mod choose;
+mod trial;
+
+pub use advisor::advise;
+pub use candidates::{Candidate, Group, candidates};
+
+use crate::sim::BodyNeeds;
+use serde::Serialize;
+use std::path::PathBuf;
+
+/// What to advise on.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AdviseOptions {
+    /// The largest probe error allowed (relative: 0.05 for 5 %).
+    pub target: f64,
+    /// The window each run covers (s); default the scene's duration.
+    pub window: Option<f64>,
+    /// The output folder.
+    pub out: PathBuf,
+}
+
+/// Advice that could not be given.
+#[derive(Debug, thiserror::Error)]
+pub enum AdviseError {
+    /// The scene as written could not be read or run.
+    #[error("{0}")]
+    Scene(String),
+    /// The scene has no probe to hold within the target.
+    #[error("{0}: the scene has no [[probe]] to hold within the target")]
+    NoProbes(String),
+    /// The target is not a positive fraction.
+    #[error("the target must be a relative error in (0, 1), got {0}")]
+    Target(f64),
+    /// A file could not be written.
+    #[error("{0}: {1}")]
+    Write(PathBuf, std::io::Error),
+}
+
+/// The advice, also written as `advice.json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct Advice {
+    /// The scene file.
+    pub scene_file: String,
+    /// The largest probe error allowed (relative).
+    pub target: f64,
+    /// The window every run covered (s).
+    pub window_s: f64,
+    /// The scene as written: time per frame (ms), the mean of its timed runs (before and after
+    /// the alternatives).
+    pub reference_ms_per_frame: f64,
+    /// The relative spread of the reference's two times per frame.
+    pub reference_spread: f64,
+    /// Per soft body: what it needed, what it was given, its alternatives.
+    pub soft_bodies: Vec<BodyAdvice>,
+    /// The scene's alternative integrators.
+    pub integrators: Vec<Alternative>,
+    /// The set of changes recommended, run.
+    pub recommendation: Recommendation,
+}
+
+/// A soft body: what the scene needed of it, what it was given, what else was measured.
+#[derive(Debug, Clone, Serialize)]
+pub struct BodyAdvice {
+    /// Its name.
+    pub name: String,
+    /// Peak strain, rotation and contact frames over the reference's window.
+    pub needs: BodyNeeds,
+    /// Its model as given.
+    pub model: String,
+    /// Its elements as given (kind and count).
+    pub elements: String,
+    /// Its discretization error estimated from the coarser mesh (relative; see the module).
+    pub discretization_error: Option<f64>,
+    /// The alternatives measured.
+    pub alternatives: Vec<Alternative>,
+}
+
+/// An alternative, run alone.
+#[derive(Debug, Clone, Serialize)]
+pub struct Alternative {
+    /// What it changes.
+    pub label: String,
+    /// Its edits, `key = value`.
+    pub edits: Vec<String>,
+    /// Its largest probe error against the reference (relative), if it ran.
+    pub error: Option<f64>,
+    /// The probe of that error.
+    pub worst_probe: Option<String>,
+    /// Its time per frame (ms), if it ran.
+    pub ms_per_frame: Option<f64>,
+    /// Whether it ran stable (the runner's verdict), if it ran.
+    pub stable: Option<bool>,
+    /// Chosen, or why not.
+    pub verdict: String,
+    /// Its run's folder.
+    pub folder: String,
+}
+
+/// The changes recommended: predicted, then measured.
+#[derive(Debug, Clone, Serialize)]
+pub struct Recommendation {
+    /// The changes (labels).
+    pub changes: Vec<String>,
+    /// The file written (the scene with the changes).
+    pub file: String,
+    /// The sum of the changes' errors alone (relative).
+    pub predicted_error: f64,
+    /// Its largest probe error, run (relative).
+    pub measured_error: f64,
+    /// The probe of that error.
+    pub worst_probe: String,
+    /// The predicted time per frame (ms).
+    pub predicted_ms_per_frame: f64,
+    /// Its time per frame, run (ms).
+    pub measured_ms_per_frame: f64,
+    /// The reference's time per frame over the recommendation's.
+    pub speed_up: f64,
+    /// Whether the measured error is within the target and the run stable.
+    pub within_target: bool,
+}
