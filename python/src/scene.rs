@@ -112,6 +112,8 @@ pub fn run_scene<'py>(
 /// cheapest set of changes whose probe errors add up to at most `target` (relative), each for
 /// `duration` (s) if given instead of the scene's; writes `recommended.toml`, `advice.json` and
 /// `trials/` into `out`, and returns the advice as a dict. The GIL is released during the runs.
+/// A malformed scene raises `rapier_fvm.SceneError`; a 2D scene, one without probes, or one that
+/// cannot be run or runs unstable as written, `rapier_fvm.Error`.
 #[pyfunction]
 #[pyo3(signature = (path, out, *, target = 0.05, duration = None))]
 pub fn advise<'py>(
@@ -129,6 +131,7 @@ pub fn advise<'py>(
     let advice = py.detach(|| -> PyResult<String> {
         let advice = advisor::advise(&path, &options, |_| {}).map_err(|e| match e {
             AdviseError::Target(_) => argument("target", e),
+            AdviseError::Scene(e) => scene_error(e),
             other => Error::new_err(other.to_string()),
         })?;
         serde_json::to_string(&advice)

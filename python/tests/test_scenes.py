@@ -125,3 +125,7 @@ def test_advise_returns_the_advice_and_writes_a_scene_that_runs(scenes, tmp_path
     assert report["frames"] == 3
     with pytest.raises(ValueError, match="target"):
         rf.advise(scenes / "cantilever.toml", tmp_path / "no", target=2.0)
+    bad = tmp_path / "bad.toml"
+    bad.write_text((scenes / "cantilever.toml").read_text().replace("poisson = 0.3", "poisson = 0.5"))
+    with pytest.raises(rf.SceneError, match="poisson"):
+        rf.advise(bad, tmp_path / "bad")

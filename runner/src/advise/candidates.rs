@@ -1,7 +1,8 @@
 //! The alternatives the advisor measures, each one change to the scene as written: per soft
 //! body another material model, linear elements in place of quadratic ones, and a mesh of half
-//! the cells along each axis; for the scene, another integrator. Each is a list of key-path
-//! edits of the scene's text ([`crate::scene::edit`]).
+//! the cells along each axis; for the scene, another integrator, a Newton tolerance a hundred
+//! times looser, and half the coupling substeps. Each is a list of key-path edits of the
+//! scene's text ([`crate::scene::edit`]).
 
 use crate::scene::Scene;
 use crate::scene::material::ModelSpec;
@@ -22,6 +23,28 @@ pub enum Group {
     Resolution(usize),
     /// The scene's integrator.
     Integrator,
+    /// The implicit integrator's Newton tolerance.
+    Tolerance,
+    /// The world's coupling substeps.
+    CouplingSubsteps,
+}
+
+impl Group {
+    /// The soft body the change is to, if to one.
+    pub fn body(&self) -> Option<usize> {
+        match self {
+            Self::Model(i) | Self::Elements(i) | Self::Resolution(i) => Some(*i),
+            _ => None,
+        }
+    }
+
+    /// Whether the change is to the whole scene rather than to one soft body.
+    pub fn is_scene_wide(&self) -> bool {
+        matches!(
+            self,
+            Self::Integrator | Self::Tolerance | Self::CouplingSubsteps
+        )
+    }
 }
 
 /// One change to the scene.
@@ -33,6 +56,9 @@ pub struct Candidate {
     pub label: String,
     /// Its edits of the scene's text: key path and value.
     pub edits: Vec<(String, Value)>,
+    /// For a coarser mesh, the refinement ratio from it to the given one (the largest over the
+    /// axes of the given cells over the coarser ones).
+    pub refinement: Option<f64>,
 }
 
 /// The models in the scene files' names, cheapest first.
@@ -44,7 +70,8 @@ const MODELS: [(ModelSpec, &str); 4] = [
 ];
 
 /// Every alternative to `scene`: per soft body, the other models, linear elements (for
-/// quadratic ones) and half the cells; then the other integrators.
+/// quadratic ones) and half the cells; then the other integrators, the looser tolerance and
+/// half the coupling substeps.
 pub fn candidates(scene: &Scene) -> Vec<Candidate> {
     let mut all = Vec::new();
     for (i, body) in scene.soft_body.iter().enumerate() {
@@ -55,6 +82,7 @@ pub fn candidates(scene: &Scene) -> Vec<Candidate> {
                     group: Group::Model(i),
                     label: format!("{}: model {name}", body.name),
                     edits: vec![(key("material.model"), Value::from(name))],
+                    refinement: None,
                 });
             }
         }
@@ -63,13 +91,15 @@ pub fn candidates(scene: &Scene) -> Vec<Candidate> {
                 group: Group::Elements(i),
                 label: format!("{}: linear elements", body.name),
                 edits: vec![(key("elements"), Value::from("linear"))],
+                refinement: None,
             });
         }
-        if let Some((what, edits)) = coarser(&body.mesh, &key("mesh")) {
+        if let Some((what, edits, ratio)) = coarser(&body.mesh, &key("mesh")) {
             all.push(Candidate {
                 group: Group::Resolution(i),
                 label: format!("{}: {what}", body.name),
                 edits,
+                refinement: Some(ratio),
             });
         }
     }
@@ -83,32 +113,75 @@ pub fn candidates(scene: &Scene) -> Vec<Candidate> {
                 group: Group::Integrator,
                 label: format!("integrator {name}"),
                 edits: vec![("integrator.kind".to_owned(), Value::from(name))],
+                refinement: None,
             });
         }
+    }
+    all.extend(scene_settings(scene));
+    all
+}
+
+/// The scene's Newton tolerance a hundred times looser (at most 1e-2), and half its coupling
+/// substeps (rounded up) where it has more than one.
+fn scene_settings(scene: &Scene) -> Vec<Candidate> {
+    let mut all = Vec::new();
+    let tolerance = scene.integrator.integrator().implicit.tolerance;
+    // To one significant digit: 1e-6 gives 1e-4, not 9.999999999999999e-5.
+    let looser = format!("{:.0e}", (tolerance * 100.0).min(1e-2));
+    let looser: f64 = looser.parse().unwrap_or(1e-2);
+    if looser > tolerance {
+        all.push(Candidate {
+            group: Group::Tolerance,
+            label: format!("Newton tolerance {looser:e}"),
+            edits: vec![("integrator.tolerance".to_owned(), Value::from(looser))],
+            refinement: None,
+        });
+    }
+    let substeps = scene.world.coupling_substeps;
+    if substeps > 1 {
+        let half = substeps.div_ceil(2);
+        all.push(Candidate {
+            group: Group::CouplingSubsteps,
+            label: format!("coupling substeps {half}"),
+            edits: vec![(
+                "world.coupling_substeps".to_owned(),
+                Value::from(i64::from(half)),
+            )],
+            refinement: None,
+        });
     }
     all
 }
 
+/// A coarser mesh: its description, its edits and the refinement ratio from it to the given
+/// mesh.
+type Coarser = (String, Vec<(String, Value)>, f64);
+
 /// Half the cells (rounded up) of a generated mesh or a filled surface along each axis, as a
-/// description and the edits under `key` (the mesh's key path); `None` when the mesh is a file
-/// of elements or already one cell across.
-fn coarser(mesh: &MeshSpec, key: &str) -> Option<(String, Vec<(String, Value)>)> {
+/// description, the edits under `key` (the mesh's key path) and the refinement ratio from it
+/// to the given mesh; `None` when the mesh is a file of elements or already one cell across.
+fn coarser(mesh: &MeshSpec, key: &str) -> Option<Coarser> {
     let half = |n: usize| n.div_ceil(2);
     let int = |n: usize| Value::from(i64::try_from(n).unwrap_or(i64::MAX));
+    let ratio = |pairs: &[(usize, usize)]| {
+        (pairs.iter())
+            .map(|(given, coarse)| *given as f64 / *coarse as f64)
+            .fold(1.0, f64::max)
+    };
     if let Some(cuboid) = &mesh.cuboid {
         let cells = cuboid.cells.map(half);
         (cells != cuboid.cells).then(|| {
             let array: Array = cells.iter().map(|n| int(*n)).collect();
-            (
-                format!("cells {cells:?}"),
-                vec![(format!("{key}.cuboid.cells"), Value::Array(array))],
-            )
+            let edit = (format!("{key}.cuboid.cells"), Value::Array(array));
+            let pairs: Vec<_> = cuboid.cells.into_iter().zip(cells).collect();
+            (format!("cells {cells:?}"), vec![edit], ratio(&pairs))
         })
     } else if let Some(sphere) = &mesh.sphere {
         let across = half(sphere.cells_across).max(2);
         (across != sphere.cells_across).then(|| {
             let edit = (format!("{key}.sphere.cells_across"), int(across));
-            (format!("{across} cells across"), vec![edit])
+            let r = ratio(&[(sphere.cells_across, across)]);
+            (format!("{across} cells across"), vec![edit], r)
         })
     } else if let Some(cylinder) = &mesh.cylinder {
         let (across, along) = (
@@ -120,7 +193,11 @@ fn coarser(mesh: &MeshSpec, key: &str) -> Option<(String, Vec<(String, Value)>)>
                 (format!("{key}.cylinder.cells_across"), int(across)),
                 (format!("{key}.cylinder.cells_along"), int(along)),
             ];
-            (format!("{across} cells across, {along} along"), edits)
+            let r = ratio(&[
+                (cylinder.cells_across, across),
+                (cylinder.cells_along, along),
+            ]);
+            (format!("{across} cells across, {along} along"), edits, r)
         })
     } else {
         let file = mesh.file.as_deref()?;
@@ -131,7 +208,11 @@ fn coarser(mesh: &MeshSpec, key: &str) -> Option<(String, Vec<(String, Value)>)>
         let across = half(given).max(2);
         (surface && across != given).then(|| {
             let edit = (format!("{key}.cells_across"), int(across));
-            (format!("{across} cells across"), vec![edit])
+            (
+                format!("{across} cells across"),
+                vec![edit],
+                ratio(&[(given, across)]),
+            )
         })
     }
 }

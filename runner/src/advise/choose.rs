@@ -1,12 +1,12 @@
-//! The recommendation: the cheapest set of changes whose errors, added, stay within the target.
+//! The choice: a cheap set of changes whose errors, added, stay within the target.
 //!
 //! Each change was measured alone against the scene as written: its error `eᵢ` (largest
 //! probe error) and its time per frame `cᵢ` against the reference's `c₀`. Changes enter
-//! greedily, largest saving `c₀ − cᵢ` first, one per [`Group`], while `Σ eᵢ ≤ target`: the
-//! predicted error of the set is that sum (a bound if the changes' effects on the probes add,
-//! by the triangle inequality), its predicted time per frame `c₀ Π (cᵢ / c₀)` (each change
-//! scales the part of the step it touches). The set is then run, and while its measured error
-//! exceeds the target the change of largest error leaves it.
+//! greedily, largest saving `c₀ − cᵢ` first, one per [`Group`], while `Σ eᵢ ≤ target` (greedy:
+//! not always the cheapest set, which is a knapsack problem): the predicted error of the set is
+//! that sum (a bound when the changes' effects on the probes add, by the triangle inequality;
+//! changes that act together can exceed it, which the set's run measures), its predicted time
+//! per frame `c₀ Π (cᵢ / c₀)` (each change scales the part of the step it touches).
 
 use super::candidates::Group;
 use std::collections::HashSet;
@@ -24,7 +24,9 @@ pub struct Measured {
 
 /// The indices into `changes` of the greedy choice within `target` (relative error): changes
 /// at least `threshold` (relative) cheaper than `reference_ms`, largest saving first, one per
-/// group, while their errors add up to at most `target`.
+/// group, while their errors add up to at most `target`. A change of zero error ran the same
+/// probes to the bit: it changed nothing this scene does (a setting the scene's bodies do not
+/// use), and a time it measured lower is noise; it is not chosen.
 pub fn choose(
     changes: &[Option<Measured>],
     reference_ms: f64,
@@ -33,7 +35,8 @@ pub fn choose(
 ) -> Vec<usize> {
     let mut eligible: Vec<(usize, &Measured)> = (changes.iter().enumerate())
         .filter_map(|(i, m)| Some((i, m.as_ref()?)))
-        .filter(|(_, m)| m.error <= target && m.ms_per_frame < reference_ms * (1.0 - threshold))
+        .filter(|(_, m)| m.error > 0.0 && m.error <= target)
+        .filter(|(_, m)| m.ms_per_frame < reference_ms * (1.0 - threshold))
         .collect();
     eligible.sort_by(|a, b| a.1.ms_per_frame.total_cmp(&b.1.ms_per_frame));
     let mut used = HashSet::new();
@@ -70,6 +73,24 @@ pub fn without_largest_error(changes: &[Option<Measured>], chosen: &[usize]) -> 
         .collect()
 }
 
+/// `chosen` without its change of smallest saving (largest time per frame alone).
+pub fn without_smallest_saving(changes: &[Option<Measured>], chosen: &[usize]) -> Vec<usize> {
+    let time = |i: &usize| {
+        changes[*i]
+            .as_ref()
+            .map_or(f64::INFINITY, |m| m.ms_per_frame)
+    };
+    let smallest = chosen
+        .iter()
+        .max_by(|a, b| time(a).total_cmp(&time(b)))
+        .copied();
+    chosen
+        .iter()
+        .copied()
+        .filter(|i| Some(*i) != smallest)
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -90,11 +111,12 @@ mod tests {
             measured(Group::Model(1), 0.04, 5.0),
             measured(Group::Integrator, 0.02, 9.0),
             measured(Group::Resolution(1), 0.01, 9.9),
+            measured(Group::Tolerance, 0.0, 1.0),
             None,
         ];
         // Cheapest first: Model(1) at 5 ms (0.04), Model(0) at 6 ms would exceed 0.05, the
         // next Model(0) at 8 ms fits (0.041), the integrator at 9 ms does not (0.061); the
-        // coarser mesh saves under the 3 % threshold.
+        // coarser mesh saves under the 3 % threshold; the tolerance changed nothing.
         let chosen = choose(&changes, 10.0, 0.05, 0.03);
         assert_eq!(chosen, [2, 1]);
         let (error, ms) = predict(&changes, &chosen, 10.0);
@@ -103,5 +125,6 @@ mod tests {
             "{error} {ms}"
         );
         assert_eq!(without_largest_error(&changes, &chosen), [1]);
+        assert_eq!(without_smallest_saving(&changes, &chosen), [2]);
     }
 }

@@ -3,18 +3,19 @@
 //!
 //! It runs the scene as written over a window (the reference: what each soft body needed, its
 //! peak strain, rotation and contact frames, and the time per frame), then each alternative of
-//! [`candidates`] alone (another model, linear elements, half the cells, another integrator),
+//! [`candidates`] alone (another model, linear elements, half the cells; another integrator, a
+//! looser Newton tolerance, half the coupling substeps),
 //! measuring its error (the largest over the probes of the relative L2 distance of their samples
 //! from the reference's) and its time per frame (stopped past twice the reference's stepping
 //! time: it could not be chosen); then chooses the cheapest set of changes whose errors add up
 //! to at most the target, runs that set, and keeps it only once its measured error is within
-//! the target. The reference runs three times: first for its probes (a process's first run
+//! the target and it is faster than the scene. The reference runs three times: first for its probes (a process's first run
 //! also pays for its thread pool's start), then before and after the alternatives for its
 //! time; the spread of those two times per frame (at least 3 %) is the smallest saving counted.
 //!
 //! The coarser mesh's error is also the estimate of the scene's own discretization error: with
-//! the errors of linear elements `O(hᵖ)`, Richardson's `|q_h − q_2h| / (2ᵖ − 1)` with the lowest
-//! order `p = 1`.
+//! errors `O(hᵖ)`, Richardson's `|q_h − q_rh| / (rᵖ − 1)` for the refinement ratio `r` from the
+//! coarser mesh (2, or 1.5 from 3 cells to 2) and the lowest order, `p = 1`.
 //!
 //! Written into the output folder: `recommended.toml` (the scene's text with the chosen edits,
 //! mesh files named by absolute paths), `advice.json` (the [`Advice`]) and `trials/<n>/`, each
@@ -22,12 +23,16 @@
 
 mod advisor;
 mod candidates;
+mod checked;
 mod choose;
+mod entries;
+mod files;
 mod trial;
 
 pub use advisor::advise;
 pub use candidates::{Candidate, Group, candidates};
 
+use crate::scene::SceneError;
 use crate::sim::BodyNeeds;
 use serde::Serialize;
 use std::path::PathBuf;
@@ -46,16 +51,28 @@ pub struct AdviseOptions {
 /// Advice that could not be given.
 #[derive(Debug, thiserror::Error)]
 pub enum AdviseError {
-    /// The scene as written could not be read or run.
+    /// The scene as written could not be read.
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    /// The scene as written could not be run, or ran unstable (it is the reference every
+    /// alternative is measured against).
     #[error("{0}")]
-    Scene(String),
+    Reference(String),
     /// The scene has no probe to hold within the target.
     #[error("{0}: the scene has no [[probe]] to hold within the target")]
     NoProbes(String),
+    /// The scene is a 2D one.
+    #[error("{0}: a 2D scene (dimension = 2); advise takes 3D scenes")]
+    Planar(String),
     /// The target is not a positive fraction.
     #[error("the target must be a relative error in (0, 1), got {0}")]
     Target(f64),
-    /// A file could not be written.
+    /// The output folder would overwrite the scene file.
+    #[error(
+        "{0}: the output folder's recommended.toml would overwrite the scene; choose another --out"
+    )]
+    Overwrite(String),
+    /// A file or folder could not be written.
     #[error("{0}: {1}")]
     Write(PathBuf, std::io::Error),
 }
@@ -67,7 +84,7 @@ pub struct Advice {
     pub scene_file: String,
     /// The largest probe error allowed (relative).
     pub target: f64,
-    /// The window every run covered (s).
+    /// The window every run covered (s): whole frames, at least one.
     pub window_s: f64,
     /// The scene as written: time per frame (ms), the mean of its timed runs (before and after
     /// the alternatives).
@@ -76,8 +93,8 @@ pub struct Advice {
     pub reference_spread: f64,
     /// Per soft body: what it needed, what it was given, its alternatives.
     pub soft_bodies: Vec<BodyAdvice>,
-    /// The scene's alternative integrators.
-    pub integrators: Vec<Alternative>,
+    /// The scene's alternatives: integrators, Newton tolerance, coupling substeps.
+    pub scene_alternatives: Vec<Alternative>,
     /// The set of changes recommended, run.
     pub recommendation: Recommendation,
 }
@@ -93,7 +110,8 @@ pub struct BodyAdvice {
     pub model: String,
     /// Its elements as given (kind and count).
     pub elements: String,
-    /// Its discretization error estimated from the coarser mesh (relative; see the module).
+    /// Its discretization error estimated from the coarser mesh, if that ran stable (relative;
+    /// see the module).
     pub discretization_error: Option<f64>,
     /// The alternatives measured.
     pub alternatives: Vec<Alternative>,
@@ -106,7 +124,8 @@ pub struct Alternative {
     pub label: String,
     /// Its edits, `key = value`.
     pub edits: Vec<String>,
-    /// Its largest probe error against the reference (relative), if it ran.
+    /// Its largest probe error against the reference (relative), if it ran and the error is
+    /// finite (the verdict says when it is not).
     pub error: Option<f64>,
     /// The probe of that error.
     pub worst_probe: Option<String>,

@@ -2,10 +2,13 @@
 //! runner's full report; one ParaView frame at each end, no pictures), and how far its probes
 //! came from the reference's.
 //!
-//! A probe's error is its relative L2 distance over the window's samples,
-//! `‖q − q_ref‖₂ / ‖q_ref‖₂` (every frame's sample, the reference's time series as the scale:
-//! a shift of an impact by a frame costs what the samples it moves differ by, not the peak);
-//! a trial's error is its largest probe error.
+//! A probe's error is the L2 distance of its samples from the reference's over the window,
+//! relative to how far the reference's samples move from their first value,
+//! `‖q − q_ref‖₂ / ‖q_ref − q_ref(0)‖₂` (every frame's sample: a shift of an impact by a frame
+//! costs what the samples it moves differ by, not the peak; the scale is the motion the probe
+//! measures, so a scene moved 10 m up measures the same errors). A probe that the reference
+//! never moves is scaled by its value, `‖q_ref‖₂`, and one that is zero throughout gives an
+//! infinite error to any run that moves it. A trial's error is its largest probe error.
 
 use crate::scene::Scene;
 use crate::scene::edit::edited;
@@ -39,17 +42,21 @@ pub fn run_trial(
     sim::run_within(&scene, &options, limit).map_err(|e| e.to_string())
 }
 
-/// The relative L2 distance of `probe`'s samples from `reference`'s (zero for two zero
-/// series; infinite for a non-zero series against a zero one, or series of other lengths).
+/// The distance of `probe`'s samples from `reference`'s relative to the reference's motion
+/// (see the module): zero for equal series, infinite against a zero scale or for series of
+/// other lengths.
 pub fn probe_error(probe: &ProbeReport, reference: &ProbeReport) -> f64 {
     if probe.values.len() != reference.values.len() {
         return f64::INFINITY;
     }
-    let (mut distance, mut scale) = (0.0, 0.0);
+    let start = reference.values.first().copied().unwrap_or(0.0);
+    let (mut distance, mut motion, mut value) = (0.0, 0.0, 0.0);
     for (q, r) in probe.values.iter().zip(&reference.values) {
         distance += (q - r) * (q - r);
-        scale += r * r;
+        motion += (r - start) * (r - start);
+        value += r * r;
     }
+    let scale = if motion > 0.0 { motion } else { value };
     if distance == 0.0 {
         0.0
     } else if scale == 0.0 {
@@ -72,4 +79,39 @@ pub fn trial_error(report: &Report, reference: &Report) -> (f64, String) {
         }
     }
     worst
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn probe(values: &[f64]) -> ProbeReport {
+        ProbeReport {
+            name: "p".to_owned(),
+            kind: "position".to_owned(),
+            unit: "m".to_owned(),
+            final_value: values.last().copied().unwrap_or(f64::NAN),
+            times: (0..values.len()).map(|i| i as f64).collect(),
+            values: values.to_vec(),
+        }
+    }
+
+    #[test]
+    fn the_error_is_relative_to_the_references_motion_wherever_it_sits() {
+        // The reference moves by (0, 3, 4) from its start: ‖motion‖ = 5; the trial is off by
+        // (0, 0, 1): 1/5, at 0 or 10 m alike.
+        for offset in [0.0, 10.0] {
+            let reference = probe(&[offset, offset + 3.0, offset + 4.0]);
+            let trial = probe(&[offset, offset + 3.0, offset + 5.0]);
+            assert!((probe_error(&trial, &reference) - 0.2).abs() < 1e-12);
+        }
+        // A reference that never moves is scaled by its value; a zero one by nothing.
+        let still = probe(&[2.0, 2.0]);
+        assert!((probe_error(&probe(&[2.0, 3.0]), &still) - 1.0 / 8f64.sqrt()).abs() < 1e-12);
+        assert_eq!(
+            probe_error(&probe(&[0.0, 1e-9]), &probe(&[0.0, 0.0])),
+            f64::INFINITY
+        );
+        assert_eq!(probe_error(&probe(&[0.0, 0.0]), &probe(&[0.0, 0.0])), 0.0);
+    }
 }

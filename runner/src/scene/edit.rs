@@ -44,6 +44,15 @@ enum Step {
     Index(usize),
 }
 
+impl std::fmt::Display for Step {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Key(key) => write!(f, "key {key:?}"),
+            Self::Index(index) => write!(f, "element [{index}]"),
+        }
+    }
+}
+
 /// The steps of the key path `path`.
 fn steps(path: &str) -> Result<Vec<Step>, EditError> {
     let malformed = || EditError {
@@ -122,7 +131,7 @@ pub fn set_at(root: &mut Table, path: &str, value: Value) -> Result<(), EditErro
                 }
                 Cursor::Value(element)
             }
-            (_, step) => return Err(missing(format!("{step:?} there"))),
+            (_, step) => return Err(missing(format!("{step} there"))),
         };
         if last {
             return Ok(());
