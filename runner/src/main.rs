@@ -219,7 +219,7 @@ fn print_advice(advice: &advise::Advice) {
     for body in &advice.soft_bodies {
         let n = &body.needs;
         println!(
-            "  {} ({}, {}): peak strain {:.4}, peak rotation {:.1} deg, {} contact frames",
+            "  {} ({}, {}): peak strain {:.4}, peak rotation {:.1} deg, pushed by a collider in {} frames",
             body.name,
             body.model,
             body.elements,

@@ -54,3 +54,20 @@ fn a_dropped_cube_touches_the_ground_from_its_landing_on() {
     );
     assert!(needs.peak_rotation_deg < 5.0, "{needs:?}");
 }
+
+#[test]
+fn a_beam_sagging_onto_a_rounded_support_is_pushed_from_its_landing_on() {
+    // cage_beam.toml for 0.5 s (30 frames): the free end of a clamped beam sags onto a fixed
+    // capsule 5 mm below it within its first frames and rests there; a capsule meets the beam's
+    // faces by its closest points (rigid-corner contacts, not the surface points' own), which
+    // count as much as the ground's contacts with a dropped cube's points. The frames before the
+    // landing, at most two (5 mm of free fall take 32 ms), are the only ones not counted.
+    let text = std::fs::read_to_string(scene_path("cage_beam.toml")).unwrap();
+    let (report, _) = run_scene("needs_cage_beam", &text, Some(0.5));
+    let needs = &report.soft_bodies[0].needs;
+    assert_eq!(report.frames, 30);
+    assert!(
+        needs.contact_frames + 2 >= report.frames && needs.contact_frames <= report.frames,
+        "{needs:?}"
+    );
+}

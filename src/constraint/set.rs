@@ -9,7 +9,8 @@ use crate::Error;
 use crate::attachment::{self, Attachment};
 use crate::body::DeformableBody;
 use crate::contact::{
-    self, ColliderView, ContactSet, ContactSettings, CornerContact, CornerPlace, NodeContact,
+    self, ColliderView, ContactSet, ContactSettings, ContactTarget, CornerContact, CornerPlace,
+    NodeContact,
 };
 use crate::rigid::RigidProxy;
 use rapier3d::dynamics::RigidBodyHandle;
@@ -125,6 +126,17 @@ impl BodyConstraints {
     /// The contacts found by the last [`BodyConstraints::detect_contacts`].
     pub fn contacts(&self) -> &[NodeContact] {
         &self.contacts.nodes
+    }
+
+    /// Whether a collider pushed the body over the last step: a contact of one of its surface
+    /// points with a collider, or of a rigid body's corner with one of its faces, carried an
+    /// impulse (a contact merely within reach carries none).
+    pub fn pushed_by_collider(&self) -> bool {
+        let point = |c: &NodeContact| {
+            matches!(c.target, ContactTarget::Collider(_)) && c.impulse != DVec3::ZERO
+        };
+        self.contacts.nodes.iter().any(point)
+            || (self.contacts.corners.iter()).any(|c| c.impulse != DVec3::ZERO)
     }
 
     /// Removes every contact (the attachments stay).

@@ -14,7 +14,6 @@ use crate::scene::{Scene, SceneError};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rapier_fvm::body::DeformableBodyHandle;
 use rapier_fvm::coupling::{Audit, SoftStepResults};
-use rapier_fvm::glamx::DVec3;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
@@ -177,8 +176,8 @@ fn record_frame(
     for (entry, report) in sim.soft.iter().zip(bodies.iter_mut()) {
         let asleep = sim.world.coupling.is_sleeping(entry.handle);
         report.asleep_frames += usize::from(asleep);
-        let touching = (sim.world.coupling.contacts(entry.handle).iter())
-            .any(|contact| contact.impulse != DVec3::ZERO);
+        let touching = (sim.world.coupling.constraints(entry.handle))
+            .is_some_and(|constraints| constraints.pushed_by_collider());
         let body = &sim.world.soft_bodies[entry.handle];
         report.needs.record(body, &entry.rest, (touching, asleep));
     }
