@@ -12,7 +12,7 @@ use toml_edit::Value;
 /// Why a chosen change left the set.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum LeftOut {
-    /// The set run with it exceeded the target or was not stable.
+    /// The set run with it could not be run, exceeded the target or was not stable.
     Error,
     /// The set run with it was not faster than the scene as written.
     Time,
@@ -31,47 +31,46 @@ pub struct CheckedSet {
     pub run: Option<(Report, f64, String)>,
 }
 
-/// Runs the changes `chosen` of `all` together with `run_set`; while their error against
-/// `first` exceeds the target or the run is not stable, leaves out the change of largest error
-/// `measured` alone, and while it is not faster than the reference by the smallest saving
-/// counted, the change of smallest saving. `limits` are the reference's time per frame (ms),
-/// the smallest saving counted (relative) and the target (relative).
-///
-/// # Errors
-/// Those of `run_set`.
-pub fn check_set<E>(
+/// Runs the changes `chosen` of `all` together with `run_set`; while the set cannot be run,
+/// its error against `first` exceeds the target or the run is not stable, leaves out the change
+/// of largest error `measured` alone, and while it is not faster than the reference by the
+/// smallest saving counted, the change of smallest saving. `limits` are the reference's time
+/// per frame (ms), the smallest saving counted (relative) and the target (relative).
+pub fn check_set(
     mut chosen: Vec<usize>,
     (all, measured): (&[Candidate], &[Option<Measured>]),
     (first, (reference_ms, saving, target)): (&Report, (f64, f64, f64)),
-    mut run_set: impl FnMut(&[(String, Value)]) -> Result<Report, E>,
-) -> Result<CheckedSet, E> {
+    mut run_set: impl FnMut(&[(String, Value)]) -> Result<Report, String>,
+) -> CheckedSet {
     let mut left_out = Vec::new();
     loop {
         let edits: Vec<(String, Value)> = (chosen.iter())
             .flat_map(|i| all[*i].edits.clone())
             .collect();
         if edits.is_empty() {
-            return Ok(CheckedSet {
+            return CheckedSet {
                 chosen,
                 left_out,
                 edits,
                 run: None,
-            });
+            };
         }
-        let report = run_set(&edits)?;
-        let (error, worst) = trial_error(&report, first);
-        let (fewer, why) = if error > target || !report.stability.stable {
-            (without_largest_error(measured, &chosen), LeftOut::Error)
-        } else if report.ms_per_frame >= reference_ms * (1.0 - saving) {
-            (without_smallest_saving(measured, &chosen), LeftOut::Time)
-        } else {
-            let run = Some((report, error, worst));
-            return Ok(CheckedSet {
-                chosen,
-                left_out,
-                edits,
-                run,
-            });
+        let report = run_set(&edits).ok().filter(|r| r.stability.stable);
+        let error = report.as_ref().map(|r| trial_error(r, first));
+        let (fewer, why) = match (report, error) {
+            (Some(report), Some((error, worst))) if error <= target => {
+                if report.ms_per_frame < reference_ms * (1.0 - saving) {
+                    let run = Some((report, error, worst));
+                    return CheckedSet {
+                        chosen,
+                        left_out,
+                        edits,
+                        run,
+                    };
+                }
+                (without_smallest_saving(measured, &chosen), LeftOut::Time)
+            }
+            _ => (without_largest_error(measured, &chosen), LeftOut::Error),
         };
         left_out.extend(
             chosen

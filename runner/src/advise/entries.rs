@@ -51,7 +51,9 @@ fn verdict(
         "chosen".to_owned()
     } else if let Some((_, why)) = left_out {
         match why {
-            LeftOut::Error => "left out: the set run with it exceeded the target or was not stable",
+            LeftOut::Error => {
+                "left out: the set with it failed, exceeded the target or was not stable"
+            }
             LeftOut::Time => "left out: the set run with it was not faster than the scene",
         }
         .to_owned()
