@@ -180,8 +180,8 @@ def run_scene(path: _Path, out: _Path, *, duration: Optional[float] = None,
               overrides: Optional[Mapping[str, Any]] = None) -> dict[str, Any]:
     """Runs a scene file (3D or 2D) as `rapier-fvm run` does; returns its report."""
 
-def advise(path: _Path, out: _Path, *, target: float = 0.05,
-           duration: Optional[float] = None) -> dict[str, Any]:
+def advise(path: _Path, out: _Path, *, target: float = 0.05, duration: Optional[float] = None,
+           overrides: Optional[Mapping[str, Any]] = None) -> dict[str, Any]:
     """Advises on a 3D scene file as `rapier-fvm advise` does; returns the advice."""
 
 def _unpickle_world(scene: Optional[Tuple[str, str]], state: bytes) -> World:

@@ -110,30 +110,34 @@ pub fn run_scene<'py>(
 /// Advises on the 3D scene file `path` as `rapier-fvm advise` does: runs it, each alternative
 /// (another model, linear elements, half the cells per soft body; another integrator) and the
 /// cheapest set of changes whose probe errors add up to at most `target` (relative), each for
-/// `duration` (s) if given instead of the scene's; writes `recommended.toml`, `advice.json` and
+/// `duration` (s) if given instead of the scene's, with `overrides` applied first (the scene
+/// so edited is the reference); writes `recommended.toml`, `advice.json` and
 /// `trials/` into `out`, and returns the advice as a dict. The GIL is released during the runs.
 /// A malformed scene raises `rapier_fvm.SceneError`; a 2D scene, one without probes, or one that
 /// cannot be run or runs unstable as written, `rapier_fvm.Error`.
 #[pyfunction]
-#[pyo3(signature = (path, out, *, target = 0.05, duration = None))]
+#[pyo3(signature = (path, out, *, target = 0.05, duration = None, overrides = None))]
 pub fn advise<'py>(
     py: Python<'py>,
     path: PathBuf,
     out: PathBuf,
     target: f64,
     duration: Option<f64>,
+    overrides: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyAny>> {
+    let text = scene_text(&path, overrides)?;
     let options = AdviseOptions {
         target,
         window: duration,
         out,
     };
     let advice = py.detach(|| -> PyResult<String> {
-        let advice = advisor::advise(&path, &options, |_| {}).map_err(|e| match e {
-            AdviseError::Target(_) => argument("target", e),
-            AdviseError::Scene(e) => scene_error(e),
-            other => Error::new_err(other.to_string()),
-        })?;
+        let advice =
+            advisor::advise_text((&path, text), &options, |_| {}).map_err(|e| match e {
+                AdviseError::Target(_) => argument("target", e),
+                AdviseError::Scene(e) => scene_error(e),
+                other => Error::new_err(other.to_string()),
+            })?;
         serde_json::to_string(&advice)
             .map_err(|e| Error::new_err(format!("the advice could not be written: {e}")))
     })?;

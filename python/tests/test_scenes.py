@@ -125,6 +125,12 @@ def test_advise_returns_the_advice_and_writes_a_scene_that_runs(scenes, tmp_path
     assert report["frames"] == 3
     with pytest.raises(ValueError, match="target"):
         rf.advise(scenes / "cantilever.toml", tmp_path / "no", target=2.0)
+    # Overrides edit the scene before it is the reference: a linear beam has no linear
+    # alternative left.
+    linear = rf.advise(scenes / "cantilever.toml", tmp_path / "linear", duration=0.2,
+                       overrides={"soft_body[0].material.model": "linear"})
+    labels = [a["label"] for a in linear["soft_bodies"][0]["alternatives"]]
+    assert "beam: model linear" not in labels and "beam: model st_venant_kirchhoff" in labels
     bad = tmp_path / "bad.toml"
     bad.write_text((scenes / "cantilever.toml").read_text().replace("poisson = 0.3", "poisson = 0.5"))
     with pytest.raises(rf.SceneError, match="poisson"):

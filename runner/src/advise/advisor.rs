@@ -31,9 +31,25 @@ const NOISY_SPREAD: f64 = 0.25;
 pub fn advise(
     path: &Path,
     options: &AdviseOptions,
+    progress: impl FnMut(&str),
+) -> Result<Advice, AdviseError> {
+    let text = std::fs::read_to_string(path).map_err(|e| {
+        AdviseError::Reference(format!("{}: cannot read the scene: {e}", path.display()))
+    })?;
+    advise_text((path, text), options, progress)
+}
+
+/// [`advise`] on `text`, read as the scene file `path` (its mesh files are named relative to
+/// `path`'s folder): a scene file's text edited before (the Python package's overrides).
+///
+/// # Errors
+/// Those of [`advise`].
+pub fn advise_text(
+    (path, text): (&Path, String),
+    options: &AdviseOptions,
     mut progress: impl FnMut(&str),
 ) -> Result<Advice, AdviseError> {
-    let (text, scene) = read_scene(path, options)?;
+    let scene = read_scene((path, &text), options)?;
     let window = options.window.unwrap_or(scene.world.duration);
     let trials = prepare_folder(path, &options.out)?;
     let run = |edits: &[(String, Value)], folder: &str, limit: Option<Duration>| {
@@ -105,22 +121,20 @@ pub fn advise(
     Ok(advice)
 }
 
-/// The scene file `path`'s text and scene, for `options`' target: a 3D scene with a probe.
-fn read_scene(path: &Path, options: &AdviseOptions) -> Result<(String, Scene), AdviseError> {
+/// The scene of `text`, read as the file `path`, for `options`' target: a 3D scene with a
+/// probe.
+fn read_scene((path, text): (&Path, &str), options: &AdviseOptions) -> Result<Scene, AdviseError> {
     if !(options.target > 0.0 && options.target < 1.0) {
         return Err(AdviseError::Target(options.target));
     }
-    let text = std::fs::read_to_string(path).map_err(|e| {
-        AdviseError::Reference(format!("{}: cannot read the scene: {e}", path.display()))
-    })?;
-    if dimension_of(&text) == Some(2) {
+    if dimension_of(text) == Some(2) {
         return Err(AdviseError::Planar(path.display().to_string()));
     }
-    let scene = Scene::parse(path, text.clone())?;
+    let scene = Scene::parse(path, text.to_owned())?;
     if scene.probe.is_empty() {
         return Err(AdviseError::NoProbes(path.display().to_string()));
     }
-    Ok((text, scene))
+    Ok(scene)
 }
 
 /// The scene as written, `run`: it must have run, and stable (every alternative is measured

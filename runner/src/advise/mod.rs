@@ -29,7 +29,7 @@ mod entries;
 mod files;
 mod trial;
 
-pub use advisor::advise;
+pub use advisor::{advise, advise_text};
 pub use candidates::{Candidate, Group, candidates};
 
 use crate::scene::SceneError;
