@@ -16,7 +16,7 @@ restored bit for bit::
     print(world.positions(cube)[:, 1].min())   # the cube's lowest point (m)
 
 `run_scene` runs a scene file as ``rapier-fvm run`` does and returns its report; `advise`
-finds the cheapest scene within a target error as ``rapier-fvm advise`` does; `sweep` runs a
+finds a cheaper scene within a target error as ``rapier-fvm advise`` does; `sweep` runs a
 scene over a grid of values, locally or on Ray.
 """
 

@@ -108,8 +108,9 @@ pub fn run_scene<'py>(
 }
 
 /// Advises on the 3D scene file `path` as `rapier-fvm advise` does: runs it, each alternative
-/// (another model, linear elements, half the cells per soft body; another integrator) and the
-/// cheapest set of changes whose probe errors add up to at most `target` (relative), each for
+/// (another model, linear elements, half the cells per soft body; another integrator, a looser
+/// Newton tolerance, half the coupling substeps) and the set of changes chosen greedily whose
+/// probe errors add up to at most `target` (relative), each for
 /// `duration` (s) if given instead of the scene's, with `overrides` applied first (the scene
 /// so edited is the reference); writes `recommended.toml`, `advice.json` and
 /// `trials/` into `out`, and returns the advice as a dict. The GIL is released during the runs.

@@ -9,7 +9,7 @@
 //!   with its probes sampled and its output written;
 //! - [`output`]: the writers;
 //! - [`planar`]: 2D scenes (`dimension = 2`), their runs and output through the same writers;
-//! - [`advise`]: the cheapest scene within a target error of the scene as written.
+//! - [`advise`]: a cheaper scene within a target error of the scene as written.
 //!
 //! Each saved frame, the runner fills a [`output::Snapshot`] (plain data: positions, velocities,
 //! tetrahedra, surfaces and stresses of the soft bodies, world-space triangle meshes of the rigid

@@ -1,4 +1,4 @@
-//! `rapier-fvm`: runs `rapier_fvm` scenes headless, checks meshes, advises on the cheapest
+//! `rapier-fvm`: runs `rapier_fvm` scenes headless, checks meshes, advises on a cheaper
 //! scene within a target error and measures the cost model.
 //!
 //! See `rapier-fvm --help`, and `assets/scenes/README.md` for the scene format.
@@ -16,7 +16,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 /// Runs scenes of finite-volume soft bodies and rapier rigid bodies (described in TOML)
-/// headless, checks meshes, finds the cheapest scene within a target error, and measures the
+/// headless, checks meshes, finds a cheaper scene within a target error, and measures the
 /// automatic integrator's costs on this machine.
 ///
 /// Errors (a missing file, a malformed scene or mesh) print one line on stderr and exit with

@@ -3,7 +3,7 @@
 
 use super::Recommendation;
 use super::candidates::Candidate;
-use super::choose::{Measured, predict, without_largest_error, without_smallest_saving};
+use super::choose::{Measured, predict, without_largest};
 use super::trial::trial_error;
 use crate::sim::Report;
 use std::path::Path;
@@ -68,9 +68,15 @@ pub fn check_set(
                         run,
                     };
                 }
-                (without_smallest_saving(measured, &chosen), LeftOut::Time)
+                (
+                    without_largest(measured, &chosen, |m| m.ms_per_frame),
+                    LeftOut::Time,
+                )
             }
-            _ => (without_largest_error(measured, &chosen), LeftOut::Error),
+            _ => (
+                without_largest(measured, &chosen, |m| m.error),
+                LeftOut::Error,
+            ),
         };
         left_out.extend(
             chosen

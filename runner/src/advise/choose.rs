@@ -59,35 +59,22 @@ pub fn predict(changes: &[Option<Measured>], chosen: &[usize], reference_ms: f64
     })
 }
 
-/// `chosen` without its change of largest error.
-pub fn without_largest_error(changes: &[Option<Measured>], chosen: &[usize]) -> Vec<usize> {
-    let error = |i: &usize| changes[*i].as_ref().map_or(f64::INFINITY, |m| m.error);
+/// `chosen` without its change of largest `key` (a change not measured counts as infinite):
+/// of largest error, or of smallest saving (largest time per frame alone).
+pub fn without_largest(
+    changes: &[Option<Measured>],
+    chosen: &[usize],
+    key: impl Fn(&Measured) -> f64,
+) -> Vec<usize> {
+    let value = |i: &usize| changes[*i].as_ref().map_or(f64::INFINITY, &key);
     let largest = chosen
         .iter()
-        .max_by(|a, b| error(a).total_cmp(&error(b)))
+        .max_by(|a, b| value(a).total_cmp(&value(b)))
         .copied();
     chosen
         .iter()
         .copied()
         .filter(|i| Some(*i) != largest)
-        .collect()
-}
-
-/// `chosen` without its change of smallest saving (largest time per frame alone).
-pub fn without_smallest_saving(changes: &[Option<Measured>], chosen: &[usize]) -> Vec<usize> {
-    let time = |i: &usize| {
-        changes[*i]
-            .as_ref()
-            .map_or(f64::INFINITY, |m| m.ms_per_frame)
-    };
-    let smallest = chosen
-        .iter()
-        .max_by(|a, b| time(a).total_cmp(&time(b)))
-        .copied();
-    chosen
-        .iter()
-        .copied()
-        .filter(|i| Some(*i) != smallest)
         .collect()
 }
 
@@ -124,7 +111,7 @@ mod tests {
             (error - 0.041).abs() < 1e-15 && (ms - 4.0).abs() < 1e-12,
             "{error} {ms}"
         );
-        assert_eq!(without_largest_error(&changes, &chosen), [1]);
-        assert_eq!(without_smallest_saving(&changes, &chosen), [2]);
+        assert_eq!(without_largest(&changes, &chosen, |m| m.error), [1]);
+        assert_eq!(without_largest(&changes, &chosen, |m| m.ms_per_frame), [2]);
     }
 }

@@ -1,25 +1,26 @@
-//! The advisor (`rapier-fvm advise`): the cheapest scene whose probes stay within a target
+//! The advisor (`rapier-fvm advise`): a cheaper scene whose probes stay within a target
 //! error of the scene as written.
 //!
 //! It runs the scene as written over a window (the reference: what each soft body needed, its
 //! peak strain, rotation and contact frames, and the time per frame), then each alternative of
 //! [`candidates`] alone (another model, linear elements, half the cells; another integrator, a
-//! looser Newton tolerance, half the coupling substeps),
-//! measuring its error (the largest over the probes of the relative L2 distance of their samples
-//! from the reference's) and its time per frame (stopped past twice the reference's stepping
-//! time: it could not be chosen); then chooses the cheapest set of changes whose errors add up
-//! to at most the target, runs that set, and keeps it only once its measured error is within
-//! the target and it is faster than the scene. The reference runs three times: first for its probes (a process's first run
-//! also pays for its thread pool's start), then before and after the alternatives for its
-//! time; the spread of those two times per frame (at least 3 %) is the smallest saving counted.
+//! looser Newton tolerance, half the coupling substeps), measuring its error (the largest over
+//! the probes of the L2 distance of their samples from the reference's, relative to the
+//! reference's motion) and its time per frame (stopped past twice the reference's stepping
+//! time and a second: it could not be chosen); then chooses greedily a cheap set of changes
+//! whose errors add up to at most the target, runs that set, and keeps it only once its
+//! measured error is within the target and it is faster than the scene. The reference runs
+//! three times: first for its probes (a process's first run also pays for its thread pool's
+//! start), then before and after the alternatives for its time; the spread of those two times
+//! per frame (at least 3 %) is the smallest saving counted.
 //!
 //! The coarser mesh's error is also the estimate of the scene's own discretization error: with
 //! errors `O(hᵖ)`, Richardson's `|q_h − q_rh| / (rᵖ − 1)` for the refinement ratio `r` from the
 //! coarser mesh (2, or 1.5 from 3 cells to 2) and the lowest order, `p = 1`.
 //!
 //! Written into the output folder: `recommended.toml` (the scene's text with the chosen edits,
-//! mesh files named by absolute paths), `advice.json` (the [`Advice`]) and `trials/<n>/`, each
-//! run's own output folder.
+//! the files it names by absolute paths), `advice.json` (the [`Advice`]) and `trials/<n>/`,
+//! each run's own output folder.
 
 mod advisor;
 mod candidates;
