@@ -219,8 +219,9 @@ fn print_advice(advice: &advise::Advice) {
     for body in &advice.soft_bodies {
         let n = &body.needs;
         println!(
-            "  {} ({}, {}): peak strain {:.4}, peak rotation {:.1} deg, pushed by a collider in {} frames",
+            "  {} ({} {}, {}): peak strain {:.4}, peak rotation {:.1} deg, pushed by a collider in {} frames",
             body.name,
+            body.material,
             body.model,
             body.elements,
             n.peak_green_strain,

@@ -69,6 +69,13 @@ const MODELS: [(ModelSpec, &str); 4] = [
     (ModelSpec::StableNeoHookean, "stable_neo_hookean"),
 ];
 
+/// The scene files' name of `model`.
+pub fn model_name(model: ModelSpec) -> &'static str {
+    (MODELS.iter())
+        .find(|(m, _)| *m == model)
+        .map_or("", |(_, name)| name)
+}
+
 /// Every alternative to `scene`: per soft body, the other models, linear elements (for
 /// quadratic ones) and half the cells; then the other integrators, the looser tolerance and
 /// half the coupling substeps.

@@ -1,7 +1,7 @@
 //! The advice's entries: each alternative with its error, time and verdict, and each soft
 //! body's needs, model, elements, alternatives and estimated discretization error.
 
-use super::candidates::{Candidate, Group};
+use super::candidates::{Candidate, Group, model_name};
 use super::checked::{CheckedSet, LeftOut};
 use super::choose::Measured;
 use super::trial::{TrialRun, trial_error};
@@ -113,7 +113,7 @@ pub fn body_advice(
 ) -> Vec<BodyAdvice> {
     (scene.soft_body.iter().enumerate())
         .zip(&first.soft_bodies)
-        .map(|((i, _), report)| {
+        .map(|((i, body), report)| {
             let mine: Vec<(&Candidate, &Alternative)> = (all.iter().zip(alternatives))
                 .filter(|(c, _)| c.group.body() == Some(i))
                 .collect();
@@ -121,7 +121,8 @@ pub fn body_advice(
             BodyAdvice {
                 name: report.name.clone(),
                 needs: report.needs.clone(),
-                model: report.material.clone(),
+                model: model_name(body.material.model).to_owned(),
+                material: report.material.clone(),
                 elements: format!("{} {}", report.elements, report.element_kind),
                 discretization_error: coarser.and_then(|(c, a)| {
                     let ratio = c.refinement?;

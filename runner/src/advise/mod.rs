@@ -107,8 +107,10 @@ pub struct BodyAdvice {
     pub name: String,
     /// Peak strain, rotation and contact frames over the reference's window.
     pub needs: BodyNeeds,
-    /// Its model as given.
+    /// Its material model as given (the scene files' name).
     pub model: String,
+    /// Its material's label (the scene's `label`, or the model's name).
+    pub material: String,
     /// Its elements as given (kind and count).
     pub elements: String,
     /// Its discretization error estimated from the coarser mesh, if that ran stable (relative;
