@@ -136,6 +136,7 @@ pub fn advise<'py>(
         let advice =
             advisor::advise_text((&path, text), &options, |_| {}).map_err(|e| match e {
                 AdviseError::Target(_) => argument("target", e),
+                AdviseError::Duration(_) => argument("duration", e),
                 AdviseError::Scene(e) => scene_error(e),
                 other => Error::new_err(other.to_string()),
             })?;

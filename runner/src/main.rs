@@ -218,20 +218,28 @@ fn print_advice(advice: &advise::Advice) {
     };
     for body in &advice.soft_bodies {
         let n = &body.needs;
+        // A material without a label is named by its model already.
+        let given = match body.material.starts_with(&body.model) {
+            true => body.material.clone(),
+            false => format!("{} {}", body.material, body.model),
+        };
         println!(
-            "  {} ({} {}, {}): peak strain {:.4}, peak rotation {:.1} deg, pushed by a collider in {} frames",
-            body.name,
-            body.material,
-            body.model,
-            body.elements,
-            n.peak_green_strain,
-            n.peak_rotation_deg,
-            n.contact_frames
+            "  {} ({given}, {}): peak strain {:.4}, peak rotation {:.1} deg, pushed by a collider in {} frames",
+            body.name, body.elements, n.peak_green_strain, n.peak_rotation_deg, n.contact_frames
         );
+        if let Some(error) = body.discretization_error {
+            println!(
+                "    its discretization error, estimated from the coarser mesh: {}",
+                percent(error)
+            );
+        }
         body.alternatives.iter().for_each(print_alternative);
     }
     println!("  the scene:");
     advice.scene_alternatives.iter().for_each(print_alternative);
+    for warning in &advice.warnings {
+        println!("  warning: {warning}");
+    }
     let r = &advice.recommendation;
     println!(
         "recommended: {}
@@ -249,7 +257,7 @@ fn print_advice(advice: &advise::Advice) {
     );
 }
 
-/// A relative error in percent, to three significant figures.
+/// A relative error in percent: three decimals, or three significant figures below 0.01 %.
 fn percent(error: f64) -> String {
     match error * 100.0 {
         p if p == 0.0 || p >= 0.01 => format!("{p:.3} %"),

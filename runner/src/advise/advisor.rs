@@ -19,14 +19,19 @@ const SMALLEST_SAVING: f64 = 0.03;
 /// The reference's relative spread above which its times are called noise.
 const NOISY_SPREAD: f64 = 0.25;
 
+/// The largest relative saving asked of a change, whatever the reference's spread (a spread of
+/// 1.7 would otherwise ask more than the whole time).
+const MOST_SAVING: f64 = 0.5;
+
 /// Advises on the scene file `path` (see the module): runs it, its alternatives and the chosen
 /// set over the window, writes the folder `options.out`, and returns the advice; `progress`
 /// hears a line per run.
 ///
 /// # Errors
-/// An [`AdviseError`] if the target is not in (0, 1), the scene is 2D, cannot be read, has no
-/// probe, cannot be run as written or runs unstable, if the output folder would overwrite the
-/// scene, or a file cannot be written. An alternative that cannot be run is a verdict in the
+/// An [`AdviseError`] if the target is not in (0, 1) or the duration not positive, the scene
+/// is 2D, cannot be read, has no probe, cannot be run as written or runs unstable, if the
+/// output folder would overwrite the scene or empty a folder `advise` did not write, or a file
+/// cannot be written. An alternative that cannot be run is a verdict in the
 /// advice, not an error.
 pub fn advise(
     path: &Path,
@@ -86,14 +91,18 @@ pub fn advise_text(
     let measured: Vec<Option<Measured>> = (all.iter().zip(&runs))
         .map(|(c, r)| measure(c, r, &first))
         .collect();
-    if spread > NOISY_SPREAD {
-        progress(&format!(
-            "warning: the scene's two timed runs differ by {:.0} %: runs this short time noise; \
-             a longer --duration times them better",
-            spread * 100.0
-        ));
-    }
-    let saving = spread.max(SMALLEST_SAVING);
+    let warnings: Vec<String> = (spread > NOISY_SPREAD)
+        .then(|| {
+            format!(
+                "the scene's two timed runs differ by {:.0} %: times this short are noise (no \
+                 saving under {:.0} % is counted); a longer --duration times them better",
+                spread * 100.0,
+                spread.min(MOST_SAVING) * 100.0
+            )
+        })
+        .into_iter()
+        .collect();
+    let saving = spread.clamp(SMALLEST_SAVING, MOST_SAVING);
     let chosen = choose(&measured, reference_ms, options.target, saving);
     let limits = (reference_ms, saving, options.target);
     let checked = check_set(chosen, (&all, &measured), (&first, limits), |edits| {
@@ -101,6 +110,11 @@ pub fn advise_text(
         progress(&format!("recommended set: {}", summary(&report, &first)));
         report
     });
+    let rejected = trials.join("recommended");
+    if checked.run.is_none() && rejected.is_dir() {
+        // The last set run and refused: not what is recommended.
+        std::fs::remove_dir_all(&rejected).map_err(|e| AdviseError::Write(rejected, e))?;
+    }
     let file = options.out.join("recommended.toml");
     write_recommended(&scene, (path, &text), &checked.edits, &file)?;
     let alternatives = alternatives((&all, &runs, &measured), &checked, &first, limits);
@@ -110,6 +124,7 @@ pub fn advise_text(
         window_s: first.simulated_time,
         reference_ms_per_frame: reference_ms,
         reference_spread: spread,
+        warnings,
         soft_bodies: body_advice(&scene, &first, &all, &alternatives),
         scene_alternatives: (all.iter().zip(&alternatives))
             .filter(|(c, _)| c.group.is_scene_wide())
@@ -126,6 +141,9 @@ pub fn advise_text(
 fn read_scene((path, text): (&Path, &str), options: &AdviseOptions) -> Result<Scene, AdviseError> {
     if !(options.target > 0.0 && options.target < 1.0) {
         return Err(AdviseError::Target(options.target));
+    }
+    if let Some(window) = options.window.filter(|w| !(w.is_finite() && *w > 0.0)) {
+        return Err(AdviseError::Duration(window));
     }
     if dimension_of(text) == Some(2) {
         return Err(AdviseError::Planar(path.display().to_string()));
@@ -175,9 +193,15 @@ fn summary(run: &TrialRun, first: &Report) -> String {
 /// The measurement of `candidate`'s run, if it ran stable.
 fn measure(candidate: &Candidate, run: &TrialRun, first: &Report) -> Option<Measured> {
     let report = run.as_ref().ok().filter(|r| r.stability.stable)?;
+    let error = trial_error(report, first).0;
+    let same_bodies = (report.soft_bodies.iter().zip(&first.soft_bodies)).all(|(a, b)| {
+        a.needs.peak_green_strain == b.needs.peak_green_strain
+            && a.needs.peak_rotation_deg == b.needs.peak_rotation_deg
+    });
     Some(Measured {
         group: candidate.group.clone(),
-        error: trial_error(report, first).0,
+        error,
         ms_per_frame: report.ms_per_frame,
+        identical: error == 0.0 && same_bodies,
     })
 }

@@ -1,7 +1,7 @@
 //! The alternatives the advisor measures, each one change to the scene as written: per soft
 //! body another material model, linear elements in place of quadratic ones, and a mesh of half
 //! the cells along each axis; for the scene, another integrator, a Newton tolerance a hundred
-//! times looser, and half the coupling substeps. Each is a list of key-path edits of the
+//! times looser (to one significant digit, at most 1e-2), and half the coupling substeps. Each is a list of key-path edits of the
 //! scene's text ([`crate::scene::edit`]).
 
 use crate::scene::Scene;
@@ -68,6 +68,11 @@ const MODELS: [(ModelSpec, &str); 4] = [
     (ModelSpec::StVenantKirchhoff, "st_venant_kirchhoff"),
     (ModelSpec::StableNeoHookean, "stable_neo_hookean"),
 ];
+
+/// An edit as `key = value`.
+pub fn edit_text((key, value): &(String, Value)) -> String {
+    format!("{key} = {}", value.to_string().trim())
+}
 
 /// The scene files' name of `model`.
 pub fn model_name(model: ModelSpec) -> &'static str {

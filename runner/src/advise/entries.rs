@@ -1,7 +1,7 @@
 //! The advice's entries: each alternative with its error, time and verdict, and each soft
 //! body's needs, model, elements, alternatives and estimated discretization error.
 
-use super::candidates::{Candidate, Group, model_name};
+use super::candidates::{Candidate, Group, edit_text, model_name};
 use super::checked::{CheckedSet, LeftOut};
 use super::choose::Measured;
 use super::trial::{TrialRun, trial_error};
@@ -62,9 +62,9 @@ fn verdict(
             .as_ref()
             .map(|r| trial_error(r, first).1)
             .unwrap_or_default();
-        format!("error unbounded: {probe} is constant in the scene as written, not in this run")
-    } else if m.error == 0.0 {
-        "no effect here: the same probes to the bit".to_owned()
+        format!("error unbounded: {probe} is zero throughout the scene as written or not finite")
+    } else if m.identical {
+        "no effect here: the same run to the bit (probes, strains, rotations)".to_owned()
     } else if m.error > target {
         "error above the target".to_owned()
     } else if m.ms_per_frame >= reference_ms * (1.0 - saving) {
@@ -89,9 +89,7 @@ fn entry(
     let error = report.map(|r| trial_error(r, first));
     Alternative {
         label: candidate.label.clone(),
-        edits: (candidate.edits.iter())
-            .map(|(key, value)| format!("{key} = {}", value.to_string().trim()))
-            .collect(),
+        edits: candidate.edits.iter().map(edit_text).collect(),
         error: error.as_ref().map(|e| e.0).filter(|e| e.is_finite()),
         worst_probe: error.map(|e| e.1),
         ms_per_frame: report.map(|r| r.ms_per_frame),

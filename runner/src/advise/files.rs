@@ -1,30 +1,54 @@
 //! The advisor's folder: `trials/` (one run's output folder per alternative), the recommended
 //! scene and `advice.json`.
 
+use super::candidates::edit_text;
 use super::{Advice, AdviseError};
 use crate::scene::Scene;
 use crate::scene::edit::edited;
 use std::path::{Path, PathBuf};
 use toml_edit::Value;
 
-/// Makes the output folder `out` for advising on the scene `path`, and empties its `trials/`
-/// (the runs of an earlier advice); returns the trials' folder.
+/// The file `advise` leaves in its `trials/` folder, so that a later advice into the same
+/// output folder knows the folder is its own to empty.
+const MARK: &str = ".written-by-rapier-fvm-advise";
+
+/// Makes the output folder `out` for advising on the scene `path`: an earlier advice's
+/// `trials/`, `advice.json` and `recommended.toml` are removed (a `trials/` folder without
+/// the mark `advise` leaves is not: the advice is refused); returns the trials' folder, marked.
 ///
 /// # Errors
-/// [`AdviseError::Overwrite`] if `out/recommended.toml` is the scene file itself, and
-/// [`AdviseError::Write`] if a folder cannot be made or emptied.
+/// [`AdviseError::Overwrite`] if `out/recommended.toml` is the scene file itself or `out/trials`
+/// is a folder `advise` did not write, and [`AdviseError::Write`] if a folder cannot be made,
+/// emptied or marked.
 pub fn prepare_folder(path: &Path, out: &Path) -> Result<PathBuf, AdviseError> {
     let written = out.join("recommended.toml");
     if let (Ok(a), Ok(b)) = (std::fs::canonicalize(path), std::fs::canonicalize(&written))
         && a == b
     {
-        return Err(AdviseError::Overwrite(path.display().to_string()));
+        return Err(AdviseError::Overwrite(format!(
+            "{}: the output folder's recommended.toml would overwrite the scene",
+            path.display()
+        )));
     }
-    std::fs::create_dir_all(out).map_err(|e| AdviseError::Write(out.to_path_buf(), e))?;
     let trials = out.join("trials");
-    if trials.is_dir() {
+    if trials.exists() {
+        if !trials.join(MARK).is_file() {
+            return Err(AdviseError::Overwrite(format!(
+                "{}: a folder advise did not write; advise would empty it",
+                trials.display()
+            )));
+        }
         std::fs::remove_dir_all(&trials).map_err(|e| AdviseError::Write(trials.clone(), e))?;
+        for file in ["advice.json", "recommended.toml"] {
+            let file = out.join(file);
+            if file.is_file() {
+                std::fs::remove_file(&file).map_err(|e| AdviseError::Write(file.clone(), e))?;
+            }
+        }
     }
+    std::fs::create_dir_all(&trials).map_err(|e| AdviseError::Write(trials.clone(), e))?;
+    let mark = trials.join(MARK);
+    std::fs::write(&mark, "").map_err(|e| AdviseError::Write(mark, e))?;
     Ok(trials)
 }
 
@@ -57,7 +81,11 @@ pub fn write_recommended(
     let folder = path.parent().unwrap_or(Path::new("."));
     let absolute = |name: &str| -> Result<Value, AdviseError> {
         let joined = folder.join(name);
-        let absolute = std::path::absolute(&joined).map_err(|e| AdviseError::Write(joined, e))?;
+        // Canonical where the file exists (no `..` left), else absolute.
+        let absolute = match std::fs::canonicalize(&joined) {
+            Ok(canonical) => canonical,
+            Err(_) => std::path::absolute(&joined).map_err(|e| AdviseError::Write(joined, e))?,
+        };
         Ok(Value::from(absolute.display().to_string()))
     };
     let mut all = edits.to_vec();
@@ -82,12 +110,11 @@ pub fn write_recommended(
     if scene.name.is_none() {
         all.push(("name".to_owned(), Value::from(scene.display_name())));
     }
-    let body = edited(text, &all).map_err(|e| AdviseError::Reference(e.to_string()))?;
+    let body = edited(text, &all).map_err(|e| AdviseError::Edit(e.to_string()))?;
     let changes = if edits.is_empty() {
         "no change was cheaper within the target".to_owned()
     } else {
-        let edit = |(k, v): &(String, Value)| format!("{k} = {}", v.to_string().trim());
-        edits.iter().map(edit).collect::<Vec<_>>().join(", ")
+        edits.iter().map(edit_text).collect::<Vec<_>>().join(", ")
     };
     // One line, whatever the path holds.
     let source = path.display().to_string().replace(['\n', '\r'], " ");

@@ -16,7 +16,8 @@
 //!
 //! The coarser mesh's error is also the estimate of the scene's own discretization error: with
 //! errors `O(hᵖ)`, Richardson's `|q_h − q_rh| / (rᵖ − 1)` for the refinement ratio `r` from the
-//! coarser mesh (2, or 1.5 from 3 cells to 2) and the lowest order, `p = 1`.
+//! coarser mesh (the largest over the axes of the given cells over the coarser ones: 2 for even
+//! counts, 1.5 from 3 to 2) and the lowest order, `p = 1`.
 //!
 //! Written into the output folder: `recommended.toml` (the scene's text with the chosen edits,
 //! the files it names by absolute paths), `advice.json` (the [`Advice`]) and `trials/<n>/`,
@@ -52,11 +53,11 @@ pub struct AdviseOptions {
 /// Advice that could not be given.
 #[derive(Debug, thiserror::Error)]
 pub enum AdviseError {
-    /// The scene as written could not be read.
+    /// The scene as written is malformed (the file, line and key named).
     #[error(transparent)]
     Scene(#[from] SceneError),
-    /// The scene as written could not be run, or ran unstable (it is the reference every
-    /// alternative is measured against).
+    /// The scene as written could not be read or run, or ran unstable (it is the reference
+    /// every alternative is measured against).
     #[error("{0}")]
     Reference(String),
     /// The scene has no probe to hold within the target.
@@ -65,14 +66,19 @@ pub enum AdviseError {
     /// The scene is a 2D one.
     #[error("{0}: a 2D scene (dimension = 2); advise takes 3D scenes")]
     Planar(String),
+    /// The window is not a positive, finite time.
+    #[error("the duration must be positive and finite (s), got {0}")]
+    Duration(f64),
     /// The target is not a positive fraction.
     #[error("the target must be a relative error in (0, 1), got {0}")]
     Target(f64),
-    /// The output folder would overwrite the scene file.
-    #[error(
-        "{0}: the output folder's recommended.toml would overwrite the scene; choose another --out"
-    )]
+    /// The output folder would overwrite the scene file, or empty a folder advise did not
+    /// write; the message says which.
+    #[error("{0}; choose another --out")]
     Overwrite(String),
+    /// The recommended scene's text could not be edited.
+    #[error("{0}")]
+    Edit(String),
     /// A file or folder could not be written.
     #[error("{0}: {1}")]
     Write(PathBuf, std::io::Error),
@@ -92,6 +98,8 @@ pub struct Advice {
     pub reference_ms_per_frame: f64,
     /// The relative spread of the reference's two times per frame.
     pub reference_spread: f64,
+    /// What the advice warns of (times too noisy to choose by).
+    pub warnings: Vec<String>,
     /// Per soft body: what it needed, what it was given, its alternatives.
     pub soft_bodies: Vec<BodyAdvice>,
     /// The scene's alternatives: integrators, Newton tolerance, coupling substeps.
@@ -109,7 +117,7 @@ pub struct BodyAdvice {
     pub needs: BodyNeeds,
     /// Its material model as given (the scene files' name).
     pub model: String,
-    /// Its material's label (the scene's `label`, or the model's name).
+    /// Its material's label (the scene's `label`, or the model and Young's modulus).
     pub material: String,
     /// Its elements as given (kind and count).
     pub elements: String,

@@ -7,8 +7,11 @@
 //! `‖q − q_ref‖₂ / ‖q_ref − q_ref(0)‖₂` (every frame's sample: a shift of an impact by a frame
 //! costs what the samples it moves differ by, not the peak; the scale is the motion the probe
 //! measures, so a scene moved 10 m up measures the same errors). A probe that the reference
-//! never moves is scaled by its value, `‖q_ref‖₂`, and one that is zero throughout gives an
-//! infinite error to any run that moves it. A trial's error is its largest probe error.
+//! never moves is scaled by its value, `‖q_ref‖₂`. Neither scale is taken below the probe
+//! unit's round-off, `√n` times [`resolution`] over `n` samples (a symmetric cube's sideways
+//! displacement of 1e-17 m is no motion to measure errors against); a probe of no unit known
+//! that is zero throughout gives an infinite error to any run that moves it. A trial's error is
+//! its largest probe error.
 
 use crate::scene::Scene;
 use crate::scene::edit::edited;
@@ -56,13 +59,27 @@ pub fn probe_error(probe: &ProbeReport, reference: &ProbeReport) -> f64 {
         motion += (r - start) * (r - start);
         value += r * r;
     }
-    let scale = if motion > 0.0 { motion } else { value };
+    let floor = reference.values.len() as f64 * resolution(&reference.unit).powi(2);
+    let scale = (if motion > 0.0 { motion } else { value }).max(floor);
     if distance == 0.0 {
         0.0
     } else if scale == 0.0 {
         f64::INFINITY
     } else {
         (distance / scale).sqrt()
+    }
+}
+
+/// The smallest value of a probe in `unit` that is not round-off: 1 nm, 1 nm/s, 1 nN,
+/// 1 pJ, 1e-12 kg m/s and N m s, 1 µPa, 1e-18 m³ (a cubic micrometre's billionth); 0 for
+/// another unit.
+pub fn resolution(unit: &str) -> f64 {
+    match unit {
+        "m" | "m/s" | "N" => 1e-9,
+        "J" | "kg m/s" | "N m s" => 1e-12,
+        "Pa" => 1e-6,
+        "m³" => 1e-18,
+        _ => 0.0,
     }
 }
 
@@ -105,13 +122,19 @@ mod tests {
             let trial = probe(&[offset, offset + 3.0, offset + 5.0]);
             assert!((probe_error(&trial, &reference) - 0.2).abs() < 1e-12);
         }
-        // A reference that never moves is scaled by its value; a zero one by nothing.
+        // A reference that never moves is scaled by its value; one that moves by round-off
+        // (in m: below 1 nm a sample) by the round-off; a zero one of no unit by nothing.
         let still = probe(&[2.0, 2.0]);
         assert!((probe_error(&probe(&[2.0, 3.0]), &still) - 1.0 / 8f64.sqrt()).abs() < 1e-12);
-        assert_eq!(
-            probe_error(&probe(&[0.0, 1e-9]), &probe(&[0.0, 0.0])),
-            f64::INFINITY
+        let sideways = probe(&[0.0, 1.9e-17]);
+        let error = probe_error(&probe(&[0.0, 2e-12]), &sideways);
+        assert!(
+            (error - (2e-12 - 1.9e-17) / (2f64.sqrt() * 1e-9)).abs() < 1e-15,
+            "{error}"
         );
-        assert_eq!(probe_error(&probe(&[0.0, 0.0]), &probe(&[0.0, 0.0])), 0.0);
+        let mut unitless = probe(&[0.0, 0.0]);
+        unitless.unit = String::new();
+        assert_eq!(probe_error(&probe(&[0.0, 1e-9]), &unitless), f64::INFINITY);
+        assert_eq!(probe_error(&probe(&[0.0, 0.0]), &unitless), 0.0);
     }
 }
