@@ -2,7 +2,7 @@
 
 use super::candidates::{Candidate, candidates};
 use super::checked::{check_set, recommendation};
-use super::choose::{Measured, choose};
+use super::choose::{Limits, Measured, choose};
 use super::entries::{alternatives, body_advice};
 use super::files::{folder_name, prepare_folder, write_json, write_recommended};
 use super::trial::{TrialRun, run_trial, trial_error};
@@ -103,8 +103,12 @@ pub fn advise_text(
         .into_iter()
         .collect();
     let saving = spread.clamp(SMALLEST_SAVING, MOST_SAVING);
-    let chosen = choose(&measured, reference_ms, options.target, saving);
-    let limits = (reference_ms, saving, options.target);
+    let limits = Limits {
+        reference_ms,
+        saving,
+        target: options.target,
+    };
+    let chosen = choose(&measured, limits);
     let checked = check_set(chosen, (&all, &measured), (&first, limits), |edits| {
         let report = run(edits, "recommended", None);
         progress(&format!("recommended set: {}", summary(&report, &first)));

@@ -3,7 +3,7 @@
 
 use super::Recommendation;
 use super::candidates::Candidate;
-use super::choose::{Measured, predict, without_largest};
+use super::choose::{Limits, Measured, predict, without_largest};
 use super::trial::trial_error;
 use crate::sim::Report;
 use std::path::Path;
@@ -34,12 +34,11 @@ pub struct CheckedSet {
 /// Runs the changes `chosen` of `all` together with `run_set`; while the set cannot be run,
 /// its error against `first` exceeds the target or the run is not stable, leaves out the change
 /// of largest error `measured` alone, and while it is not faster than the reference by the
-/// smallest saving counted, the change of smallest saving. `limits` are the reference's time
-/// per frame (ms), the smallest saving counted (relative) and the target (relative).
+/// smallest saving counted (`limits`), the change of smallest saving.
 pub fn check_set(
     mut chosen: Vec<usize>,
     (all, measured): (&[Candidate], &[Option<Measured>]),
-    (first, (reference_ms, saving, target)): (&Report, (f64, f64, f64)),
+    (first, limits): (&Report, Limits),
     mut run_set: impl FnMut(&[(String, Value)]) -> Result<Report, String>,
 ) -> CheckedSet {
     let mut left_out = Vec::new();
@@ -58,8 +57,8 @@ pub fn check_set(
         let report = run_set(&edits).ok().filter(|r| r.stability.stable);
         let error = report.as_ref().map(|r| trial_error(r, first));
         let (fewer, why) = match (report, error) {
-            (Some(report), Some((error, worst))) if error <= target => {
-                if report.ms_per_frame < reference_ms * (1.0 - saving) {
+            (Some(report), Some((error, worst))) if error <= limits.target => {
+                if limits.cheaper(report.ms_per_frame) {
                     let run = Some((report, error, worst));
                     return CheckedSet {
                         chosen,
@@ -89,17 +88,17 @@ pub fn check_set(
 }
 
 /// The recommendation of the set `checked` of the changes `all` (`measured` alone), the scene
-/// as written taking `reference_ms` per frame for the `target`, written into `file`.
+/// as written held to `limits`, written into `file`.
 pub fn recommendation(
     checked: &CheckedSet,
     (all, measured): (&[Candidate], &[Option<Measured>]),
-    (reference_ms, _, target): (f64, f64, f64),
+    limits: Limits,
     file: &Path,
 ) -> Recommendation {
-    let (predicted_error, predicted_ms) = predict(measured, &checked.chosen, reference_ms);
+    let (predicted_error, predicted_ms) = predict(measured, &checked.chosen, limits.reference_ms);
     let (measured_ms, measured_error, worst_probe) = match &checked.run {
         Some((report, error, worst)) => (report.ms_per_frame, *error, worst.clone()),
-        None => (reference_ms, 0.0, String::new()),
+        None => (limits.reference_ms, 0.0, String::new()),
     };
     Recommendation {
         changes: (checked.chosen.iter())
@@ -111,7 +110,7 @@ pub fn recommendation(
         worst_probe,
         predicted_ms_per_frame: predicted_ms,
         measured_ms_per_frame: measured_ms,
-        speed_up: reference_ms / measured_ms,
-        within_target: measured_error <= target,
+        speed_up: limits.reference_ms / measured_ms,
+        within_target: measured_error <= limits.target,
     }
 }

@@ -11,6 +11,25 @@
 use super::candidates::Group;
 use std::collections::HashSet;
 
+/// What a change is held to: the scene as written's time per frame (ms), the smallest relative
+/// saving counted, and the target (the largest relative error).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Limits {
+    /// The scene as written's time per frame (ms).
+    pub reference_ms: f64,
+    /// The smallest saving counted, relative to `reference_ms`.
+    pub saving: f64,
+    /// The largest probe error allowed (relative).
+    pub target: f64,
+}
+
+impl Limits {
+    /// Whether `ms_per_frame` saves at least the smallest saving counted.
+    pub fn cheaper(&self, ms_per_frame: f64) -> bool {
+        ms_per_frame < self.reference_ms * (1.0 - self.saving)
+    }
+}
+
 /// A change measured alone: its group, error and time per frame (ms).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Measured {
@@ -25,26 +44,21 @@ pub struct Measured {
     pub identical: bool,
 }
 
-/// The indices into `changes` of the greedy choice within `target` (relative error): changes
-/// at least `threshold` (relative) cheaper than `reference_ms`, largest saving first, one per
-/// group, while their errors add up to at most `target`. A change whose run was the
+/// The indices into `changes` of the greedy choice within `limits`: changes at least the
+/// smallest saving cheaper than the reference, largest saving first, one per group, while their
+/// errors add up to at most the target. A change whose run was the
 /// reference's to the bit changed nothing this scene does (a setting its bodies do not use): a
 /// time it measured lower is noise, and it is not chosen. (A change to a body no probe watches
 /// has zero error too, but its run differs: it is chosen on its saving.)
-pub fn choose(
-    changes: &[Option<Measured>],
-    reference_ms: f64,
-    target: f64,
-    threshold: f64,
-) -> Vec<usize> {
+pub fn choose(changes: &[Option<Measured>], limits: Limits) -> Vec<usize> {
     let mut eligible: Vec<(usize, &Measured)> = (changes.iter().enumerate())
         .filter_map(|(i, m)| Some((i, m.as_ref()?)))
-        .filter(|(_, m)| !m.identical && m.error <= target)
-        .filter(|(_, m)| m.ms_per_frame < reference_ms * (1.0 - threshold))
+        .filter(|(_, m)| !m.identical && m.error <= limits.target)
+        .filter(|(_, m)| limits.cheaper(m.ms_per_frame))
         .collect();
     eligible.sort_by(|a, b| a.1.ms_per_frame.total_cmp(&b.1.ms_per_frame));
     let mut used = HashSet::new();
-    let mut budget = target;
+    let mut budget = limits.target;
     let mut chosen = Vec::new();
     for (i, m) in eligible {
         if m.error <= budget && used.insert(m.group.clone()) {
@@ -110,7 +124,12 @@ mod tests {
         // Cheapest first: Model(1) at 5 ms (0.04), Model(0) at 6 ms would exceed 0.05, the
         // next Model(0) at 8 ms fits (0.041), the integrator at 9 ms does not (0.061); the
         // coarser mesh saves under the 3 % threshold; the tolerance ran the reference's run.
-        let chosen = choose(&changes, 10.0, 0.05, 0.03);
+        let limits = Limits {
+            reference_ms: 10.0,
+            saving: 0.03,
+            target: 0.05,
+        };
+        let chosen = choose(&changes, limits);
         assert_eq!(chosen, [2, 1]);
         let (error, ms) = predict(&changes, &chosen, 10.0);
         assert!(

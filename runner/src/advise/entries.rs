@@ -3,20 +3,19 @@
 
 use super::candidates::{Candidate, Group, edit_text, model_name};
 use super::checked::{CheckedSet, LeftOut};
-use super::choose::Measured;
+use super::choose::{Limits, Measured};
 use super::trial::{TrialRun, trial_error};
 use super::{Alternative, BodyAdvice};
 use crate::scene::Scene;
 use crate::sim::Report;
 
 /// The entries of the alternatives `all`, their `runs` and measurements, with their verdicts
-/// given the set `checked`, the reference `first`, and `limits`: the reference's time per frame
-/// (ms), the smallest saving counted and the target (relative).
+/// given the set `checked`, the reference `first`, and the `limits` changes are held to.
 pub fn alternatives(
     (all, runs, measured): (&[Candidate], &[TrialRun], &[Option<Measured>]),
     checked: &CheckedSet,
     first: &Report,
-    limits: (f64, f64, f64),
+    limits: Limits,
 ) -> Vec<Alternative> {
     (all.iter().enumerate())
         .map(|(k, c)| {
@@ -38,7 +37,7 @@ fn verdict(
     (run, measured): (&TrialRun, Option<&Measured>),
     checked: &CheckedSet,
     first: &Report,
-    (reference_ms, saving, target): (f64, f64, f64),
+    limits: Limits,
 ) -> String {
     let Some(m) = measured else {
         return match run {
@@ -65,12 +64,12 @@ fn verdict(
         format!("error unbounded: {probe} is zero throughout the scene as written or not finite")
     } else if m.identical {
         "no effect here: the same run to the bit (probes, strains, rotations)".to_owned()
-    } else if m.error > target {
+    } else if m.error > limits.target {
         "error above the target".to_owned()
-    } else if m.ms_per_frame >= reference_ms * (1.0 - saving) {
+    } else if !limits.cheaper(m.ms_per_frame) {
         format!(
             "not cheaper by {:.0} % or more (timing noise)",
-            saving * 100.0
+            limits.saving * 100.0
         )
     } else {
         "not chosen: a cheaper change of its kind was, or the target was spent on others".to_owned()
