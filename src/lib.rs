@@ -122,6 +122,7 @@ pub mod prelude {
     pub use crate::Error;
     pub use crate::body::{
         DeformableBody, DeformableBodyBuilder, DeformableBodyHandle, DeformableBodySet,
+        RigidStandIn,
     };
     pub use crate::constraint::BodyConstraints;
     pub use crate::contact::{BodyPoint, ContactSettings, ContactTarget, NodeContact};

@@ -3,7 +3,8 @@
 //! bit for bit (tolerance 0), under the automatic integrator and under forced implicit BDF2
 //! steps (whose two-step history and kept factorization the file carries), with contacts, a
 //! dynamic rigid body on a soft one, an attachment, loads (a pressure and a cable), a quadratic
-//! body and an embedded mesh; a
+//! body, an embedded mesh and a stiff brick standing in as a rigid body (written in flight,
+//! landing after); a
 //! file that breaks a body's rules is refused with the error a new body would get, never a panic.
 
 mod common;
@@ -80,6 +81,18 @@ fn scene(integrator: Option<IntegratorKind>) -> Result<FvmWorld, Error> {
         .translation(DVec3::new(-0.5, 0.3, 0.0))
         .build()?;
     world.soft_bodies.insert(cube);
+    let stiff = Material::new(MaterialModel::StableNeoHookean, 1e8, 0.35, 1190.0)?;
+    let brick = DeformableBodyBuilder::new(
+        mesh::cuboid(DVec3::new(0.06, 0.03, 0.04), [3, 2, 2])?,
+        stiff,
+    )
+    .damping(RayleighDamping::stiffness_proportional(1e-4, stiff.lame())?)
+    .translation(DVec3::new(-1.5, 0.8, 0.0))
+    .linvel(DVec3::new(0.5, 0.5, 0.0))
+    .angvel(DVec3::new(1.0, 3.0, 0.0))
+    .rigid_stand_in(1e-3)
+    .build()?;
+    world.soft_bodies.insert(brick);
     Ok(world)
 }
 
@@ -88,6 +101,10 @@ fn a_world_read_back_steps_on_bit_identically() -> Result<(), Error> {
     for integrator in [None, Some(IntegratorKind::Implicit)] {
         let mut original = scene(integrator)?;
         run(&mut original, 20)?;
+        let standing_in = (original.soft_bodies.iter())
+            .filter(|(handle, _)| original.coupling.rigid_stand_in_of(*handle).is_some())
+            .count();
+        assert_eq!(standing_in, 1, "the brick stands in, in flight");
         let mut file = Vec::new();
         ciborium::into_writer(&original, &mut file).expect("a world serializes");
         let mut restored: FvmWorld = ciborium::from_reader(&file[..]).expect("and reads back");

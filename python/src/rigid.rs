@@ -132,10 +132,12 @@ impl World {
         ))
     }
 
-    /// The rigid bodies, in the order of their handles.
+    /// The rigid bodies, in the order of their handles (a soft body standing in as a rigid
+    /// body is not one of them).
     #[getter]
     fn rigid_bodies(&self) -> Vec<RigidBody> {
         (self.sim.world.physics.bodies.iter())
+            .filter(|(handle, _)| self.sim.world.coupling.stand_in_for(*handle).is_none())
             .map(|(handle, _)| RigidBody::of(handle))
             .collect()
     }
@@ -171,6 +173,7 @@ impl World {
     /// translation (m) then the rotation quaternion `(x, y, z, w)`.
     fn rigid_poses<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
         let flat: Vec<f64> = (self.sim.world.physics.bodies.iter())
+            .filter(|(handle, _)| self.sim.world.coupling.stand_in_for(*handle).is_none())
             .flat_map(|(_, b)| {
                 let [x, y, z] = b.translation().as_dvec3().to_array();
                 let [qx, qy, qz, qw] = b.rotation().as_dquat().to_array();

@@ -44,10 +44,12 @@ impl World {
     /// centre of mass; `stiffness_time` is the stiffness-proportional Rayleigh damping's time
     /// constant β (s; the viscosities are β λ and β μ; a scene's `damping.stiffness_time`),
     /// `pinned` node indices held in place (move them with `set_positions`), `friction` its Coulomb
-    /// coefficient (default the library's), `self_contact` whether it collides with itself.
+    /// coefficient (default the library's), `self_contact` whether it collides with itself,
+    /// `rigid_stand_in` the strain tolerance below which it may step as a rapier rigid body
+    /// (a scene's `rigid_stand_in`; default none).
     #[pyo3(signature = (mesh, material, *, translation = [0.0; 3], rotation = [0.0; 3],
         linvel = [0.0; 3], angvel = [0.0; 3], stiffness_time = None, pinned = Vec::new(),
-        friction = None, self_contact = false))]
+        friction = None, self_contact = false, rigid_stand_in = None))]
     #[allow(clippy::too_many_arguments)]
     fn add_soft_body(
         &mut self,
@@ -61,6 +63,7 @@ impl World {
         pinned: Vec<i64>,
         friction: Option<f64>,
         self_contact: bool,
+        rigid_stand_in: Option<f64>,
     ) -> PyResult<SoftBody> {
         let pinned = node_indices("pinned", &pinned, mesh.inner.node_count())?;
         let mut builder = DeformableBodyBuilder::new(mesh.inner.clone(), material.inner)
@@ -78,8 +81,23 @@ impl World {
         if let Some(friction) = friction {
             builder = builder.friction(friction);
         }
+        if let Some(tolerance) = rigid_stand_in {
+            builder = builder.rigid_stand_in(tolerance);
+        }
         let body = builder.build().map_err(library)?;
         Ok(SoftBody::of(self.sim.world.soft_bodies.insert(body)))
+    }
+
+    /// Whether `soft` stands in as a rapier rigid body now (see `add_soft_body`'s
+    /// `rigid_stand_in`).
+    fn stands_in(&self, soft: SoftBody) -> PyResult<bool> {
+        self.soft(soft)?;
+        Ok(self
+            .sim
+            .world
+            .coupling
+            .rigid_stand_in_of(soft.handle())
+            .is_some())
     }
 
     /// Glues the nodes `nodes` of `soft` to the rigid body `rigid` where they are now.

@@ -56,6 +56,27 @@ def test_a_free_spinning_body_keeps_its_momenta():
     assert lz_after == pytest.approx(lz, rel=1e-6)
 
 
+def test_a_stiff_body_stands_in_as_a_rigid_body_with_its_momentum():
+    # A stiff free block (E = 100 MPa) allowed a stand-in below a strain of 1e-3 turns rigid at
+    # the first frame and moves as a rapier body, spun about its principal axis z: its momentum
+    # is the nodes' to rapier's f32 (1e-6, the library's own test); rapier's bodies listed do
+    # not include it.
+    world = rf.World(dt=1 / 60, gravity=(0.0, 0.0, 0.0))
+    stiff = rf.Material("stable_neo_hookean", young=1e8, poisson=0.3, density=1000.0)
+    mesh = rf.Mesh.cuboid((0.1, 0.05, 0.05), (4, 2, 2))
+    body = world.add_soft_body(mesh, stiff, linvel=(0.2, 0.0, 0.0), angvel=(0.0, 0.0, 5.0),
+                               rigid_stand_in=1e-3)
+    before = world.measures(body)
+    world.step(1)
+    assert world.stands_in(body)
+    assert world.rigid_bodies == []
+    after = world.measures(body)
+    # 0.4 kg m/s along x; the other components are round-off (1e-17): 1e-6 of its size.
+    np.testing.assert_allclose(after["linear_momentum"], before["linear_momentum"], atol=4e-7)
+    with pytest.raises(rf.Error, match="rigid_stand_in"):
+        world.add_soft_body(mesh, stiff, rigid_stand_in=2.0)
+
+
 def test_a_body_force_changes_momentum_at_its_resultant():
     world = rf.World(dt=1 / 60, gravity=(0.0, 0.0, 0.0))
     body = world.add_soft_body(rf.Mesh.cuboid((0.1, 0.1, 0.1), (2, 2, 2)), rubber())

@@ -410,7 +410,7 @@ fn print_soft_body(body: &sim::SoftBodyReport) {
         .embedded_tets
         .map_or(String::new(), |tets| format!(", carrying {tets} tets"));
     println!(
-        "  soft {:<16} {:>6} {} {:>5} nodes{embedded}; {} explicit / {} implicit / {} asleep frames; {} failed; max inverted {}",
+        "  soft {:<16} {:>6} {} {:>5} nodes{embedded}; {} explicit / {} implicit / {} asleep / {} rigid frames; {} failed; max inverted {}",
         body.name,
         body.elements,
         body.element_kind,
@@ -418,6 +418,7 @@ fn print_soft_body(body: &sim::SoftBodyReport) {
         body.explicit_frames,
         body.implicit_frames,
         body.asleep_frames,
+        body.rigid_frames,
         body.failed_frames,
         body.max_inverted_elements
     );

@@ -32,6 +32,7 @@ fn every_shipped_scene_parses_and_builds() {
         "showcase.toml",
         "spinning_block.toml",
         "pneumatic_finger.toml",
+        "tossed_bricks.toml",
     ];
     let folder = scene_path("");
     let mut found: Vec<String> = std::fs::read_dir(&folder)

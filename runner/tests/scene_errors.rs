@@ -330,3 +330,14 @@ fn a_vector_with_more_elements_than_its_key_takes_is_refused() {
     let e = error(with_soft_body_key("angvel = [0.0, 3.0, 0.0, 1.0]"));
     assert_names(&e, 16, "soft_body[0].angvel", "more than the key takes");
 }
+
+#[test]
+fn a_stand_in_tolerance_out_of_range_is_named_with_its_line() {
+    for bad in ["0.0", "1.5", "-1e-3"] {
+        let e = error(broken(
+            "translation = [0.0, 0.1, 0.0]",
+            &format!("translation = [0.0, 0.1, 0.0]\nrigid_stand_in = {bad}"),
+        ));
+        assert_names(&e, 16, "soft_body[0].rigid_stand_in", "must lie in (0, 1)");
+    }
+}

@@ -1,7 +1,7 @@
 //! [`DeformableBodyBuilder`]: the rapier-style way to describe a soft body before creating it.
 
 use super::state::check_velocity;
-use super::{BodySurface, DeformableBody, SPEED_OF_LIGHT, lumped_masses};
+use super::{BodySurface, DeformableBody, RigidStandIn, SPEED_OF_LIGHT, lumped_masses};
 use crate::Error;
 use crate::damping::RayleighDamping;
 use crate::element::{ElementShape, Elements, PressureBasis, QuadraticElements};
@@ -56,6 +56,7 @@ pub struct DeformableBodyBuilder {
     restitution: f64,
     restitution_combine_rule: CoefficientCombineRule,
     self_contact: bool,
+    rigid_stand_in: Option<f64>,
     embedded: Option<TetMesh>,
     /// Elements given their own material, in the order given.
     region_materials: Vec<(Vec<u32>, Material)>,
@@ -102,6 +103,7 @@ impl DeformableBodyBuilder {
             restitution: 0.0,
             restitution_combine_rule: CoefficientCombineRule::Average,
             self_contact: false,
+            rigid_stand_in: None,
             embedded: None,
             region_materials: Vec::new(),
         }
@@ -407,6 +409,15 @@ impl DeformableBodyBuilder {
         self
     }
 
+    /// Lets the coupling step the body as a rapier rigid body while its strain stays below
+    /// `strain_tolerance` (dimensionless), and as a deformable body again when the loads on it
+    /// rise (see [`RigidStandIn`](super::RigidStandIn)); for stiff bodies whose deformation does
+    /// not matter. Refused by [`DeformableBodyBuilder::build`] unless `0 < strain_tolerance < 1`.
+    pub fn rigid_stand_in(mut self, strain_tolerance: f64) -> Self {
+        self.rigid_stand_in = Some(strain_tolerance);
+        self
+    }
+
     /// A fine tetrahedral mesh (rest positions in the same frame as the body's mesh, m) for the
     /// body to carry: each vertex moves with the element it lies in at rest (see
     /// [`crate::embedding`]), and contacts with colliders act on its surface instead of the
@@ -461,12 +472,14 @@ impl DeformableBodyBuilder {
     /// on an element that does not exist or of another model or Poisson's ratio;
     /// [`Error::OutsideSimulationMesh`] naming a vertex of the embedded mesh that no element
     /// carries;
-    /// [`Error::InvalidSetting`] for a minimum quality outside `[0, 1)`, a negative or
+    /// [`Error::InvalidSetting`] for a minimum quality outside `[0, 1)`, a
+    /// [rigid stand-in](DeformableBodyBuilder::rigid_stand_in) tolerance outside `(0, 1)`, a negative or
     /// non-finite friction or restitution, or a [`DeformableBodyBuilder::linvel`] faster than
     /// [`SPEED_OF_LIGHT`](crate::body::SPEED_OF_LIGHT); [`Error::SpeedOutOfRange`] naming the
     /// first node that the angular velocity or a region's velocity sets moving faster than that.
     pub fn build(self) -> Result<DeformableBody, Error> {
         self.check_settings()?;
+        let rigid_stand_in = self.rigid_stand_in.map(RigidStandIn::new).transpose()?;
         let pinned = self.pinned_flags()?;
         self.check_placement_and_velocity()?;
         let positions = self.placed_positions()?;
@@ -518,6 +531,7 @@ impl DeformableBodyBuilder {
             restitution_combine_rule: self.restitution_combine_rule,
             self_contact: self.self_contact,
             user_data: self.user_data,
+            rigid_stand_in,
         })
     }
 

@@ -8,12 +8,14 @@ mod loads;
 #[cfg(feature = "serde-serialize")]
 mod record;
 mod set;
+mod stand_in;
 mod state;
 mod stress;
 mod surface;
 
 pub use builder::{DEFAULT_FRICTION, DEFAULT_MIN_ELEMENT_QUALITY, DeformableBodyBuilder};
 pub use set::{DeformableBodyHandle, DeformableBodySet};
+pub use stand_in::RigidStandIn;
 pub use state::SPEED_OF_LIGHT;
 pub(crate) use surface::BodySurface;
 
@@ -87,6 +89,9 @@ pub struct DeformableBody {
     pub self_contact: bool,
     /// Arbitrary user data, as on rapier's bodies.
     pub user_data: u128,
+    /// Whether the coupling may step the body as a rapier rigid body while its strain stays
+    /// small (see [`RigidStandIn`]); none by default.
+    pub rigid_stand_in: Option<RigidStandIn>,
 }
 
 impl DeformableBody {
@@ -274,6 +279,12 @@ impl DeformableBody {
     /// How many times the state was edited from outside the integrators.
     pub(crate) fn state_edits(&self) -> u64 {
         self.state_edits
+    }
+
+    /// Counts a change of the state made outside the integrators (a rigid stand-in handing the
+    /// body back): two-step integrators restart.
+    pub(crate) fn mark_state_edited(&mut self) {
+        self.state_edits += 1;
     }
 
     /// Counts an edit of the state from outside the integrators (a static solve).

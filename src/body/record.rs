@@ -4,7 +4,7 @@
 //! the body is built again by [`DeformableBodyBuilder`], so every check of a new body applies to a file (a typed error,
 //! never a panic), and the rest data comes out as it was: the build is deterministic.
 
-use super::{DeformableBody, DeformableBodyBuilder};
+use super::{DeformableBody, DeformableBodyBuilder, RigidStandIn};
 use crate::Error;
 use crate::damping::RayleighDamping;
 use crate::element::ElementShape;
@@ -40,6 +40,9 @@ pub(super) struct BodyRecord {
     restitution_combine_rule: CoefficientCombineRule,
     self_contact: bool,
     user_data: u128,
+    /// Whether the body may stand in as a rigid body (none in files written before stand-ins).
+    #[serde(default)]
+    rigid_stand_in: Option<RigidStandIn>,
     /// The loads besides gravity (none in files written before loads existed).
     #[serde(default)]
     loads: Vec<Load>,
@@ -78,6 +81,7 @@ impl From<&DeformableBody> for BodyRecord {
             restitution_combine_rule: body.restitution_combine_rule,
             self_contact: body.self_contact,
             user_data: body.user_data,
+            rigid_stand_in: body.rigid_stand_in,
             loads: body.loads.clone(),
             load_edits: body.load_edits,
             load_change_work: body.load_change_work,
@@ -107,7 +111,7 @@ impl TryFrom<BodyRecord> for DeformableBody {
         for (elements, material) in record.region_materials {
             builder = builder.region_material(elements, material);
         }
-        let mut body = builder
+        builder = builder
             .volumetric(record.volumetric)
             .pinned_nodes(record.pinned)
             // The body passed its quality check when first built.
@@ -118,8 +122,11 @@ impl TryFrom<BodyRecord> for DeformableBody {
             .restitution(record.restitution)
             .restitution_combine_rule(record.restitution_combine_rule)
             .self_contact(record.self_contact)
-            .user_data(record.user_data)
-            .build()?;
+            .user_data(record.user_data);
+        if let Some(stand_in) = record.rigid_stand_in {
+            builder = builder.rigid_stand_in(stand_in.strain_tolerance);
+        }
+        let mut body = builder.build()?;
         let nodes = body.node_count();
         for given in [record.positions.len(), record.velocities.len()] {
             if given != nodes {

@@ -85,6 +85,21 @@ impl<T: Clone> BodyMap<T> {
         self.map.get_mut(&handle)
     }
 
+    /// Sets the value of `handle`.
+    pub(super) fn insert(&mut self, handle: DeformableBodyHandle, value: T) {
+        self.map.insert(handle, value);
+    }
+
+    /// Every body's value, mutably.
+    pub(super) fn values_mut(&mut self) -> impl Iterator<Item = &mut T> {
+        self.map.values_mut()
+    }
+
+    /// Every body's value, by handle, mutably.
+    pub(super) fn iter_mut(&mut self) -> impl Iterator<Item = (DeformableBodyHandle, &mut T)> {
+        self.map.iter_mut().map(|(&handle, value)| (handle, value))
+    }
+
     /// Forgets the value of `handle`.
     pub(super) fn remove(&mut self, handle: DeformableBodyHandle) {
         self.map.remove(&handle);

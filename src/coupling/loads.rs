@@ -153,7 +153,7 @@ impl FrameLoads {
 
     /// Adds a substep's impulse (N s) and angular impulse about the centre of mass (N m s) on a
     /// rigid body to the frame's total for the pair.
-    fn add_rigid(
+    pub(super) fn add_rigid(
         &mut self,
         soft_body: DeformableBodyHandle,
         rigid_body: RigidBodyHandle,
@@ -171,7 +171,7 @@ impl FrameLoads {
 
     /// Adds a substep's impulse (N s) and angular impulse about the world origin (N m s) on a
     /// collider to the frame's total for the pair.
-    fn add_collider(
+    pub(super) fn add_collider(
         &mut self,
         soft_body: DeformableBodyHandle,
         collider: ColliderHandle,

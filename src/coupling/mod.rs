@@ -58,6 +58,7 @@ mod pull;
 mod rapier_view;
 mod reach;
 mod sleep;
+mod stand_in;
 mod substep;
 mod touches;
 mod uncoupled;
@@ -88,6 +89,7 @@ use rapier3d::glamx::DVec3;
 use rapier3d::math::Vector;
 use rapier3d::pipeline::{EventHandler, PhysicsHooks, PhysicsPipeline};
 use sleep::SleepSet;
+use stand_in::StandInSet;
 use touches::RigidTouches;
 use uncoupled::Uncoupled;
 
@@ -197,6 +199,9 @@ pub struct SoftCoupling {
     links: LinkSet,
     /// Each deformable body's sleep, by handle.
     sleeping: SleepSet,
+    /// The bodies standing in as rapier rigid bodies, by handle.
+    #[cfg_attr(feature = "serde-serialize", serde(default))]
+    stand_ins: StandInSet,
 }
 
 impl Default for SoftCoupling {
@@ -211,6 +216,7 @@ impl Default for SoftCoupling {
             pull: RapierPull::default(),
             links: LinkSet::default(),
             sleeping: SleepSet::default(),
+            stand_ins: StandInSet::default(),
         }
     }
 }
@@ -236,7 +242,7 @@ impl SoftCoupling {
         events: &dyn EventHandler,
     ) -> SoftStepResults {
         let frame = *rapier.integration_parameters;
-        self.loads.clear();
+        let last_loads = std::mem::take(&mut self.loads);
         self.touches.clear();
         if let Some(error) = self.frame_error(frame.dt) {
             return refused(soft_bodies, &error);
@@ -251,9 +257,18 @@ impl SoftCoupling {
         let gravity = rapier.gravity.as_dvec3();
         self.links.prune(soft_bodies);
         self.sleeping.prune(soft_bodies);
+        let frame_dt = f64::from(frame.dt);
+        let (sleeping, links) = (&self.sleeping, &self.links);
+        let eligible = |handle| {
+            !sleeping.is_asleep(handle)
+                && links
+                    .get(handle)
+                    .is_none_or(|l| l.constraints.attachments.is_empty())
+        };
+        let reach = (h, self.contact.margin);
+        (self.stand_ins).switch(soft_bodies, &mut rapier, (&last_loads, eligible), reach);
         let mut outcomes = unstepped(soft_bodies);
         let paths = KinematicPath::all(rapier.bodies);
-        let frame_dt = f64::from(frame.dt);
         let alone = if substeps > 1 {
             let rigid = RigidSets {
                 bodies: rapier.bodies,
@@ -335,6 +350,10 @@ impl SoftCoupling {
             rapier.step_rapier(pipeline, &substep_parameters, hooks, events);
             carry.settle(rapier.bodies);
             self.record_touches(rapier);
+            let sets = (&*rapier.bodies, &*rapier.colliders, &*rapier.narrow_phase);
+            let reach = (h, gravity, self.contact.margin);
+            (self.stand_ins).after_rapier_step(soft_bodies, sets, &mut self.loads, reach);
+            self.stand_ins.end_overloaded(soft_bodies, rapier);
         }
     }
 
@@ -378,6 +397,9 @@ impl SoftCoupling {
         (self.touches).record(rigid.bodies, rigid.colliders, rigid.narrow_phase);
         self.links.prune(soft_bodies);
         self.sleeping.prune(soft_bodies);
+        let sets = (&*rigid.bodies, rigid.colliders, rigid.narrow_phase);
+        let reach = (h, gravity, self.contact.margin);
+        (self.stand_ins).after_rapier_step(soft_bodies, sets, &mut self.loads, reach);
         let mut outcomes = unstepped(soft_bodies);
         self.step_soft_bodies(soft_bodies, rigid, &mut outcomes, &[], (h, gravity));
         if h > 0.0 {
@@ -433,6 +455,7 @@ impl SoftCoupling {
     ) -> Result<(), Error> {
         let body = soft_bodies.get(soft).ok_or(Error::UnknownDeformableBody)?;
         self.sleeping.wake_up(soft);
+        self.stand_ins.release(soft);
         self.links
             .entry(soft)
             .constraints
@@ -442,6 +465,7 @@ impl SoftCoupling {
     /// Removes every attachment of the deformable body `soft` to the rigid body `rigid`.
     pub fn detach(&mut self, soft: DeformableBodyHandle, rigid: RigidBodyHandle) {
         self.sleeping.wake_up(soft);
+        self.stand_ins.release(soft);
         if let Some(links) = self.links.get_mut(soft) {
             links.constraints.detach(rigid);
         }
@@ -456,8 +480,22 @@ impl SoftCoupling {
     /// Wakes the deformable body `soft` if it is asleep, and restarts the time it must stay still
     /// before it sleeps again: call it after changing what a step reads that the coupling does
     /// not watch (its friction, say). Editing its positions or velocities wakes it by itself.
+    /// A body standing in as a rigid body turns elastic at the next frame.
     pub fn wake_up(&mut self, soft: DeformableBodyHandle) {
         self.sleeping.wake_up(soft);
+        self.stand_ins.release(soft);
+    }
+
+    /// The rapier rigid body the deformable body `soft` stands in as (see
+    /// [`RigidStandIn`](crate::body::RigidStandIn)), while it does.
+    pub fn rigid_stand_in_of(&self, soft: DeformableBodyHandle) -> Option<RigidBodyHandle> {
+        self.stand_ins.rigid_of(soft)
+    }
+
+    /// The deformable body the rapier rigid body `rigid` stands in for, if it is a stand-in:
+    /// a program listing rapier's bodies skips those.
+    pub fn stand_in_for(&self, rigid: RigidBodyHandle) -> Option<DeformableBodyHandle> {
+        self.stand_ins.soft_of(rigid)
     }
 
     /// The contacts, rigid corners and attachments of the deformable body `soft` as the last

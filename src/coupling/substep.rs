@@ -64,7 +64,14 @@ impl SoftCoupling {
         self.hold_refused(soft_bodies, &held, &mut rigid, h, gravity);
         let links = &self.links;
         let constraints = |handle| links.get(handle).map(|l: &BodyLinks| &l.constraints);
-        (self.sleeping).settle(soft_bodies, constraints, &mut rigid, &self.sleep, sleep);
+        let standing = self.stand_ins.handles();
+        (self.sleeping).settle(
+            (soft_bodies, &standing),
+            constraints,
+            &mut rigid,
+            &self.sleep,
+            sleep,
+        );
         let proxies = (self.links.iter()).flat_map(|(_, l)| &l.constraints.rigid_proxies);
         self.pull.note_handed(proxies, rigid.bodies, h);
         carried
@@ -199,7 +206,10 @@ impl SoftCoupling {
         let lookup = rapier_view::rigid_lookup(rigid.bodies, h);
         let (mut live, mut held) = (Vec::new(), Vec::new());
         for (handle, outcome) in outcomes.iter_mut() {
-            if self.sleeping.is_asleep(*handle) || skip.contains(handle) {
+            if self.sleeping.is_asleep(*handle)
+                || self.stand_ins.contains(*handle)
+                || skip.contains(handle)
+            {
                 continue;
             }
             let body = &soft_bodies[*handle];

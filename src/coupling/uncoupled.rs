@@ -72,6 +72,7 @@ impl SoftCoupling {
             if outcome.is_some()
                 || body.self_contact
                 || self.sleeping.is_asleep(*handle)
+                || self.stand_ins.contains(*handle)
                 || coupled_before
                 || near_another(*handle)
                 || body.check_state().is_err()
@@ -110,7 +111,14 @@ impl SoftCoupling {
         let links = &self.links;
         let constraints = |handle| links.get(handle).map(|l: &BodyLinks| &l.constraints);
         let sleep = (h, gravity, self.contact.margin);
-        (self.sleeping).settle(soft_bodies, constraints, &mut rigid, &self.sleep, sleep);
+        let standing = self.stand_ins.handles();
+        (self.sleeping).settle(
+            (soft_bodies, &standing),
+            constraints,
+            &mut rigid,
+            &self.sleep,
+            sleep,
+        );
     }
 }
 

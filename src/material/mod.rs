@@ -16,6 +16,7 @@ mod stvk;
 mod volumetric;
 
 pub use corotated::Corotated;
+pub(crate) use corotated::polar_rotation;
 pub use linear::LinearElastic;
 pub use neo_hookean::StableNeoHookean;
 pub(crate) use per_element::ElementMaterials;

@@ -71,7 +71,7 @@ pub fn advise_text(
     // An alternative is not waited for past twice the scene's own stepping time and a second
     // (it could not be chosen).
     let limit = Duration::from_secs_f64(2.0 * second.stepping_time_s + 1.0);
-    let all = candidates(&scene);
+    let all = candidates(&scene, options.target);
     let runs: Vec<TrialRun> = (all.iter().enumerate())
         .map(|(k, candidate)| {
             let folder = folder_name(k, &candidate.label);

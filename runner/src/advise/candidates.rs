@@ -1,6 +1,7 @@
 //! The alternatives the advisor measures, each one change to the scene as written: per soft
-//! body another material model, linear elements in place of quadratic ones, and a mesh of half
-//! the cells along each axis; for the scene, another integrator, a Newton tolerance a hundred
+//! body another material model, linear elements in place of quadratic ones, a mesh of half
+//! the cells along each axis, and a rigid stand-in below a strain of a tenth of the target (for
+//! a body free of pins, attachments, loads and embedded meshes, which could not stand in); for the scene, another integrator, a Newton tolerance a hundred
 //! times looser (to one significant digit, at most 1e-2), and half the coupling substeps. Each is a list of key-path edits of the
 //! scene's text ([`crate::scene::edit`]).
 
@@ -21,6 +22,8 @@ pub enum Group {
     Elements(usize),
     /// A soft body's mesh resolution.
     Resolution(usize),
+    /// A soft body's rigid stand-in.
+    StandIn(usize),
     /// The scene's integrator.
     Integrator,
     /// The implicit integrator's Newton tolerance.
@@ -33,7 +36,7 @@ impl Group {
     /// The soft body the change is to, if to one.
     pub fn body(&self) -> Option<usize> {
         match self {
-            Self::Model(i) | Self::Elements(i) | Self::Resolution(i) => Some(*i),
+            Self::Model(i) | Self::Elements(i) | Self::Resolution(i) | Self::StandIn(i) => Some(*i),
             _ => None,
         }
     }
@@ -81,10 +84,10 @@ pub fn model_name(model: ModelSpec) -> &'static str {
         .map_or("", |(_, name)| name)
 }
 
-/// Every alternative to `scene`: per soft body, the other models, linear elements (for
-/// quadratic ones) and half the cells; then the other integrators, the looser tolerance and
-/// half the coupling substeps.
-pub fn candidates(scene: &Scene) -> Vec<Candidate> {
+/// Every alternative to `scene` for a probe error of `target` (relative): per soft body, the
+/// other models, linear elements (for quadratic ones), half the cells and a rigid stand-in;
+/// then the other integrators, the looser tolerance and half the coupling substeps.
+pub fn candidates(scene: &Scene, target: f64) -> Vec<Candidate> {
     let mut all = Vec::new();
     for (i, body) in scene.soft_body.iter().enumerate() {
         let key = |rest: &str| format!("soft_body[{i}].{rest}");
@@ -114,6 +117,19 @@ pub fn candidates(scene: &Scene) -> Vec<Candidate> {
                 refinement: Some(ratio),
             });
         }
+        let free = body.pinned.is_empty()
+            && body.attach.is_empty()
+            && body.loads.is_empty()
+            && body.embedded.is_none();
+        if free && body.rigid_stand_in.is_none() {
+            let strain = one_digit(target / 10.0);
+            all.push(Candidate {
+                group: Group::StandIn(i),
+                label: format!("{}: rigid stand-in below strain {strain:e}", body.name),
+                edits: vec![(key("rigid_stand_in"), Value::from(strain))],
+                refinement: None,
+            });
+        }
     }
     for (kind, name) in [
         (IntegratorChoice::Automatic, "automatic"),
@@ -138,9 +154,7 @@ pub fn candidates(scene: &Scene) -> Vec<Candidate> {
 fn scene_settings(scene: &Scene) -> Vec<Candidate> {
     let mut all = Vec::new();
     let tolerance = scene.integrator.integrator().implicit.tolerance;
-    // To one significant digit: 1e-6 gives 1e-4, not 9.999999999999999e-5.
-    let looser = format!("{:.0e}", (tolerance * 100.0).min(1e-2));
-    let looser: f64 = looser.parse().unwrap_or(1e-2);
+    let looser = one_digit((tolerance * 100.0).min(1e-2));
     if looser > tolerance {
         all.push(Candidate {
             group: Group::Tolerance,
@@ -163,6 +177,11 @@ fn scene_settings(scene: &Scene) -> Vec<Candidate> {
         });
     }
     all
+}
+
+/// `value` to one significant digit: 1e-6 × 100 gives 1e-4, not 9.999999999999999e-5.
+fn one_digit(value: f64) -> f64 {
+    format!("{value:.0e}").parse().unwrap_or(value)
 }
 
 /// A coarser mesh: its description, its edits and the refinement ratio from it to the given

@@ -18,6 +18,9 @@
 //! angvel = [0.0, 0.0, 0.0]        # rad/s about the placed centre of mass, default 0
 //! friction = 0.5                  # default 0.5
 //! self_contact = false            # default false
+//! rigid_stand_in = 1e-4           # strain tolerance: while strained less, the body steps as a
+//!                                 # rapier rigid body (its hull the collider), elastic again
+//!                                 # when loads rise; default none
 //! volumetric = "per_element"      # or "nodal_average" / "element_average" (nearly incompressible:
 //!                                 # linear / quadratic elements), default per_element
 //! elements = "linear"             # or "quadratic" (10-node tetrahedra, accurate in bending), or
@@ -83,6 +86,9 @@ pub struct SoftBodySpec {
     /// Whether the surface collides with itself; default false.
     #[serde(default)]
     pub self_contact: bool,
+    /// The strain tolerance (dimensionless) below which the body may step as a rapier rigid
+    /// body (see `rapier_fvm::body::RigidStandIn`); default none.
+    pub rigid_stand_in: Option<f64>,
     /// How the volumetric energy is evaluated; default per element.
     #[serde(default)]
     pub volumetric: VolumetricSpec,
@@ -311,6 +317,14 @@ impl SoftBodySpec {
         c.speed(&format!("{key}.linvel"), self.linvel);
         c.finite_vector(&format!("{key}.angvel"), self.angvel);
         c.non_negative(&format!("{key}.friction"), self.friction, "dimensionless");
+        if let Some(tolerance) = self.rigid_stand_in
+            && !(tolerance > 0.0 && tolerance < 1.0)
+        {
+            c.fail(
+                &format!("{key}.rigid_stand_in"),
+                format!("the strain tolerance must lie in (0, 1), got {tolerance}"),
+            );
+        }
         let selections = (self.pinned.iter().map(RegionSpec::selection))
             .chain(self.attach.iter().map(AttachmentSpec::selection))
             .chain(self.velocity.iter().map(RegionVelocitySpec::selection))

@@ -294,6 +294,9 @@ fn insert_soft(
     if let Some(fine) = embedded {
         builder = builder.embedded(fine);
     }
+    if let Some(tolerance) = spec.rigid_stand_in {
+        builder = builder.rigid_stand_in(tolerance);
+    }
     let mut builder = builder
         .translation(DVec3::from_array(spec.translation))
         .rotation(DVec3::from_array(spec.rotation))

@@ -96,6 +96,8 @@ pub struct SoftBodyReport {
     pub implicit_frames: usize,
     /// Frames it ended asleep, not stepped.
     pub asleep_frames: usize,
+    /// Frames it ended standing in as a rapier rigid body, not stepped.
+    pub rigid_frames: usize,
     /// Frames chosen explicit but redone implicitly.
     pub fell_back_frames: usize,
     /// Mean explicit substeps per explicit coupling substep.

@@ -176,6 +176,8 @@ fn record_frame(
     for (entry, report) in sim.soft.iter().zip(bodies.iter_mut()) {
         let asleep = sim.world.coupling.is_sleeping(entry.handle);
         report.asleep_frames += usize::from(asleep);
+        let standing_in = sim.world.coupling.rigid_stand_in_of(entry.handle).is_some();
+        report.rigid_frames += usize::from(standing_in);
         let touching = (sim.world.coupling.constraints(entry.handle))
             .is_some_and(|constraints| constraints.pushed_by_collider());
         let body = &sim.world.soft_bodies[entry.handle];

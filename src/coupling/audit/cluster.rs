@@ -12,7 +12,8 @@
 //! is then counted too (its position correction lifting a box, a ball spinning at 20 rad/s
 //! meeting a box, measured up to 1.7e-4 J in a frame of the game scene), so each cluster keeps
 //! the list of its members without the bodies only those contacts joined: the audit checks
-//! both (see the module's documentation).
+//! both (see the module's documentation). A deformable body standing in as a rigid body
+//! counts as one: its rapier contacts are rapier's, and alone it is not checked.
 
 use super::AuditInput;
 use super::energy::Member;
@@ -32,6 +33,9 @@ pub(super) fn clusters(input: &AuditInput<'_>) -> Vec<Cluster> {
     let mut clusters: Vec<Vec<Member>> = Vec::new();
     let soft: Vec<_> = input.soft_bodies.iter().collect();
     for (handle, body) in &soft {
+        // A stand-in meets rigid bodies through rapier's contacts, as rigid bodies do; its
+        // coupling's constraints are those of its last elastic step.
+        let standing_in = input.coupling.rigid_stand_in_of(*handle).is_some();
         let mut members = vec![Member::Soft(*handle)];
         let loaded = (input.coupling.rigid_loads().iter())
             .filter(|load| load.soft_body == *handle)
@@ -44,10 +48,11 @@ pub(super) fn clusters(input: &AuditInput<'_>) -> Vec<Cluster> {
                 (c.rigid_proxies.iter().map(|p| p.handle))
                     .chain(c.attachments.iter().map(|a| a.body))
             });
-        for rigid in loaded.chain(linked) {
+        for rigid in loaded.chain(linked).filter(|_| !standing_in) {
             let dynamic = input.bodies.get(rigid).is_some_and(|b| b.is_dynamic());
-            if dynamic && !members.contains(&Member::Rigid(rigid)) {
-                members.push(Member::Rigid(rigid));
+            let member = rigid_member(input, rigid);
+            if dynamic && !members.contains(&member) {
+                members.push(member);
             }
         }
         let (lo, hi) = body.position_bounds();
@@ -58,10 +63,18 @@ pub(super) fn clusters(input: &AuditInput<'_>) -> Vec<Cluster> {
                 members.push(Member::Soft(*other));
             }
         }
+        if standing_in && members.len() == 1 {
+            // Alone, it is rapier's to answer for, as a rigid body that met only rapier's
+            // contacts.
+            continue;
+        }
         merge(&mut clusters, members);
     }
     let exchanging: Vec<Member> = clusters.iter().flatten().copied().collect();
-    join_touching(&mut clusters, input.coupling.rigid_touches());
+    let touches: Vec<(Member, Member)> = (input.coupling.rigid_touches().iter())
+        .map(|&(a, b)| (rigid_member(input, a), rigid_member(input, b)))
+        .collect();
+    join_touching(&mut clusters, &touches);
     (clusters.into_iter())
         .map(|mut members| {
             members.sort_by_key(|member| matches!(member, Member::Rigid(_)));
@@ -76,21 +89,27 @@ pub(super) fn clusters(input: &AuditInput<'_>) -> Vec<Cluster> {
         .collect()
 }
 
-/// Adds to each of `clusters` the rigid bodies `touches` holds against one of its rigid members,
-/// until no pair joins one more (two clusters a pair links become one).
-fn join_touching(clusters: &mut Vec<Vec<Member>>, touches: &[(RigidBodyHandle, RigidBodyHandle)]) {
-    let cluster_of = |clusters: &[Vec<Member>], rigid| {
-        clusters
-            .iter()
-            .position(|c| c.contains(&Member::Rigid(rigid)))
-    };
+/// The member a rigid body counts as: the deformable body it stands in for, if it is a
+/// stand-in (its nodes carry its energy), or itself.
+fn rigid_member(input: &AuditInput<'_>, rigid: RigidBodyHandle) -> Member {
+    input
+        .coupling
+        .stand_in_for(rigid)
+        .map_or(Member::Rigid(rigid), Member::Soft)
+}
+
+/// Adds to each of `clusters` the bodies `touches` holds against one of its members, until no
+/// pair joins one more (two clusters a pair links become one).
+fn join_touching(clusters: &mut Vec<Vec<Member>>, touches: &[(Member, Member)]) {
+    let cluster_of =
+        |clusters: &[Vec<Member>], member| clusters.iter().position(|c| c.contains(&member));
     let mut joined = true;
     while joined {
         joined = false;
         for &(a, b) in touches {
             let (of_a, of_b) = (cluster_of(clusters, a), cluster_of(clusters, b));
             if of_a != of_b {
-                merge(clusters, vec![Member::Rigid(a), Member::Rigid(b)]);
+                merge(clusters, vec![a, b]);
                 joined = true;
             }
         }

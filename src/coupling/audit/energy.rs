@@ -90,8 +90,20 @@ pub(super) fn energies(
     results: &SoftStepResults,
 ) -> HashMap<Member, MemberEnergy> {
     let g = input.gravity;
+    let h = rigid_integration_step(input);
     let mut all = HashMap::new();
     for (handle, body) in input.soft_bodies.iter() {
+        let stand_in = (input.coupling.rigid_stand_in_of(handle)).and_then(|r| input.bodies.get(r));
+        if let Some(rigid) = stand_in {
+            // Its nodes are carried by its rigid body: rapier's energy, and its elastic energy.
+            let mut energy = rigid_energy(rigid, g, h);
+            let elastic = body.elastic_energy();
+            energy.total += elastic + body.load_potential_energy();
+            energy.moving += elastic;
+            energy.load_change_work = body.load_change_work();
+            all.insert(Member::Soft(handle), energy);
+            continue;
+        }
         let report = results
             .iter()
             .find(|(h, _)| *h == handle)
@@ -114,8 +126,9 @@ pub(super) fn energies(
             },
         );
     }
-    let h = rigid_integration_step(input);
-    for (handle, body) in input.bodies.iter().filter(|(_, b)| b.is_dynamic()) {
+    let rigid = (input.bodies.iter())
+        .filter(|(handle, b)| b.is_dynamic() && input.coupling.stand_in_for(*handle).is_none());
+    for (handle, body) in rigid {
         all.insert(Member::Rigid(handle), rigid_energy(body, g, h));
     }
     all

@@ -245,14 +245,18 @@ impl Audit {
         let checked = Checked::new(body, glued, before, tolerance);
         let mut penetrations = Penetrations::default();
         let poses = previous.map_or(HashMap::new(), |p| p.collider_poses.clone());
-        penetration::against_colliders(
-            &checked,
-            input.colliders,
-            input.bodies,
-            &poses,
-            &mut penetrations,
-        );
-        penetration::colliders_inside(&checked, input.colliders, &mut penetrations);
+        // A body standing in as a rigid body meets colliders through rapier's contacts, as
+        // rigid bodies do: rapier answers for them.
+        if input.coupling.rigid_stand_in_of(handle).is_none() {
+            penetration::against_colliders(
+                &checked,
+                input.colliders,
+                input.bodies,
+                &poses,
+                &mut penetrations,
+            );
+            penetration::colliders_inside(&checked, input.colliders, &mut penetrations);
+        }
         for (other_handle, other) in input.soft_bodies.iter() {
             if other_handle != handle {
                 penetration::against_soft(&checked, other, other_handle, &mut penetrations);

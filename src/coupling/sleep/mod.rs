@@ -254,10 +254,11 @@ impl SleepSet {
     /// Puts to sleep, after a substep of `h` (s) under `gravity` (m/s²), every group of awake
     /// bodies of `soft_bodies` (bounds widened by `margin` (m) overlapping, or touching the same
     /// dynamic rigid body; their constraints from `constraints`) that have all been still long
-    /// enough, one of them resting on something, with the dynamic rigid bodies they touch.
+    /// enough, one of them resting on something, with the dynamic rigid bodies they touch. Bodies
+    /// `standing` in as rigid bodies are rapier's to put to sleep, and keep none awake.
     pub(super) fn settle<'c>(
         &mut self,
-        soft_bodies: &mut DeformableBodySet,
+        (soft_bodies, standing): (&mut DeformableBodySet, &[DeformableBodyHandle]),
         constraints: impl Fn(DeformableBodyHandle) -> Option<&'c BodyConstraints>,
         rigid: &mut RigidSets<'_>,
         settings: &SleepSettings,
@@ -270,7 +271,7 @@ impl SleepSet {
             return;
         }
         let awake: Vec<(DeformableBodyHandle, Bounds, Vec<RigidBodyHandle>)> = (soft_bodies.iter())
-            .filter(|(handle, _)| !self.is_asleep(*handle))
+            .filter(|(handle, _)| !self.is_asleep(*handle) && !standing.contains(handle))
             .map(|(handle, body)| {
                 let partners = constraints(handle).map(partners_of).unwrap_or_default();
                 (handle, widen(body.position_bounds(), margin), partners)
