@@ -62,19 +62,27 @@ impl SoftCoupling {
             (h, gravity),
         );
         self.hold_refused(soft_bodies, &held, &mut rigid, h, gravity);
-        let links = &self.links;
-        let constraints = |handle| links.get(handle).map(|l: &BodyLinks| &l.constraints);
-        let standing = self.stand_ins.handles();
-        (self.sleeping).settle(
-            (soft_bodies, &standing),
-            constraints,
-            &mut rigid,
-            &self.sleep,
-            sleep,
-        );
+        self.settle_still(soft_bodies, &mut rigid, (h, gravity));
         let proxies = (self.links.iter()).flat_map(|(_, l)| &l.constraints.rigid_proxies);
         self.pull.note_handed(proxies, rigid.bodies, h);
         carried
+    }
+
+    /// Puts to sleep, after a step of `h` (s) under `gravity` (m/s²), the bodies still long
+    /// enough (`SleepSet::settle`); a stand-in is rapier's to put to
+    /// sleep.
+    pub(super) fn settle_still(
+        &mut self,
+        soft_bodies: &mut DeformableBodySet,
+        rigid: &mut RigidSets<'_>,
+        (h, gravity): (f64, DVec3),
+    ) {
+        let links = &self.links;
+        let constraints = |handle| links.get(handle).map(|l: &BodyLinks| &l.constraints);
+        let standing = self.stand_ins.handles();
+        let sleep = (h, gravity, self.contact.margin);
+        let bodies = (soft_bodies, &standing[..]);
+        (self.sleeping).settle(bodies, constraints, rigid, &self.sleep, sleep);
     }
 
     /// Steps the bodies `live` over `h` (s) under `gravity` (m/s²), in the groups the contacts

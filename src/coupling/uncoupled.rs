@@ -108,17 +108,7 @@ impl SoftCoupling {
         let alone = uncoupled.give_back(soft_bodies, &mut self.links);
         let results = (&alone[..], stepped);
         self.record_steps(soft_bodies, &mut rigid, outcomes, results, (dt, gravity));
-        let links = &self.links;
-        let constraints = |handle| links.get(handle).map(|l: &BodyLinks| &l.constraints);
-        let sleep = (h, gravity, self.contact.margin);
-        let standing = self.stand_ins.handles();
-        (self.sleeping).settle(
-            (soft_bodies, &standing),
-            constraints,
-            &mut rigid,
-            &self.sleep,
-            sleep,
-        );
+        self.settle_still(soft_bodies, &mut rigid, (h, gravity));
     }
 }
 

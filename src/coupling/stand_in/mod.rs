@@ -7,8 +7,8 @@
 //! closing speed `v` by about `v / c` (`c` its slowest wave speed); see
 //! `contacts::approaching` for the colliders about to meet it.
 //!
-//! - **Turning elastic.** After each rapier step of [`SoftCoupling::step`](super::SoftCoupling::step),
-//!   a stand-in turns elastic when the mean force over the frame so far (its rapier contacts'
+//! - **Turning elastic.** After each rapier step of
+//!   [`SoftCoupling::step`](super::SoftCoupling::step), a stand-in turns elastic when the mean force over the frame so far (its rapier contacts'
 //!   normal impulses and the deformable bodies pushing it) with the weight and strike of the
 //!   colliders about to meet it predicts a strain above its tolerance `ε_tol`, or another body
 //!   allowed a stand-in comes within its reach (stand-ins do not stack: see
@@ -26,9 +26,9 @@
 //!   volume by more than 1 %: rapier would collide with the hull), with the body's friction,
 //!   restitution and collision groups.
 //!
-//! While it stands in, the body is neither detected nor stepped; after each rapier step its nodes
-//! are carried by the rigid pose, `xᵢ = c + R rᵢ`, `vᵢ = V + ω × (xᵢ − c)`, and its rapier contacts'
-//! normal impulses count in the loads as the body's. Other deformable bodies meet its collider
+//! While it stands in, the body is neither detected nor stepped; after each rapier step its
+//! nodes are carried by the rigid pose, `xᵢ = c + R rᵢ`, `vᵢ = V + ω × (xᵢ − c)`, and its rapier
+//! contacts' normal impulses count in the loads as the body's. Other deformable bodies meet its collider
 //! as any rapier collider. Switches happen only in `step`:
 //! [`SoftCoupling::substep`](super::SoftCoupling::substep) carries stand-ins and switches none.
 

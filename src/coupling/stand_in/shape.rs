@@ -66,7 +66,7 @@ impl RigidMotion {
 }
 
 /// `a bᵀ`.
-fn outer(a: DVec3, b: DVec3) -> DMat3 {
+pub(super) fn outer(a: DVec3, b: DVec3) -> DMat3 {
     DMat3::from_cols(a * b.x, a * b.y, a * b.z)
 }
 

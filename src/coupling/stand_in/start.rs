@@ -2,7 +2,7 @@
 //! strain (see `shape`) and the strain the force on it predicts at most half its tolerance, its
 //! convex hull within [`HULL_EXCESS`] of its volume.
 
-use super::shape::{RigidMotion, peak_green_strain, softest};
+use super::shape::{RigidMotion, outer, peak_green_strain, softest};
 use super::{StandIn, strain_predicted};
 use crate::body::{DeformableBody, RigidStandIn};
 use crate::coupling::RapierSets;
@@ -15,8 +15,8 @@ use rapier3d::prelude::MassProperties;
 /// How much the convex hull may exceed the body's volume (dimensionless) for it to stand in.
 const HULL_EXCESS: f64 = 0.01;
 
-/// A body ready to turn rigid: its stand-in, its rigid motion, its nodes' offsets (m) from the centre as
-/// rapier holds it (f32), that centre, and its collider.
+/// A body ready to turn rigid: its stand-in, its rigid motion, its nodes' offsets (m) from the
+/// centre as rapier holds it (f32), that centre, and its collider.
 pub(super) struct Ready {
     settings: RigidStandIn,
     motion: RigidMotion,
@@ -123,14 +123,10 @@ fn rest_hull_points(body: &DeformableBody, motion: &RigidMotion, origin: Vec3) -
         .collect()
 }
 
-/// `a bᵀ`.
-fn outer(a: DVec3, b: DVec3) -> DMat3 {
-    DMat3::from_cols(a * b.x, a * b.y, a * b.z)
-}
-
 /// The collider of `body` standing in with its hull through `points` (m, offsets from its
-/// centre of mass): their convex hull, with the body's contact coefficients and groups; `None` when the hull
-/// exceeds the body's volume by more than [`HULL_EXCESS`] or cannot be built.
+/// centre of mass, its rest shape turned): their convex hull, with the body's contact
+/// coefficients and groups; `None` when the hull exceeds the body's rest volume by more than
+/// [`HULL_EXCESS`] or cannot be built.
 fn hull_collider(body: &DeformableBody, points: &[DVec3]) -> Option<Collider> {
     let points: Vec<_> = points.iter().map(|r| r.as_vec3()).collect();
     // parry's hull must not unwind into the caller: a body it cannot take stays elastic.
@@ -144,5 +140,5 @@ fn hull_collider(body: &DeformableBody, points: &[DVec3]) -> Option<Collider> {
         .collision_groups(body.collision_groups)
         .build();
     let hull_volume = f64::from(collider.shape().mass_properties(1.0).mass());
-    (hull_volume <= (1.0 + HULL_EXCESS) * body.deformed_volume()).then_some(collider)
+    (hull_volume <= (1.0 + HULL_EXCESS) * body.mesh().volume()).then_some(collider)
 }
