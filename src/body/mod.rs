@@ -27,7 +27,7 @@ use crate::material::{ElementMaterials, Material, with_hyperelastic_model};
 use crate::mesh::TetMesh;
 use rapier3d::dynamics::CoefficientCombineRule;
 use rapier3d::geometry::InteractionGroups;
-use rapier3d::glamx::DVec3;
+use rapier3d::glamx::{DMat3, DVec3};
 
 /// A deformable body discretized by tetrahedra, linear (simulated by finite volumes) or
 /// quadratic.
@@ -396,6 +396,18 @@ impl DeformableBody {
             .sum()
     }
 
+    /// The inertia tensor (kg m²) of the nodes about `point` (m), `Σ mᵢ (|rᵢ|² 𝟙 − rᵢ rᵢᵀ)` with
+    /// `rᵢ = xᵢ − point`.
+    pub(crate) fn inertia_about(&self, point: DVec3) -> DMat3 {
+        (self.positions.iter())
+            .zip(&self.masses)
+            .map(|(x, m)| {
+                let r = *x - point;
+                (DMat3::IDENTITY * r.length_squared() - outer(r, r)) * *m
+            })
+            .fold(DMat3::ZERO, |a, b| a + b)
+    }
+
     /// Centre of mass (m).
     pub fn center_of_mass(&self) -> DVec3 {
         let weighted: DVec3 = self
@@ -406,6 +418,19 @@ impl DeformableBody {
             .sum();
         weighted / self.total_mass()
     }
+}
+
+/// `a bᵀ`.
+pub(crate) fn outer(a: DVec3, b: DVec3) -> DMat3 {
+    DMat3::from_cols(a * b.x, a * b.y, a * b.z)
+}
+
+/// The angular velocity `I⁻¹ L` (rad/s) of the inertia tensor `inertia` (kg m²) holding the
+/// angular momentum `momentum` (N m s), or `None` for a singular inertia (every node on one
+/// line through the point).
+pub(crate) fn spin_of(inertia: DMat3, momentum: DVec3) -> Option<DVec3> {
+    let trace = inertia.x_axis.x + inertia.y_axis.y + inertia.z_axis.z;
+    (inertia.determinant() > 1e-12 * trace.powi(3)).then(|| inertia.inverse() * momentum)
 }
 
 /// Lumped nodal masses (kg): each node receives a quarter of the mass of every tetrahedron it

@@ -133,6 +133,9 @@ impl StandInSet {
         (h, gravity, margin): (f64, DVec3, f64),
     ) {
         let handles = self.handles();
+        if handles.is_empty() {
+            return;
+        }
         for &handle in &handles {
             if let (Some(body), Some(state)) =
                 (soft_bodies.get_mut(handle), self.states.get(handle))

@@ -12,7 +12,7 @@
 //! over the slowest dilatational wave speed, `|vᵢ − V − ω × rᵢ| / c`: a wave of particle speed
 //! `v` carries the strain `v / c`.
 
-use crate::body::DeformableBody;
+use crate::body::{DeformableBody, spin_of};
 use crate::element::deformation_gradient;
 use rapier3d::glamx::{DMat3, DVec3};
 
@@ -31,29 +31,16 @@ impl RigidMotion {
     /// `body`'s rigid motion; `None` for an inertia tensor that cannot be inverted (nodes on a
     /// line).
     pub(super) fn of(body: &DeformableBody) -> Option<Self> {
-        let (masses, x, v) = (body.masses(), body.positions(), body.velocities());
         let mass = body.total_mass();
         let center = body.center_of_mass();
-        let offsets: Vec<DVec3> = x.iter().map(|&p| p - center).collect();
-        let mut inertia = DMat3::ZERO;
-        let (mut momentum, mut angular) = (DVec3::ZERO, DVec3::ZERO);
-        for ((&m, &r), &vi) in masses.iter().zip(&offsets).zip(v) {
-            inertia += (DMat3::from_diagonal(DVec3::splat(r.length_squared())) - outer(r, r)) * m;
-            momentum += vi * m;
-            angular += r.cross(vi) * m;
-        }
-        let determinant = inertia.determinant();
-        let scale = inertia.x_axis.x + inertia.y_axis.y + inertia.z_axis.z;
-        if !(determinant.is_finite() && determinant > 1e-12 * scale * scale * scale) {
-            return None;
-        }
+        let inertia = body.inertia_about(center);
         Some(Self {
             mass,
             center,
             inertia,
-            linvel: momentum / mass,
-            angvel: inertia.inverse() * angular,
-            offsets,
+            linvel: body.linear_momentum() / mass,
+            angvel: spin_of(inertia, body.angular_momentum())?,
+            offsets: body.positions().iter().map(|&x| x - center).collect(),
         })
     }
 
@@ -63,11 +50,6 @@ impl RigidMotion {
             .map(|(&v, &r)| (v - self.linvel - self.angvel.cross(r)).length())
             .fold(0.0, f64::max)
     }
-}
-
-/// `a bᵀ`.
-pub(super) fn outer(a: DVec3, b: DVec3) -> DMat3 {
-    DMat3::from_cols(a * b.x, a * b.y, a * b.z)
 }
 
 /// The largest Frobenius norm (dimensionless) of the Green strain over `body`'s integration

@@ -2,9 +2,9 @@
 //! strain (see `shape`) and the strain the force on it predicts at most half its tolerance, its
 //! convex hull within [`HULL_EXCESS`] of its volume.
 
-use super::shape::{RigidMotion, outer, peak_green_strain, softest};
+use super::shape::{RigidMotion, peak_green_strain, softest};
 use super::{StandIn, strain_predicted};
-use crate::body::{DeformableBody, RigidStandIn};
+use crate::body::{DeformableBody, RigidStandIn, outer};
 use crate::coupling::RapierSets;
 use crate::material::polar_rotation;
 use rapier3d::dynamics::RigidBodyBuilder;

@@ -35,8 +35,8 @@
 //! rigid bodies take the opposite ([`keep_exchanged`]): the exchange is then exact, the drain
 //! and the Newton tolerance's share included.
 
-use crate::body::DeformableBody;
-use rapier3d::glamx::{DMat3, DVec3};
+use crate::body::{DeformableBody, spin_of};
+use rapier3d::glamx::DVec3;
 
 /// Pinned nodes further than this fraction of the body's size from the line through the two
 /// furthest apart are not collinear (dimensionless).
@@ -155,8 +155,8 @@ fn turn_about(body: &mut DeformableBody, pivot: Pivot, lost: DVec3) {
 /// How fast `body` turns (rad/s): its angular momentum about its centre of mass over its inertia
 /// there, `|I_c⁻¹ L_c|`; zero for a body whose nodes lie on one line.
 pub(super) fn spin(body: &DeformableBody) -> f64 {
-    let inertia = inertia_about(body, body.center_of_mass());
-    solve(inertia, body.angular_momentum()).map_or(0.0, |turn| turn.length())
+    let inertia = body.inertia_about(body.center_of_mass());
+    spin_of(inertia, body.angular_momentum()).map_or(0.0, |turn| turn.length())
 }
 
 /// What the pins of a body leave it free to turn about.
@@ -210,7 +210,7 @@ impl Pivot {
     fn rotation(self, body: &DeformableBody, lost: DVec3) -> Option<(DVec3, DVec3)> {
         match self {
             Pivot::Free(centre) | Pivot::Point(centre) => {
-                solve(inertia_about(body, centre), lost).map(|turn| (centre, turn))
+                spin_of(body.inertia_about(centre), lost).map(|turn| (centre, turn))
             }
             Pivot::Hinge(centre, axis) => {
                 let about_axis: f64 = (0..body.positions.len())
@@ -222,26 +222,4 @@ impl Pivot {
             }
         }
     }
-}
-
-/// The inertia tensor (kg m²) of the body's nodes about `point` (m).
-fn inertia_about(body: &DeformableBody, point: DVec3) -> DMat3 {
-    (body.positions.iter())
-        .zip(&body.masses)
-        .map(|(x, m)| {
-            let r = *x - point;
-            (DMat3::IDENTITY * r.length_squared() - outer(r, r)) * *m
-        })
-        .fold(DMat3::ZERO, |a, b| a + b)
-}
-
-/// `a bᵀ`.
-fn outer(a: DVec3, b: DVec3) -> DMat3 {
-    DMat3::from_cols(a * b.x, a * b.y, a * b.z)
-}
-
-/// `I⁻¹ L`, or `None` for a singular inertia (every node on one line through the point).
-fn solve(inertia: DMat3, momentum: DVec3) -> Option<DVec3> {
-    let trace = inertia.x_axis.x + inertia.y_axis.y + inertia.z_axis.z;
-    (inertia.determinant() > 1e-12 * trace.powi(3)).then(|| inertia.inverse() * momentum)
 }
