@@ -307,3 +307,65 @@ fn an_elastic_bar_striking_a_wall_end_on_rebounds_at_its_impact_speed() {
     assert!((speed - 1.0).abs() < 0.05);
     assert!((contact_time / expected_time - 1.0).abs() < 0.05);
 }
+
+/// The contacts `detect_contacts` finds for `body` (its frame 1/60 s, default settings) among
+/// `colliders` and `bodies`, split into those with `ground` and the rest.
+fn contacts_with(
+    body: &DeformableBody,
+    (colliders, bodies): (&ColliderSet, &RigidBodySet),
+    ground: rapier3d::prelude::ColliderHandle,
+) -> (usize, usize) {
+    let mut constraints = BodyConstraints::new();
+    let settings = ContactSettings::default();
+    let found =
+        (constraints.detect_contacts(body, colliders, bodies, 1.0 / 60.0, GRAVITY, &settings))
+            .unwrap();
+    let on_ground = (found.iter())
+        .filter(|c| c.target == ContactTarget::Collider(ground))
+        .count();
+    (on_ground, found.len() - on_ground)
+}
+
+/// A fixed rigid body holding a ground half-space (as scenes make the ground), and its collider.
+fn fixed_ground() -> (ColliderSet, RigidBodySet, rapier3d::prelude::ColliderHandle) {
+    use rapier3d::prelude::RigidBodyBuilder;
+    let (mut colliders, mut bodies) = (ColliderSet::new(), RigidBodySet::new());
+    let fixed = bodies.insert(RigidBodyBuilder::fixed());
+    let shape = ColliderBuilder::new(SharedShape::halfspace(rapier_fvm::glamx::Vec3::Y));
+    let ground = colliders.insert_with_parent(shape, fixed, &mut bodies);
+    (colliders, bodies, ground)
+}
+
+#[test]
+fn a_body_resting_on_a_fixed_half_space_touches_it_only_within_reach() {
+    // Reach at rest over a 1/60 s frame: the 1 mm margin plus 2 |g| dt² = 5.45 mm. The cube's
+    // bottom face (5 x 5 nodes) is 0.5 mm above the ground, its next layer 25.5 mm: 25 contacts.
+    // A half-space's bounds are infinite; its fixed body, not turning, must not make every
+    // surface node within a metre a contact (it did: 0 x infinity made the reach NaN, which
+    // `f64::min` turned into the largest collider reach, 1 m).
+    let (colliders, bodies, ground) = fixed_ground();
+    let cube = rubber_cube(DVec3::new(0.0, 0.0505, 0.0), DVec3::ZERO);
+    assert_eq!(contacts_with(&cube, (&colliders, &bodies), ground), (25, 0));
+}
+
+#[test]
+fn a_collider_about_to_strike_a_body_widens_its_reach_to_the_ground() {
+    // The cube's bottom is 10 mm above the ground, beyond its own reach at rest (6.45 mm): no
+    // contact. A box 2 mm above its top falling at 3 m/s can drive it down within the frame,
+    // so the ground's reach grows by the box's travel (2 x 3 m/s x 1/60 s = 0.1 m, to 106.5 mm):
+    // the bottom face's 25 nodes and the 16 surface nodes of each layer 35, 60 and 85 mm up
+    // touch it, not the top face at 110 mm.
+    use rapier3d::prelude::RigidBodyBuilder;
+    let (mut colliders, mut bodies, ground) = fixed_ground();
+    let cube = rubber_cube(DVec3::new(0.0, 0.06, 0.0), DVec3::ZERO);
+    assert_eq!(contacts_with(&cube, (&colliders, &bodies), ground), (0, 0));
+    let falling = RigidBodyBuilder::dynamic()
+        .translation(rapier_fvm::glamx::Vec3::new(0.0, 0.127, 0.0))
+        .linvel(rapier_fvm::glamx::Vec3::new(0.0, -3.0, 0.0));
+    let falling = bodies.insert(falling);
+    let shape = ColliderBuilder::cuboid(0.015, 0.015, 0.015);
+    colliders.insert_with_parent(shape, falling, &mut bodies);
+    let (on_ground, on_box) = contacts_with(&cube, (&colliders, &bodies), ground);
+    assert_eq!(on_ground, 25 + 3 * 16);
+    assert!(on_box > 0, "the box's own contacts with the top face");
+}

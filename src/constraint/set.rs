@@ -76,14 +76,15 @@ impl BodyConstraints {
     }
 
     /// [`BodyConstraints::detect_contacts`] against `colliders` as the coupling sees them, with
-    /// `rigid` telling an attached rigid body's pose and fresh proxy.
+    /// `rigid` telling an attached rigid body's pose and fresh proxy; `struck` (m) is what the
+    /// fastest other deformable body that can meet this one travels over the step.
     ///
     /// # Errors
     /// Those of [`BodyConstraints::detect_contacts`].
     pub(crate) fn detect_among(
         &mut self,
         body: &DeformableBody,
-        colliders: &[ColliderView],
+        colliders: (&[ColliderView], f64),
         rigid: &dyn Fn(RigidBodyHandle) -> Option<(Pose, RigidProxy)>,
         frame_dt: f64,
         gravity: DVec3,

@@ -45,13 +45,14 @@ pub(crate) struct Detection {
     pub(crate) reach: f64,
 }
 
-/// Finds the contacts of `body`'s surface points with the `colliders` for a frame of `frame_dt`
-/// (s) under `gravity` (m/s²) (see
+/// Finds the contacts of `body`'s surface points with the `colliders` for a frame of `frame_dt` (s)
+/// under `gravity` (m/s²) (see
 /// [`BodyConstraints::detect_contacts`](crate::constraint::BodyConstraints::detect_contacts));
-/// `glued` lists the rigid bodies and the nodes glued to them, which do not touch their
-/// colliders; `previous` are the contacts of the last detection and the rigid proxies of its
-/// step, whose points' paths since then tell the face a point entered a collider by (see
-/// [`super::entry`]).
+/// `struck` (m) is what the fastest other deformable body that can meet it travels over the step
+/// (twice its fastest node's distance); `glued` lists the rigid bodies and the nodes glued to them,
+/// which do not touch their colliders; `previous` are the contacts of the last detection and the
+/// rigid proxies of its step, whose points' paths since then tell the face a point entered a
+/// collider by (see [`super::entry`]).
 ///
 /// # Errors
 /// [`Error::InvalidTimeStep`], [`Error::NonFiniteInput`] or [`Error::InvalidSetting`] for a bad
@@ -59,7 +60,7 @@ pub(crate) struct Detection {
 pub(crate) fn detect(
     body: &DeformableBody,
     (glued, previous): (&[(RigidBodyHandle, u32)], LastDetection<'_>),
-    colliders: &[ColliderView],
+    (colliders, struck): (&[ColliderView], f64),
     frame_dt: f64,
     gravity: DVec3,
     settings: &ContactSettings,
@@ -73,6 +74,11 @@ pub(crate) fn detect(
     let reach = settings.margin
         + 2.0 * (body.fastest_node_speed() + gravity.length() * frame_dt) * frame_dt;
     let bounds = body.position_bounds();
+    // A body striking this one within the step speeds its nodes up towards the others (a box
+    // landing on a block drives the block's bottom into the ground): each collider's reach is
+    // widened by the travel of the fastest other collider or body that can meet it. Not its own
+    // again: a contact plane taken far from a box sliding past would sweep into the body.
+    let strikers = Strikers::of(body, colliders, (bounds, reach), struck);
     let mut tree = None;
     let mut corners = Vec::new();
     let contact_points = contact_points(body);
@@ -88,7 +94,7 @@ pub(crate) fn detect(
         if !body.collision_groups.test(view.groups) {
             continue;
         }
-        let near = near_collider(body, glued, view, reach);
+        let near = near_collider(body, glued, view, reach + strikers.other_than(view.handle));
         let mut proxy = None;
         // A point is a candidate only within the collider's widened box (`node_contact_with`).
         let candidates = if near.overlaps(point_bounds) {
@@ -126,6 +132,65 @@ pub(crate) fn detect(
         proxies,
         reach,
     })
+}
+
+/// The fastest colliders that can meet a body within a step: the largest travel (m, at most
+/// [`MAX_COLLIDER_REACH`]) with its collider, the second largest, and that of the other
+/// deformable bodies (which no collider's handle names).
+struct Strikers {
+    fastest: Option<(ColliderHandle, f64)>,
+    second: f64,
+    bodies: f64,
+}
+
+impl Strikers {
+    /// Among the `colliders` `body` interacts with, those whose bounds, widened by `reach` (m)
+    /// and their travel, overlap the body's `bounds`; and the other bodies, whose fastest that
+    /// can meet it travels `struck` (m).
+    fn of(
+        body: &DeformableBody,
+        colliders: &[ColliderView],
+        (bounds, reach): ((DVec3, DVec3), f64),
+        struck: f64,
+    ) -> Self {
+        let mut strikers = Self {
+            fastest: None,
+            second: 0.0,
+            bodies: struck.min(MAX_COLLIDER_REACH),
+        };
+        for view in colliders {
+            let travel = view.travel.min(MAX_COLLIDER_REACH);
+            let widen = DVec3::splat(reach + travel);
+            let (lo, hi) = view.bounds;
+            if travel <= 0.0
+                || !body.collision_groups.test(view.groups)
+                || (hi + widen).cmplt(bounds.0).any()
+                || (lo - widen).cmpgt(bounds.1).any()
+            {
+                continue;
+            }
+            match strikers.fastest {
+                Some((_, fastest)) if travel <= fastest => {
+                    strikers.second = strikers.second.max(travel);
+                }
+                _ => {
+                    strikers.second = strikers.fastest.map_or(0.0, |(_, t)| t);
+                    strikers.fastest = Some((view.handle, travel));
+                }
+            }
+        }
+        strikers
+    }
+
+    /// The travel (m) of the fastest of them other than `collider`.
+    fn other_than(&self, collider: ColliderHandle) -> f64 {
+        let colliders = match self.fastest {
+            Some((handle, _)) if handle == collider => self.second,
+            Some((_, travel)) => travel,
+            None => 0.0,
+        };
+        colliders.max(self.bodies)
+    }
 }
 
 /// What detection needs of the collider `view` for `body`: the nodes glued to its body (from

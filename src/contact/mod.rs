@@ -3,9 +3,11 @@
 //!
 //! Detection ([`BodyConstraints::detect_contacts`](crate::constraint::BodyConstraints::detect_contacts)) projects every surface node onto every collider
 //! (parry's point projection, which covers all of rapier's shapes) that the node can reach within
-//! the coming frame, and keeps the nearest surface point and its outward normal as a
-//! [`NodeContact`]: a plane the node must stay on the outer side of during the frame. The
-//! integrators then enforce the planes:
+//! the coming frame (its body's fastest node, gravity, the collider's own motion, and the fastest
+//! other collider or deformable body that can strike the body, which can drive its nodes towards
+//! the others), and keeps the nearest surface point and its outward normal as a [`NodeContact`]:
+//! a plane the node must stay on the outer side of during the frame. The integrators then enforce
+//! the planes:
 //!
 //! - [`SymplecticEuler`](crate::integrate::SymplecticEuler), at every substep, as velocity
 //!   constraints: a node's normal velocity is raised so that it does not cross its plane within

@@ -4,6 +4,7 @@
 //! impulses the soft step gave dynamic rigid bodies, applied at the end of the step. The
 //! [`BodyConstraints`] methods that take rapier's sets live here.
 
+use super::reach::turning_speed;
 use crate::Error;
 use crate::attachment;
 use crate::body::DeformableBody;
@@ -34,7 +35,7 @@ pub(crate) fn collider_views(
             let travel = parent.map_or(0.0, |(_, body)| {
                 let radius = f64::from(aabb.half_extents().length());
                 let (linvel, angvel) = coming_velocity(body, dt);
-                2.0 * (linvel.length() + angvel.length() * radius) * dt
+                2.0 * (linvel.length() + turning_speed(angvel.length(), radius)) * dt
             });
             ColliderView {
                 handle,
@@ -69,7 +70,9 @@ impl BodyConstraints {
     /// [`collision_groups`](crate::body::DeformableBody::collision_groups) interact with and it
     /// is within `settings.margin` of, plus twice the distance the body's fastest node can
     /// travel in the frame (`2 (|v|max + |g| dt) dt`), plus twice the collider's own travel (at
-    /// most 1 m), except the colliders of a rigid body the point is attached to; with
+    /// most 1 m) and twice that of the fastest collider that can meet the body (a collider
+    /// striking it can drive its nodes into another), except the colliders of a rigid body the
+    /// point is attached to; with
     /// [`self_contact`](crate::body::DeformableBody::self_contact) on, also with the body's own
     /// boundary. The integrators enforce them until the next detection. It also places the
     /// attachments' anchors where their rigid bodies of `bodies` are now (dropping attachments
@@ -89,7 +92,7 @@ impl BodyConstraints {
     ) -> Result<&[NodeContact], Error> {
         let views = collider_views(colliders, bodies, frame_dt);
         let rigid = rigid_lookup(bodies, frame_dt);
-        self.detect_among(body, &views, &rigid, frame_dt, gravity, settings)
+        self.detect_among(body, (&views, 0.0), &rigid, frame_dt, gravity, settings)
     }
 
     /// Glues `nodes` of `body` to the rigid body `rigid` of `bodies` where they are now: each

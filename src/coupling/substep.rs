@@ -8,7 +8,7 @@ use super::carry::Carried;
 use super::groups::{GroupStep, step_groups, touching_groups};
 use super::loads::FrameLoads;
 use super::pull::RapierPull;
-use super::{Outcome, RigidSets, SoftCoupling, rapier_view};
+use super::{Outcome, RigidSets, SoftCoupling, rapier_view, reach};
 use crate::Error;
 use crate::body::{DeformableBody, DeformableBodyHandle, DeformableBodySet};
 use crate::constraint::{self, BodyConstraints};
@@ -213,18 +213,24 @@ impl SoftCoupling {
         let views = rapier_view::collider_views(rigid.colliders, rigid.bodies, h);
         let lookup = rapier_view::rigid_lookup(rigid.bodies, h);
         let (mut live, mut held) = (Vec::new(), Vec::new());
-        for (handle, outcome) in outcomes.iter_mut() {
-            if self.sleeping.is_asleep(*handle)
-                || self.stand_ins.contains(*handle)
-                || skip.contains(handle)
-            {
-                continue;
-            }
-            let body = &soft_bodies[*handle];
+        let awake: Vec<usize> = (outcomes.iter().enumerate())
+            .filter(|(_, (handle, _))| {
+                !(self.sleeping.is_asleep(*handle)
+                    || self.stand_ins.contains(*handle)
+                    || skip.contains(handle))
+            })
+            .map(|(i, _)| i)
+            .collect();
+        let bodies: Vec<&DeformableBody> = (awake.iter())
+            .map(|&i| &soft_bodies[outcomes[i].0])
+            .collect();
+        let struck = reach::struck_by(&bodies, self.contact.margin, h, gravity);
+        for (&i, (body, struck)) in awake.iter().zip(bodies.into_iter().zip(struck)) {
+            let (handle, outcome) = &mut outcomes[i];
             let detected = body.check_state().and_then(|()| {
                 self.links.entry(*handle).constraints.detect_among(
                     body,
-                    &views,
+                    (&views, struck),
                     &lookup,
                     h,
                     gravity,

@@ -80,7 +80,10 @@ impl SoftCoupling {
                 continue;
             }
             let constraints = &mut self.links.entry(*handle).constraints;
-            let detected = constraints.detect_among(body, &views, &lookup, dt, gravity, &settings);
+            // Near no other deformable body: none strikes it.
+            let colliders = (&views[..], 0.0);
+            let detected =
+                constraints.detect_among(body, colliders, &lookup, dt, gravity, &settings);
             if detected.is_ok() && !constraints.touches_dynamic_body() {
                 alone.push(*handle);
             }
