@@ -160,12 +160,9 @@ impl Strikers {
         };
         for view in colliders {
             let travel = view.travel.min(MAX_COLLIDER_REACH);
-            let widen = DVec3::splat(reach + travel);
-            let (lo, hi) = view.bounds;
             if travel <= 0.0
                 || !body.collision_groups.test(view.groups)
-                || (hi + widen).cmplt(bounds.0).any()
-                || (lo - widen).cmpgt(bounds.1).any()
+                || !overlaps_widened(view.bounds, reach + travel, bounds)
             {
                 continue;
             }
@@ -432,12 +429,16 @@ impl NearCollider<'_> {
             .map(|fresh| RigidProxy::index_in(proxies, fresh))
     }
 
-    /// Whether its bounding box, widened by the reach, overlaps the box `(lo, hi)` (m).
-    fn overlaps(&self, (lo, hi): (DVec3, DVec3)) -> bool {
-        let reach = DVec3::splat(self.reach);
-        let (own_lo, own_hi) = self.bounds;
-        !((own_hi + reach).cmplt(lo).any() || (own_lo - reach).cmpgt(hi).any())
+    /// Whether its bounding box, widened by the reach, overlaps the box `other` (m).
+    fn overlaps(&self, other: (DVec3, DVec3)) -> bool {
+        overlaps_widened(self.bounds, self.reach, other)
     }
+}
+
+/// Whether the box `(lo, hi)` (m), widened by `by` (m) on every side, overlaps the box `other`.
+fn overlaps_widened((lo, hi): (DVec3, DVec3), by: f64, other: (DVec3, DVec3)) -> bool {
+    let by = DVec3::splat(by);
+    !((hi + by).cmplt(other.0).any() || (lo - by).cmpgt(other.1).any())
 }
 
 /// The most (m) a rigid collider's own motion widens the detection reach (a body flung across

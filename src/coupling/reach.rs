@@ -70,8 +70,8 @@ pub(crate) fn struck_by(
 ) -> Vec<f64> {
     let reaches: Vec<(Bounds, f64)> = (bodies.iter())
         .map(|body| {
-            let travel = body_travel(body, dt, gravity);
-            (widen(body.position_bounds(), margin + travel), travel)
+            let reach = body_reach(body, margin, dt, gravity);
+            (reach, body_travel(body, dt, gravity))
         })
         .collect();
     (reaches.iter().enumerate())
