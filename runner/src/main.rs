@@ -127,6 +127,9 @@ enum Command {
     Calibrate,
 }
 
+/// The exit status after a reader closed stdout early: a shell's for a program SIGPIPE ended.
+const BROKEN_PIPE_STATUS: i32 = 141;
+
 fn main() -> ExitCode {
     // A bug must still end in one line, not a backtrace.
     std::panic::set_hook(Box::new(|info| {
@@ -136,6 +139,12 @@ fn main() -> ExitCode {
             .map(|s| (*s).to_owned())
             .or_else(|| info.payload().downcast_ref::<String>().cloned())
             .unwrap_or_default();
+        // A reader that stopped early (`rapier-fvm run ... | head -1`) closed stdout, and
+        // `println!` panics: end as `cat` ends there, quietly, with 128 + SIGPIPE (`run` prints
+        // its summary once its files are written).
+        if message.starts_with("failed printing to stdout") {
+            std::process::exit(BROKEN_PIPE_STATUS);
+        }
         eprintln!("error: internal error: {message}");
     }));
     let cli = Cli::parse();

@@ -157,6 +157,35 @@ fn a_short_run_succeeds_and_prints_a_summary() {
 }
 
 #[test]
+fn a_reader_that_stops_early_ends_the_run_quietly() {
+    // As `rapier-fvm run ... | head -1`: the pipe is closed before the summary is printed. The
+    // program ends quietly with 141, as a shell reports `cat` ended by SIGPIPE; before, it
+    // printed "error: internal error: failed printing to stdout: Broken pipe".
+    use std::process::{Command, Stdio};
+    let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("cli_pipe");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_rapier-fvm"))
+        .args([
+            "run",
+            "assets/scenes/cantilever.toml",
+            "--duration",
+            "0.05",
+            "--out",
+        ])
+        .arg(&out)
+        .current_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the binary runs");
+    drop(child.stdout.take());
+    let output = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(stderr.is_empty(), "{stderr:?}");
+    assert_eq!(output.status.code(), Some(141));
+    assert!(out.join("report.json").is_file(), "the run itself finished");
+}
+
+#[test]
 fn calibrate_prints_a_cost_table_a_scene_reads() {
     // The measured values differ from machine to machine and run to run; what is checked is
     // that the printed table is a scene's `[integrator.cost]`, read back to the printed digits,
