@@ -2,6 +2,9 @@
 //! and wakes when something touches it, its state is edited or a rigid body it rests with moves;
 //! a free body never sleeps, however slow.
 
+mod common;
+
+use common::ground_load;
 use rapier_fvm::coupling::Audit;
 use rapier_fvm::glamx::Vec3;
 use rapier_fvm::prelude::*;
@@ -48,15 +51,6 @@ fn until_asleep(world: &mut FvmWorld, soft: DeformableBodyHandle, frames: usize)
         }
     }
     panic!("not asleep after {frames} frames");
-}
-
-/// The vertical force (N) the deformable bodies exert on the colliders without a rigid body
-/// (the ground) over the last frame.
-fn ground_load(world: &FvmWorld) -> f64 {
-    (world.collider_loads().iter())
-        .filter(|load| world.physics.colliders[load.collider].parent().is_none())
-        .map(|load| load.force.y)
-        .sum()
 }
 
 #[test]

@@ -2,6 +2,9 @@
 //! rapier rigid body, keeps its momentum across the switch, carries a soft body resting on it,
 //! and turns elastic when the loads on it rise.
 
+mod common;
+
+use common::ground_load;
 use rapier_fvm::coupling::Audit;
 use rapier_fvm::glamx::Vec3;
 use rapier_fvm::prelude::*;
@@ -139,16 +142,6 @@ fn a_body_standing_in_moves_as_rapiers_rigid_bodies_do() {
     );
     assert!((l - l0).length() < 1e-2 * l0.length(), "{l} against {l0}");
     assert!((k - k0).abs() < 1e-3 * k0, "{k} J against {k0} J");
-}
-
-/// The vertical force (N) the deformable bodies (stand-ins through their rapier contacts)
-/// exerted on the colliders without a rigid body (the ground) over the last frame: negative,
-/// they push it down.
-fn ground_load(world: &FvmWorld) -> f64 {
-    (world.collider_loads().iter())
-        .filter(|load| world.physics.colliders[load.collider].parent().is_none())
-        .map(|load| load.force.y)
-        .sum()
 }
 
 #[test]

@@ -601,3 +601,12 @@ pub fn glue_to_fixed_axle(
     world.attach(handle, hinge.iter().copied(), fixed).unwrap();
     fixed
 }
+
+/// The vertical force (N) the deformable bodies exert on the colliders without a rigid body
+/// (the ground) over the last frame: negative, they push it down.
+pub fn ground_load(world: &FvmWorld) -> f64 {
+    (world.collider_loads().iter())
+        .filter(|load| world.physics.colliders[load.collider].parent().is_none())
+        .map(|load| load.force.y)
+        .sum()
+}
