@@ -59,12 +59,12 @@ impl Default for CostModel {
     fn default() -> Self {
         Self {
             explicit_tet: 19.0e-9,
-            explicit_tet_corotated: 164e-9,
+            explicit_tet_corotated: 98e-9,
             explicit_damped_factor: 1.64,
             explicit_contact_point: 138e-9,
             newton_tet: 1.10e-6,
             newton_size_exponent: 0.16,
-            newton_tet_corotated: 2.13e-6,
+            newton_tet_corotated: 1.69e-6,
             newton_iterations: 1.27,
         }
     }
