@@ -90,18 +90,25 @@ impl VelocityConstraint {
 
     /// One sweep's correction along the plane's unit `normal` with Coulomb coefficient
     /// `friction`; returns the impulse (N s) it gave the node. Nothing when no impulse moves
-    /// either side (both held: a pinned node, or a held body's node, against a fixed obstacle).
+    /// either side (both held: a pinned node, or a held body's node, against a fixed obstacle),
+    /// nor for a contact that has pushed nothing yet and whose node keeps clear of the plane
+    /// (most of a sweep's contacts: the reach takes nodes that may meet the obstacle): its
+    /// normal impulse would stay zero, and with it the friction's limit.
     pub(crate) fn correct(
         &mut self,
         normal: DVec3,
         friction: f64,
         sides: &mut impl ContactSides,
     ) -> DVec3 {
+        let normal_speed = sides.relative_velocity().dot(normal);
+        let untouched = self.normal_impulse == 0.0 && self.friction_impulse == DVec3::ZERO;
+        if untouched && normal_speed >= self.lowest_speed {
+            return DVec3::ZERO;
+        }
         let inverse_mass = sides.inverse_mass_along(normal);
         if inverse_mass <= 0.0 {
             return DVec3::ZERO;
         }
-        let normal_speed = sides.relative_velocity().dot(normal);
         let normal_impulse =
             (self.normal_impulse + (self.lowest_speed - normal_speed) / inverse_mass).max(0.0);
         let pushed = normal * (normal_impulse - self.normal_impulse);
