@@ -374,6 +374,7 @@ fn print_summary(report: &sim::Report, out: &std::path::Path) {
             report.stepping_time_s,
         ],
     );
+    print_frame_times(&report.frame_times);
     for body in &report.soft_bodies {
         print_soft_body(body);
     }
@@ -410,6 +411,21 @@ fn print_summary(report: &sim::Report, out: &std::path::Path) {
         );
     }
     println!("  written to {}", out.display());
+}
+
+/// Prints where a 3D run's stepping time went: the median and slowest frames, and the frames
+/// slower than real time with their share of the stepping.
+fn print_frame_times(times: &sim::FrameTimes) {
+    println!(
+        "  frames: median {:.2} ms, slowest {:.2} ms (frame {}); {} of {} over the real-time budget of {:.2} ms, {:.0} % of the stepping",
+        times.median_ms,
+        times.slowest_ms,
+        times.slowest_frame,
+        times.over_budget_frames,
+        times.ms.len(),
+        times.budget_ms,
+        100.0 * times.over_budget_share,
+    );
 }
 
 /// Prints a 3D soft body's line of the summary: its elements, frames, failures and the cost

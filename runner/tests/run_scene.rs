@@ -102,6 +102,15 @@ fn a_short_drop_writes_every_output_and_the_vtu_matches_the_body() {
     assert_eq!(json["frames"], 6);
     assert_eq!(json["probes"][0]["values"].as_array().unwrap().len(), 7);
     assert!(json["ms_per_frame"].as_f64().unwrap() > 0.0);
+    // Each frame's stepping time, summing to the stepping time, and the one body awake (the
+    // cube falls for all six frames).
+    let times = &report.frame_times;
+    assert_eq!(times.ms.len(), 6);
+    assert!(times.ms.iter().all(|&t| t > 0.0));
+    let summed: f64 = times.ms.iter().sum();
+    assert!((summed - 1e3 * report.stepping_time_s).abs() < 1e-6 * summed);
+    assert_eq!(times.awake_soft_bodies, vec![1; 6]);
+    assert_eq!(json["frame_times"]["ms"].as_array().unwrap().len(), 6);
     // Saved frames 0, 3, 6: one .vtu each, an OBJ each, the index.
     let pvd = std::fs::read_to_string(out.join("paraview/drop.pvd")).unwrap();
     assert_eq!(pvd.matches("<DataSet").count(), 3);
@@ -121,7 +130,11 @@ fn a_short_drop_writes_every_output_and_the_vtu_matches_the_body() {
         let png = std::fs::read(out.join("pictures").join(file)).unwrap();
         assert_eq!(&png[1..4], b"PNG", "{file}");
     }
-    for file in ["cube_centre_height_change.png", "ground_reaction.png"] {
+    for file in [
+        "cube_centre_height_change.png",
+        "ground_reaction.png",
+        "stepping_time_per_frame.png",
+    ] {
         assert!(out.join("plots").join(file).is_file(), "{file}");
     }
 

@@ -8,9 +8,11 @@
 //! | `obj/surface_<n>.obj` | every body's surface per saved frame (Blender) |
 //! | `pictures/view_<frame>.png`, `pictures/stress_<frame>.png` | rendered views by material and by von Mises stress |
 //! | `plots/<probe>.png` | each probe against time |
+//! | `plots/stepping_time_per_frame.png` | each frame's stepping wall time (ms) against time |
 
 mod build;
 mod cost;
+mod frame_times;
 mod loads;
 mod materials;
 mod meshes;
@@ -26,7 +28,7 @@ pub use loads::{DrivenLoad, LoadSchedule};
 pub use needs::BodyNeeds;
 pub use probe::Probe;
 pub use report::{
-    BodyFlags, Files, Flag, ProbeReport, Report, RigidBodyReport, Settings, SoftBodyReport,
-    Stability,
+    BodyFlags, Files, Flag, FrameTimes, ProbeReport, Report, RigidBodyReport, Settings,
+    SoftBodyReport, Stability,
 };
 pub use run::{RunError, RunOptions, run, run_within};

@@ -9,6 +9,7 @@ use rapier_fvm::integrate::{AutomaticReport, IntegratorKind};
 use serde::Serialize;
 
 pub use super::cost::StepCost;
+pub use super::frame_times::FrameTimes;
 
 /// The whole report.
 #[derive(Debug, Clone, Serialize)]
@@ -35,6 +36,8 @@ pub struct Report {
     pub ms_per_frame: f64,
     /// Simulated time over stepping wall time (above 1: faster than real time).
     pub speed_vs_real_time: f64,
+    /// Each frame's stepping time and awake soft bodies, and where the time went.
+    pub frame_times: FrameTimes,
     /// Whether anything went wrong numerically.
     pub stability: Stability,
     /// Every probe's samples and final value.

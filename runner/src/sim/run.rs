@@ -1,8 +1,9 @@
 //! The frame loop: drive the kinematic bodies, step, record each body's outcome and what the
-//! per-frame audit finds, sample the probes, save frames, then render the pictures and plots and
-//! write the report with its stability verdict.
+//! per-frame audit finds and each frame's stepping time, sample the probes, save frames, then
+//! render the pictures and plots and write the report with its stability verdict.
 
 use super::build::Simulation;
+use super::frame_times::FrameTimes;
 use super::report::{
     ProbeReport, Report, RigidBodyReport, Settings, SoftBodyReport, Stability, write_report,
 };
@@ -99,13 +100,16 @@ pub fn run_within(
     writer.frame(0, |time, patch| sim.snapshot(time, patch))?;
     let progress = progress_bar(frames, options.progress);
     let mut stepping = Duration::ZERO;
+    let (mut frame_ms, mut awake) = (Vec::with_capacity(frames), Vec::with_capacity(frames));
     for frame in 1..=frames {
         let t = frame as f64 * dt;
         let step_start = Instant::now();
         sim.drive_kinematic(t);
         sim.drive_loads(t, &scene.source)?;
         let outcomes = sim.world.step();
-        stepping += step_start.elapsed();
+        let frame_time = step_start.elapsed();
+        stepping += frame_time;
+        frame_ms.push(frame_time.as_secs_f64() * 1e3);
         if limit.is_some_and(|limit| stepping > limit) {
             return Err(RunError::OverTime {
                 frame,
@@ -113,11 +117,11 @@ pub fn run_within(
                 stepping_s: stepping.as_secs_f64(),
             });
         }
-        record_frame(
+        awake.push(record_frame(
             &sim,
             (frame, &outcomes),
             (&mut bodies, &mut stability, &mut audit),
-        );
+        ));
         sim.sample_probes(t);
         writer.frame(frame, |time, patch| sim.snapshot(time, patch))?;
         progress.set_position(frame as u64);
@@ -125,7 +129,10 @@ pub fn run_within(
         progress.set_message(format!("t = {t:.3} s, {speed:.2}x real time"));
     }
     progress.finish_and_clear();
-    let files = writer.finish(sim.probes.iter().map(|p| &p.series))?;
+    let frame_times = FrameTimes::new(frame_ms, awake, dt);
+    let frame_series = frame_times.series(dt);
+    let plotted = sim.probes.iter().map(|p| &p.series);
+    let files = writer.finish(plotted.chain([&frame_series]))?;
     stability.final_state_finite = (sim.soft.iter())
         .map(|entry| &sim.world.soft_bodies[entry.handle])
         .all(|b| {
@@ -149,6 +156,7 @@ pub fn run_within(
         stepping_time_s: stepping_s,
         ms_per_frame: stepping_s * 1e3 / frames as f64,
         speed_vs_real_time: simulated / stepping_s.max(1e-9),
+        frame_times,
         stability,
         probes: (sim.probes.iter())
             .map(|p| ProbeReport::of(&p.series, p.kind.name()))
@@ -161,13 +169,15 @@ pub fn run_within(
 
 /// Records what frame `frame`'s step `outcomes` were in each soft body's report, the bodies
 /// asleep, their strain, rotation and contacts, and what the `audit` of the frame finds, in
-/// the reports and the `stability`.
+/// the reports and the `stability`; returns the soft bodies awake (neither asleep nor standing
+/// in as a rigid body).
 fn record_frame(
     sim: &Simulation,
     (frame, outcomes): (usize, &SoftStepResults),
     (bodies, stability, audit): (&mut [SoftBodyReport], &mut Stability, &mut Audit),
-) {
+) -> usize {
     let report_of = |handle: DeformableBodyHandle| sim.soft.iter().position(|e| e.handle == handle);
+    let mut awake = 0;
     for (handle, outcome) in outcomes {
         if let Some(i) = report_of(*handle) {
             bodies[i].record(outcome, stability);
@@ -178,6 +188,7 @@ fn record_frame(
         report.asleep_frames += usize::from(asleep);
         let standing_in = sim.world.coupling.rigid_stand_in_of(entry.handle).is_some();
         report.rigid_frames += usize::from(standing_in);
+        awake += usize::from(!asleep && !standing_in);
         let touching = (sim.world.coupling.constraints(entry.handle))
             .is_some_and(|constraints| constraints.pushed_by_collider());
         let body = &sim.world.soft_bodies[entry.handle];
@@ -190,6 +201,7 @@ fn record_frame(
             bodies[i].record_audit(frame, body_audit);
         }
     }
+    awake
 }
 
 /// A progress bar over `frames`, drawn on stderr only when it is a terminal and `show` is set.

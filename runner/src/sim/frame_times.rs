@@ -1,0 +1,107 @@
+//! Where a run's stepping time goes, frame by frame: each frame's stepping wall time (ms) and the
+//! soft bodies awake after it, summed up as the median and slowest frame and the frames slower
+//! than real time (a frame's stepping longer than its `dt`) with their share of the stepping.
+
+use crate::output::TimeSeries;
+use serde::Serialize;
+
+/// Each frame's stepping time and awake soft bodies, with their summary (`frame_times` in
+/// `report.json`).
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct FrameTimes {
+    /// Stepping wall time (ms) of each frame, the first frame first.
+    pub ms: Vec<f64>,
+    /// Soft bodies awake (neither asleep nor standing in as a rigid body) after each frame.
+    pub awake_soft_bodies: Vec<usize>,
+    /// The median frame's stepping time (ms).
+    pub median_ms: f64,
+    /// The slowest frame (counted from 1), 0 when there are none.
+    pub slowest_frame: usize,
+    /// The slowest frame's stepping time (ms).
+    pub slowest_ms: f64,
+    /// The real-time budget of a frame, its `dt` (ms).
+    pub budget_ms: f64,
+    /// The frames whose stepping took longer than the budget.
+    pub over_budget_frames: usize,
+    /// Those frames' share of the whole stepping time (0 to 1).
+    pub over_budget_share: f64,
+}
+
+impl FrameTimes {
+    /// The summary of frames that took `ms` (ms each) with `awake_soft_bodies` awake after each,
+    /// against the budget of a frame of `dt` (s).
+    pub fn new(ms: Vec<f64>, awake_soft_bodies: Vec<usize>, dt: f64) -> Self {
+        let budget_ms = dt * 1e3;
+        let total: f64 = ms.iter().sum();
+        let over: Vec<f64> = ms.iter().copied().filter(|&t| t > budget_ms).collect();
+        let (slowest_frame, slowest_ms) = (ms.iter().enumerate())
+            .max_by(|a, b| a.1.total_cmp(b.1))
+            .map_or((0, 0.0), |(i, &t)| (i + 1, t));
+        Self {
+            median_ms: median(&ms),
+            slowest_frame,
+            slowest_ms,
+            budget_ms,
+            over_budget_frames: over.len(),
+            over_budget_share: if total > 0.0 {
+                over.iter().sum::<f64>() / total
+            } else {
+                0.0
+            },
+            ms,
+            awake_soft_bodies,
+        }
+    }
+
+    /// The stepping time per frame against simulated time, for a plot.
+    pub fn series(&self, dt: f64) -> TimeSeries {
+        TimeSeries {
+            name: "stepping time per frame".to_owned(),
+            unit: "ms".to_owned(),
+            samples: (self.ms.iter().enumerate())
+                .map(|(i, &t)| ((i + 1) as f64 * dt, t))
+                .collect(),
+        }
+    }
+}
+
+/// The median of `values` (the mean of the middle two for an even count), 0 for none.
+fn median(values: &[f64]) -> f64 {
+    let mut sorted = values.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    let n = sorted.len();
+    match n {
+        0 => 0.0,
+        _ if n % 2 == 1 => sorted[n / 2],
+        _ => 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_summary_counts_the_frames_slower_than_real_time_and_their_share() {
+        // At 60 Hz the budget is 16.67 ms: frames 2 and 3 (20 and 30 ms) are over it and take
+        // 50 of the 65 ms stepped; the median of 5, 10, 20, 30 is 15.
+        let times = FrameTimes::new(vec![10.0, 20.0, 30.0, 5.0], vec![3, 3, 2, 1], 1.0 / 60.0);
+        assert_eq!(times.over_budget_frames, 2);
+        assert!((times.over_budget_share - 50.0 / 65.0).abs() < 1e-15);
+        assert_eq!(times.median_ms, 15.0);
+        assert_eq!((times.slowest_frame, times.slowest_ms), (3, 30.0));
+        assert!((times.budget_ms - 1000.0 / 60.0).abs() < 1e-12);
+        let series = times.series(1.0 / 60.0);
+        assert_eq!(series.samples[3], (4.0 / 60.0, 5.0));
+    }
+
+    #[test]
+    fn no_frames_give_an_empty_summary() {
+        let times = FrameTimes::new(Vec::new(), Vec::new(), 1.0 / 60.0);
+        assert_eq!((times.median_ms, times.slowest_frame), (0.0, 0));
+        assert_eq!(
+            (times.over_budget_frames, times.over_budget_share),
+            (0, 0.0)
+        );
+    }
+}
