@@ -295,6 +295,7 @@ fn run_planar(path: PathBuf, text: String, options: &RunOptions) -> Result<(), S
             report.stepping_time_s,
         ],
     );
+    print_frame_times(&report.frame_times);
     for body in &report.soft_bodies {
         println!(
             "  soft {:<16} {:>6} triangles {:>5} nodes, plane {}, {:.3} kg; {} implicit frames, at most {} explicit substeps per coupling substep; {} failed",
@@ -413,7 +414,7 @@ fn print_summary(report: &sim::Report, out: &std::path::Path) {
     println!("  written to {}", out.display());
 }
 
-/// Prints where a 3D run's stepping time went: the median and slowest frames, and the frames
+/// Prints where a run's stepping time went: the median and slowest frames, and the frames
 /// slower than real time with their share of the stepping.
 fn print_frame_times(times: &sim::FrameTimes) {
     println!(

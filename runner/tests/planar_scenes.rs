@@ -89,12 +89,24 @@ fn the_dropped_box_rests_with_the_ground_carrying_both_weights() {
         let png = std::fs::read(out.join(file)).unwrap();
         assert_eq!(&png[1..4], b"PNG", "{file}");
     }
-    for file in ["ground_reaction.png", "box_height.png", "block_energy.png"] {
+    for file in [
+        "ground_reaction.png",
+        "box_height.png",
+        "block_energy.png",
+        "stepping_time_per_frame.png",
+    ] {
         assert!(out.join("plots").join(file).is_file(), "{file}");
     }
+    // Each of the 180 frames' stepping time, summing to the stepping time, the block awake.
+    let times = &report.frame_times;
+    assert_eq!(times.ms.len(), 180);
+    let summed: f64 = times.ms.iter().sum();
+    assert!((summed - 1e3 * report.stepping_time_s).abs() < 1e-6 * summed);
+    assert_eq!(times.awake_soft_bodies, vec![1; 180]);
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
     assert_eq!(json["dimension"], 2);
+    assert_eq!(json["frame_times"]["ms"].as_array().unwrap().len(), 180);
     assert_eq!(json["soft_bodies"][0]["plane"], "strain");
 
     assert_last_vtu_matches(&scene, &out.join("paraview/block_00045.vtu"));

@@ -6,7 +6,7 @@ use super::build::PlanarSimulation;
 use super::scene::{PlanarRigidKind, PlanarScene, PlaneSpec};
 use crate::sim::report::write_report;
 use crate::sim::writer::{View, Writer};
-use crate::sim::{Files, ProbeReport, RunError, RunOptions};
+use crate::sim::{Files, FrameTimes, ProbeReport, RunError, RunOptions};
 use rapier_fvm::glamx::DVec2;
 use rapier_fvm::planar::PlanarStepReport;
 use serde::Serialize;
@@ -49,6 +49,8 @@ pub struct PlanarReport {
     pub ms_per_frame: f64,
     /// Simulated time over stepping time.
     pub speed_vs_real_time: f64,
+    /// Each frame's stepping time, and where the time went (every soft body is awake in 2D).
+    pub frame_times: FrameTimes,
     /// Whether every node's position and velocity are finite at the end.
     pub final_state_finite: bool,
     /// The largest rise of the mechanical energy (J) over one frame (soft bodies' elastic,
@@ -112,13 +114,16 @@ pub fn run_planar(scene: &PlanarScene, options: &RunOptions) -> Result<PlanarRep
     sim.sample_probes(0.0);
     writer.frame(0, |time, patch| sim.snapshot(time, patch))?;
     let mut stepping = Duration::ZERO;
+    let mut frame_ms = Vec::with_capacity(frames);
     let mut energy = mechanical_energy(&sim);
     let mut largest_rise = (f64::NEG_INFINITY, 0);
     for frame in 1..=frames {
         let t = frame as f64 * dt;
         let step_start = Instant::now();
         let outcomes = sim.coupling.step(&mut sim.physics, &mut sim.bodies);
-        stepping += step_start.elapsed();
+        let frame_time = step_start.elapsed();
+        stepping += frame_time;
+        frame_ms.push(frame_time.as_secs_f64() * 1e3);
         let outcomes = outcomes.map_err(|e| scene.source.error("world.dt", e.to_string()))?;
         for (report, outcome) in bodies.iter_mut().zip(outcomes) {
             report.record(frame, outcome);
@@ -131,9 +136,13 @@ pub fn run_planar(scene: &PlanarScene, options: &RunOptions) -> Result<PlanarRep
         sim.sample_probes(t);
         writer.frame(frame, |time, patch| sim.snapshot(time, patch))?;
     }
-    let files = writer.finish(sim.probes.iter().map(|p| &p.series))?;
+    let frame_times = FrameTimes::new(frame_ms, vec![bodies.len(); frames], dt);
+    let frame_series = frame_times.series(dt);
+    let plotted = sim.probes.iter().map(|p| &p.series);
+    let files = writer.finish(plotted.chain([&frame_series]))?;
     let report = PlanarReport {
         soft_bodies: bodies,
+        frame_times,
         largest_energy_rise: largest_rise,
         files,
         ..PlanarReport::of(scene, &sim, (frames, started.elapsed(), stepping))
@@ -144,7 +153,7 @@ pub fn run_planar(scene: &PlanarScene, options: &RunOptions) -> Result<PlanarRep
 
 impl PlanarReport {
     /// The report of `scene` run in `sim` for `frames` frames, taking `wall` and `stepping`
-    /// time, with no soft body, energy rise or file yet.
+    /// time, with no soft body, frame times, energy rise or file yet.
     fn of(
         scene: &PlanarScene,
         sim: &PlanarSimulation,
@@ -169,6 +178,7 @@ impl PlanarReport {
             stepping_time_s: stepping_s,
             ms_per_frame: stepping_s * 1e3 / frames as f64,
             speed_vs_real_time: simulated / stepping_s.max(1e-9),
+            frame_times: FrameTimes::default(),
             final_state_finite: (sim.bodies.iter()).all(|b| {
                 b.positions()
                     .iter()

@@ -33,7 +33,9 @@ impl FrameTimes {
     pub fn new(ms: Vec<f64>, awake_soft_bodies: Vec<usize>, dt: f64) -> Self {
         let budget_ms = dt * 1e3;
         let total: f64 = ms.iter().sum();
-        let over: Vec<f64> = ms.iter().copied().filter(|&t| t > budget_ms).collect();
+        let over = ms.iter().filter(|&&t| t > budget_ms);
+        // Summed from +0 (`Sum` starts from -0, printed "-0 %" when no frame is over).
+        let over_ms = over.clone().fold(0.0, |sum, t| sum + t);
         let (slowest_frame, slowest_ms) = (ms.iter().enumerate())
             .max_by(|a, b| a.1.total_cmp(b.1))
             .map_or((0, 0.0), |(i, &t)| (i + 1, t));
@@ -42,12 +44,8 @@ impl FrameTimes {
             slowest_frame,
             slowest_ms,
             budget_ms,
-            over_budget_frames: over.len(),
-            over_budget_share: if total > 0.0 {
-                over.iter().sum::<f64>() / total
-            } else {
-                0.0
-            },
+            over_budget_frames: over.count(),
+            over_budget_share: if total > 0.0 { over_ms / total } else { 0.0 },
             ms,
             awake_soft_bodies,
         }
@@ -93,6 +91,14 @@ mod tests {
         assert!((times.budget_ms - 1000.0 / 60.0).abs() < 1e-12);
         let series = times.series(1.0 / 60.0);
         assert_eq!(series.samples[3], (4.0 / 60.0, 5.0));
+    }
+
+    #[test]
+    fn frames_within_the_budget_have_no_share_over_it() {
+        let times = FrameTimes::new(vec![1.0, 2.0, 3.0], vec![1; 3], 1.0 / 60.0);
+        assert_eq!(times.over_budget_frames, 0);
+        assert!(times.over_budget_share == 0.0 && times.over_budget_share.is_sign_positive());
+        assert_eq!(times.median_ms, 2.0);
     }
 
     #[test]
