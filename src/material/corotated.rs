@@ -11,6 +11,7 @@
 //! `R` stays a rotation and the energy pushes the element back to positive volume.
 
 use super::diagonal::signed_svd;
+use super::neo_hookean::cofactor;
 use super::{HyperelasticModel, LameParameters, trace};
 use rapier3d::glamx::{DMat3, DVec3};
 
@@ -72,17 +73,10 @@ fn polar_rotation_newton(f: &DMat3, mut scaled: bool) -> Option<DMat3> {
     None
 }
 
-/// `X⁻ᵀ`: the cofactor matrix, columns `(x₁ × x₂, x₂ × x₀, x₀ × x₁)`, over `det X`.
+/// `X⁻ᵀ`: the cofactor matrix over `det X`.
 fn inverse_transpose(x: &DMat3) -> DMat3 {
-    let first = x.y_axis.cross(x.z_axis);
-    let second = x.z_axis.cross(x.x_axis);
-    let third = x.x_axis.cross(x.y_axis);
-    let inverse_determinant = 1.0 / x.x_axis.dot(first);
-    DMat3::from_cols(
-        first * inverse_determinant,
-        second * inverse_determinant,
-        third * inverse_determinant,
-    )
+    let cofactor = cofactor(x);
+    cofactor * (1.0 / x.x_axis.dot(cofactor.x_axis))
 }
 
 /// The polar rotation from the SVD with the inversion sign fix.
