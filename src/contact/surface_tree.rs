@@ -118,6 +118,63 @@ impl SurfaceTree {
         }
         nearest
     }
+
+    /// The boundary point of `body` (the tree's) nearest to `x` (m), among all its triangles
+    /// within `reach` (m), with the unit direction from it to `x` as the normal, if `x` lies
+    /// outside the body there; `None` if `x` lies inside (or on the boundary, or no triangle is
+    /// within reach). Inside or outside is the sign of `x` minus the point along the
+    /// angle-weighted pseudo-normal of the feature the point lies on (Bærentzen and Aanæs 2005):
+    /// a face's normal, the sum of an edge's two faces' normals, or the sum of a node's faces'
+    /// normals each weighted by its angle there; exact for a closed surface, where the plane of
+    /// a facing triangle alone does not tell a point beyond the body's edge (above a block's
+    /// top, behind the plane of its side face) from one within it.
+    pub(crate) fn outside_point(
+        &self,
+        body: &DeformableBody,
+        x: DVec3,
+        reach: f64,
+    ) -> Option<TrianglePoint> {
+        let query = Aabb::new(
+            (x - DVec3::splat(reach)).as_vec3(),
+            (x + DVec3::splat(reach)).as_vec3(),
+        );
+        let near: Vec<u32> = self.bvh.intersect_aabb(&query).collect();
+        let nodes_of = |t: u32| body.surface.triangles[t as usize];
+        let corners = |t: u32| nodes_of(t).map(|n| body.positions[n as usize]);
+        let (nearest, weights, point) = (near.iter())
+            .filter_map(|&t| nearest_point_on_triangle(corners(t), x).map(|(w, p)| (t, w, p)))
+            .min_by(|a, b| x.distance_squared(a.2).total_cmp(&x.distance_squared(b.2)))?;
+        let triangle = nodes_of(nearest);
+        let feature: Vec<u32> = (triangle.iter().zip(weights))
+            .filter(|&(_, w)| w != 0.0)
+            .map(|(&n, _)| n)
+            .collect();
+        let pseudo_normal: DVec3 = (near.iter())
+            .filter(|&&t| feature.iter().all(|n| nodes_of(t).contains(n)))
+            .map(|&t| {
+                let [a, b, c] = corners(t);
+                let normal = (b - a).cross(c - a).normalize_or_zero();
+                match feature[..] {
+                    [node] => angle_at(node, nodes_of(t), [a, b, c]) * normal,
+                    _ => normal,
+                }
+            })
+            .sum();
+        let offset = x - point;
+        (offset.dot(pseudo_normal) > 0.0).then(|| TrianglePoint {
+            triangle,
+            weights,
+            point,
+            normal: offset.normalize(),
+        })
+    }
+}
+
+/// The angle (rad) at its corner `node` of the triangle of `nodes` at `corners` (m).
+fn angle_at(node: u32, nodes: [u32; 3], corners: [DVec3; 3]) -> f64 {
+    let i = nodes.iter().position(|&n| n == node).unwrap_or(0);
+    let at = corners[i];
+    (corners[(i + 1) % 3] - at).angle_between(corners[(i + 2) % 3] - at)
 }
 
 /// The barycentric weights of the point of triangle `corners` (m) nearest to `x` (m), and that
@@ -163,5 +220,55 @@ impl DeformableBody {
             .iter()
             .map(|v| v.length())
             .fold(0.0, f64::max)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::prelude::{DeformableBodyBuilder, Material, MaterialModel, mesh};
+
+    /// A 10 cm cube of 3³ cells centred at the origin.
+    fn cube() -> DeformableBody {
+        let material = Material::new(MaterialModel::StableNeoHookean, 1e5, 0.3, 1000.0).unwrap();
+        DeformableBodyBuilder::new(mesh::cuboid(DVec3::splat(0.05), [3; 3]).unwrap(), material)
+            .build()
+            .unwrap()
+    }
+
+    // Points to 1e-7 m and normals to 1e-5: parry projects in f32, rounding a point by about
+    // 1e-8 m, which over the 1-2 mm from it to the query point turns the normal by 1e-5.
+    #[test]
+    fn points_past_the_edges_and_corners_of_a_cube_lie_outside_it_and_points_within_inside() {
+        let body = cube();
+        let tree = SurfaceTree::of(&body);
+        let outside = |x: DVec3| tree.outside_point(&body, x, 0.1);
+        // Above the top face near its edge x = 0.05, behind the side face's plane by 17 mm: the
+        // top face's point straight below, the normal up.
+        let above = outside(DVec3::new(0.033, 0.08, 0.01)).expect("above the top");
+        assert!((above.point - DVec3::new(0.033, 0.05, 0.01)).length() < 1e-7);
+        assert!((above.normal - DVec3::Y).length() < 1e-5);
+        // Past the edge between the top and the side x = 0.05, 2 mm out and 1 mm below the top
+        // (behind the top's plane): the side's point, the normal along x; 1 mm above the top:
+        // the edge's point, the normal from it.
+        let past_edge = outside(DVec3::new(0.052, 0.049, 0.01)).expect("past the edge");
+        assert!((past_edge.point - DVec3::new(0.05, 0.049, 0.01)).length() < 1e-7);
+        assert!((past_edge.normal - DVec3::X).length() < 1e-5);
+        let beyond_edge = outside(DVec3::new(0.052, 0.051, 0.01)).expect("beyond the edge");
+        assert!((beyond_edge.point - DVec3::new(0.05, 0.05, 0.01)).length() < 1e-7);
+        assert!((beyond_edge.normal - DVec3::new(2.0, 1.0, 0.0).normalize()).length() < 1e-5);
+        // Beyond the corner (0.05, 0.05, 0.05) along the diagonal: the corner.
+        let corner = outside(DVec3::splat(0.051)).expect("beyond the corner");
+        assert!((corner.point - DVec3::splat(0.05)).length() < 1e-7);
+        assert!((corner.normal - DVec3::ONE.normalize()).length() < 1e-5);
+        // Within 1 mm of the edge, of the corner, of a face's centre, and at the centre: inside.
+        for x in [
+            DVec3::new(0.049, 0.049, 0.01),
+            DVec3::splat(0.049),
+            DVec3::new(0.0, 0.049, 0.0),
+            DVec3::ZERO,
+        ] {
+            assert!(outside(x).is_none(), "{x}");
+        }
     }
 }
