@@ -1,6 +1,8 @@
 //! A soft body's boundary triangles, where they are now, in a parry bounding-volume hierarchy:
 //! the nearest triangle facing a point, for self-contact, contact between soft bodies and rigid
-//! vertices, and the triangles within a box, for rounded rigid shapes' closest points.
+//! vertices; whether a point lies outside the body (the sign along the angle-weighted
+//! pseudo-normal of its nearest feature), for rigid vertices behind a facing triangle's plane;
+//! and the triangles within a box, for rounded rigid shapes' closest points.
 
 use super::SoftPoint;
 use crate::body::DeformableBody;

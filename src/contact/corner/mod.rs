@@ -34,7 +34,6 @@ use super::stiffening::Stiffening;
 use super::support;
 use super::surface_tree::{SurfaceTree, TrianglePoint};
 use super::{Coefficients, ContactSet, ContactSides, SoftPoint, VelocityConstraint};
-
 use crate::body::DeformableBody;
 use crate::rigid::RigidProxy;
 use rapier3d::geometry::{ColliderHandle, Shape};
@@ -182,10 +181,9 @@ fn for_each_vertex(shape: &dyn Shape, pose: &Pose, each: &mut impl FnMut(DVec3, 
 
 /// The contacts of `near`'s shape within its reach (m) of `body`'s boundary triangles in
 /// `tree`: its vertices' if it has corners (against the nearest facing triangle, or the body's
-/// nearest point for a vertex overhanging the body, see [`overhanging`]), its closest
-/// points' if it is rounded (see
-/// [`super::support`]), part by part in a compound; skipping triangles with a node glued to the
-/// collider's rigid body; their proxy is left for the caller to set.
+/// nearest point for a vertex overhanging the body, see [`overhanging`]), its closest points'
+/// if it is rounded (see [`super::support`]), part by part in a compound; skipping triangles
+/// with a node glued to the collider's rigid body; their proxy is left for the caller to set.
 pub(super) fn find_corner_contacts(
     body: &DeformableBody,
     tree: &SurfaceTree,
