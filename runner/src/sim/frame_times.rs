@@ -33,9 +33,9 @@ impl FrameTimes {
     pub fn new(ms: Vec<f64>, awake_soft_bodies: Vec<usize>, dt: f64) -> Self {
         let budget_ms = dt * 1e3;
         let total: f64 = ms.iter().sum();
-        let over = ms.iter().filter(|&&t| t > budget_ms);
         // Summed from +0 (`Sum` starts from -0, printed "-0 %" when no frame is over).
-        let over_ms = over.clone().fold(0.0, |sum, t| sum + t);
+        let (over_frames, over_ms) = (ms.iter().filter(|&&t| t > budget_ms))
+            .fold((0, 0.0), |(count, sum), t| (count + 1, sum + t));
         let (slowest_frame, slowest_ms) = (ms.iter().enumerate())
             .max_by(|a, b| a.1.total_cmp(b.1))
             .map_or((0, 0.0), |(i, &t)| (i + 1, t));
@@ -44,7 +44,7 @@ impl FrameTimes {
             slowest_frame,
             slowest_ms,
             budget_ms,
-            over_budget_frames: over.count(),
+            over_budget_frames: over_frames,
             over_budget_share: if total > 0.0 { over_ms / total } else { 0.0 },
             ms,
             awake_soft_bodies,
