@@ -38,22 +38,35 @@ use rapier3d::glamx::DVec3;
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Carried {
     /// The body.
-    handle: RigidBodyHandle,
+    pub(super) handle: RigidBodyHandle,
     /// The gravity scale it fell by in the soft step (0 when rapier's contacts hold it up).
-    gravity_scale: f64,
+    pub(super) gravity_scale: f64,
+    /// Whether rapier's contacts hold it up (see [`RigidProxy::hold`]).
+    pub(super) held: bool,
+    /// The change of its linear velocity (m/s) the implicit steps' impulses made, summed over
+    /// the soft bodies that moved it.
+    pub(super) impulse_velocity: DVec3,
 }
 
 impl Carried {
     /// Adds to `carried` each dynamic rigid body of `proxies`, those of a soft body an implicit
-    /// step just moved, unless already there (its gravity scale is the same in every step).
+    /// step just moved, unless already there (its gravity scale is the same in every step), and
+    /// the change of velocity their impulses made (before they are handed to rapier).
     pub(super) fn add(carried: &mut Vec<Carried>, proxies: &[RigidProxy]) {
         for proxy in proxies.iter().filter(|p| p.is_dynamic()) {
-            if !carried.iter().any(|c| c.handle == proxy.handle) {
-                carried.push(Carried {
-                    handle: proxy.handle,
-                    gravity_scale: proxy.gravity_scale(),
-                });
-            }
+            let index = match carried.iter().position(|c| c.handle == proxy.handle) {
+                Some(index) => index,
+                None => {
+                    carried.push(Carried {
+                        handle: proxy.handle,
+                        gravity_scale: proxy.gravity_scale(),
+                        held: proxy.is_held(),
+                        impulse_velocity: DVec3::ZERO,
+                    });
+                    carried.len() - 1
+                }
+            };
+            carried[index].impulse_velocity += proxy.impulse_velocity();
         }
     }
 }

@@ -51,6 +51,7 @@
 mod audit;
 mod bodies;
 mod carry;
+mod exchange;
 mod groups;
 mod kinematic;
 mod loads;
@@ -77,6 +78,7 @@ use crate::contact::{ContactSettings, NodeContact};
 use crate::integrate::{AutomaticIntegrator, AutomaticReport};
 use bodies::LinkSet;
 use carry::RapierCarry;
+use exchange::{RigidExchange, SoftExchange};
 use kinematic::KinematicPath;
 use loads::FrameLoads;
 use pull::RapierPull;
@@ -195,6 +197,9 @@ pub struct SoftCoupling {
     /// What rapier's last step did to the rigid bodies its contacts hold.
     #[cfg_attr(feature = "serde-serialize", serde(default))]
     pull: RapierPull,
+    /// What the soft steps gave each dynamic rigid body over the last frame.
+    #[cfg_attr(feature = "serde-serialize", serde(default))]
+    exchange: SoftExchange,
     /// Each deformable body's constraints and solver caches, by handle.
     links: LinkSet,
     /// Each deformable body's sleep, by handle.
@@ -214,6 +219,7 @@ impl Default for SoftCoupling {
             loads: FrameLoads::default(),
             touches: RigidTouches::default(),
             pull: RapierPull::default(),
+            exchange: SoftExchange::default(),
             links: LinkSet::default(),
             sleeping: SleepSet::default(),
             stand_ins: StandInSet::default(),
@@ -244,6 +250,7 @@ impl SoftCoupling {
         let frame = *rapier.integration_parameters;
         let last_loads = std::mem::take(&mut self.loads);
         self.touches.clear();
+        self.exchange.clear();
         if let Some(error) = self.frame_error(frame.dt) {
             return refused(soft_bodies, &error);
         }
@@ -394,6 +401,7 @@ impl SoftCoupling {
     ) -> SoftStepResults {
         self.loads.clear();
         self.touches.clear();
+        self.exchange.clear();
         (self.touches).record(rigid.bodies, rigid.colliders, rigid.narrow_phase);
         self.links.prune(soft_bodies);
         self.sleeping.prune(soft_bodies);
@@ -430,6 +438,12 @@ impl SoftCoupling {
     /// deformable bodies.
     pub(crate) fn rigid_touches(&self) -> &[(RigidBodyHandle, RigidBodyHandle)] {
         self.touches.pairs()
+    }
+
+    /// What the soft steps of the last frame (or the last [`SoftCoupling::substep`]) gave the
+    /// dynamic rigid body `rigid`.
+    pub(crate) fn rigid_exchange(&self, rigid: RigidBodyHandle) -> RigidExchange {
+        self.exchange.of(rigid)
     }
 
     /// The mean force (N) and torque about its centre of mass (N m) deformable body `soft`
