@@ -38,14 +38,16 @@ use rapier3d::glamx::DVec3;
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Carried {
     /// The body.
-    pub(super) handle: RigidBodyHandle,
+    handle: RigidBodyHandle,
     /// The gravity scale it fell by in the soft step (0 when rapier's contacts hold it up).
-    pub(super) gravity_scale: f64,
+    gravity_scale: f64,
     /// Whether rapier's contacts hold it up (see [`RigidProxy::hold`]).
-    pub(super) held: bool,
+    held: bool,
+    /// 1 along the axes it translates along, 0 along locked ones.
+    free_axes: DVec3,
     /// The change of its linear velocity (m/s) the implicit steps' impulses made, summed over
     /// the soft bodies that moved it.
-    pub(super) impulse_velocity: DVec3,
+    impulse_velocity: DVec3,
 }
 
 impl Carried {
@@ -54,20 +56,82 @@ impl Carried {
     /// the change of velocity their impulses made (before they are handed to rapier).
     pub(super) fn add(carried: &mut Vec<Carried>, proxies: &[RigidProxy]) {
         for proxy in proxies.iter().filter(|p| p.is_dynamic()) {
-            let index = match carried.iter().position(|c| c.handle == proxy.handle) {
-                Some(index) => index,
-                None => {
+            let index =
+                (carried.iter().position(|c| c.handle == proxy.handle)).unwrap_or_else(|| {
                     carried.push(Carried {
                         handle: proxy.handle,
                         gravity_scale: proxy.gravity_scale(),
                         held: proxy.is_held(),
+                        free_axes: proxy.free_axes(),
                         impulse_velocity: DVec3::ZERO,
                     });
                     carried.len() - 1
-                }
-            };
+                });
             carried[index].impulse_velocity += proxy.impulse_velocity();
         }
+    }
+}
+
+/// The change of linear velocity (m/s) of each dynamic rigid body over the coupling substeps of
+/// the last frame (or the last [`SoftCoupling::substep`](super::SoftCoupling::substep)) in which
+/// implicit soft steps carried it: not held by rapier's contacts, awake, moved by the impulses'
+/// `M⁻¹ι` and its fall `g h` along its free axes. The energy audit measures such changes at the
+/// centre of mass: the step moves the body with the soft body as one backward Euler step, whose
+/// energy measured there cannot rise (see the audit's `energy` module). Several soft bodies
+/// stepped apart (not grouped) that carry one rigid body in a substep each solve their own step;
+/// their impulses are summed here as if one step had moved it.
+#[derive(Debug, Clone, Default)]
+#[cfg_attr(
+    feature = "serde-serialize",
+    derive(serde::Serialize, serde::Deserialize)
+)]
+pub(super) struct CarriedMotion {
+    /// Per body, its change (m/s) so far in the frame.
+    changes: Vec<(RigidBodyHandle, DVec3)>,
+    /// How many frames (or substeps run alone) have begun: the audit tells by it whether a step
+    /// ran since it last looked.
+    frames: u64,
+}
+
+impl CarriedMotion {
+    /// Begins a frame (or a substep run alone): the last one's changes are forgotten.
+    pub(super) fn begin_frame(&mut self) {
+        self.changes.clear();
+        self.frames += 1;
+    }
+
+    /// Adds the changes of a substep of `h` (s) under `gravity` (m/s²) of the bodies `carried`
+    /// that rapier's contacts do not hold and that are awake in `bodies`.
+    pub(super) fn add(
+        &mut self,
+        carried: &[Carried],
+        bodies: &RigidBodySet,
+        (h, gravity): (f64, DVec3),
+    ) {
+        let awake = |c: &&Carried| bodies.get(c.handle).is_some_and(|b| !b.is_sleeping());
+        for c in carried.iter().filter(|c| !c.held).filter(awake) {
+            let change = c.impulse_velocity + gravity * (c.gravity_scale * h) * c.free_axes;
+            match self
+                .changes
+                .iter_mut()
+                .find(|(handle, _)| *handle == c.handle)
+            {
+                Some((_, total)) => *total += change,
+                None => self.changes.push((c.handle, change)),
+            }
+        }
+    }
+
+    /// The change (m/s) of `handle` over the frame's carried substeps.
+    pub(super) fn of(&self, handle: RigidBodyHandle) -> DVec3 {
+        (self.changes.iter())
+            .find(|(h, _)| *h == handle)
+            .map_or(DVec3::ZERO, |&(_, change)| change)
+    }
+
+    /// How many frames (or substeps run alone) have begun.
+    pub(super) fn frames(&self) -> u64 {
+        self.frames
     }
 }
 

@@ -51,7 +51,6 @@
 mod audit;
 mod bodies;
 mod carry;
-mod exchange;
 mod groups;
 mod kinematic;
 mod loads;
@@ -77,8 +76,7 @@ use crate::constraint::BodyConstraints;
 use crate::contact::{ContactSettings, NodeContact};
 use crate::integrate::{AutomaticIntegrator, AutomaticReport};
 use bodies::LinkSet;
-use carry::RapierCarry;
-use exchange::{RigidExchange, SoftExchange};
+use carry::{CarriedMotion, RapierCarry};
 use kinematic::KinematicPath;
 use loads::FrameLoads;
 use pull::RapierPull;
@@ -197,9 +195,9 @@ pub struct SoftCoupling {
     /// What rapier's last step did to the rigid bodies its contacts hold.
     #[cfg_attr(feature = "serde-serialize", serde(default))]
     pull: RapierPull,
-    /// What the soft steps gave each dynamic rigid body over the last frame.
+    /// The velocity changes of the rigid bodies implicit steps carried over the last frame.
     #[cfg_attr(feature = "serde-serialize", serde(default))]
-    exchange: SoftExchange,
+    carried: CarriedMotion,
     /// Each deformable body's constraints and solver caches, by handle.
     links: LinkSet,
     /// Each deformable body's sleep, by handle.
@@ -219,7 +217,7 @@ impl Default for SoftCoupling {
             loads: FrameLoads::default(),
             touches: RigidTouches::default(),
             pull: RapierPull::default(),
-            exchange: SoftExchange::default(),
+            carried: CarriedMotion::default(),
             links: LinkSet::default(),
             sleeping: SleepSet::default(),
             stand_ins: StandInSet::default(),
@@ -250,7 +248,7 @@ impl SoftCoupling {
         let frame = *rapier.integration_parameters;
         let last_loads = std::mem::take(&mut self.loads);
         self.touches.clear();
-        self.exchange.clear();
+        self.carried.begin_frame();
         if let Some(error) = self.frame_error(frame.dt) {
             return refused(soft_bodies, &error);
         }
@@ -401,7 +399,7 @@ impl SoftCoupling {
     ) -> SoftStepResults {
         self.loads.clear();
         self.touches.clear();
-        self.exchange.clear();
+        self.carried.begin_frame();
         (self.touches).record(rigid.bodies, rigid.colliders, rigid.narrow_phase);
         self.links.prune(soft_bodies);
         self.sleeping.prune(soft_bodies);
@@ -440,10 +438,17 @@ impl SoftCoupling {
         self.touches.pairs()
     }
 
-    /// What the soft steps of the last frame (or the last [`SoftCoupling::substep`]) gave the
-    /// dynamic rigid body `rigid`.
-    pub(crate) fn rigid_exchange(&self, rigid: RigidBodyHandle) -> RigidExchange {
-        self.exchange.of(rigid)
+    /// The change of linear velocity (m/s) of the dynamic rigid body `rigid` over the coupling
+    /// substeps of the last frame (or the last [`SoftCoupling::substep`]) in which implicit soft
+    /// steps carried it, rapier's contacts not holding it: their impulses and its fall.
+    pub(crate) fn carried_velocity_change(&self, rigid: RigidBodyHandle) -> DVec3 {
+        self.carried.of(rigid)
+    }
+
+    /// How many frames of [`SoftCoupling::step`] (and calls of [`SoftCoupling::substep`]) have
+    /// begun: whether a step ran between two looks at the coupling.
+    pub(crate) fn frames_begun(&self) -> u64 {
+        self.carried.frames()
     }
 
     /// The mean force (N) and torque about its centre of mass (N m) deformable body `soft`

@@ -5,7 +5,6 @@
 
 use super::bodies::BodyLinks;
 use super::carry::Carried;
-use super::exchange::SoftExchange;
 use super::groups::{GroupStep, step_groups, touching_groups};
 use super::loads::FrameLoads;
 use super::pull::RapierPull;
@@ -64,7 +63,7 @@ impl SoftCoupling {
         );
         self.hold_refused(soft_bodies, &held, &mut rigid, h, gravity);
         self.settle_still(soft_bodies, &mut rigid, (h, gravity));
-        (self.exchange).note_carried(&carried, rigid.bodies, (h, gravity));
+        (self.carried).add(&carried, rigid.bodies, (h, gravity));
         let proxies = (self.links.iter()).flat_map(|(_, l)| &l.constraints.rigid_proxies);
         self.pull.note_handed(proxies, rigid.bodies, h);
         carried
@@ -159,12 +158,7 @@ impl SoftCoupling {
                 &self.sleep,
                 (h, result.is_ok(), margin),
             );
-            hand_over(
-                (&mut self.loads, &mut self.exchange),
-                *handle,
-                &mut step,
-                rigid.bodies,
-            );
+            hand_over(&mut self.loads, *handle, &mut step, rigid.bodies);
             if let Some((_, outcome)) = outcomes.iter_mut().find(|(h, _)| h == handle) {
                 // A step refused in an earlier substep of the frame stays reported.
                 if !matches!(outcome, Some(Err(_))) {
@@ -199,12 +193,7 @@ impl SoftCoupling {
                 &self.sleep,
                 (h, false, self.contact.margin),
             );
-            hand_over(
-                (&mut self.loads, &mut self.exchange),
-                *handle,
-                &mut step,
-                rigid.bodies,
-            );
+            hand_over(&mut self.loads, *handle, &mut step, rigid.bodies);
         }
         self.links.set_last_step(held, h);
     }
@@ -262,16 +251,14 @@ impl SoftCoupling {
 }
 
 /// Hands the impulses `step`'s body (`handle`) gave rigid bodies over its substep to rapier's
-/// `bodies` and adds them, and those on colliders, to the frame's `loads`, and the kinetic
-/// energy they give to the frame's `exchange`.
+/// `bodies` and adds them, and those on colliders, to the frame's `loads`.
 fn hand_over(
-    (loads, exchange): (&mut FrameLoads, &mut SoftExchange),
+    loads: &mut FrameLoads,
     handle: DeformableBodyHandle,
     step: &mut BodyInStep<'_>,
     bodies: &mut RigidBodySet,
 ) {
     loads.add_body(handle, step.body, step.constraints);
-    exchange.note_impulses(&step.constraints.rigid_proxies, bodies);
     step.constraints.transfer_contact_impulses(bodies);
 }
 

@@ -30,16 +30,13 @@
 //!   `½ h m g·Δv` with each velocity change `Δv` the step gives it (the 20 kg ball on the 20 g
 //!   rope at 1/60 s frames: +2.3e-3 J in a frame measured half a substep back, −1.0e-3 J at the
 //!   centre of mass). So the frame's gain leaves out `½ h m g·Δv_c`, `Δv_c` the velocity change
-//!   over those substeps (the impulses' `M⁻¹ι` and the fall `g h`, `SoftCoupling`'s exchange
-//!   record); a body carried in every substep is measured at its centre of mass, one carried in
-//!   none half a substep back, as rapier moves it. Fixed and kinematic bodies carry none.
-//! - A dynamic rigid body rapier's own contacts held in a substep of the frame in which a soft
-//!   body could touch it counts its energy's change over the frame at most as the kinetic energy
-//!   the soft impulses gave it, `Σ (ι·v + ½ ι·M⁻¹ι + τ·ω + ½ τ·I⁻¹τ)` at the velocities they
-//!   met: what rapier's contacts and position correction add is rapier's, as for bodies no soft
-//!   body touched (a 27 g box of the game scene tipping over its edge on the ground beside a
-//!   block, the block's impulses on it nil, gained 5.4e-5 J in a frame measured half a substep
-//!   back). What the soft impulses give is counted in full.
+//!   over those substeps (the impulses' `M⁻¹ι` and the fall `g h` along the body's free axes,
+//!   recorded by the coupling, `carry::CarriedMotion`); a body carried in every substep is
+//!   measured at its centre of mass, one carried in none half an integration step back, as
+//!   rapier moves it (a 27 g box of the game scene landing on the ground through rapier's
+//!   contact beside an implicit block gained 6.0e-5 J in a frame measured at its centre of mass
+//!   over the whole frame, 3.5e-7 J so). A check made with no step since the last one (a state
+//!   changed by hand) leaves nothing out. Fixed and kinematic bodies carry none.
 //! - Work: a kinematic (or fixed) rigid body a deformable body pushed with the mean force `F` and
 //!   torque `τ` over the frame ([`RigidLoad`](crate::coupling::RigidLoad)) while moving its centre
 //!   of mass by `Δx` and turning by `Δθ` did `W = -(F·Δx + τ·Δθ)` on it. Gravity's work is in the
@@ -86,10 +83,6 @@ pub(super) struct MemberEnergy {
     /// a rigid body moved `half_step_back` by, `½ h m g·Δv`, which the frame's gain leaves out;
     /// zero for a deformable body.
     pub(super) carried_shift: f64,
-    /// For a rigid body rapier's own contacts held in a substep of the frame in which a soft
-    /// body could touch it, the kinetic energy (J) the soft impulses gave it: its energy's
-    /// change over the frame counts at most that (what rapier's contacts add is rapier's).
-    pub(super) given: Option<f64>,
     pub(super) moving: f64,
     /// The work (J) changes of a deformable body's loads did since it was built; zero for a
     /// rigid body.
@@ -139,7 +132,6 @@ pub(super) fn energies(
                 total,
                 half_step_back: 0.0,
                 carried_shift: 0.0,
-                given: None,
                 moving,
                 load_change_work: body.load_change_work(),
                 allowance: ratio.min(1.0) * moving,
@@ -150,10 +142,8 @@ pub(super) fn energies(
         .filter(|(handle, b)| b.is_dynamic() && input.coupling.stand_in_for(*handle).is_none());
     for (handle, body) in rigid {
         let mut energy = rigid_energy(body, g, h);
-        let exchange = input.coupling.rigid_exchange(handle);
-        let carried = exchange.carried_velocity_change;
+        let carried = input.coupling.carried_velocity_change(handle);
         energy.carried_shift = f64::from(body.mass()) * g.dot(carried) * (h / 2.0);
-        energy.given = exchange.held.then_some(exchange.energy_given);
         all.insert(Member::Rigid(handle), energy);
     }
     all
@@ -254,7 +244,6 @@ fn rigid_energy(body: &RigidBody, g: DVec3, h: f64) -> MemberEnergy {
         total: moving - mass * g.dot(com),
         half_step_back: mass * g.dot(v) * (h / 2.0),
         carried_shift: 0.0,
-        given: None,
         moving,
         load_change_work: 0.0,
         // f32 keeps about 7 digits of the position and velocity.
@@ -328,8 +317,8 @@ pub(super) fn kinematic_work(
 /// tolerance `relative` times the energy in motion and strain (the larger of now and before)
 /// plus the members' allowances (now and before: an oscillation may go down then up) plus
 /// `floor` (J). Members absent before count as unchanged. A rigid body's gravitational energy is
-/// taken half a substep back in both frames, less now what the substeps in which implicit soft
-/// steps carried it moved that by (see the module's documentation).
+/// taken half an integration step back in both frames, less now what the substeps in which
+/// implicit soft steps carried it moved that by (see the module's documentation).
 pub(super) fn check(
     members: &[Member],
     (now, before): (
@@ -345,17 +334,9 @@ pub(super) fn check(
             continue;
         };
         let then = before.get(member);
-        let measured_then = then.map_or(here.total + here.half_step_back, |e| {
-            e.total + e.half_step_back
-        });
-        let change = here.total + here.half_step_back - here.carried_shift - measured_then;
-        let change = if then.is_none() {
-            0.0
-        } else {
-            here.given.map_or(change, |given| change.min(given))
-        };
-        energy += measured_then + change;
-        previous += measured_then;
+        let measured = here.total + here.half_step_back - here.carried_shift;
+        energy += measured;
+        previous += then.map_or(measured, |e| e.total + e.half_step_back);
         let then = then.unwrap_or(here);
         moving += here.moving.max(then.moving);
         allowance += here.allowance + then.allowance;

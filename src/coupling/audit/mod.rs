@@ -13,13 +13,12 @@
 //!    frame. A rigid body that met only rapier's own contacts in the frame is rapier's to
 //!    answer for: rapier's position correction can lift a body that lands on an edge (a 100 kg
 //!    box tumbling off a soft block onto the ground gained 0.64 J in one 1/30 s frame, the same
-//!    with the block moved 10 m away before the frame); likewise a rigid body rapier's contacts
-//!    held while a soft body touched it counts at most the energy the soft impulses gave it.
-//!    Rapier's contacts also carry energy between rigid bodies (a box falling onto a ball that
-//!    rests against a block), so each check is made twice, with the dynamic bodies rapier's
-//!    contacts held against the checked rigid bodies in the frame (one contact after another)
-//!    and without them, and a gain counts only when both show it: the first counts rapier's own
-//!    gains in those bodies, the second misses the energy they handed in.
+//!    with the block moved 10 m away before the frame). Rapier's contacts also carry energy
+//!    between rigid bodies (a box falling onto a ball that rests against a block), so each check
+//!    is made twice, with the dynamic bodies rapier's contacts held against the checked rigid
+//!    bodies in the frame (one contact after another) and without them, and a gain counts only
+//!    when both show it: the first counts rapier's own gains in those bodies, the second misses
+//!    the energy they handed in.
 //! 2. **Contacts**: no contact point of a body lies deeper than the penetration tolerance inside
 //!    a collider or another deformable body, and none crossed a collider or another deformable
 //!    body over the frame.
@@ -125,6 +124,8 @@ pub struct AuditInput<'a> {
 #[derive(Debug, Clone, Default)]
 struct Snapshot {
     energies: HashMap<Member, MemberEnergy>,
+    /// The coupling's frames begun ([`SoftCoupling::frames_begun`]) when it was taken.
+    frames_begun: u64,
     rigid_poses: HashMap<RigidBodyHandle, RigidPose>,
     collider_poses: HashMap<ColliderHandle, Pose>,
     positions: HashMap<DeformableBodyHandle, Vec<DVec3>>,
@@ -166,6 +167,12 @@ impl Audit {
         let previous = self.previous.as_ref();
         if let Some(before) = previous {
             energy::keep_sleeping(&input, results, &before.energies, &mut now.energies);
+            if before.frames_begun == now.frames_begun {
+                // No step since: the carried changes are the last frame's, already counted.
+                now.energies
+                    .values_mut()
+                    .for_each(|e| e.carried_shift = 0.0);
+            }
         }
         let energy_of = |members: &[Member]| {
             previous.map(|before| {
@@ -286,6 +293,7 @@ impl Audit {
 fn snapshot(input: &AuditInput<'_>, results: &SoftStepResults) -> Snapshot {
     Snapshot {
         energies: energy::energies(input, results),
+        frames_begun: input.coupling.frames_begun(),
         rigid_poses: energy::rigid_poses(input),
         collider_poses: (input.colliders.iter())
             .map(|(handle, collider)| (handle, *collider.position()))

@@ -8,9 +8,7 @@ use rapier3d::geometry::ColliderHandle;
 /// work done on them (J).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EnergyCheck {
-    /// The energy now (J): the previous frame's plus the change counted (a rigid body rapier's
-    /// own contacts held counts at most the energy the soft impulses gave it, see
-    /// [`Audit`](super::Audit)).
+    /// The energy now (J).
     pub energy: f64,
     /// The previous frame's energy plus the work counted (J).
     pub expected: f64,
