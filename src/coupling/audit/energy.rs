@@ -83,6 +83,8 @@ pub(super) struct MemberEnergy {
     /// a rigid body moved `half_step_back` by, `½ h m g·Δv`, which the frame's gain leaves out;
     /// zero for a deformable body.
     pub(super) carried_shift: f64,
+    /// The energy in motion and strain (J): kinetic, and for a deformable body elastic and the
+    /// implicit penalties'; the relative tolerance is taken of it.
     pub(super) moving: f64,
     /// The work (J) changes of a deformable body's loads did since it was built; zero for a
     /// rigid body.
