@@ -44,8 +44,8 @@ fn step(world: &mut FvmWorld, handle: DeformableBodyHandle) -> AutomaticReport {
 #[test]
 fn the_prediction_is_the_cost_models_formula_and_the_cheaper_integrator_is_taken() {
     // A damped cube resting on the ground, 60 frames: each frame's prediction must be the cost
-    // model's formula (explicit: n (T c d + P s c_p); implicit: k N T c_N (T/1000)^α) to
-    // round-off (1e-12 relative), with the contacts counted, and the integrator taken the
+    // model's formula (explicit: n (T c d + P s c_p); implicit: k (T (T/1000)^α (N c_N + F c_F)
+    // + L (c_cg + T c_cg_tet) + E c_E)) to round-off (1e-12 relative), with the contacts counted, and the integrator taken the
     // cheaper one. Kept awake: every frame is stepped and predicted (asleep, the resting cube
     // would not be).
     let (mut world, handle) = world_with(cube(0.0, true));
@@ -61,7 +61,13 @@ fn the_prediction_is_the_cost_models_formula_and_the_cheaper_integrator_is_taken
             * (tets * cost.explicit_tet * cost.explicit_damped_factor
                 + p.contact_points as f64 * cost.explicit_contact_point);
         let size = (tets / 1000.0).powf(cost.newton_size_exponent);
-        let implicit = p.newton_iterations * tets * cost.newton_tet * size;
+        let newton = p.newton;
+        let direct =
+            newton.iterations * cost.newton_tet + newton.factorizations * cost.factorization_tet;
+        let per_cg = cost.conjugate_gradient_iteration + tets * cost.conjugate_gradient_tet;
+        let implicit = tets * size * direct
+            + newton.linear_iterations * per_cg
+            + newton.energy_evaluations * cost.energy_evaluation;
         assert!((p.explicit_seconds - explicit).abs() <= 1e-12 * explicit);
         assert!((p.implicit_seconds - implicit).abs() <= 1e-12 * implicit);
         assert_eq!(report.choice, p.cheaper());
@@ -127,16 +133,15 @@ fn a_frame_the_implicit_integrator_cannot_take_is_handed_to_the_explicit_one() {
 }
 
 #[test]
-fn a_soft_block_under_a_box_only_it_holds_steps_implicitly_and_carries_the_weight() {
+fn a_soft_block_under_a_box_only_it_holds_carries_the_weight_in_implicit_steps() {
     // A 0.2 kg, 4 cm rigid box dropped from 0.5 mm onto the damped cube above, default coupling
     // (four substeps per 1/60 s frame), 1 s. The box's corners press on the cube's top face,
     // and nothing but the cube holds the box up: the implicit step, which solves the box's
-    // motion with the cube's, is then exact about it, and the automatic choice takes the
-    // cheaper integrator (implicit: its prediction is 3 to 10 times below the explicit one's
-    // here). Once the box has landed and settled (from frame 20; measured: the first 11 frames,
-    // the box falling and striking, are explicit), every frame stepped must be implicit; at
-    // the end the ground must carry the cube and the box (1 %: the f32 ground and the damped
-    // ringing of the cube), and the box rest (1 mm/s).
+    // motion with the cube's, is then exact about it. The first 20 frames (the box falling,
+    // striking and settling) by the automatic choice, the rest forced implicit (the automatic
+    // choice finds both integrators about as dear here, 0.20 ms a step predicted each, and
+    // measured 0.14 ms): at the end the ground must carry the cube and the box (1 %: the f32
+    // ground and the damped ringing of the cube), and the box rest (1 mm/s).
     let (mut world, handle) = world_with(cube(0.0, true));
     world.coupling.substeps = 4;
     let ground = world.physics.colliders.iter().next().unwrap().0;
@@ -152,14 +157,16 @@ fn a_soft_block_under_a_box_only_it_holds_steps_implicitly_and_carries_the_weigh
             .density(box_mass / (8.0 * half * half * half))
             .friction(0.8),
     );
-    let mut explicit_after_landing = 0;
-    // Frames 0 to 19 may be either.
+    let mut implicit_after_landing = 0;
     for frame in 0..60 {
+        if frame == 20 {
+            world.coupling.integrator.force = Some(IntegratorKind::Implicit);
+        }
         let results = world.step();
         for (_, outcome) in results {
             let report = outcome.unwrap_or_else(|error| panic!("frame {frame}: {error}"));
-            if frame >= 20 && report.explicit.is_some() {
-                explicit_after_landing += 1;
+            if frame >= 20 && report.implicit.is_some() {
+                implicit_after_landing += 1;
             }
         }
     }
@@ -170,10 +177,10 @@ fn a_soft_block_under_a_box_only_it_holds_steps_implicitly_and_carries_the_weigh
         .sum();
     let speed = world.physics.bodies[rigid].linvel().length();
     println!(
-        "explicit frames after landing {explicit_after_landing}; ground reaction {reaction:.4} N \
+        "implicit frames after landing {implicit_after_landing}; ground reaction {reaction:.4} N \
          for {weight:.4} N; box speed {speed:.2e} m/s"
     );
-    assert_eq!(explicit_after_landing, 0);
+    assert!(implicit_after_landing > 0);
     assert!((reaction - weight).abs() < 0.01 * weight, "{reaction} N");
     assert!(speed < 1e-3, "{speed} m/s");
 }
@@ -181,14 +188,25 @@ fn a_soft_block_under_a_box_only_it_holds_steps_implicitly_and_carries_the_weigh
 #[test]
 fn a_gel_ball_landing_at_two_metres_a_second_converges_in_its_implicit_frames() {
     // The showcase's gel ball (5 cm radius, E = 2e4 Pa, ν = 0.35, 1000 kg/m³, stiffness damping
-    // 5 ms) dropped from 25 cm onto a ground of friction 0.6, 1/60 s frames: its contacts' Newton
-    // directions take the pieces of penalty and friction they land on, so every frame converges
-    // implicitly, none taking more than 20 Newton iterations, and none is handed to the explicit
-    // integrator (taking the pieces the points are on, its impact frames took 47 and 79
-    // iterations, then gave a frame of 0.36 s to the explicit integrator). Physics: it comes to
-    // rest on the ground (its centre's speed below 5 cm/s after 1 s from the drop: the rocking
-    // the gel keeps, about 6 mm/s in the showcase, bounds it) and no node ends more than the
-    // resting depth (1 mm) behind the ground.
+    // 5 ms) dropped from 25 cm onto a ground of friction 0.6, 1/60 s frames, implicit forced:
+    // its contacts' Newton directions take the pieces of penalty and friction they land on, so
+    // every frame converges, none taking more than 20 Newton iterations (taking the pieces the
+    // points are on, its impact frames took 47 and 79 iterations). Then the same drop by the
+    // automatic choice (which takes the explicit integrator for some frames once the ball
+    // rests: measured, 1.8 ms a frame forced explicit against 2.7 forced implicit): no frame is
+    // handed from one integrator to the other (before, an impact frame of 0.36 s was handed to
+    // the explicit integrator). Physics: it comes to rest on the ground (its centre's speed
+    // below 5 cm/s after 1 s from the drop: the rocking the gel keeps, about 6 mm/s in the
+    // showcase, bounds it) and no node ends more than the resting depth (1 mm) behind the
+    // ground.
+    for force in [Some(IntegratorKind::Implicit), None] {
+        gel_ball_landing(force);
+    }
+}
+
+/// The drop of [`a_gel_ball_landing_at_two_metres_a_second_converges_in_its_implicit_frames`]
+/// with the integrator `force`d or chosen.
+fn gel_ball_landing(force: Option<IntegratorKind>) {
     let material = Material::new(MaterialModel::StableNeoHookean, 2e4, 0.35, 1000.0).unwrap();
     let damping = RayleighDamping::stiffness_proportional(5e-3, material.lame()).unwrap();
     let ball = DeformableBodyBuilder::new(mesh::sphere(0.05, 6).unwrap(), material)
@@ -199,6 +217,7 @@ fn a_gel_ball_landing_at_two_metres_a_second_converges_in_its_implicit_frames() 
         .unwrap();
     let mut world = FvmWorld::default();
     world.coupling.sleep = SleepSettings::never();
+    world.coupling.integrator.force = force;
     world.physics.insert_collider(
         ColliderBuilder::new(SharedShape::halfspace(Vector::Y)).friction(0.6),
         None,
@@ -207,10 +226,11 @@ fn a_gel_ball_landing_at_two_metres_a_second_converges_in_its_implicit_frames() 
     let mut most = 0;
     for _ in 0..60 {
         let report = step(&mut world, handle);
-        assert!(!report.fell_back && report.choice == IntegratorKind::Implicit);
-        let implicit = report.implicit.unwrap();
-        assert!(implicit.converged);
-        most = most.max(implicit.newton_iterations);
+        assert!(!report.fell_back);
+        if let Some(implicit) = report.implicit {
+            assert!(implicit.converged);
+            most = most.max(implicit.newton_iterations);
+        }
     }
     let body = &world.soft_bodies[handle];
     let mass: f64 = body.masses().iter().sum();
@@ -222,7 +242,7 @@ fn a_gel_ball_landing_at_two_metres_a_second_converges_in_its_implicit_frames() 
         .fold(f64::INFINITY, f64::min);
     let speed = momentum.length() / mass;
     println!(
-        "most Newton iterations in a frame {most}; centre speed {speed:.2e} m/s, lowest node {lowest:.2e} m"
+        "{force:?}: most Newton iterations in a frame {most}; centre speed {speed:.2e} m/s, lowest node {lowest:.2e} m"
     );
     assert!(most <= 20);
     assert!(speed < 0.05);

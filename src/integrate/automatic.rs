@@ -5,7 +5,7 @@
 //! preferred at equal cost: it has no numerical damping.
 
 use super::choice::{AutomaticReport, CostPrediction, IntegratorKind};
-use super::cost::{CostModel, NewtonHistory, Workload};
+use super::cost::{CostModel, NewtonHistory, NewtonWork, Workload};
 use super::refusal::FrameInputs;
 use super::{
     BodyInStep, ImplicitIntegrator, ImplicitReport, SolverWorkspace, StepReport, SymplecticEuler,
@@ -49,17 +49,18 @@ impl AutomaticIntegrator {
             .explicit
             .needed_substeps(body, frame_dt)
             .unwrap_or(f64::INFINITY);
-        let work = self.workload(body, None, None);
+        let work = self.workload(body, None, None, frame_dt);
         self.prediction(&work, needed)
     }
 
-    /// What the cost of a frame of `body` depends on, with its `constraints` (contacts) and
-    /// `workspace` (Newton history) where known.
+    /// What the cost of a frame of `frame_dt` (s) of `body` depends on, with its `constraints`
+    /// (contacts) and `workspace` (Newton history) where known.
     fn workload(
         &self,
         body: &DeformableBody,
         constraints: Option<&BodyConstraints>,
         workspace: Option<&SolverWorkspace>,
+        frame_dt: f64,
     ) -> Workload {
         let (contact_points, sweeps) = constraints.map_or((0, 1), |c| {
             let sweeps = if c.coupled() {
@@ -69,15 +70,32 @@ impl AutomaticIntegrator {
             };
             (c.contacts.point_count(), sweeps)
         });
+        let assumed = || self.assumed_work(body, frame_dt);
         Workload {
             tets: body.mesh().tet_count() as f64,
             model: body.material().model(),
             damped: body.damping.is_some(),
             contact_points: contact_points as f64,
             sweeps: f64::from(sweeps),
-            newton_iterations: workspace.map_or(self.cost.newton_iterations, |w| {
-                w.newton.or(self.cost.newton_iterations)
-            }),
+            newton: workspace.map_or_else(assumed, |w| w.newton.or(assumed)),
+        }
+    }
+
+    /// The work per implicit substep assumed for `body` before its own implicit frames:
+    /// [`CostModel::newton_iterations`], each factorizing its tangent, or, where the linear
+    /// solver would take the conjugate gradient for substeps of a frame of `frame_dt` (s),
+    /// each solving with the iterations it predicts ([`NewtonWork::factorizing`] otherwise).
+    fn assumed_work(&self, body: &DeformableBody, frame_dt: f64) -> NewtonWork {
+        let iterations = self.cost.newton_iterations;
+        let h = frame_dt / f64::from(self.implicit.substeps.max(1));
+        let direct = NewtonWork::factorizing(iterations);
+        match (self.implicit.linear_solver).predicted_cg_iterations(body, h) {
+            None => direct,
+            Some(per_solve) => NewtonWork {
+                factorizations: 0.0,
+                linear_iterations: iterations * per_solve,
+                ..direct
+            },
         }
     }
 
@@ -87,7 +105,7 @@ impl AutomaticIntegrator {
         CostPrediction {
             explicit_substeps,
             contact_points: work.contact_points as usize,
-            newton_iterations: work.newton_iterations,
+            newton: work.newton,
             explicit_seconds: self.cost.explicit_seconds(work, explicit_substeps),
             implicit_seconds: self.cost.implicit_seconds(work, implicit_substeps),
         }
@@ -122,7 +140,7 @@ impl AutomaticIntegrator {
         // The stability limit is evaluated once and serves both the prediction and the step.
         let needed = self.explicit.needed_substeps(body, frame_dt)?;
         let prediction = self.prediction(
-            &self.workload(body, Some(constraints), Some(workspace)),
+            &self.workload(body, Some(constraints), Some(workspace), frame_dt),
             needed,
         );
         let choice = self.force.unwrap_or_else(|| {
@@ -223,7 +241,7 @@ impl AutomaticIntegrator {
         }
         let substeps = f64::from(self.implicit.substeps.max(1));
         let per_iteration =
-            prediction.implicit_seconds / (prediction.newton_iterations.max(1.0) * substeps);
+            prediction.implicit_seconds / (prediction.newton.iterations.max(1.0) * substeps);
         let affordable = prediction.explicit_seconds / per_iteration / substeps;
         let budget = (histories.into_iter())
             .map(|history| history.budget(affordable))
@@ -306,7 +324,7 @@ impl AutomaticIntegrator {
             needed = needed.max(self.explicit.needed_substeps(step.body, frame_dt)?);
         }
         let works: Vec<Workload> = (bodies.iter())
-            .map(|s| self.workload(s.body, Some(s.constraints), Some(s.workspace)))
+            .map(|s| self.workload(s.body, Some(s.constraints), Some(s.workspace), frame_dt))
             .collect();
         let predictions: Vec<CostPrediction> =
             works.iter().map(|w| self.prediction(w, needed)).collect();
@@ -317,10 +335,9 @@ impl AutomaticIntegrator {
         let total = CostPrediction {
             explicit_substeps: needed,
             contact_points: between + predictions.iter().map(|p| p.contact_points).sum::<usize>(),
-            newton_iterations: works
-                .iter()
-                .map(|w| w.newton_iterations)
-                .fold(0.0, f64::max),
+            newton: (works.iter().map(|w| w.newton))
+                .reduce(|a, b| if b.iterations > a.iterations { b } else { a })
+                .unwrap_or_default(),
             explicit_seconds: explicit,
             implicit_seconds: predictions.iter().map(|p| p.implicit_seconds).sum(),
         };

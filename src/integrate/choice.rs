@@ -2,7 +2,7 @@
 //! ([`IntegratorKind`]), the predicted cost of a frame with each ([`CostPrediction`], from the
 //! [`CostModel`](super::CostModel)), and the frame's report ([`AutomaticReport`]).
 
-use super::{ImplicitReport, StepReport};
+use super::{ImplicitReport, NewtonWork, StepReport};
 
 /// Which integrator advanced a frame.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -24,8 +24,8 @@ pub struct CostPrediction {
     pub explicit_substeps: f64,
     /// Contact points the explicit substeps sweep (those found at the frame's start).
     pub contact_points: usize,
-    /// Newton iterations per implicit substep expected (the body's recent mean).
-    pub newton_iterations: f64,
+    /// The work per implicit substep expected (the body's recent means).
+    pub newton: NewtonWork,
     /// Predicted time of the explicit frame (s).
     pub explicit_seconds: f64,
     /// Predicted time of the implicit frame (s).

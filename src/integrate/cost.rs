@@ -6,15 +6,31 @@
 //! - explicit: `n (T c_tet d + P s c_point)`: the `n` substeps the stability limit needs, `T`
 //!   tetrahedra at `c_tet` each (the material model's), `d` the factor damping costs (1 when
 //!   undamped), and `P` contact points swept `s` times per substep at `c_point` each;
-//! - implicit: `k N T c_newton (T/1000)^α`: `k` substeps of `N` Newton iterations over `T`
-//!   tetrahedra at `c_newton` each at a thousand tetrahedra (the material model's), dearer per
-//!   tetrahedron in larger bodies by the exponent `α` (the sparse factorization's fill grows
-//!   faster than the mesh). `N` is the body's own mean over its recent implicit frames
-//!   ([`NewtonHistory`]), [`CostModel::newton_iterations`] until it has one.
+//! - implicit: `k (T g (N c_newton + F c_factor) + L (c_cg + T c_cg_tet) + E c_energy)`: `k`
+//!   substeps, each of `N` Newton iterations (residual, line search and solve, at `c_newton`
+//!   per tetrahedron, the material model's) and `F` numeric factorizations with their
+//!   tangent's assembly (`c_factor`), these per tetrahedron of a body of a thousand and dearer
+//!   in larger ones by `g = (T/1000)^α` (the sparse factorization's fill grows faster than the
+//!   mesh), `L` conjugate gradient iterations (`c_cg` each and `c_cg_tet` per tetrahedron: a
+//!   sparse matrix–vector product and the vector operations), and `E` evaluations of the
+//!   incremental potential's energy (`c_energy` each whatever the size: the response of the
+//!   dynamic rigid bodies the body touches, its contact terms, and what the line search does
+//!   beyond the elements, whose energy is in `c_newton`). `N`, `F`, `L` and `E` are the body's
+//!   own means over its recent implicit frames ([`NewtonHistory`]); until it has them, `N` is
+//!   [`CostModel::newton_iterations`], each iteration factorizing its tangent (or, for a body
+//!   the linear solver would solve by the conjugate gradient, taking the iterations that solver
+//!   predicts, see [`LinearSolver::Automatic`](crate::linear_solver::LinearSolver)) and
+//!   evaluating the energy twice.
 //!
 //! Only the ratio of the two predictions decides, so the constants need be right relative to
 //! each other on the machine at hand; a run's report gives each body's predictions beside its
-//! measured time per frame.
+//! measured time per frame. Counting the factorizations and energy evaluations apart from the
+//! iterations matters where a body reuses its factorization in quiet frames and refactors
+//! several times an iteration in hard ones (a tangent projected, a substep redone), or where
+//! its line searches shorten the step many times (a soft stack under a box, 19 evaluations a
+//! step): on the implicit body steps of `rapier-fvm calibrate`'s cases, the showcase and the
+//! game scene (`benches/scenes/game.toml`), a least-squares fit of this model put 96 to 100 %
+//! of the steps within a factor of two of their time, against 60 to 80 % for `N` alone.
 
 use super::{ImplicitIntegrator, ImplicitReport};
 use crate::Error;
@@ -39,15 +55,37 @@ pub struct CostModel {
     pub explicit_damped_factor: f64,
     /// Explicit: seconds per contact point per velocity sweep per substep.
     pub explicit_contact_point: f64,
-    /// Implicit: seconds per tetrahedron per Newton iteration (assembly, factorization or
-    /// reuse, solve, line search) in a body of a thousand tetrahedra, for the linear, St.
+    /// Implicit: seconds per tetrahedron per Newton iteration beyond its factorization
+    /// (residual, line search, solve) in a body of a thousand tetrahedra, for the linear, St.
     /// Venant–Kirchhoff and stable Neo-Hookean models.
     pub newton_tet: f64,
-    /// Implicit: how the cost per tetrahedron of a Newton iteration grows with the body's
-    /// tetrahedra `T`, as `(T/1000)^α` (dimensionless, from 0 to 1).
+    /// Implicit: how the cost per tetrahedron of a Newton iteration and of a factorization grow
+    /// with the body's tetrahedra `T`, as `(T/1000)^α` (dimensionless, from 0 to 1).
     pub newton_size_exponent: f64,
     /// Implicit: seconds per tetrahedron per Newton iteration for the corotated model.
     pub newton_tet_corotated: f64,
+    /// Implicit: seconds per tetrahedron per numeric factorization of the Newton system, with
+    /// the assembly of its tangent, in a body of a thousand tetrahedra.
+    #[cfg_attr(feature = "serde-serialize", serde(default = "default_factorization"))]
+    pub factorization_tet: f64,
+    /// Implicit: seconds per evaluation of the incremental potential's energy, whatever the
+    /// body's size (the dynamic rigid bodies' response, the contact terms).
+    #[cfg_attr(feature = "serde-serialize", serde(default = "default_energy"))]
+    pub energy_evaluation: f64,
+    /// Implicit: seconds per conjugate gradient iteration whatever the body's size (its vector
+    /// operations' fixed costs).
+    #[cfg_attr(
+        feature = "serde-serialize",
+        serde(default = "default_conjugate_gradient")
+    )]
+    pub conjugate_gradient_iteration: f64,
+    /// Implicit: seconds per tetrahedron per conjugate gradient iteration (a sparse
+    /// matrix–vector product and the vector operations).
+    #[cfg_attr(
+        feature = "serde-serialize",
+        serde(default = "default_conjugate_gradient_tet")
+    )]
+    pub conjugate_gradient_tet: f64,
     /// Implicit: Newton iterations per substep assumed for a body that has not yet taken an
     /// implicit step.
     pub newton_iterations: f64,
@@ -58,16 +96,40 @@ impl Default for CostModel {
     /// README's "Choosing the integrator".
     fn default() -> Self {
         Self {
-            explicit_tet: 19.0e-9,
-            explicit_tet_corotated: 98e-9,
-            explicit_damped_factor: 1.64,
-            explicit_contact_point: 138e-9,
-            newton_tet: 1.10e-6,
-            newton_size_exponent: 0.16,
-            newton_tet_corotated: 1.69e-6,
-            newton_iterations: 1.27,
+            explicit_tet: 22.1e-9,
+            explicit_tet_corotated: 98.9e-9,
+            explicit_damped_factor: 1.24,
+            explicit_contact_point: 147e-9,
+            newton_tet: 0.084e-6,
+            newton_size_exponent: 0.40,
+            newton_tet_corotated: 0.425e-6,
+            factorization_tet: default_factorization(),
+            energy_evaluation: default_energy(),
+            conjugate_gradient_iteration: default_conjugate_gradient(),
+            conjugate_gradient_tet: default_conjugate_gradient_tet(),
+            newton_iterations: 1.36,
         }
     }
+}
+
+/// [`CostModel::factorization_tet`] of [`CostModel::default`] (s).
+fn default_factorization() -> f64 {
+    1.01e-6
+}
+
+/// [`CostModel::energy_evaluation`] of [`CostModel::default`] (s).
+fn default_energy() -> f64 {
+    85.6e-6
+}
+
+/// [`CostModel::conjugate_gradient_iteration`] of [`CostModel::default`] (s).
+fn default_conjugate_gradient() -> f64 {
+    14.5e-6
+}
+
+/// [`CostModel::conjugate_gradient_tet`] of [`CostModel::default`] (s).
+fn default_conjugate_gradient_tet() -> f64 {
+    6.89e-9
 }
 
 /// What a frame's prediction needs to know of a body.
@@ -84,8 +146,8 @@ pub(crate) struct Workload {
     pub(crate) contact_points: f64,
     /// Velocity sweeps per explicit substep.
     pub(crate) sweeps: f64,
-    /// Newton iterations per implicit substep expected.
-    pub(crate) newton_iterations: f64,
+    /// The work per implicit substep expected.
+    pub(crate) newton: NewtonWork,
 }
 
 impl CostModel {
@@ -112,29 +174,100 @@ impl CostModel {
 
     /// Predicted seconds of an implicit frame of `substeps` for `work`.
     pub(crate) fn implicit_seconds(&self, work: &Workload, substeps: f64) -> f64 {
-        let per_tet = match work.model {
+        let per_iteration = match work.model {
             MaterialModel::Corotated => self.newton_tet_corotated,
             _ => self.newton_tet,
         };
         let size = (work.tets / 1000.0).powf(self.newton_size_exponent);
-        substeps * work.newton_iterations * work.tets * per_tet * size
+        let newton = &work.newton;
+        let direct =
+            newton.iterations * per_iteration + newton.factorizations * self.factorization_tet;
+        let conjugate_gradient =
+            self.conjugate_gradient_iteration + work.tets * self.conjugate_gradient_tet;
+        substeps
+            * (work.tets * size * direct
+                + newton.linear_iterations * conjugate_gradient
+                + newton.energy_evaluations * self.energy_evaluation)
     }
 }
 
-/// A body's Newton iterations per implicit substep, averaged over its recent implicit frames
-/// (each new frame weighs [`NewtonHistory::WEIGHT`]), and drawn back towards the cost model's
-/// assumption by each explicit frame (by [`NewtonHistory::FORGETTING`]), so that a body that
-/// left the implicit integrator after a few hard frames (an impact) tries it again once they are
+/// The work of an implicit substep: Newton iterations, numeric factorizations, conjugate
+/// gradient iterations and energy evaluations (each a mean per substep).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(
+    feature = "serde-serialize",
+    derive(serde::Serialize, serde::Deserialize)
+)]
+pub struct NewtonWork {
+    /// Newton iterations.
+    pub iterations: f64,
+    /// Numeric factorizations of the Newton system.
+    pub factorizations: f64,
+    /// Conjugate gradient iterations.
+    pub linear_iterations: f64,
+    /// Evaluations of the incremental potential's energy.
+    pub energy_evaluations: f64,
+}
+
+impl NewtonWork {
+    /// Iterations that each factorize their tangent and evaluate the energy twice (the solve's
+    /// start and one line-search trial), `iterations` of them.
+    pub(crate) fn factorizing(iterations: f64) -> Self {
+        Self {
+            iterations,
+            factorizations: iterations,
+            linear_iterations: 0.0,
+            energy_evaluations: 2.0 * iterations,
+        }
+    }
+
+    /// Every count times `factor`.
+    fn times(&self, factor: f64) -> Self {
+        Self {
+            iterations: self.iterations * factor,
+            factorizations: self.factorizations * factor,
+            linear_iterations: self.linear_iterations * factor,
+            energy_evaluations: self.energy_evaluations * factor,
+        }
+    }
+
+    /// Every count moved `weight` of the way towards `new`'s.
+    fn towards(&self, new: &Self, weight: f64) -> Self {
+        let blend = |mean: f64, new: f64| mean + weight * (new - mean);
+        Self {
+            iterations: blend(self.iterations, new.iterations),
+            factorizations: blend(self.factorizations, new.factorizations),
+            linear_iterations: blend(self.linear_iterations, new.linear_iterations),
+            energy_evaluations: blend(self.energy_evaluations, new.energy_evaluations),
+        }
+    }
+
+    /// `iterations` Newton iterations, each with the rest of the work of an iteration of
+    /// `like`, or [`NewtonWork::factorizing`] if `like` has no iteration.
+    fn scaled(iterations: f64, like: &NewtonWork) -> Self {
+        if like.iterations > 0.0 {
+            like.times(iterations / like.iterations)
+        } else {
+            Self::factorizing(iterations)
+        }
+    }
+}
+
+/// A body's implicit work per substep ([`NewtonWork`]), averaged over its recent implicit frames
+/// (each new frame weighs [`NewtonHistory::WEIGHT`]), its iterations drawn back towards the cost
+/// model's assumption by each explicit frame (by [`NewtonHistory::FORGETTING`], the rest of the
+/// work with them in proportion), so that a body that left the
+/// implicit integrator after a few hard frames (an impact) tries it again once they are
 /// forgotten. It also keeps the Newton iterations a budget of the automatic choice allowed and
 /// its frames left unspent, for a harder frame to use (see [`NewtonHistory::budget`]). The same
-/// run gives the same history, so the choices it drives repeat bit for bit.
+/// run gives the same history (counts, not times), so the choices it drives repeat bit for bit.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 #[cfg_attr(
     feature = "serde-serialize",
     derive(serde::Serialize, serde::Deserialize)
 )]
 pub(crate) struct NewtonHistory {
-    mean: Option<f64>,
+    mean: Option<NewtonWork>,
     /// Newton iterations per substep allowed and left unspent by the last implicit frames.
     #[cfg_attr(feature = "serde-serialize", serde(default))]
     saved: f64,
@@ -161,19 +294,20 @@ impl NewtonHistory {
         (self.saved + affordable).min(Self::SAVED_FRAMES * affordable)
     }
 
-    /// Takes in an implicit frame of `iterations` Newton iterations over `substeps`, allowed
-    /// `allowed` per substep.
-    fn record(&mut self, iterations: usize, substeps: u32, allowed: usize) {
-        let per_substep = iterations as f64 / f64::from(substeps.max(1));
-        self.saved = (allowed as f64 - per_substep).max(0.0);
+    /// Takes in an implicit frame of `frame` work over `substeps`, allowed `allowed` Newton
+    /// iterations per substep.
+    fn record(&mut self, frame: NewtonWork, substeps: u32, allowed: usize) {
+        let new = frame.times(1.0 / f64::from(substeps.max(1)));
+        self.saved = (allowed as f64 - new.iterations).max(0.0);
         self.mean = Some(match self.mean {
-            Some(mean) => mean + Self::WEIGHT * (per_substep - mean),
-            None => per_substep,
+            Some(mean) => mean.towards(&new, Self::WEIGHT),
+            None => new,
         });
     }
 
-    /// Takes in an implicit frame's `outcome` by `integrator`: its iterations, or for a frame
-    /// it could not take, every iteration it was allowed (what the attempt cost).
+    /// Takes in an implicit frame's `outcome` by `integrator`: its work, or for a frame it
+    /// could not take, every iteration it was allowed (what the attempt cost), each with the
+    /// rest of the work of the body's mean iteration.
     pub(crate) fn record_outcome(
         &mut self,
         outcome: &Result<ImplicitReport, Error>,
@@ -181,22 +315,41 @@ impl NewtonHistory {
     ) {
         let allowed = integrator.max_newton_iterations;
         match outcome {
-            Ok(report) => self.record(report.newton_iterations, report.substeps, allowed),
-            Err(_) => self.record(allowed, 1, allowed),
+            Ok(report) => {
+                let frame = NewtonWork {
+                    iterations: report.newton_iterations as f64,
+                    factorizations: report.factorizations as f64,
+                    linear_iterations: report.linear_iterations as f64,
+                    energy_evaluations: report.energy_evaluations as f64,
+                };
+                self.record(frame, report.substeps, allowed);
+            }
+            Err(_) => {
+                let like = self.mean.unwrap_or_default();
+                self.record(NewtonWork::scaled(allowed as f64, &like), 1, allowed);
+            }
         }
     }
 
-    /// Takes in an explicit frame: the mean moves towards `assumed`, and nothing is saved.
+    /// Takes in an explicit frame: the mean iterations move towards `assumed`, the rest of the
+    /// work with them in proportion, and nothing is saved.
     pub(crate) fn forget(&mut self, assumed: f64) {
         self.saved = 0.0;
         if let Some(mean) = &mut self.mean {
-            *mean += Self::FORGETTING * (assumed - *mean);
+            let iterations = mean.iterations + Self::FORGETTING * (assumed - mean.iterations);
+            *mean = NewtonWork::scaled(iterations, mean);
         }
     }
 
-    /// The mean, or `default` before any implicit frame.
-    pub(crate) fn or(&self, default: f64) -> f64 {
-        self.mean.unwrap_or(default)
+    /// The mean work per substep, or `assumed` before any implicit frame.
+    pub(crate) fn or(&self, assumed: impl FnOnce() -> NewtonWork) -> NewtonWork {
+        self.mean.unwrap_or_else(assumed)
+    }
+
+    /// Whether the body has taken (or tried) an implicit frame.
+    #[cfg(test)]
+    pub(crate) fn has_history(&self) -> bool {
+        self.mean.is_some()
     }
 }
 
@@ -204,23 +357,50 @@ impl NewtonHistory {
 mod tests {
     use super::*;
 
+    /// A frame's (or a substep's) work.
+    fn work(iterations: f64, factorizations: f64, linear: f64, energy: f64) -> NewtonWork {
+        NewtonWork {
+            iterations,
+            factorizations,
+            linear_iterations: linear,
+            energy_evaluations: energy,
+        }
+    }
+
+    /// `left` equals `right` to round-off (1e-12 relative).
+    fn assert_close(left: NewtonWork, right: NewtonWork) {
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b.abs().max(1.0);
+        assert!(
+            close(left.iterations, right.iterations)
+                && close(left.factorizations, right.factorizations)
+                && close(left.linear_iterations, right.linear_iterations)
+                && close(left.energy_evaluations, right.energy_evaluations),
+            "{left:?} against {right:?}"
+        );
+    }
+
     #[test]
     fn the_history_is_an_exponential_mean_drawn_back_by_explicit_frames() {
-        // Closed form: 4 per substep, then 8 → 4 + (8 − 4)/4 = 5; an explicit frame → 5 + (1 −
-        // 5)/16 = 4.75; a refused frame of budget 20 → 4.75 + (20 − 4.75)/4 = 8.5625.
+        // Closed form, per substep (iterations, factorizations, conjugate gradient iterations,
+        // energy evaluations): (8, 8, 0, 16) over 2 substeps → (4, 4, 0, 8); then (8, 2, 16, 24)
+        // → (4 + 4/4, 4 − 2/4, 16/4, 8 + 16/4) = (5, 3.5, 4, 12); an explicit frame → iterations
+        // 5 + (1 − 5)/16 = 4.75, the rest scaled by 0.95 → (4.75, 3.325, 3.8, 11.4); a refused
+        // frame allowed 20 counts 20 iterations with the mean's 0.7 factorizations, 0.8 CG
+        // iterations and 2.4 evaluations each, (20, 14, 16, 48) → (4.75 + 15.25/4, 3.325 +
+        // 10.675/4, 3.8 + 12.2/4, 11.4 + 36.6/4) = (8.5625, 5.99375, 6.85, 20.55).
+        let assumed = || NewtonWork::factorizing(1.0);
         let mut history = NewtonHistory::default();
-        assert_eq!(history.or(1.0), 1.0);
+        assert_eq!(history.or(assumed), work(1.0, 1.0, 0.0, 2.0));
         history.forget(1.0);
-        assert_eq!(
-            history.or(1.0),
-            1.0,
+        assert!(
+            !history.has_history(),
             "nothing to forget before an implicit frame"
         );
-        history.record(8, 2, 100);
-        history.record(8, 1, 100);
-        assert_eq!(history.or(1.0), 5.0);
+        history.record(work(8.0, 8.0, 0.0, 16.0), 2, 100);
+        history.record(work(8.0, 2.0, 16.0, 24.0), 1, 100);
+        assert_close(history.or(assumed), work(5.0, 3.5, 4.0, 12.0));
         history.forget(1.0);
-        assert_eq!(history.or(1.0), 4.75);
+        assert_close(history.or(assumed), work(4.75, 3.325, 3.8, 11.4));
         let integrator = ImplicitIntegrator {
             max_newton_iterations: 20,
             ..ImplicitIntegrator::default()
@@ -230,7 +410,7 @@ mod tests {
             substeps: 1,
         });
         history.record_outcome(&refused, &integrator);
-        assert_eq!(history.or(1.0), 8.5625);
+        assert_close(history.or(assumed), work(8.5625, 5.99375, 6.85, 20.55));
     }
 
     #[test]
@@ -240,13 +420,13 @@ mod tests {
         // frame or a refused one leaves nothing → 10.
         let mut history = NewtonHistory::default();
         assert_eq!(history.budget(10.0), 10.0);
-        history.record(2, 1, 10);
+        history.record(work(2.0, 2.0, 0.0, 4.0), 1, 10);
         assert_eq!(history.budget(10.0), 18.0);
-        history.record(1, 1, 100);
+        history.record(work(1.0, 1.0, 0.0, 2.0), 1, 100);
         assert_eq!(history.budget(10.0), 80.0);
         history.forget(1.0);
         assert_eq!(history.budget(10.0), 10.0);
-        history.record(1, 1, 100);
+        history.record(work(1.0, 1.0, 0.0, 2.0), 1, 100);
         let refused = Err(Error::NewtonDidNotConverge {
             residual: 1.0,
             substeps: 1,

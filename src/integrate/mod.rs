@@ -16,7 +16,7 @@ mod workspace;
 
 pub use automatic::AutomaticIntegrator;
 pub use choice::{AutomaticReport, CostPrediction, IntegratorKind};
-pub use cost::CostModel;
+pub use cost::{CostModel, NewtonWork};
 pub use crush::COLLAPSE_RATIO;
 pub(crate) use crush::CrushWatch;
 pub use explicit::{COURANT_NUMBER, StepReport, Substeps, SymplecticEuler};

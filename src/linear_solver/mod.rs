@@ -175,6 +175,25 @@ impl LinearSolver {
     }
 }
 
+impl LinearSolver {
+    /// The conjugate gradient iterations per solve predicted for substeps of `h` (s) on `body`
+    /// in its current shape (see [`LinearSolver::Automatic`]), at most the solver's limit, or
+    /// `None` where the direct method is used.
+    pub(crate) fn predicted_cg_iterations(&self, body: &DeformableBody, h: f64) -> Option<f64> {
+        let (tolerance, most) = match self.method(body, h) {
+            Method::Direct => return None,
+            Method::ConjugateGradient {
+                tolerance,
+                max_iterations,
+            } => (tolerance, max_iterations),
+            Method::AutomaticConjugateGradient { max_iterations } => {
+                (AUTOMATIC_CG_TOLERANCE, max_iterations)
+            }
+        };
+        Some(predict(body, h, tolerance).cg_iterations.min(most as f64))
+    }
+}
+
 /// The predicted costs [`LinearSolver::Automatic`] compares.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SolverPrediction {

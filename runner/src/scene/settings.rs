@@ -155,12 +155,23 @@ pub struct CostSpec {
     pub explicit_damped_factor: Option<f64>,
     /// Seconds per contact point per velocity sweep per explicit substep.
     pub explicit_contact_point: Option<f64>,
-    /// Seconds per tetrahedron per Newton iteration, at a thousand tetrahedra.
+    /// Seconds per tetrahedron per Newton iteration beyond its factorization, at a thousand
+    /// tetrahedra.
     pub newton_tet: Option<f64>,
-    /// The exponent of the per-tetrahedron Newton cost's growth with size, in [0, 1].
+    /// The exponent of the per-tetrahedron Newton and factorization costs' growth with size,
+    /// in [0, 1].
     pub newton_size_exponent: Option<f64>,
     /// The same, corotated model.
     pub newton_tet_corotated: Option<f64>,
+    /// Seconds per tetrahedron per factorization with its tangent's assembly, at a thousand
+    /// tetrahedra.
+    pub factorization_tet: Option<f64>,
+    /// Seconds per energy evaluation.
+    pub energy_evaluation: Option<f64>,
+    /// Seconds per conjugate gradient iteration whatever the size.
+    pub conjugate_gradient_iteration: Option<f64>,
+    /// Seconds per tetrahedron per conjugate gradient iteration.
+    pub conjugate_gradient_tet: Option<f64>,
     /// Newton iterations per implicit substep before a body has its own.
     pub newton_iterations: Option<f64>,
 }
@@ -183,21 +194,40 @@ impl CostSpec {
             newton_tet: self.newton_tet.unwrap_or(d.newton_tet),
             newton_size_exponent: self.newton_size_exponent.unwrap_or(d.newton_size_exponent),
             newton_tet_corotated: self.newton_tet_corotated.unwrap_or(d.newton_tet_corotated),
+            factorization_tet: self.factorization_tet.unwrap_or(d.factorization_tet),
+            energy_evaluation: self.energy_evaluation.unwrap_or(d.energy_evaluation),
+            conjugate_gradient_iteration: self
+                .conjugate_gradient_iteration
+                .unwrap_or(d.conjugate_gradient_iteration),
+            conjugate_gradient_tet: self
+                .conjugate_gradient_tet
+                .unwrap_or(d.conjugate_gradient_tet),
             newton_iterations: self.newton_iterations.unwrap_or(d.newton_iterations),
         }
     }
 
-    /// Checks every key given: finite, positive (the contact cost may be zero), the damping
-    /// factor at least 1, the size exponent in [0, 1].
+    /// Checks every key given: finite, positive (the contact cost and the implicit work's
+    /// parts may be zero), the damping factor at least 1, the size exponent in [0, 1].
     fn check(&self, c: &mut Checker<'_>) {
-        if let Some(value) = self.explicit_contact_point {
-            c.non_negative("integrator.cost.explicit_contact_point", value, "s");
+        for (key, value) in [
+            ("explicit_contact_point", self.explicit_contact_point),
+            ("newton_tet", self.newton_tet),
+            ("newton_tet_corotated", self.newton_tet_corotated),
+            ("factorization_tet", self.factorization_tet),
+            ("energy_evaluation", self.energy_evaluation),
+            (
+                "conjugate_gradient_iteration",
+                self.conjugate_gradient_iteration,
+            ),
+            ("conjugate_gradient_tet", self.conjugate_gradient_tet),
+        ] {
+            if let Some(value) = value {
+                c.non_negative(&format!("integrator.cost.{key}"), value, "s");
+            }
         }
         for (key, value) in [
             ("explicit_tet", self.explicit_tet),
             ("explicit_tet_corotated", self.explicit_tet_corotated),
-            ("newton_tet", self.newton_tet),
-            ("newton_tet_corotated", self.newton_tet_corotated),
             ("newton_iterations", self.newton_iterations),
         ] {
             if let Some(value) = value {
