@@ -228,6 +228,14 @@ impl BodyConstraints {
         self.rigid_proxies.iter().any(RigidProxy::is_dynamic)
     }
 
+    /// The dynamic rigid bodies the contacts and attachments touch (as the last detection found
+    /// them).
+    pub(crate) fn dynamic_body_count(&self) -> usize {
+        (self.rigid_proxies.iter())
+            .filter(|proxy| proxy.is_dynamic())
+            .count()
+    }
+
     /// Sets aside what a step moves (no allocation after the first call), and starts counting
     /// the contact impulses of a new step.
     pub(crate) fn save(&mut self) {

@@ -62,13 +62,13 @@ impl AutomaticIntegrator {
         workspace: Option<&SolverWorkspace>,
         frame_dt: f64,
     ) -> Workload {
-        let (contact_points, sweeps) = constraints.map_or((0, 1), |c| {
+        let (contact_points, sweeps, rigid_partners) = constraints.map_or((0, 1, 0), |c| {
             let sweeps = if c.coupled() {
                 c.contacts.settings.velocity_iterations.max(1)
             } else {
                 1
             };
-            (c.contacts.point_count(), sweeps)
+            (c.contacts.point_count(), sweeps, c.dynamic_body_count())
         });
         let assumed = || self.assumed_work(body, frame_dt);
         Workload {
@@ -77,18 +77,20 @@ impl AutomaticIntegrator {
             damped: body.damping.is_some(),
             contact_points: contact_points as f64,
             sweeps: f64::from(sweeps),
+            rigid_partners: rigid_partners as f64,
             newton: workspace.map_or_else(assumed, |w| w.newton.or(assumed)),
         }
     }
 
-    /// The work per implicit substep assumed for `body` before its own implicit frames:
-    /// [`CostModel::newton_iterations`], each factorizing its tangent, or, where the linear
-    /// solver would take the conjugate gradient for substeps of a frame of `frame_dt` (s),
-    /// each solving with the iterations it predicts ([`NewtonWork::factorizing`] otherwise).
+    /// The work per implicit substep assumed for `body` before its own implicit frames (and
+    /// which explicit frames draw its history back to): [`CostModel::newton_iterations`]
+    /// solved directly ([`NewtonWork::assumed_direct`]), or, where the linear solver would take
+    /// the conjugate gradient for substeps of a frame of `frame_dt` (s), with the iterations it
+    /// predicts and no factorization.
     fn assumed_work(&self, body: &DeformableBody, frame_dt: f64) -> NewtonWork {
         let iterations = self.cost.newton_iterations;
         let h = frame_dt / f64::from(self.implicit.substeps.max(1));
-        let direct = NewtonWork::factorizing(iterations);
+        let direct = NewtonWork::assumed_direct(iterations, self.implicit.reuse_factorization);
         match (self.implicit.linear_solver).predicted_cg_iterations(body, h) {
             None => direct,
             Some(per_solve) => NewtonWork {
@@ -105,6 +107,7 @@ impl AutomaticIntegrator {
         CostPrediction {
             explicit_substeps,
             contact_points: work.contact_points as usize,
+            rigid_partners: work.rigid_partners as usize,
             newton: work.newton,
             explicit_seconds: self.cost.explicit_seconds(work, explicit_substeps),
             implicit_seconds: self.cost.implicit_seconds(work, implicit_substeps),
@@ -210,7 +213,8 @@ impl AutomaticIntegrator {
             implicit_frame,
         )?;
         if explicit.is_some() {
-            step.workspace.newton.forget(self.cost.newton_iterations);
+            let assumed = self.assumed_work(step.body, frame_dt);
+            step.workspace.newton.forget(&assumed);
         }
         Ok(AutomaticReport::of(
             prediction,
@@ -335,6 +339,7 @@ impl AutomaticIntegrator {
         let total = CostPrediction {
             explicit_substeps: needed,
             contact_points: between + predictions.iter().map(|p| p.contact_points).sum::<usize>(),
+            rigid_partners: predictions.iter().map(|p| p.rigid_partners).sum(),
             newton: (works.iter().map(|w| w.newton))
                 .reduce(|a, b| if b.iterations > a.iterations { b } else { a })
                 .unwrap_or_default(),
@@ -402,7 +407,8 @@ impl AutomaticIntegrator {
         {
             (Some(reports), _) => {
                 for step in bodies.iter_mut() {
-                    step.workspace.newton.forget(self.cost.newton_iterations);
+                    let assumed = self.assumed_work(step.body, frame_dt);
+                    step.workspace.newton.forget(&assumed);
                 }
                 reports.into_iter().map(|r| (Some(r), None)).collect()
             }

@@ -24,6 +24,8 @@ pub struct CostPrediction {
     pub explicit_substeps: f64,
     /// Contact points the explicit substeps sweep (those found at the frame's start).
     pub contact_points: usize,
+    /// Dynamic rigid bodies the contacts and attachments touch (found at the frame's start).
+    pub rigid_partners: usize,
     /// The work per implicit substep expected (the body's recent means).
     pub newton: NewtonWork,
     /// Predicted time of the explicit frame (s).

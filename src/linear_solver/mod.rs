@@ -173,9 +173,7 @@ impl LinearSolver {
             }
         }
     }
-}
 
-impl LinearSolver {
     /// The conjugate gradient iterations per solve predicted for substeps of `h` (s) on `body`
     /// in its current shape (see [`LinearSolver::Automatic`]), at most the solver's limit, or
     /// `None` where the direct method is used.

@@ -1,6 +1,6 @@
 //! The implicit constants of the [`CostModel`] from measured frames: each frame's integration
 //! time `t` against its work, `t = T g (N c_newton + F c_factor) + L (c_cg + T c_cg_tet) +
-//! E c_energy` with `g = (T/1000)^α` (see `rapier_fvm::integrate::CostModel`): for each `α`
+//! E (c_energy + R c_partner)` with `g = (T/1000)^α` (see `rapier_fvm::integrate::CostModel`): for each `α`
 //! from 0 to 1 in steps of [`EXPONENT_STEP`], the non-negative least squares of the relative
 //! residuals `(prediction − t)/t` over every frame; the `α` of the smallest sum is kept.
 
@@ -8,6 +8,10 @@ use rapier_fvm::integrate::CostModel;
 
 /// The step (dimensionless) of the size exponents tried.
 const EXPONENT_STEP: f64 = 0.05;
+
+/// The constants fitted: per Newton iteration, factorization, energy evaluation, energy
+/// evaluation per rigid partner, conjugate gradient iteration and its tetrahedron.
+const CONSTANTS: usize = 6;
 
 /// One implicit frame of a body: its integration time and work.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -24,16 +28,19 @@ pub struct ImplicitFrame {
     pub linear_iterations: f64,
     /// Evaluations of the incremental potential's energy.
     pub energy_evaluations: f64,
+    /// Dynamic rigid bodies touched at the frame's start.
+    pub rigid_partners: f64,
 }
 
 impl ImplicitFrame {
     /// The frame's work per constant of [`fit`], at size exponent `exponent`.
-    fn columns(&self, exponent: f64) -> [f64; 5] {
+    fn columns(&self, exponent: f64) -> [f64; CONSTANTS] {
         let sized = self.tets * (self.tets / 1000.0).powf(exponent);
         [
             sized * self.newton_iterations,
             sized * self.factorizations,
             self.energy_evaluations,
+            self.energy_evaluations * self.rigid_partners,
             self.linear_iterations,
             self.linear_iterations * self.tets,
         ]
@@ -53,8 +60,8 @@ pub fn fit(frames: &[ImplicitFrame], corotated: &[ImplicitFrame]) -> CostModel {
         })
         .min_by(|a, b| a.2.total_cmp(&b.2))
         .map(|(exponent, constants, _)| (exponent, constants))
-        .unwrap_or((0.0, [0.0; 5]));
-    let [newton, factorization, energy, cg_iteration, cg_tet] = constants;
+        .unwrap_or((0.0, [0.0; CONSTANTS]));
+    let [newton, factorization, energy, partner, cg_iteration, cg_tet] = constants;
     // The corotated iteration: what its frames took beyond the other constants' share.
     let (mut beyond, mut iterations) = (0.0, 0.0);
     for frame in corotated {
@@ -73,6 +80,7 @@ pub fn fit(frames: &[ImplicitFrame], corotated: &[ImplicitFrame]) -> CostModel {
         },
         factorization_tet: factorization,
         energy_evaluation: energy,
+        partner_evaluation: partner,
         conjugate_gradient_iteration: cg_iteration,
         conjugate_gradient_tet: cg_tet,
         ..CostModel::default()
@@ -80,7 +88,7 @@ pub fn fit(frames: &[ImplicitFrame], corotated: &[ImplicitFrame]) -> CostModel {
 }
 
 /// The sum of the squared relative residuals of `constants` over `frames`.
-fn residual(frames: &[ImplicitFrame], exponent: f64, constants: &[f64; 5]) -> f64 {
+fn residual(frames: &[ImplicitFrame], exponent: f64, constants: &[f64; CONSTANTS]) -> f64 {
     (frames.iter().filter(|f| f.seconds > 0.0))
         .map(|f| {
             let predicted: f64 = (f.columns(exponent).iter().zip(constants))
@@ -93,11 +101,11 @@ fn residual(frames: &[ImplicitFrame], exponent: f64, constants: &[f64; 5]) -> f6
 
 /// The non-negative least-squares constants at `exponent`: a constant that comes out negative
 /// is set to zero and the rest fitted again.
-fn fit_non_negative(frames: &[ImplicitFrame], exponent: f64) -> [f64; 5] {
-    let mut free = [true; 5];
+fn fit_non_negative(frames: &[ImplicitFrame], exponent: f64) -> [f64; CONSTANTS] {
+    let mut free = [true; CONSTANTS];
     loop {
         let fitted = least_squares(frames, exponent, free);
-        match (0..5).find(|&k| free[k] && fitted[k] < 0.0) {
+        match (0..CONSTANTS).find(|&k| free[k] && fitted[k] < 0.0) {
             Some(k) => free[k] = false,
             None => return fitted,
         }
@@ -107,23 +115,30 @@ fn fit_non_negative(frames: &[ImplicitFrame], exponent: f64) -> [f64; 5] {
 /// The least-squares constants of the relative residuals with those not `free` zero: the
 /// normal equations, solved by Gaussian elimination with partial pivoting; a constant with no
 /// work to fit (or a singular system) is zero.
-fn least_squares(frames: &[ImplicitFrame], exponent: f64, free: [bool; 5]) -> [f64; 5] {
-    let mut normal = [[0.0f64; 6]; 5];
+fn least_squares(
+    frames: &[ImplicitFrame],
+    exponent: f64,
+    free: [bool; CONSTANTS],
+) -> [f64; CONSTANTS] {
+    const RHS: usize = CONSTANTS;
+    let mut normal = [[0.0f64; CONSTANTS + 1]; CONSTANTS];
     for frame in frames.iter().filter(|f| f.seconds > 0.0) {
         let row = frame.columns(exponent).map(|w| w / frame.seconds);
-        for i in 0..5 {
-            for j in 0..5 {
+        for i in 0..CONSTANTS {
+            for j in 0..CONSTANTS {
                 normal[i][j] += row[i] * row[j];
             }
-            normal[i][5] += row[i];
+            normal[i][RHS] += row[i];
         }
     }
-    let unknowns: Vec<usize> = (0..5).filter(|&k| free[k] && normal[k][k] > 0.0).collect();
+    let unknowns: Vec<usize> = (0..CONSTANTS)
+        .filter(|&k| free[k] && normal[k][k] > 0.0)
+        .collect();
     let n = unknowns.len();
     let mut system: Vec<Vec<f64>> = (unknowns.iter())
         .map(|&i| {
             let mut row: Vec<f64> = unknowns.iter().map(|&j| normal[i][j]).collect();
-            row.push(normal[i][5]);
+            row.push(normal[i][RHS]);
             row
         })
         .collect();
@@ -146,7 +161,7 @@ fn least_squares(frames: &[ImplicitFrame], exponent: f64, free: [bool; 5]) -> [f
             .sum();
         solution[row] = (system[row][n] - known) / system[row][row];
     }
-    let mut constants = [0.0; 5];
+    let mut constants = [0.0; CONSTANTS];
     for (k, value) in unknowns.into_iter().zip(solution) {
         constants[k] = if value.is_finite() { value } else { 0.0 };
     }
@@ -161,7 +176,7 @@ mod tests {
     fn frames_made_by_the_model_give_back_its_constants_and_exponent() {
         // Frames computed from known constants and α = 0.35 (a multiple of the step): the fit
         // must recover them to 1e-9 relative (round-off in the normal equations).
-        let truth = [3e-7, 9e-7, 5e-5, 2e-5, 8e-9];
+        let truth = [3e-7, 9e-7, 5e-5, 8e-6, 2e-5, 8e-9];
         let exponent = 0.35;
         let mut frames = Vec::new();
         for (k, tets) in [320.0, 1080.0, 5000.0, 20480.0].into_iter().enumerate() {
@@ -173,6 +188,7 @@ mod tests {
                     factorizations: ((n + k) % 3) as f64,
                     linear_iterations: (10 * ((n + 2 * k) % 4)) as f64,
                     energy_evaluations: (2 * n + k % 2) as f64,
+                    rigid_partners: ((n + k) % 3) as f64,
                 };
                 let seconds = (frame.columns(exponent).iter().zip(truth))
                     .map(|(w, c)| w * c)
@@ -186,6 +202,7 @@ mod tests {
             cost.newton_tet,
             cost.factorization_tet,
             cost.energy_evaluation,
+            cost.partner_evaluation,
             cost.conjugate_gradient_iteration,
             cost.conjugate_gradient_tet,
         ];

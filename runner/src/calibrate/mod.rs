@@ -81,9 +81,21 @@ enum Start {
 /// # Errors
 /// A step's error (none is expected of these cases).
 pub fn calibrate(mut log: impl FnMut(&str)) -> Result<CostModel, Error> {
-    use IntegratorKind::{Explicit, Implicit};
-    use MaterialModel::{Corotated, StableNeoHookean};
-    let case = |model, damped, start, force| Case {
+    let explicit = explicit_constants(&mut log)?;
+    let implicit = implicit_constants(&mut log)?;
+    Ok(CostModel {
+        explicit_tet: explicit.explicit_tet,
+        explicit_tet_corotated: explicit.explicit_tet_corotated,
+        explicit_damped_factor: explicit.explicit_damped_factor,
+        explicit_contact_point: explicit.explicit_contact_point,
+        ..implicit
+    })
+}
+
+/// A case of the stable Neo-Hookean or corotated `model` on 6 cells a side, undamped unless
+/// `damped`, from `start`, with `force`d integrator and the automatic linear solver.
+fn case(model: MaterialModel, damped: bool, start: Start, force: IntegratorKind) -> Case {
+    Case {
         model,
         damped,
         start,
@@ -91,40 +103,78 @@ pub fn calibrate(mut log: impl FnMut(&str)) -> Result<CostModel, Error> {
         cells: 6,
         solver: LinearSolver::Automatic,
         reuse: true,
-    };
-    let mut fastest = |c: Case, name: &str| -> Result<Sample, Error> {
-        let mut best = measure(c)?;
-        for _ in 1..RUNS {
-            let sample = measure(c)?;
-            if sample.seconds < best.seconds {
-                best = sample;
-            }
+    }
+}
+
+/// The fastest of [`RUNS`] runs of `case`, its line (named `name`) given to `log`.
+fn fastest(case: Case, name: &str, log: &mut impl FnMut(&str)) -> Result<Sample, Error> {
+    let mut best = measure(case)?;
+    for _ in 1..RUNS {
+        let sample = measure(case)?;
+        if sample.seconds < best.seconds {
+            best = sample;
         }
-        log(&describe(&best, name));
-        Ok(best)
-    };
+    }
+    log(&describe(&best, name));
+    Ok(best)
+}
+
+/// The explicit constants (the rest [`CostModel::default`]'s): per tetrahedron per substep
+/// spinning free, undamped, damped and corotated, and per contact point from the drop.
+fn explicit_constants(log: &mut impl FnMut(&str)) -> Result<CostModel, Error> {
+    use MaterialModel::{Corotated, StableNeoHookean};
+    let explicit = |model, damped, start| case(model, damped, start, IntegratorKind::Explicit);
     let free = fastest(
-        case(StableNeoHookean, false, Start::Free, Explicit),
+        explicit(StableNeoHookean, false, Start::Free),
         "explicit, free",
+        log,
     )?;
     let damped = fastest(
-        case(StableNeoHookean, true, Start::Free, Explicit),
+        explicit(StableNeoHookean, true, Start::Free),
         "explicit, free, damped",
+        log,
     )?;
     let corotated = fastest(
-        case(Corotated, false, Start::Free, Explicit),
+        explicit(Corotated, false, Start::Free),
         "explicit, free, corotated",
+        log,
     )?;
     let dropped = fastest(
-        case(StableNeoHookean, false, Start::Dropped, Explicit),
+        explicit(StableNeoHookean, false, Start::Dropped),
         "explicit, dropped",
+        log,
     )?;
-    let automatic = case(StableNeoHookean, false, Start::Dropped, Implicit);
+    let per_tet_substep = |s: &Sample| s.seconds / (s.tets * s.substeps);
+    let explicit_tet = per_tet_substep(&free);
+    let contact_seconds = dropped.seconds - explicit_tet * dropped.tets * dropped.substeps;
+    Ok(CostModel {
+        explicit_tet,
+        explicit_tet_corotated: per_tet_substep(&corotated),
+        explicit_damped_factor: (per_tet_substep(&damped) / explicit_tet).max(1.0),
+        explicit_contact_point: (contact_seconds / dropped.contact_substeps.max(1.0)).max(0.0),
+        ..CostModel::default()
+    })
+}
+
+/// The implicit constants (the rest [`CostModel::default`]'s): the frames of the implicit
+/// cases fitted together ([`fit::fit`]), the corotated drop's for its Newton iteration, and the
+/// Newton iterations a substep of the drop by the automatic linear solver as the assumption.
+fn implicit_constants(log: &mut impl FnMut(&str)) -> Result<CostModel, Error> {
+    let automatic = case(
+        MaterialModel::StableNeoHookean,
+        false,
+        Start::Dropped,
+        IntegratorKind::Implicit,
+    );
     let direct = Case {
         solver: LinearSolver::Direct,
         ..automatic
     };
-    let implicit_cases = [
+    let under_boxes = Case {
+        start: Start::UnderBoxes,
+        ..direct
+    };
+    let cases = [
         (direct, "implicit, dropped, direct"),
         (
             Case {
@@ -148,50 +198,35 @@ pub fn calibrate(mut log: impl FnMut(&str)) -> Result<CostModel, Error> {
             },
             "implicit, dropped, 16 cells",
         ),
+        (under_boxes, "implicit, under boxes, direct"),
         (
             Case {
-                start: Start::UnderBoxes,
-                ..direct
-            },
-            "implicit, under boxes, direct",
-        ),
-        (
-            Case {
-                start: Start::UnderBoxes,
                 cells: 3,
-                ..direct
+                ..under_boxes
             },
             "implicit, under boxes, direct, 3 cells",
         ),
     ];
     let mut frames = Vec::new();
     let mut newton_iterations = 1.0;
-    for (c, name) in implicit_cases {
-        let sample = fastest(c, name)?;
+    for (c, name) in cases {
+        let sample = fastest(c, name, log)?;
         if c.solver == LinearSolver::Automatic && c.cells == 6 {
-            let iterations: f64 = sample
-                .implicit_frames
-                .iter()
+            let iterations: f64 = (sample.implicit_frames.iter())
                 .map(|f| f.newton_iterations)
                 .sum();
             newton_iterations = iterations / sample.implicit_substeps.max(1.0);
         }
         frames.extend(sample.implicit_frames);
     }
-    let newton_corotated = fastest(
-        case(Corotated, false, Start::Dropped, Implicit),
-        "implicit, dropped, corotated",
-    )?;
-    let per_tet_substep = |s: &Sample| s.seconds / (s.tets * s.substeps);
-    let explicit_tet = per_tet_substep(&free);
-    let contact_seconds = dropped.seconds - explicit_tet * dropped.tets * dropped.substeps;
+    let corotated = Case {
+        model: MaterialModel::Corotated,
+        ..automatic
+    };
+    let corotated = fastest(corotated, "implicit, dropped, corotated", log)?;
     Ok(CostModel {
-        explicit_tet,
-        explicit_tet_corotated: per_tet_substep(&corotated),
-        explicit_damped_factor: (per_tet_substep(&damped) / explicit_tet).max(1.0),
-        explicit_contact_point: (contact_seconds / dropped.contact_substeps.max(1.0)).max(0.0),
         newton_iterations,
-        ..fit::fit(&frames, &newton_corotated.implicit_frames)
+        ..fit::fit(&frames, &corotated.implicit_frames)
     })
 }
 
@@ -271,6 +306,11 @@ pub fn as_toml(cost: &CostModel) -> String {
             "s per evaluation of the energy, whatever the size",
         ),
         (
+            "partner_evaluation",
+            cost.partner_evaluation,
+            "s per evaluation of the energy per dynamic rigid body touched",
+        ),
+        (
             "conjugate_gradient_iteration",
             cost.conjugate_gradient_iteration,
             "s per conjugate gradient iteration",
@@ -324,6 +364,7 @@ fn measure(case: Case) -> Result<Sample, Error> {
                     factorizations: implicit.factorizations as f64,
                     linear_iterations: implicit.linear_iterations as f64,
                     energy_evaluations: implicit.energy_evaluations as f64,
+                    rigid_partners: report.prediction.rigid_partners as f64,
                 });
             }
         }

@@ -168,6 +168,8 @@ pub struct CostSpec {
     pub factorization_tet: Option<f64>,
     /// Seconds per energy evaluation.
     pub energy_evaluation: Option<f64>,
+    /// Seconds per energy evaluation per dynamic rigid body touched.
+    pub partner_evaluation: Option<f64>,
     /// Seconds per conjugate gradient iteration whatever the size.
     pub conjugate_gradient_iteration: Option<f64>,
     /// Seconds per tetrahedron per conjugate gradient iteration.
@@ -196,6 +198,7 @@ impl CostSpec {
             newton_tet_corotated: self.newton_tet_corotated.unwrap_or(d.newton_tet_corotated),
             factorization_tet: self.factorization_tet.unwrap_or(d.factorization_tet),
             energy_evaluation: self.energy_evaluation.unwrap_or(d.energy_evaluation),
+            partner_evaluation: self.partner_evaluation.unwrap_or(d.partner_evaluation),
             conjugate_gradient_iteration: self
                 .conjugate_gradient_iteration
                 .unwrap_or(d.conjugate_gradient_iteration),
@@ -215,6 +218,7 @@ impl CostSpec {
             ("newton_tet_corotated", self.newton_tet_corotated),
             ("factorization_tet", self.factorization_tet),
             ("energy_evaluation", self.energy_evaluation),
+            ("partner_evaluation", self.partner_evaluation),
             (
                 "conjugate_gradient_iteration",
                 self.conjugate_gradient_iteration,
