@@ -32,9 +32,13 @@
 //! iterations matters where a body reuses its factorization in quiet frames and refactors
 //! several times an iteration in hard ones (a tangent projected, a substep redone), or where
 //! its line searches shorten the step many times (a soft stack under a box, 19 evaluations a
-//! step): on the implicit body steps of `rapier-fvm calibrate`'s cases, the showcase and the
-//! game scene (`benches/scenes/game.toml`), a least-squares fit of this model put 96 to 100 %
-//! of the steps within a factor of two of their time, against 60 to 80 % for `N` alone.
+//! step). Measured on the implicit body steps of `rapier-fvm calibrate`'s cases, the showcase,
+//! the game scene (`benches/scenes/game.toml`), a 320-tetrahedron cube dropped at 1/240 s
+//! frames and the resting cube at 1 080 and 13 720 tetrahedra: this model fitted to them all
+//! puts 98 to 100 % of each one's steps within a factor of two of their time (83 % of the
+//! smaller resting cube's 30); fitted to calibrate's cases alone, each one's total within a
+//! factor of 1.6 and the showcase's bodies within 1.71; the model before (the Newton iterations
+//! alone) put 69 % of the game's steps within a factor of two (one run of the build before).
 
 use super::{ImplicitIntegrator, ImplicitReport};
 use crate::Error;
@@ -104,13 +108,13 @@ impl Default for CostModel {
     /// README's "Choosing the integrator".
     fn default() -> Self {
         Self {
-            explicit_tet: 21.0e-9,
-            explicit_tet_corotated: 97.6e-9,
-            explicit_damped_factor: 1.25,
-            explicit_contact_point: 131e-9,
-            newton_tet: 0.118e-6,
-            newton_size_exponent: 0.30,
-            newton_tet_corotated: 0.955e-6,
+            explicit_tet: 25.9e-9,
+            explicit_tet_corotated: 107.7e-9,
+            explicit_damped_factor: 1.27,
+            explicit_contact_point: 149e-9,
+            newton_tet: 0.165e-6,
+            newton_size_exponent: 0.20,
+            newton_tet_corotated: 0.472e-6,
             factorization_tet: default_factorization(),
             energy_evaluation: default_energy(),
             partner_evaluation: default_partner(),
@@ -123,27 +127,27 @@ impl Default for CostModel {
 
 /// [`CostModel::factorization_tet`] of [`CostModel::default`] (s).
 fn default_factorization() -> f64 {
-    1.05e-6
+    1.34e-6
 }
 
 /// [`CostModel::energy_evaluation`] of [`CostModel::default`] (s).
 fn default_energy() -> f64 {
-    40.5e-6
+    35.0e-6
 }
 
 /// [`CostModel::partner_evaluation`] of [`CostModel::default`] (s).
 fn default_partner() -> f64 {
-    12.3e-6
+    19.4e-6
 }
 
 /// [`CostModel::conjugate_gradient_iteration`] of [`CostModel::default`] (s).
 fn default_conjugate_gradient() -> f64 {
-    16.9e-6
+    22.9e-6
 }
 
 /// [`CostModel::conjugate_gradient_tet`] of [`CostModel::default`] (s).
 fn default_conjugate_gradient_tet() -> f64 {
-    6.18e-9
+    7.21e-9
 }
 
 /// What a frame's prediction needs to know of a body.

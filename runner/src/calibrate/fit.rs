@@ -47,10 +47,15 @@ impl ImplicitFrame {
     }
 }
 
-/// The implicit constants fitted to `frames` (those of the stable Neo-Hookean model), the
-/// corotated Newton iteration from `corotated` frames given the rest; the other constants
-/// are [`CostModel::default`]'s.
-pub fn fit(frames: &[ImplicitFrame], corotated: &[ImplicitFrame]) -> CostModel {
+/// The implicit constants fitted to `frames` (those of the stable Neo-Hookean model), and the
+/// corotated Newton iteration from `corotated` frames against `paired` ones, the same case with
+/// the stable Neo-Hookean model: the Neo-Hookean iteration plus what the corotated frames took
+/// beyond the paired ones per (sized) Newton iteration, so that the fit's own error cancels;
+/// the other constants are [`CostModel::default`]'s.
+pub fn fit(
+    frames: &[ImplicitFrame],
+    (corotated, paired): (&[ImplicitFrame], &[ImplicitFrame]),
+) -> CostModel {
     let steps = (1.0 / EXPONENT_STEP).round() as usize;
     let (exponent, constants) = (0..=steps)
         .map(|k| {
@@ -62,22 +67,17 @@ pub fn fit(frames: &[ImplicitFrame], corotated: &[ImplicitFrame]) -> CostModel {
         .map(|(exponent, constants, _)| (exponent, constants))
         .unwrap_or((0.0, [0.0; CONSTANTS]));
     let [newton, factorization, energy, partner, cg_iteration, cg_tet] = constants;
-    // The corotated iteration: what its frames took beyond the other constants' share.
-    let (mut beyond, mut iterations) = (0.0, 0.0);
-    for frame in corotated {
-        let c = frame.columns(exponent);
-        let others = factorization * c[1] + energy * c[2] + cg_iteration * c[3] + cg_tet * c[4];
-        beyond += frame.seconds - others;
-        iterations += c[0];
-    }
+    let seconds = |frames: &[ImplicitFrame]| frames.iter().map(|f| f.seconds).sum::<f64>();
+    let sized_iterations: f64 = corotated.iter().map(|f| f.columns(exponent)[0]).sum();
+    let newton_corotated = if sized_iterations > 0.0 && !paired.is_empty() {
+        (newton + (seconds(corotated) - seconds(paired)) / sized_iterations).max(0.0)
+    } else {
+        newton
+    };
     CostModel {
         newton_tet: newton,
         newton_size_exponent: exponent,
-        newton_tet_corotated: if iterations > 0.0 {
-            (beyond / iterations).max(0.0)
-        } else {
-            newton
-        },
+        newton_tet_corotated: newton_corotated,
         factorization_tet: factorization,
         energy_evaluation: energy,
         partner_evaluation: partner,
@@ -175,7 +175,8 @@ mod tests {
     #[test]
     fn frames_made_by_the_model_give_back_its_constants_and_exponent() {
         // Frames computed from known constants and α = 0.35 (a multiple of the step): the fit
-        // must recover them to 1e-9 relative (round-off in the normal equations).
+        // must recover them to 1e-9 relative (round-off in the normal equations), and the
+        // corotated iteration from frames dearer by a known amount.
         let truth = [3e-7, 9e-7, 5e-5, 8e-6, 2e-5, 8e-9];
         let exponent = 0.35;
         let mut frames = Vec::new();
@@ -196,7 +197,17 @@ mod tests {
                 frames.push(ImplicitFrame { seconds, ..frame });
             }
         }
-        let cost = fit(&frames, &[]);
+        // The corotated frames: the first four frames again, each dearer by 2e-7 s per sized
+        // Newton iteration; its iteration must come out the fitted one plus that.
+        let paired = &frames[..4];
+        let corotated: Vec<ImplicitFrame> = (paired.iter())
+            .map(|f| ImplicitFrame {
+                seconds: f.seconds + 2e-7 * f.columns(exponent)[0],
+                ..*f
+            })
+            .collect();
+        let cost = fit(&frames, (&corotated, paired));
+        assert!((cost.newton_tet_corotated - (truth[0] + 2e-7)).abs() <= 1e-9 * 5e-7);
         assert!((cost.newton_size_exponent - exponent).abs() < 1e-12);
         let fitted = [
             cost.newton_tet,
