@@ -150,7 +150,7 @@ impl AutomaticIntegrator {
             if constraints.needs_explicit_contacts() {
                 IntegratorKind::Explicit
             } else {
-                prediction.cheaper()
+                prediction.cheaper_after(last_kind(workspace.newton.last_implicit()))
             }
         });
         let implicit = self.implicit_for(&prediction, [&workspace.newton]);
@@ -353,7 +353,16 @@ impl AutomaticIntegrator {
             {
                 IntegratorKind::Explicit
             } else {
-                total.cheaper()
+                let lasts: Vec<Option<bool>> = (bodies.iter())
+                    .map(|s| s.workspace.newton.last_implicit())
+                    .collect();
+                let shared = lasts.windows(2).all(|w| w[0] == w[1]);
+                let last = if shared {
+                    lasts.first().copied().flatten()
+                } else {
+                    None
+                };
+                total.cheaper_after(last_kind(last))
             }
         });
         Ok((predictions, total, choice))
@@ -427,6 +436,17 @@ impl AutomaticIntegrator {
             })
             .collect())
     }
+}
+
+/// The integrator of a last frame that was implicit or not (`None` before any frame).
+fn last_kind(last_implicit: Option<bool>) -> Option<IntegratorKind> {
+    last_implicit.map(|implicit| {
+        if implicit {
+            IntegratorKind::Implicit
+        } else {
+            IntegratorKind::Explicit
+        }
+    })
 }
 
 /// `seconds` a group's frame took, shared among its bodies in proportion to their `predictions`

@@ -308,6 +308,9 @@ pub(crate) struct NewtonHistory {
     /// Newton iterations per substep allowed and left unspent by the last implicit frames.
     #[cfg_attr(feature = "serde-serialize", serde(default))]
     saved: f64,
+    /// Whether the last frame was implicit (`None` before any frame).
+    #[cfg_attr(feature = "serde-serialize", serde(default))]
+    last_implicit: Option<bool>,
 }
 
 impl NewtonHistory {
@@ -336,6 +339,7 @@ impl NewtonHistory {
     fn record(&mut self, frame: NewtonWork, substeps: u32, allowed: usize) {
         let new = frame.times(1.0 / f64::from(substeps.max(1)));
         self.saved = (allowed as f64 - new.iterations).max(0.0);
+        self.last_implicit = Some(true);
         self.mean = Some(match self.mean {
             Some(mean) => mean.towards(&new, Self::WEIGHT),
             None => new,
@@ -372,9 +376,15 @@ impl NewtonHistory {
     /// saved.
     pub(crate) fn forget(&mut self, assumed: &NewtonWork) {
         self.saved = 0.0;
+        self.last_implicit = Some(false);
         if let Some(mean) = &mut self.mean {
             *mean = mean.towards(assumed, Self::FORGETTING);
         }
+    }
+
+    /// Whether the body's last frame was implicit (`None` before any frame).
+    pub(crate) fn last_implicit(&self) -> Option<bool> {
+        self.last_implicit
     }
 
     /// The mean work per substep, or `assumed` before any implicit frame.

@@ -15,7 +15,7 @@ mod refusal;
 mod workspace;
 
 pub use automatic::AutomaticIntegrator;
-pub use choice::{AutomaticReport, CostPrediction, IntegratorKind};
+pub use choice::{AutomaticReport, CostPrediction, IntegratorKind, SWITCH_MARGIN};
 pub use cost::{CostModel, NewtonWork};
 pub use crush::COLLAPSE_RATIO;
 pub(crate) use crush::CrushWatch;
