@@ -131,3 +131,32 @@ impl AutomaticReport {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A prediction of `explicit` and `implicit` seconds.
+    fn prediction(explicit: f64, implicit: f64) -> CostPrediction {
+        CostPrediction {
+            explicit_substeps: 1.0,
+            contact_points: 0,
+            rigid_partners: 0,
+            newton: super::super::NewtonWork::default(),
+            explicit_seconds: explicit,
+            implicit_seconds: implicit,
+        }
+    }
+
+    #[test]
+    fn a_body_switches_integrators_only_for_a_prediction_below_the_margin() {
+        // Implicit predicted 1.4 times cheaper: within the margin of 1.5, a body that stepped
+        // explicitly stays so; 1.6 times cheaper, it switches; before any frame, the cheaper.
+        use IntegratorKind::{Explicit, Implicit};
+        assert_eq!(prediction(1.4, 1.0).cheaper_after(Some(Explicit)), Explicit);
+        assert_eq!(prediction(1.6, 1.0).cheaper_after(Some(Explicit)), Implicit);
+        assert_eq!(prediction(1.0, 1.4).cheaper_after(Some(Implicit)), Implicit);
+        assert_eq!(prediction(1.0, 1.6).cheaper_after(Some(Implicit)), Explicit);
+        assert_eq!(prediction(1.4, 1.0).cheaper_after(None), Implicit);
+    }
+}
