@@ -1,8 +1,10 @@
 //! Automatic choice between explicit and implicit integration: for each frame, the cost of the
 //! explicit substeps the stability limit requires (with the body's contacts) is compared with
-//! the cost of an implicit step (with the body's own Newton iterations), both predicted by the
-//! [`CostModel`] measured on the machine, and the cheaper is taken. Explicit integration is
-//! preferred at equal cost: it has no numerical damping.
+//! the cost of an implicit step (with the body's own recent implicit work, [`NewtonWork`]), both
+//! predicted by the [`CostModel`] measured on the machine, and the cheaper is taken, the body
+//! keeping its last frame's integrator unless the other is
+//! [`SWITCH_MARGIN`](super::SWITCH_MARGIN) times cheaper. Explicit integration is preferred at
+//! equal cost: it has no numerical damping.
 
 use super::choice::{AutomaticReport, CostPrediction, IntegratorKind};
 use super::cost::{CostModel, NewtonHistory, NewtonWork, Workload};
