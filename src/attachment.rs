@@ -220,7 +220,8 @@ impl Attachment {
 
 /// Calls `each(attachment, stiffness k (N/m), target (m))` for every attachment of a free node
 /// in the implicit `step`: the node is pulled toward the anchor's end position with the energy
-/// `k/2 |x - target|²` (see [`Attachment::spring_stiffness`]).
+/// `k/2 |x - target|²` (see [`Attachment::spring_stiffness`]); only those to a dynamic rigid body
+/// if the step wants [`partners_only`](ImplicitStep::partners_only).
 pub(crate) fn for_each_spring<'a>(
     body: &DeformableBody,
     attachments: &'a [Attachment],
@@ -230,7 +231,7 @@ pub(crate) fn for_each_spring<'a>(
 ) {
     for attachment in attachments {
         let n = attachment.node as usize;
-        if !body.pinned[n] {
+        if !body.pinned[n] && !step.skips(&attachment.partner(step)) {
             let stiffness = attachment.spring_stiffness(body, settings, step);
             each(attachment, stiffness, attachment.spring_target(step));
         }

@@ -85,7 +85,7 @@ impl BodyConstraints {
         &mut self,
         body: &DeformableBody,
         colliders: (&[ColliderView], f64),
-        rigid: &dyn Fn(RigidBodyHandle) -> Option<(Pose, RigidProxy)>,
+        rigid: &(dyn Fn(RigidBodyHandle) -> Option<(Pose, RigidProxy)> + Sync),
         frame_dt: f64,
         gravity: DVec3,
         settings: &ContactSettings,

@@ -97,5 +97,6 @@ fn between_bodies((effective, penalty_step): (f64, f64)) -> ImplicitStep<'static
         penalty_step,
         length: effective,
         rigid: &[],
+        partners_only: false,
     }
 }

@@ -120,6 +120,17 @@ pub(crate) struct ImplicitStep<'a> {
     pub(crate) length: f64,
     /// The rigid bodies the body touches, at the velocities the step's solve gives them.
     pub(crate) rigid: &'a [RigidProxy],
+    /// Whether only the terms acting against a dynamic rigid body are wanted (the rigid bodies'
+    /// response, solved many times per step, needs no others): the rest are skipped unevaluated.
+    pub(crate) partners_only: bool,
+}
+
+impl ImplicitStep<'_> {
+    /// Whether a term whose rigid partner is `partner` is skipped (see
+    /// [`ImplicitStep::partners_only`]).
+    pub(crate) fn skips<T>(&self, partner: &Option<T>) -> bool {
+        self.partners_only && partner.is_none()
+    }
 }
 
 /// How contacts are detected and enforced.

@@ -246,9 +246,12 @@ pub(super) fn for_each_term_at(
 ) {
     // Every penalty, then every friction term.
     for contact in contacts {
+        let obstacle = carried(contact, &step);
+        if step.skips(&obstacle.partner) {
+            continue;
+        }
         let point = contact_point(contact, embedding);
         let at = point.stencil();
-        let obstacle = carried(contact, &step);
         let mass = effective_mass(&at, nodes.masses, nodes.pinned);
         let x = point.position(nodes.positions) - obstacle.travel;
         if let Some(penalty) = contact.penalty(x, mass, settings, step.penalty_step) {
@@ -262,8 +265,11 @@ pub(super) fn for_each_term_at(
         }
     }
     for contact in contacts {
-        let point = contact_point(contact, embedding);
         let obstacle = carried(contact, &step);
+        if step.skips(&obstacle.partner) {
+            continue;
+        }
+        let point = contact_point(contact, embedding);
         let x = point.position(nodes.positions) - obstacle.travel;
         if let Some((energy, force, tangent)) = contact.friction_term(x, settings, step.effective) {
             each(point.stencil(), obstacle.partner, energy, force, tangent);

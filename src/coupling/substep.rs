@@ -226,24 +226,30 @@ impl SoftCoupling {
             .map(|&i| &soft_bodies[outcomes[i].0])
             .collect();
         let struck = reach::struck_by(&bodies, self.contact.margin, h, gravity);
-        for (&i, (body, struck)) in awake.iter().zip(bodies.into_iter().zip(struck)) {
-            let (handle, outcome) = &mut outcomes[i];
-            let detected = body.check_state().and_then(|()| {
-                self.links.entry(*handle).constraints.detect_among(
-                    body,
-                    (&views, struck),
-                    &lookup,
-                    h,
-                    gravity,
-                    &self.contact,
-                )
+        let handles: Vec<DeformableBodyHandle> = awake.iter().map(|&i| outcomes[i].0).collect();
+        let settings = &self.contact;
+        let mut detections: Vec<_> = (self.links.many_mut(&handles).into_iter())
+            .zip(bodies.into_iter().zip(struck))
+            .map(|(links, (body, struck))| (links, body, struck, Ok(())))
+            .collect();
+        // Each body's detection reads the rigid sets and writes its own constraints only: the
+        // bodies are detected at once on the pool, the same bit for bit in any order.
+        crate::parallel::for_each(&mut detections, |(links, body, struck, detected)| {
+            *detected = body.check_state().and_then(|()| {
+                let colliders = (&views[..], *struck);
+                let constraints = &mut links.constraints;
+                constraints.detect_among(body, colliders, &lookup, h, gravity, settings)?;
+                Ok(())
             });
+        });
+        for (&i, (_, _, _, detected)) in awake.iter().zip(detections) {
+            let (handle, outcome) = &mut outcomes[i];
             let refused_before = matches!(outcome, Some(Err(_)));
             match detected {
                 Err(error) if !refused_before => *outcome = Some(Err(error)),
                 Err(_) => {}
-                Ok(_) if refused_before => held.push(*handle),
-                Ok(_) => live.push(*handle),
+                Ok(()) if refused_before => held.push(*handle),
+                Ok(()) => live.push(*handle),
             }
         }
         (live, held)

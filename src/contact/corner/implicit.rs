@@ -133,8 +133,11 @@ pub(crate) fn for_each_corner_term(
 ) {
     let terms = (&contacts.settings, &step);
     for contact in &contacts.corners {
-        let (at, point, mass, velocity) = contact.sides(body, step.rigid);
         let partner = contact.partner(&step);
+        if step.skips(&partner) {
+            continue;
+        }
+        let (at, point, mass, velocity) = contact.sides(body, step.rigid);
         if let Some(penalty) = contact.penalty(point, mass, velocity, terms) {
             let tangent = penalty_tangent(penalty.stiffness, contact.normal);
             each(

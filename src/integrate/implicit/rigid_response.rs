@@ -198,6 +198,16 @@ impl RigidResponse {
             penalty_step: self.penalty_step,
             length: self.length,
             rigid,
+            partners_only: false,
+        }
+    }
+
+    /// [`RigidResponse::step`] for the terms against a dynamic body only: all the response's
+    /// own evaluations need.
+    fn partner_step(&self) -> ImplicitStep<'_> {
+        ImplicitStep {
+            partners_only: true,
+            ..self.step()
         }
     }
 
@@ -350,7 +360,7 @@ impl RigidResponse {
     fn evaluate(&self, body: &DeformableBody, constraints: &BodyConstraints) -> Evaluation {
         let mut energy = self.kinetic_energy();
         let mut gathered = vec![None; self.base.len()];
-        constraint::for_each_implicit_term(body, constraints, self.step(), &mut |term| {
+        constraint::for_each_implicit_term(body, constraints, self.partner_step(), &mut |term| {
             if let Some(partner) = term.partner {
                 energy += term.energy;
                 let arm = partner.point - self.base[partner.proxy].center_of_mass();
@@ -479,7 +489,7 @@ impl RigidResponse {
             columns: Vec::new(),
         };
         let mut slot_of: Vec<Option<usize>> = vec![None; self.base.len()];
-        constraint::for_each_implicit_term(body, constraints, self.step(), &mut |term| {
+        constraint::for_each_implicit_term(body, constraints, self.partner_step(), &mut |term| {
             let Some(partner) = term.partner else {
                 return;
             };
