@@ -21,6 +21,11 @@ pub(super) struct BodyLinks {
     /// that needed no coupling; zero before any.
     #[cfg_attr(feature = "serde-serialize", serde(default))]
     pub(super) last_step: f64,
+    /// The wall-clock time (s) the body's last step took (its report's `seconds`; zero before
+    /// any, or after a refused step): what its next one is expected to take, for the order in
+    /// which groups start ([`step_groups`](super::groups::step_groups)). Measured, so not written.
+    #[cfg_attr(feature = "serde-serialize", serde(skip))]
+    pub(super) last_seconds: f64,
 }
 
 impl BodyLinks {
@@ -154,12 +159,30 @@ impl LinkSet {
         self.map.extend(lent);
     }
 
-    /// Records that the bodies `stepped` (which have links) last stepped over `h` (s).
-    pub(super) fn set_last_step(&mut self, stepped: &[DeformableBodyHandle], h: f64) {
-        for &handle in stepped {
+    /// Records that the bodies `stepped` (which have links) last stepped over `h` (s), in the
+    /// wall-clock `seconds` each took.
+    pub(super) fn set_last_step(
+        &mut self,
+        stepped: &[DeformableBodyHandle],
+        h: f64,
+        seconds: &[f64],
+    ) {
+        for (&handle, &seconds) in stepped.iter().zip(seconds) {
             if let Some(links) = self.get_mut(handle) {
                 links.last_step = h;
+                links.last_seconds = seconds;
             }
         }
+    }
+
+    /// What the last steps of `handles` took together (s, see [`BodyLinks::last_seconds`]).
+    pub(super) fn last_seconds(
+        &self,
+        handles: impl IntoIterator<Item = DeformableBodyHandle>,
+    ) -> f64 {
+        (handles.into_iter())
+            .filter_map(|handle| self.get(handle))
+            .map(|links| links.last_seconds)
+            .sum()
     }
 }

@@ -9,14 +9,15 @@ use crate::Error;
 use crate::contact::{BetweenContact, ContactSettings};
 use crate::integrate::{AutomaticIntegrator, AutomaticReport, BodyInStep};
 use rapier3d::glamx::DVec3;
-#[cfg(feature = "parallel")]
-use rayon::prelude::*;
 
 /// A group of touching bodies ready to step: the bodies and the contacts between them (indices
 /// into the bodies).
 pub(super) struct GroupStep<'a> {
     pub(super) bodies: Vec<BodyInStep<'a>>,
     pub(super) between: Vec<BetweenContact>,
+    /// What the bodies' last steps took (s, [`BodyLinks::last_seconds`](super::bodies::BodyLinks)):
+    /// the dearest groups start first.
+    pub(super) expected_seconds: f64,
 }
 
 /// Steps every group by `h` (s) under `gravity` (m/s²) with `integrator`, the contacts between
@@ -28,11 +29,9 @@ pub(super) fn step_groups(
     (h, gravity): (f64, DVec3),
 ) -> Vec<Vec<Result<AutomaticReport, Error>>> {
     let step = |group: &mut GroupStep<'_>| step_group(group, integrator, settings, (h, gravity));
+    let expected = |group: &GroupStep<'_>| group.expected_seconds;
     // On the pool: a lone group would otherwise step on the calling thread.
-    #[cfg(feature = "parallel")]
-    return crate::parallel::on_pool(|| groups.par_iter_mut().map(step).collect());
-    #[cfg(not(feature = "parallel"))]
-    groups.iter_mut().map(step).collect()
+    crate::parallel::on_pool(|| crate::parallel::map_dearest_first(groups, expected, step))
 }
 
 /// Steps one group: a lone body by itself, touching bodies together.

@@ -102,13 +102,17 @@ impl SoftCoupling {
         let handles: Vec<DeformableBodyHandle> = (groups.iter())
             .flat_map(|(group, _)| group.iter().map(|&i| live[i]))
             .collect();
+        let expected: Vec<f64> = (groups.iter())
+            .map(|(group, _)| self.links.last_seconds(group.iter().map(|&i| live[i])))
+            .collect();
         let mut steps = (self.links.many_mut(&handles).into_iter())
             .zip(soft_bodies.get_many_mut(&handles))
             .map(|(links, body)| links.with(body));
-        let mut ready: Vec<GroupStep> = (groups.into_iter())
-            .map(|(group, between)| GroupStep {
+        let mut ready: Vec<GroupStep> = (groups.into_iter().zip(expected))
+            .map(|((group, between), expected_seconds)| GroupStep {
                 bodies: steps.by_ref().take(group.len()).collect(),
                 between,
+                expected_seconds,
             })
             .collect();
         for step in ready.iter_mut().flat_map(|group| group.bodies.iter_mut()) {
@@ -141,6 +145,9 @@ impl SoftCoupling {
         let steps = (self.links.many_mut(handles).into_iter())
             .zip(soft_bodies.get_many_mut(handles))
             .map(|(links, body)| links.with(body));
+        let seconds: Vec<f64> = (stepped.iter())
+            .map(|result| result.as_ref().map_or(0.0, |report| report.seconds))
+            .collect();
         let mut carried = Vec::new();
         for ((handle, mut step), result) in handles.iter().zip(steps).zip(stepped) {
             if result.is_err() {
@@ -166,7 +173,7 @@ impl SoftCoupling {
                 }
             }
         }
-        self.links.set_last_step(handles, h);
+        self.links.set_last_step(handles, h, &seconds);
         carried
     }
 
@@ -195,7 +202,7 @@ impl SoftCoupling {
             );
             hand_over(&mut self.loads, *handle, &mut step, rigid.bodies);
         }
-        self.links.set_last_step(held, h);
+        self.links.set_last_step(held, h, &vec![0.0; held.len()]);
     }
 
     /// Finds the contacts of every awake body of `outcomes` not in `skip` whose state a step can

@@ -150,6 +150,7 @@ impl Uncoupled {
         let mut groups: Vec<GroupStep> = (self.bodies.iter_mut())
             .zip(self.links.iter_mut())
             .map(|((_, body), (_, links))| GroupStep {
+                expected_seconds: links.last_seconds,
                 bodies: vec![links.with(body)],
                 between: Vec::new(),
             })
