@@ -90,9 +90,10 @@ pub(crate) fn for_each<T: Send>(items: &mut [T], work: impl Fn(&mut T) + Sync + 
 
 /// `work(item)` on each of `items`, the results in the items' order. The items start dearest
 /// first by `expected` cost (equal costs in their order), each taken by the next thread free:
-/// greedy list scheduling of independent items, within 4/3 of the shortest time two threads can
-/// take, where splitting the slice in halves can leave the dearest item for last on one thread
-/// while the other waits. Each item's work is the same whichever thread does it.
+/// longest-first list scheduling of independent items, within `4/3 − 1/(3p)` of the shortest
+/// time `p` threads can take when the expected costs are the true ones (7/6 on two), where
+/// splitting the slice in halves can leave the dearest item for last on one thread while the
+/// other waits. Each item's work is the same whichever thread does it.
 pub(crate) fn map_dearest_first<T: Send, R: Send>(
     items: &mut [T],
     expected: impl Fn(&T) -> f64,
