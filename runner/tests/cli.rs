@@ -240,10 +240,14 @@ fn calibrate_prints_a_cost_table_a_scene_reads() {
         // A contact point may cost nothing measurable; the size exponent lies in [0, 1], and is
         // 0 when a larger body costs no more per tetrahedron (on two threads its loops split);
         // the implicit work's parts are fitted not negative, and may come out zero.
-        let may_be_zero = key == "explicit_contact_point"
-            || key == "newton_size_exponent"
-            || !(key.starts_with("explicit") || key == "newton_iterations");
-        let least = if may_be_zero { 0.0 } else { f64::MIN_POSITIVE };
+        let positive = matches!(
+            key,
+            "explicit_tet"
+                | "explicit_tet_corotated"
+                | "explicit_damped_factor"
+                | "newton_iterations"
+        );
+        let least = if positive { f64::MIN_POSITIVE } else { 0.0 };
         assert!(value.is_finite() && value >= least, "{key} = {value}");
         assert_eq!(value, printed(key), "{key}");
     }
