@@ -642,3 +642,31 @@ fn a_frame_of_negative_or_undefined_length_or_no_substeps_is_refused_and_moves_n
         );
     }
 }
+
+#[test]
+fn the_frame_timing_counts_a_block_under_a_box_as_stepped_with_a_rigid_partner() {
+    // A box resting on a soft block, stepped implicitly: after it lands, every frame's soft
+    // steps are implicit steps with a dynamic rigid partner, in the four coupling substeps,
+    // with rapier's steps and the contacts' detection beside them; nothing is counted as
+    // explicit or as stepped without a partner.
+    let mut world = common::world_with_ground(Some(IntegratorKind::Implicit));
+    world.coupling.sleep = SleepSettings::never();
+    world
+        .soft_bodies
+        .insert(soft_cube(0.1, 3, DVec3::new(0.0, 0.05, 0.0), 1e5));
+    world.physics.insert(
+        RigidBodyBuilder::dynamic().translation(Vec3::new(0.0, 0.1205, 0.0)),
+        ColliderBuilder::cuboid(0.02, 0.02, 0.02).density(1000.0),
+    );
+    for _ in 0..10 {
+        step(&mut world);
+    }
+    let timing = *world.coupling.last_frame_timing();
+    println!("{timing:?}");
+    assert!(timing.implicit_with_rigid_partners > 0.0);
+    assert_eq!(timing.implicit_without_rigid_partners, 0.0);
+    assert_eq!(timing.explicit_with_rigid_partners, 0.0);
+    assert_eq!(timing.explicit_without_rigid_partners, 0.0);
+    assert_eq!(timing.soft_steps(), timing.implicit_with_rigid_partners);
+    assert!(timing.contact_detection > 0.0 && timing.rapier_steps > 0.0);
+}

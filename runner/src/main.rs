@@ -414,8 +414,8 @@ fn print_summary(report: &sim::Report, out: &std::path::Path) {
     println!("  written to {}", out.display());
 }
 
-/// Prints where a run's stepping time went: the median and slowest frames, and the frames
-/// slower than real time with their share of the stepping.
+/// Prints where a run's stepping time went: the median and slowest frames, the frames slower
+/// than real time with their share of the stepping, and (3D) the parts of the stepping.
 fn print_frame_times(times: &sim::FrameTimes) {
     println!(
         "  frames: median {:.2} ms, slowest {:.2} ms (frame {}); {} of {} over the real-time budget of {:.2} ms, {:.0} % of the stepping",
@@ -427,6 +427,18 @@ fn print_frame_times(times: &sim::FrameTimes) {
         times.budget_ms,
         100.0 * times.over_budget_share,
     );
+    if let Some(parts) = &times.parts {
+        println!(
+            "  time: soft steps {:.2} s over the threads (implicit {:.2} s with dynamic rigid partners, {:.2} s without; explicit {:.2} s with, {:.2} s without), contact detection {:.2} s, rapier {:.2} s",
+            parts.soft_steps_s(),
+            parts.implicit_with_rigid_partners_s,
+            parts.implicit_without_rigid_partners_s,
+            parts.explicit_with_rigid_partners_s,
+            parts.explicit_without_rigid_partners_s,
+            parts.contact_detection_s,
+            parts.rapier_steps_s,
+        );
+    }
 }
 
 /// Prints a 3D soft body's line of the summary: its elements, frames, failures and the cost

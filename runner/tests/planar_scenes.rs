@@ -107,6 +107,7 @@ fn the_dropped_box_rests_with_the_ground_carrying_both_weights() {
         serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
     assert_eq!(json["dimension"], 2);
     assert_eq!(json["frame_times"]["ms"].as_array().unwrap().len(), 180);
+    assert!(json["frame_times"]["parts"].is_null());
     assert_eq!(json["soft_bodies"][0]["plane"], "strain");
 
     assert_last_vtu_matches(&scene, &out.join("paraview/block_00045.vtu"));

@@ -111,6 +111,20 @@ fn a_short_drop_writes_every_output_and_the_vtu_matches_the_body() {
     assert!((summed - 1e3 * report.stepping_time_s).abs() < 1e-6 * summed);
     assert_eq!(times.awake_soft_bodies, vec![1; 6]);
     assert_eq!(json["frame_times"]["ms"].as_array().unwrap().len(), 6);
+    // Where the stepping went: the cube's steps, without rigid partners (only the fixed ground
+    // is near it), and the detection of its contacts, each a part of the stepping (one thread
+    // steps the lone cube at a time).
+    let parts = times.parts.expect("a 3D run reports its parts");
+    assert!(parts.soft_steps_s() > 0.0 && parts.contact_detection_s > 0.0);
+    assert_eq!(parts.implicit_with_rigid_partners_s, 0.0);
+    assert_eq!(parts.explicit_with_rigid_partners_s, 0.0);
+    assert!(parts.soft_steps_s() + parts.contact_detection_s < report.stepping_time_s);
+    assert!(
+        json["frame_times"]["parts"]["contact_detection_s"]
+            .as_f64()
+            .unwrap()
+            > 0.0
+    );
     // Saved frames 0, 3, 6: one .vtu each, an OBJ each, the index.
     let pvd = std::fs::read_to_string(out.join("paraview/drop.pvd")).unwrap();
     assert_eq!(pvd.matches("<DataSet").count(), 3);

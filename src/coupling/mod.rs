@@ -60,6 +60,7 @@ mod reach;
 mod sleep;
 mod stand_in;
 mod substep;
+mod timing;
 mod touches;
 mod uncoupled;
 
@@ -69,6 +70,7 @@ pub use audit::{
 };
 pub use loads::{ColliderLoad, RigidLoad};
 pub use sleep::SleepSettings;
+pub use timing::FrameTiming;
 
 use crate::Error;
 use crate::body::{DeformableBodyHandle, DeformableBodySet};
@@ -205,6 +207,9 @@ pub struct SoftCoupling {
     /// The bodies standing in as rapier rigid bodies, by handle.
     #[cfg_attr(feature = "serde-serialize", serde(default))]
     stand_ins: StandInSet,
+    /// Where the last frame's time went (not saved: wall-clock times).
+    #[cfg_attr(feature = "serde-serialize", serde(skip))]
+    timing: FrameTiming,
 }
 
 impl Default for SoftCoupling {
@@ -221,6 +226,7 @@ impl Default for SoftCoupling {
             links: LinkSet::default(),
             sleeping: SleepSet::default(),
             stand_ins: StandInSet::default(),
+            timing: FrameTiming::default(),
         }
     }
 }
@@ -249,11 +255,14 @@ impl SoftCoupling {
         let last_loads = std::mem::take(&mut self.loads);
         self.touches.clear();
         self.carried.begin_frame();
+        self.timing = FrameTiming::default();
         if let Some(error) = self.frame_error(frame.dt) {
             return refused(soft_bodies, &error);
         }
         if frame.dt == 0.0 {
+            let started = std::time::Instant::now();
             rapier.step_rapier(pipeline, &frame, hooks, events);
+            self.timing.rapier_steps = started.elapsed().as_secs_f64();
             self.record_touches(&rapier);
             return Vec::new();
         }
@@ -280,7 +289,10 @@ impl SoftCoupling {
                 colliders: rapier.colliders,
                 narrow_phase: rapier.narrow_phase,
             };
-            self.find_uncoupled(soft_bodies, &rigid, &outcomes, (frame_dt, gravity))
+            let started = std::time::Instant::now();
+            let alone = self.find_uncoupled(soft_bodies, &rigid, &outcomes, (frame_dt, gravity));
+            self.timing.contact_detection += started.elapsed().as_secs_f64();
+            alone
         } else {
             Vec::new()
         };
@@ -352,7 +364,9 @@ impl SoftCoupling {
             let carried = self.step_soft_bodies(soft_bodies, rigid, outcomes, skip, (h, gravity));
             let iterations = substep_parameters.num_solver_iterations;
             let carry = RapierCarry::lead(&carried, rapier.bodies, gravity, (h, iterations));
+            let started = std::time::Instant::now();
             rapier.step_rapier(pipeline, &substep_parameters, hooks, events);
+            self.timing.rapier_steps += started.elapsed().as_secs_f64();
             carry.settle(rapier.bodies);
             self.record_touches(rapier);
             let sets = (&*rapier.bodies, &*rapier.colliders, &*rapier.narrow_phase);
@@ -400,6 +414,7 @@ impl SoftCoupling {
         self.loads.clear();
         self.touches.clear();
         self.carried.begin_frame();
+        self.timing = FrameTiming::default();
         (self.touches).record(rigid.bodies, rigid.colliders, rigid.narrow_phase);
         self.links.prune(soft_bodies);
         self.sleeping.prune(soft_bodies);
@@ -412,6 +427,14 @@ impl SoftCoupling {
             self.loads.finish(h);
         }
         results(outcomes)
+    }
+
+    /// Where the last [`SoftCoupling::step`] (or [`SoftCoupling::substep`]) spent its time, in
+    /// wall-clock seconds: the deformable bodies' steps by integrator and rigid partners,
+    /// contact detection and rapier's steps (see [`FrameTiming`]). A program's profile of its
+    /// scene; nothing depends on it.
+    pub fn last_frame_timing(&self) -> &FrameTiming {
+        &self.timing
     }
 
     /// The mean force and torque each deformable body exerted on each rigid body it touched or

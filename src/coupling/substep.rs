@@ -49,11 +49,13 @@ impl SoftCoupling {
             &self.sleep,
             sleep,
         );
+        let started = std::time::Instant::now();
         let (live, held) = self.detect(soft_bodies, &rigid, outcomes, skip, (h, gravity));
         let between = {
             let bodies: Vec<&DeformableBody> = live.iter().map(|&h| &soft_bodies[h]).collect();
             contact::detect_between(&bodies, &self.contact, h, gravity)
         };
+        self.timing.contact_detection += started.elapsed().as_secs_f64();
         let carried = self.step_live(
             soft_bodies,
             &mut rigid,
@@ -148,6 +150,11 @@ impl SoftCoupling {
         let seconds: Vec<f64> = (stepped.iter())
             .map(|result| result.as_ref().map_or(0.0, |report| report.seconds))
             .collect();
+        for report in stepped.iter().flatten() {
+            let explicit = report.explicit.is_some();
+            let with_partners = report.prediction.rigid_partners > 0;
+            (self.timing).add_step(report.seconds, explicit, with_partners);
+        }
         let mut carried = Vec::new();
         for ((handle, mut step), result) in handles.iter().zip(steps).zip(stepped) {
             if result.is_err() {

@@ -3,6 +3,7 @@
 //! than real time (a frame's stepping longer than its `dt`) with their share of the stepping.
 
 use crate::output::TimeSeries;
+use rapier_fvm::coupling::FrameTiming;
 use serde::Serialize;
 
 /// Each frame's stepping time and awake soft bodies, with their summary (`frame_times` in
@@ -25,6 +26,50 @@ pub struct FrameTimes {
     pub over_budget_frames: usize,
     /// Those frames' share of the whole stepping time (0 to 1).
     pub over_budget_share: f64,
+    /// Where the stepping time went, summed over the frames (`null` for a 2D scene).
+    pub parts: Option<StepParts>,
+}
+
+/// Where a run's stepping time went (s, wall clock), from each frame's
+/// [`FrameTiming`](rapier_fvm::coupling::FrameTiming): the soft bodies' steps summed body by body
+/// over the threads that ran them (so they can add up to more than the stepping time), contact
+/// detection and rapier's steps.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+pub struct StepParts {
+    /// Implicit steps of bodies touching or glued to a dynamic rigid body (s).
+    pub implicit_with_rigid_partners_s: f64,
+    /// Implicit steps of bodies without dynamic rigid partners (s).
+    pub implicit_without_rigid_partners_s: f64,
+    /// Explicit steps of bodies touching or glued to a dynamic rigid body (s).
+    pub explicit_with_rigid_partners_s: f64,
+    /// Explicit steps of bodies without dynamic rigid partners (s).
+    pub explicit_without_rigid_partners_s: f64,
+    /// Contact detection (s).
+    pub contact_detection_s: f64,
+    /// rapier's steps (s).
+    pub rapier_steps_s: f64,
+}
+
+impl StepParts {
+    /// The parts of a run whose frames' timings summed to `timing`.
+    pub fn of(timing: &FrameTiming) -> Self {
+        Self {
+            implicit_with_rigid_partners_s: timing.implicit_with_rigid_partners,
+            implicit_without_rigid_partners_s: timing.implicit_without_rigid_partners,
+            explicit_with_rigid_partners_s: timing.explicit_with_rigid_partners,
+            explicit_without_rigid_partners_s: timing.explicit_without_rigid_partners,
+            contact_detection_s: timing.contact_detection,
+            rapier_steps_s: timing.rapier_steps,
+        }
+    }
+
+    /// The soft steps' seconds, both integrators, with and without rigid partners (s).
+    pub fn soft_steps_s(&self) -> f64 {
+        self.implicit_with_rigid_partners_s
+            + self.implicit_without_rigid_partners_s
+            + self.explicit_with_rigid_partners_s
+            + self.explicit_without_rigid_partners_s
+    }
 }
 
 impl FrameTimes {
@@ -48,6 +93,15 @@ impl FrameTimes {
             over_budget_share: if total > 0.0 { over_ms / total } else { 0.0 },
             ms,
             awake_soft_bodies,
+            parts: None,
+        }
+    }
+
+    /// These frames with where their stepping time went.
+    pub fn with_parts(self, parts: StepParts) -> Self {
+        Self {
+            parts: Some(parts),
+            ..self
         }
     }
 

@@ -29,6 +29,6 @@ pub use needs::BodyNeeds;
 pub use probe::Probe;
 pub use report::{
     BodyFlags, Files, Flag, FrameTimes, ProbeReport, Report, RigidBodyReport, Settings,
-    SoftBodyReport, Stability,
+    SoftBodyReport, Stability, StepParts,
 };
 pub use run::{RunError, RunOptions, run, run_within};

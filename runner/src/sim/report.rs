@@ -9,7 +9,7 @@ use rapier_fvm::integrate::{AutomaticReport, IntegratorKind};
 use serde::Serialize;
 
 pub use super::cost::StepCost;
-pub use super::frame_times::FrameTimes;
+pub use super::frame_times::{FrameTimes, StepParts};
 
 /// The whole report.
 #[derive(Debug, Clone, Serialize)]

@@ -3,7 +3,7 @@
 //! render the pictures and plots and write the report with its stability verdict.
 
 use super::build::Simulation;
-use super::frame_times::FrameTimes;
+use super::frame_times::{FrameTimes, StepParts};
 use super::report::{
     ProbeReport, Report, RigidBodyReport, Settings, SoftBodyReport, Stability, write_report,
 };
@@ -14,7 +14,7 @@ use crate::scene::world::WorldSpec;
 use crate::scene::{Scene, SceneError};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rapier_fvm::body::DeformableBodyHandle;
-use rapier_fvm::coupling::{Audit, SoftStepResults};
+use rapier_fvm::coupling::{Audit, FrameTiming, SoftStepResults};
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
@@ -101,6 +101,7 @@ pub fn run_within(
     let progress = progress_bar(frames, options.progress);
     let mut stepping = Duration::ZERO;
     let (mut frame_ms, mut awake) = (Vec::with_capacity(frames), Vec::with_capacity(frames));
+    let mut timing = FrameTiming::default();
     for frame in 1..=frames {
         let t = frame as f64 * dt;
         let step_start = Instant::now();
@@ -108,6 +109,7 @@ pub fn run_within(
         sim.drive_loads(t, &scene.source)?;
         let outcomes = sim.world.step();
         let frame_time = step_start.elapsed();
+        timing.accumulate(sim.world.coupling.last_frame_timing());
         stepping += frame_time;
         frame_ms.push(frame_time.as_secs_f64() * 1e3);
         if limit.is_some_and(|limit| stepping > limit) {
@@ -129,7 +131,7 @@ pub fn run_within(
         progress.set_message(format!("t = {t:.3} s, {speed:.2}x real time"));
     }
     progress.finish_and_clear();
-    let frame_times = FrameTimes::new(frame_ms, awake, dt);
+    let frame_times = FrameTimes::new(frame_ms, awake, dt).with_parts(StepParts::of(&timing));
     let frame_series = frame_times.series(dt);
     let plotted = sim.probes.iter().map(|p| &p.series);
     let files = writer.finish(plotted.chain([&frame_series]))?;
