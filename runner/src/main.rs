@@ -35,7 +35,9 @@ enum Command {
     /// Steps the scene frame by frame (progress bar on stderr when it is a terminal), then
     /// writes into the output folder: report.json (settings used, tets and nodes per body,
     /// integrator choices, each body's predicted and measured step cost, wall time and ms per
-    /// frame, stability flags, every probe as a time series with its final value);
+    /// frame, where the stepping went (soft steps by integrator and rigid partners, contact
+    /// detection, rapier's steps), stability flags, every probe as a time series with its final
+    /// value);
     /// paraview/<scene>.pvd with a .vtu per soft body per saved frame (displacement,
     /// velocity, Cauchy and von Mises stress); obj/surface_<frame>.obj
     /// (every body's surface, for Blender); pictures/view_<frame>.png and
