@@ -432,7 +432,7 @@ fn print_frame_times(times: &sim::FrameTimes) {
     if let Some(parts) = &times.parts {
         println!(
             "  time: soft steps {:.2} s over the threads (implicit {:.2} s with dynamic rigid partners, {:.2} s without; explicit {:.2} s with, {:.2} s without), contact detection {:.2} s, rapier {:.2} s",
-            parts.soft_steps_s(),
+            parts.soft_steps_s,
             parts.implicit_with_rigid_partners_s,
             parts.implicit_without_rigid_partners_s,
             parts.explicit_with_rigid_partners_s,

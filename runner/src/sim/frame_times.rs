@@ -48,6 +48,8 @@ pub struct StepParts {
     pub contact_detection_s: f64,
     /// rapier's steps (s).
     pub rapier_steps_s: f64,
+    /// The soft steps' seconds, both integrators, with and without rigid partners (s).
+    pub soft_steps_s: f64,
 }
 
 impl StepParts {
@@ -60,15 +62,8 @@ impl StepParts {
             explicit_without_rigid_partners_s: timing.explicit_without_rigid_partners,
             contact_detection_s: timing.contact_detection,
             rapier_steps_s: timing.rapier_steps,
+            soft_steps_s: timing.soft_steps(),
         }
-    }
-
-    /// The soft steps' seconds, both integrators, with and without rigid partners (s).
-    pub fn soft_steps_s(&self) -> f64 {
-        self.implicit_with_rigid_partners_s
-            + self.implicit_without_rigid_partners_s
-            + self.explicit_with_rigid_partners_s
-            + self.explicit_without_rigid_partners_s
     }
 }
 
