@@ -159,11 +159,12 @@ impl LinearSolver {
                 tolerance,
                 max_iterations,
             },
+            // A body too small for the conjugate gradient needs no prediction (its wave length
+            // scale is a pass over the elements).
+            LinearSolver::Automatic if free_dofs(body) < MIN_AUTOMATIC_CG_DOFS => Method::Direct,
             LinearSolver::Automatic => {
                 let prediction = predict(body, h, AUTOMATIC_CG_TOLERANCE);
-                if prediction.free_dofs >= MIN_AUTOMATIC_CG_DOFS
-                    && prediction.cg_iterations < prediction.cholesky_in_products
-                {
+                if prediction.cg_iterations < prediction.cholesky_in_products {
                     Method::AutomaticConjugateGradient {
                         max_iterations: (2.0 * prediction.cholesky_in_products).ceil() as usize,
                     }
@@ -219,10 +220,7 @@ pub fn predict(body: &DeformableBody, h: f64, tolerance: f64) -> SolverPredictio
     let condition = (1.0 + highest * highest * weight) / (1.0 + lowest * lowest * weight);
     // A flat element (ℓ = 0) makes the estimate infinite (or NaN): the direct solve is chosen.
     let cg_iterations = CG_ITERATION_FACTOR * condition.sqrt() * (2.0 / tolerance).ln() / 2.0;
-    let free = 3
-        * (0..body.node_count())
-            .filter(|&n| !body.is_pinned(n))
-            .count();
+    let free = free_dofs(body);
     SolverPrediction {
         condition,
         cg_iterations: if cg_iterations.is_nan() {
@@ -233,6 +231,13 @@ pub fn predict(body: &DeformableBody, h: f64, tolerance: f64) -> SolverPredictio
         cholesky_in_products: CHOLESKY_COST_SCALE * (free as f64).sqrt(),
         free_dofs: free,
     }
+}
+
+/// The unknowns of `body`'s Newton system: three per free node.
+fn free_dofs(body: &DeformableBody) -> usize {
+    3 * (0..body.node_count())
+        .filter(|&n| !body.is_pinned(n))
+        .count()
 }
 
 /// A resolved choice of [`LinearSolver`].
