@@ -10,7 +10,7 @@ use crate::attachment::{self, Attachment};
 use crate::body::DeformableBody;
 use crate::contact::{
     self, ColliderView, ContactSet, ContactSettings, ContactTarget, CornerContact, CornerPlace,
-    NodeContact,
+    KeptTree, NodeContact,
 };
 use crate::rigid::RigidProxy;
 use rapier3d::dynamics::RigidBodyHandle;
@@ -56,6 +56,9 @@ pub struct BodyConstraints {
     /// What [`BodyConstraints::save`] set aside.
     #[cfg_attr(feature = "serde-serialize", serde(skip))]
     saved: SavedConstraints,
+    /// The hierarchy over the body's boundary the last detection built, for the next to refit.
+    #[cfg_attr(feature = "serde-serialize", serde(skip))]
+    surface_tree: KeptTree,
 }
 
 /// The proxies, attachment anchors (m), contact planes (point and normal) and rigid corners
@@ -93,7 +96,7 @@ impl BodyConstraints {
         let glued: Vec<(RigidBodyHandle, u32)> =
             self.attachments.iter().map(|a| (a.body, a.node)).collect();
         let found = contact::detect(
-            body,
+            (body, &mut self.surface_tree),
             (&glued, (&self.contacts, &self.rigid_proxies)),
             colliders,
             frame_dt,

@@ -6,9 +6,10 @@
 //! on any collider.
 
 use super::entry::{LastContact, entered_surface_point};
+use super::surface_tree::{KeptTree, SurfaceTree};
 use super::{
     BodyPoint, Coefficients, ContactSet, ContactSettings, ContactTarget, CornerContact,
-    NodeContact, Obstacle, SurfaceCoefficients, corner, surface_tree,
+    NodeContact, Obstacle, SurfaceCoefficients, corner,
 };
 use crate::Error;
 use crate::body::DeformableBody;
@@ -52,13 +53,14 @@ pub(crate) struct Detection {
 /// (twice its fastest node's distance); `glued` lists the rigid bodies and the nodes glued to them,
 /// which do not touch their colliders; `previous` are the contacts of the last detection and the
 /// rigid proxies of its step, whose points' paths since then tell the face a point entered a
-/// collider by (see [`super::entry`]).
+/// collider by (see [`super::entry`]). `kept` holds the hierarchy over the body's boundary from
+/// the last detection that built one, refitted here if rigid corners need it and given back.
 ///
 /// # Errors
 /// [`Error::InvalidTimeStep`], [`Error::NonFiniteInput`] or [`Error::InvalidSetting`] for a bad
 /// step, gravity or setting.
 pub(crate) fn detect(
-    body: &DeformableBody,
+    (body, kept): (&DeformableBody, &mut KeptTree),
     (glued, previous): (&[(RigidBodyHandle, u32)], LastDetection<'_>),
     (colliders, struck): (&[ColliderView], f64),
     frame_dt: f64,
@@ -113,7 +115,7 @@ pub(crate) fn detect(
             nodes.push(contact.with_proxy(proxy));
         }
         if near.overlaps(bounds) && corner::meets_faces(near.shape.as_ref()) {
-            let tree = tree.get_or_insert_with(|| surface_tree::SurfaceTree::of(body));
+            let tree = tree.get_or_insert_with(|| SurfaceTree::refitted(body, kept.0.take()));
             let mut found = corner::find_corner_contacts(body, tree, &near);
             if !found.is_empty() {
                 let proxy = proxy.or_else(|| near.proxy_in(&mut proxies));
@@ -125,6 +127,9 @@ pub(crate) fn detect(
             }
             corners.extend(found);
         }
+    }
+    if let Some(tree) = tree {
+        kept.0 = Some(tree.into_kept());
     }
     Ok(Detection {
         nodes,

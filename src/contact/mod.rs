@@ -92,7 +92,7 @@ pub(crate) use penalty::{
 pub(crate) use self_contact::detect_self_contacts;
 pub(crate) use set::ContactSet;
 use soft_point::SoftPoint;
-pub(crate) use surface_tree::nearest_point_on_triangle;
+pub(crate) use surface_tree::{KeptTree, nearest_point_on_triangle};
 use sweep::partners;
 pub(crate) use sweep::{advance_planes, prepare_velocities, solve_velocities};
 pub use velocity_constraint::RESTITUTION_THRESHOLD;

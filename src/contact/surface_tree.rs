@@ -35,6 +35,25 @@ pub(crate) struct SurfaceTree {
     pub(crate) bounds: Aabb,
 }
 
+/// The hierarchy a body's last detection built over its boundary, which the next one refits
+/// ([`SurfaceTree::refitted`]); a clone starts without one (the queries answer the same with a
+/// tree built afresh).
+#[derive(Default)]
+pub(crate) struct KeptTree(pub(crate) Option<Bvh>);
+
+impl Clone for KeptTree {
+    fn clone(&self) -> Self {
+        Self(None)
+    }
+}
+
+impl std::fmt::Debug for KeptTree {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let leaves = self.0.as_ref().map(Bvh::leaf_count);
+        f.debug_struct("KeptTree").field("leaves", &leaves).finish()
+    }
+}
+
 impl TrianglePoint {
     /// The point as a side of a contact.
     pub(crate) fn soft_point(&self) -> SoftPoint {
@@ -48,6 +67,15 @@ impl TrianglePoint {
 impl SurfaceTree {
     /// The tree of `body`'s boundary as it is now.
     pub(crate) fn of(body: &DeformableBody) -> Self {
+        Self::refitted(body, None)
+    }
+
+    /// The tree of `body`'s boundary as it is now: `kept` (the tree of an earlier detection, see
+    /// [`SurfaceTree::into_kept`]) refitted to the triangles' bounds now, a pass over them, or,
+    /// without one, a tree built afresh, a sort of them. A refitted tree keeps the branches of
+    /// the shape it was built at, which a body that deforms only loosens; the queries answer the
+    /// same whatever the branches (candidates taken in the order of their triangles).
+    pub(crate) fn refitted(body: &DeformableBody, kept: Option<Bvh>) -> Self {
         let leaves: Vec<Aabb> = body
             .surface
             .triangles
@@ -63,17 +91,31 @@ impl SurfaceTree {
         let bounds = leaves
             .iter()
             .fold(Aabb::new_invalid(), |all, leaf| all.merged(leaf));
-        Self {
-            bvh: Bvh::from_leaves(BvhBuildStrategy::Binned, &leaves),
-            bounds,
-        }
+        let bvh = match kept {
+            Some(mut bvh) if bvh.leaf_count() as usize == leaves.len() => {
+                for (leaf, bounds) in (0u32..).zip(&leaves) {
+                    bvh.update_partially_if_present(*bounds, leaf, 0.0);
+                }
+                bvh.refit_without_opt();
+                bvh
+            }
+            _ => Bvh::from_leaves(BvhBuildStrategy::Binned, &leaves),
+        };
+        Self { bvh, bounds }
+    }
+
+    /// The hierarchy, to be refitted by the next detection ([`SurfaceTree::refitted`]).
+    pub(crate) fn into_kept(self) -> Bvh {
+        self.bvh
     }
 
     /// The indices of the body's boundary triangles whose bounds overlap the box from `lo` to
-    /// `hi` (m).
+    /// `hi` (m), in increasing order.
     pub(crate) fn triangles_in(&self, lo: DVec3, hi: DVec3) -> Vec<u32> {
         let query = Aabb::new(lo.as_vec3(), hi.as_vec3());
-        self.bvh.intersect_aabb(&query).collect()
+        let mut found: Vec<u32> = self.bvh.intersect_aabb(&query).collect();
+        found.sort_unstable();
+        found
     }
 
     /// The triangle of `body` (the tree's) nearest to `x` (m) within `reach` (m), among those
@@ -94,6 +136,7 @@ impl SurfaceTree {
         );
         let mut nearest = None;
         let mut nearest_distance = reach;
+        let mut nearest_leaf = u32::MAX;
         for leaf in self.bvh.intersect_aabb(&query) {
             let triangle = body.surface.triangles[leaf as usize];
             if skipped(&triangle) {
@@ -106,10 +149,13 @@ impl SurfaceTree {
             if normal.dot(facing) >= 0.0 {
                 continue;
             }
+            // Of equally near triangles the first: the answer does not hang on the branches.
             if let Some((weights, point)) = nearest_point_on_triangle(corners, x)
-                && x.distance(point) <= nearest_distance
+                && (x.distance(point) < nearest_distance
+                    || (x.distance(point) == nearest_distance && leaf < nearest_leaf))
             {
                 nearest_distance = x.distance(point);
+                nearest_leaf = leaf;
                 nearest = Some(TrianglePoint {
                     triangle,
                     weights,
@@ -140,7 +186,10 @@ impl SurfaceTree {
             (x - DVec3::splat(reach)).as_vec3(),
             (x + DVec3::splat(reach)).as_vec3(),
         );
-        let near: Vec<u32> = self.bvh.intersect_aabb(&query).collect();
+        let mut near: Vec<u32> = self.bvh.intersect_aabb(&query).collect();
+        // In the triangles' order: the nearest of equally near ones, and the pseudo-normal's
+        // sum, do not hang on the branches.
+        near.sort_unstable();
         let nodes_of = |t: u32| body.surface.triangles[t as usize];
         let corners = |t: u32| nodes_of(t).map(|n| body.positions[n as usize]);
         let (nearest, weights, point) = (near.iter())
@@ -272,5 +321,57 @@ mod tests {
         ] {
             assert!(outside(x).is_none(), "{x}");
         }
+    }
+
+    /// A tree built at rest and refitted after the cube is sheared by 30 %, turned and moved
+    /// answers every query as a tree built afresh there, to the bit: the nearest triangle facing
+    /// a point (points on the grid of the cube's nodes, equally near several triangles, among
+    /// them), the point outside, and the triangles within a box.
+    #[test]
+    fn a_refitted_tree_answers_as_a_tree_built_afresh() {
+        let mut body = cube();
+        let kept = SurfaceTree::of(&body).into_kept();
+        let turn =
+            rapier3d::glamx::DQuat::from_axis_angle(DVec3::new(1.0, 2.0, 0.5).normalize(), 0.8);
+        for x in &mut body.positions {
+            *x = turn * DVec3::new(x.x + 0.3 * x.y, x.y, x.z) + DVec3::new(0.2, -0.1, 0.4);
+        }
+        let (refitted, fresh) = (
+            SurfaceTree::refitted(&body, Some(kept)),
+            SurfaceTree::of(&body),
+        );
+        let queries: Vec<DVec3> = (0..125)
+            .map(|i| {
+                let grid = DVec3::new((i % 5) as f64, (i / 5 % 5) as f64, (i / 25) as f64);
+                turn * (grid * 0.03 - DVec3::splat(0.06)) + DVec3::new(0.2, -0.1, 0.4)
+            })
+            .collect();
+        let key = |hit: Option<TrianglePoint>| {
+            hit.map(|h| {
+                (
+                    h.triangle,
+                    h.weights.map(f64::to_bits),
+                    h.normal.to_array().map(f64::to_bits),
+                )
+            })
+        };
+        let mut found = 0;
+        for x in queries {
+            for facing in [
+                DVec3::X,
+                DVec3::NEG_Y,
+                DVec3::new(1.0, 1.0, -1.0).normalize(),
+            ] {
+                let [a, b] = [&refitted, &fresh]
+                    .map(|t| key(t.nearest_facing(&body, x, facing, 0.05, |_| false)));
+                found += usize::from(a.is_some());
+                assert_eq!(a, b, "nearest facing {facing} from {x}");
+            }
+            let [a, b] = [&refitted, &fresh].map(|t| key(t.outside_point(&body, x, 0.05)));
+            assert_eq!(a, b, "outside point from {x}");
+            let [a, b] = [&refitted, &fresh].map(|t| t.triangles_in(x, x + DVec3::splat(0.02)));
+            assert_eq!(a, b, "triangles near {x}");
+        }
+        assert!(found > 100, "the queries meet the surface ({found} hits)");
     }
 }

@@ -384,7 +384,7 @@ impl ContactSides for Corner<'_> {
 mod tests {
     use super::*;
     use crate::contact::detect::{ColliderView, detect};
-    use crate::contact::{ContactSettings, SurfaceCoefficients};
+    use crate::contact::{ContactSettings, KeptTree, SurfaceCoefficients};
     use crate::prelude::{DeformableBodyBuilder, Material, MaterialModel, mesh};
     use rapier3d::geometry::{InteractionGroups, SharedShape};
 
@@ -420,7 +420,7 @@ mod tests {
         };
         let previous = ContactSet::default();
         let found = detect(
-            &block,
+            (&block, &mut KeptTree::default()),
             (&[], (&previous, &[])),
             (&[view], 0.0),
             1.0 / 240.0,
