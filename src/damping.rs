@@ -169,6 +169,33 @@ impl RayleighDamping {
             df * stress + *f * self.stress_of_rate(&d_rate)
         })
     }
+
+    /// [`RayleighDamping::step_first_piola_differentials`] for the nine unit changes of `F` in
+    /// column-major order (`dF = e_i e_jᵀ` for column `3j + i`), the stress tangent's columns
+    /// (Pa): the products with a unit change taken as the row or column it picks (`dF S` is
+    /// `S`'s row `j` in row `i`, `Fᵀ dF` is `F`'s row `i` in column `j`) instead of multiplied
+    /// through its zeros, the same values.
+    pub(crate) fn step_first_piola_unit_differentials(
+        &self,
+        f: &DMat3,
+        green_previous: &DMat3,
+        h: f64,
+    ) -> [DMat3; 9] {
+        let rate = (green_strain(f) - *green_previous) * (1.0 / h);
+        let stress = self.stress_of_rate(&rate);
+        let f_rows = f.transpose();
+        std::array::from_fn(|column| {
+            let (i, j) = (column % 3, column / 3);
+            let mut picked = DMat3::ZERO;
+            *picked.col_mut(j) = f_rows.col(i);
+            let d_rate = symmetric_part(&picked) * (1.0 / h);
+            let mut df_stress = DMat3::ZERO;
+            for k in 0..3 {
+                df_stress.col_mut(k)[i] = stress.col(k)[j];
+            }
+            df_stress + *f * self.stress_of_rate(&d_rate)
+        })
+    }
 }
 
 #[cfg(test)]
@@ -213,6 +240,34 @@ mod tests {
                 .iter()
                 .fold(0.0f64, |m, x| m.max(x.abs()));
             assert!(error < 1e-6 * dp_scale);
+        }
+    }
+
+    /// The unit changes' differentials are the general ones for the unit changes, value for
+    /// value (`==`: a zero's sign may differ), at deformations stretched, sheared, turned and
+    /// inverted.
+    #[test]
+    fn unit_differentials_are_the_general_ones_for_unit_changes() {
+        let damping = RayleighDamping::new(300.0, 200.0).unwrap();
+        let units: [DMat3; 9] = std::array::from_fn(|column| {
+            let mut unit = [0.0; 9];
+            unit[column] = 1.0;
+            DMat3::from_cols_array(&unit)
+        });
+        let previous = green_strain(&DMat3::from_cols_array(&[
+            1.0, 0.01, 0.0, 0.0, 1.02, 0.01, 0.02, 0.0, 0.98,
+        ]));
+        let turn =
+            DMat3::from_axis_angle(rapier3d::glamx::DVec3::new(1.0, 2.0, -0.5).normalize(), 0.9);
+        for f in [
+            DMat3::from_cols_array(&[1.1, 0.05, -0.02, 0.03, 0.95, 0.04, -0.01, 0.02, 1.05]),
+            turn * DMat3::from_cols_array(&[1.3, 0.2, 0.0, -0.1, 0.7, 0.3, 0.0, 0.1, 0.9]),
+            DMat3::from_cols_array(&[-0.9, 0.1, 0.2, 0.0, 1.1, -0.3, 0.4, 0.0, 1.0]),
+        ] {
+            let h = 1.0 / 240.0;
+            let general = damping.step_first_piola_differentials(&f, &previous, h, &units);
+            let unit = damping.step_first_piola_unit_differentials(&f, &previous, h);
+            assert_eq!(general, unit, "F = {f}");
         }
     }
 }

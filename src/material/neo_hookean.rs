@@ -161,11 +161,20 @@ impl HyperelasticModel for StableNeoHookean {
     }
 
     fn first_piola_differential(&self, f: &DMat3, df: &DMat3) -> DMat3 {
+        self.first_piola_differentials(f, &[*df])[0]
+    }
+
+    /// `μ dF + V''(J) (cof(F) : dF) cof(F) + V'(J) d cof(F)[dF]`, with `cof(F)`, `J` and the
+    /// volume terms' slope and curvature evaluated once for all the changes.
+    fn first_piola_differentials<const N: usize>(&self, f: &DMat3, dfs: &[DMat3; N]) -> [DMat3; N] {
         let cof = cofactor(f);
         let j = f.determinant();
-        *df * self.mu
-            + cof * (self.volume_curvature(j) * double_dot(&cof, df))
-            + cofactor_differential(f, df) * self.volume_slope(j)
+        let (curvature, slope) = (self.volume_curvature(j), self.volume_slope(j));
+        dfs.each_ref().map(|df| {
+            *df * self.mu
+                + cof * (curvature * double_dot(&cof, df))
+                + cofactor_differential(f, df) * slope
+        })
     }
 
     /// `F (μ I + S_extra) + V'(J) cof(F)`.

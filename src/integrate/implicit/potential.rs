@@ -301,8 +301,9 @@ impl<'a> Potential<'a> {
         project: bool,
     ) {
         let damping = body.damping;
-        stiffness.assemble(body, Some(inertia), project, |t, f, dfs| match &damping {
-            Some(d) => d.step_first_piola_differentials(f, &self.start.green[t], self.start.h, dfs),
+        // `assemble` asks for the differentials of the nine unit changes of `F`.
+        stiffness.assemble(body, Some(inertia), project, |t, f, _| match &damping {
+            Some(d) => d.step_first_piola_unit_differentials(f, &self.start.green[t], self.start.h),
             None => [DMat3::ZERO; 9],
         });
         let mut rigid = self.rigid.borrow_mut();
