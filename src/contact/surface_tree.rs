@@ -1,4 +1,5 @@
-//! A soft body's boundary triangles, where they are now, in a parry bounding-volume hierarchy:
+//! A soft body's boundary triangles, where they are now, in a parry bounding-volume hierarchy
+//! (kept by contact detection from one detection to the next and refitted, [`KeptTree`]):
 //! the nearest triangle facing a point, for self-contact, contact between soft bodies and rigid
 //! vertices; whether a point lies outside the body (the sign along the angle-weighted
 //! pseudo-normal of its nearest feature), for rigid vertices behind a facing triangle's plane;
@@ -325,8 +326,9 @@ mod tests {
 
     /// A tree built at rest and refitted after the cube is sheared by 30 %, turned and moved
     /// answers every query as a tree built afresh there, to the bit: the nearest triangle facing
-    /// a point (points on the grid of the cube's nodes, equally near several triangles, among
-    /// them), the point outside, and the triangles within a box.
+    /// a point, the point outside, and the triangles within a box, from points on a grid across
+    /// the cube and from points 5 mm out from each boundary node along its normal (equally near
+    /// every triangle around the node: the order decides among them).
     #[test]
     fn a_refitted_tree_answers_as_a_tree_built_afresh() {
         let mut body = cube();
@@ -340,11 +342,15 @@ mod tests {
             SurfaceTree::refitted(&body, Some(kept)),
             SurfaceTree::of(&body),
         );
+        let normals = body.surface_node_normals();
+        let off_nodes = (body.surface.nodes.iter())
+            .map(|&n| body.positions[n as usize] + normals[n as usize] * 0.005);
         let queries: Vec<DVec3> = (0..125)
             .map(|i| {
                 let grid = DVec3::new((i % 5) as f64, (i / 5 % 5) as f64, (i / 25) as f64);
                 turn * (grid * 0.03 - DVec3::splat(0.06)) + DVec3::new(0.2, -0.1, 0.4)
             })
+            .chain(off_nodes)
             .collect();
         let key = |hit: Option<TrianglePoint>| {
             hit.map(|h| {
