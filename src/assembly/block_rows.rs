@@ -131,7 +131,7 @@ mod tests {
         let body = deformed_block([3, 2, 2], [0, 5, 17], (7, 0.01));
         let mut stiffness = Stiffness::new(&body);
         let diagonal = vec![3.0e3; body.node_count()];
-        stiffness.assemble(&body, Some(&diagonal), false, |_, _, _| [DMat3::ZERO; 9]);
+        stiffness.assemble(&body, Some(&diagonal), false, |_, _| [DMat3::ZERO; 9]);
         (body, stiffness)
     }
 

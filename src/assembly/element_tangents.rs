@@ -261,7 +261,7 @@ mod tests {
             .num_threads(threads)
             .build()
             .expect("a pool")
-            .install(|| stiffness.assemble(&body, None, false, |_, _, _| [DMat3::ZERO; 9]));
+            .install(|| stiffness.assemble(&body, None, false, |_, _| [DMat3::ZERO; 9]));
         stiffness.values
     }
 

@@ -168,8 +168,9 @@ impl Stiffness {
 
     /// Fills the values with the body's tangent stiffness at its current positions: for every
     /// integration point (see [`crate::element`]) `w ∇N_aᵀ A ∇N_b` with `A` the stress tangent of
-    /// the elastic stress differential plus `extra(point, F, dFs)` (further stress differentials,
-    /// Pa, for the nine unit changes `dFs` of `F`), projected to be positive semi-definite if `project`; the coupling of nodal averaging
+    /// the elastic stress differential plus `extra(point, F)` (further stress differentials, Pa,
+    /// for the nine unit changes of `F` in column-major order: a further tangent's columns),
+    /// projected to be positive semi-definite if `project`; the coupling of nodal averaging
     /// if the body uses it; the Hessians of its follower loads' potentials ([`crate::load`]; a
     /// chamber's pressure not if `project`); and `diagonal[n] I` on each free node.
     pub(crate) fn assemble(
@@ -177,7 +178,7 @@ impl Stiffness {
         body: &DeformableBody,
         diagonal: Option<&[f64]>,
         project: bool,
-        extra: impl Fn(usize, &DMat3, &[DMat3; 9]) -> [DMat3; 9] + Sync,
+        extra: impl Fn(usize, &DMat3) -> [DMat3; 9] + Sync,
     ) {
         self.values.fill(0.0);
         let x = body.positions();
@@ -198,7 +199,7 @@ impl Stiffness {
                         .map(|df| NodalAveraging::element_differential(&model, &f, excess, &df)),
                     None => model.first_piola_differentials(&f, &changes),
                 };
-                let extra = extra(point, &f, &changes);
+                let extra = extra(point, &f);
                 let a = tangent_from_columns(std::array::from_fn(|c| elastic[c] + extra[c]));
                 if project { project_positive(a) } else { a }
             };
@@ -489,7 +490,7 @@ pub(crate) fn assert_forces_and_tangent_match_energy(body: &mut DeformableBody, 
         -work
     );
     let mut stiffness = Stiffness::new(body);
-    stiffness.assemble(body, None, false, |_, _, _| [DMat3::ZERO; 9]);
+    stiffness.assemble(body, None, false, |_, _| [DMat3::ZERO; 9]);
     let k_d = stiffness.multiply(&direction);
     let scale = k_d.iter().map(|v| v.length()).fold(0.0, f64::max);
     for node in 0..n {

@@ -226,7 +226,7 @@ mod tests {
     fn the_taken_in_direction_solves_the_system_with_the_liquid() {
         let body = cube_with_chamber();
         let mut stiffness = Stiffness::new(&body);
-        stiffness.assemble(&body, None, false, |_, _, _| [DMat3::ZERO; 9]);
+        stiffness.assemble(&body, None, false, |_, _| [DMat3::ZERO; 9]);
         let factor = factorize(&mut stiffness, 0).unwrap();
         // A fixed out-of-balance force on the free nodes.
         let residual = fixed_direction(&body);

@@ -244,7 +244,7 @@ pub fn fundamental_frequency(body: &DeformableBody) -> Result<f64, Error> {
 /// The elastic tangent stiffness at the body's current positions, projected per element to be
 /// positive semi-definite if `project`.
 fn assemble_elastic(stiffness: &mut Stiffness, body: &DeformableBody, project: bool) {
-    stiffness.assemble(body, None, project, |_, _, _| [DMat3::ZERO; 9]);
+    stiffness.assemble(body, None, project, |_, _| [DMat3::ZERO; 9]);
 }
 
 /// `f_int(x) + load`, zero on pinned nodes (N).

@@ -301,8 +301,7 @@ impl<'a> Potential<'a> {
         project: bool,
     ) {
         let damping = body.damping;
-        // `assemble` asks for the differentials of the nine unit changes of `F`.
-        stiffness.assemble(body, Some(inertia), project, |t, f, _| match &damping {
+        stiffness.assemble(body, Some(inertia), project, |t, f| match &damping {
             Some(d) => d.step_first_piola_unit_differentials(f, &self.start.green[t], self.start.h),
             None => [DMat3::ZERO; 9],
         });
