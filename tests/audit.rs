@@ -12,9 +12,12 @@
 
 mod common;
 
-use rapier_fvm::coupling::{Audit, AuditSettings, FrameAudit, PenetrationTarget};
-use rapier_fvm::glamx::Vec3;
+use rapier_fvm::coupling::{Audit, AuditSettings, BodyAudit, FrameAudit, PenetrationTarget};
+use rapier_fvm::glamx::{Quat, Vec3};
 use rapier_fvm::prelude::*;
+use rapier3d::math::Pose;
+use rapier3d::parry::query::{Ray, RayCast};
+use rapier3d::parry::shape::Cuboid;
 use rapier3d::prelude::{ColliderBuilder, RigidBodyBuilder};
 
 /// A 10 cm cube (4 x 4 x 4 cells, E = 1e6 Pa, ν = 0.3, 1000 kg/m³, lightly damped) with its
@@ -151,6 +154,64 @@ fn a_cube_moved_through_a_thin_wall_has_crossed_it() {
     let body = found.body(handle).unwrap();
     // Every boundary node passed through the wall: 4 x 4 x 4 cells have 98 boundary nodes.
     assert_eq!(body.penetrations.crossed, 98);
+    assert!(body.crossed() && !body.penetrates());
+}
+
+/// The audit of a still 10 cm cube (centred at the origin, no gravity) after a collider without
+/// a body, `shape` at `then`, is set by hand at `now`, as one frame.
+fn audit_after_setting_collider(shape: ColliderBuilder, then: Pose, now: Pose) -> BodyAudit {
+    let mut world = FvmWorld::default();
+    world.physics.gravity = Vec3::ZERO;
+    let collider = world.physics.insert_collider(shape.position(then), None);
+    let handle = world.soft_bodies.insert(cube(-0.05));
+    let mut audit = Audit::default();
+    audit.restart_world(&world);
+    world.physics.colliders[collider].set_position(now);
+    let found = audit.check_world(&world, &Vec::new());
+    found.body(handle).unwrap().clone()
+}
+
+#[test]
+fn a_still_cube_beside_a_box_turning_fast_has_not_crossed_it() {
+    // A 3 cm box centred 28 mm beyond the middle of the cube's +x face, turned 2.2 rad about
+    // its own vertical axis (z) over the frame, from 27° (0.471 rad). In the box's frame the
+    // face's middle node moves on a circle of 28 mm about that axis, outside the box (whose
+    // corners are 21.2 mm from it); the nodes off the middle are farther, or beyond the box's
+    // half height of 15 mm. The straight chord of that arc runs along the box's x axis,
+    // 28 cos(1.1) = 12.7 mm from it, through the box from its -x face to its +x face: checked
+    // below, so that the audit would have found a crossing had it followed the chord.
+    let centre = Vec3::new(0.078, 0.0, 0.0);
+    let (from, turn) = (0.471, 2.2);
+    let then = Pose::from_parts(centre, Quat::from_rotation_z(from));
+    let now = Pose::from_parts(centre, Quat::from_rotation_z(from + turn));
+    let node = Vec3::new(0.05, 0.0, 0.0);
+    let (start, end) = (
+        then.inverse_transform_point(node),
+        now.inverse_transform_point(node),
+    );
+    let shape = Cuboid::new(Vec3::splat(0.015));
+    let hit =
+        |a: Vec3, b: Vec3| shape.cast_local_ray_and_get_normal(&Ray::new(a, b - a), 1.0, false);
+    let (entry, exit) = (hit(start, end).unwrap(), hit(end, start).unwrap());
+    assert!(entry.time_of_impact + exit.time_of_impact < 1.0);
+    assert!(entry.normal.dot(exit.normal) < 0.0);
+    let body =
+        audit_after_setting_collider(ColliderBuilder::cuboid(0.015, 0.015, 0.015), then, now);
+    assert!(!body.crossed() && !body.penetrates(), "{body:#?}");
+}
+
+#[test]
+fn a_cube_a_thin_wall_turns_through_has_crossed_it() {
+    // A 2 mm wall (1 m square) across x = 0.1 m, turned 0.4 rad about a vertical axis at
+    // x = 0.1 m, z = -0.45 m over the frame: its part beside the cube (z from -5 to 5 cm) swings
+    // from x = 0.1 m to x = -0.07 m to -0.11 m, past the whole cube (x from -5 to 5 cm), whose
+    // 98 boundary nodes (4 x 4 x 4 cells) all went through it, in one face and out of the other.
+    let pivot = Vec3::new(0.1, 0.0, -0.45);
+    let turned = Quat::from_rotation_y(-0.4);
+    let then = Pose::from_parts(Vec3::new(0.1, 0.0, 0.0), Quat::IDENTITY);
+    let now = Pose::from_parts(pivot + turned * (then.translation - pivot), turned);
+    let body = audit_after_setting_collider(ColliderBuilder::cuboid(0.001, 0.5, 0.5), then, now);
+    assert_eq!(body.penetrations.crossed, 98, "{body:#?}");
     assert!(body.crossed() && !body.penetrates());
 }
 

@@ -49,6 +49,7 @@
 //! frame's: call [`Audit::restart`] after changing it.
 
 mod cluster;
+mod collider_path;
 mod crossing;
 mod elements;
 mod energy;

@@ -8,15 +8,17 @@
 //!   another deformable body's tetrahedra deeper than the tolerance below its boundary; or a
 //!   convex collider whose centre lies that deep inside the body's own tetrahedra (a rigid body
 //!   that went in between the contact points).
-//! - **Crossing**: a point outside a collider before and after the frame whose straight path over
-//!   the frame, taken in the collider's frame (so that a moving collider is followed), runs
-//!   through the collider's interior for longer than the tolerance (a solid shape), or through
-//!   its surface to end deeper than the tolerance on the far side (a triangle mesh or height
-//!   field, which has no interior): the point went through it.
+//! - **Crossing**: a point outside a collider before and after the frame whose path over the
+//!   frame, taken in the collider's frame (so that a moving collider is followed, its turning
+//!   included, see the `collider_path` module), enters a solid shape through one face and leaves
+//!   it through one facing away from it (a path longer than the tolerance), or goes through its
+//!   surface to end deeper than the tolerance on the far side (a triangle mesh or height field,
+//!   which has no interior): the point went through it.
 //!
 //! Crossings of other deformable bodies are the `crossing` module's; self-penetration is not
 //! checked.
 
+use super::collider_path::ColliderMotion;
 use super::{PenetrationTarget, Penetrations};
 use crate::body::{DeformableBody, DeformableBodyHandle};
 use crate::contact::{contact_point_positions, nearest_point_on_triangle};
@@ -87,11 +89,11 @@ pub(super) fn disjoint(a: (DVec3, DVec3), b: (DVec3, DVec3)) -> bool {
 /// Records in `found` the body's points deeper than the tolerance in `colliders`, and those
 /// that crossed one since the previous frame, whose colliders were at `poses` then.
 ///
-/// A collider is passed over whole when its box, widened by the longest path a point can have
-/// taken in its frame, misses the points' box: a point's path (its start carried along with
-/// the collider's motion) lies within the path's length of its end, and that length is at most
-/// the point's own move plus how far the collider's motion carried its start, the latter
-/// largest at a corner of the box of the starts (the carrying is affine, its length convex).
+/// A collider is passed over whole when its box, widened by how far a point's path in its frame
+/// can lie from the point's end, misses the points' box: each place on the path is where the
+/// point was at some instant, carried with the collider's motion from that instant to now, so it
+/// lies within the point's own move plus that carry from its end, the carry largest at a corner
+/// of a box holding the point's places (the carrying is affine, its length convex).
 pub(super) fn against_colliders(
     checked: &Checked<'_>,
     colliders: &ColliderSet,
@@ -112,9 +114,16 @@ pub(super) fn against_colliders(
         }
         let aabb = collider.compute_aabb();
         let aabb = (aabb.mins.as_dvec3(), aabb.maxs.as_dvec3());
-        let then = poses.get(&handle);
-        let carried = match (before_bounds, then) {
-            (Some(before), Some(then)) => longest_carry(collider.position(), then, before),
+        let motion = poses
+            .get(&handle)
+            .map(|then| ColliderMotion::new(then, collider.position()));
+        // The points' places at the instants the paths are taken at lie within the box of
+        // their ends (on straight lines between them).
+        let carried = match (before_bounds, &motion) {
+            (Some(before), Some(motion)) => {
+                let ends = (before.0.min(now_bounds.0), before.1.max(now_bounds.1));
+                motion.longest_carry(ends)
+            }
             _ => 0.0,
         };
         // The tolerance on top covers the single-precision poses' round-off in `crossed`.
@@ -134,9 +143,14 @@ pub(super) fn against_colliders(
             let depth = depth_in(collider, aabb, *x);
             if depth > checked.tolerance {
                 found.add_penetration(depth, PenetrationTarget::Collider(handle));
-            } else if let (Some(before), Some(then)) = (&checked.before, then)
+            } else if let (Some(before), Some(motion)) = (&checked.before, &motion)
                 && depth <= 0.0
-                && crossed((collider, aabb), then, (before[i].0, *x), checked.tolerance)
+                && crossed(
+                    (collider, aabb),
+                    motion,
+                    (before[i].0, *x),
+                    checked.tolerance,
+                )
             {
                 found.crossed += 1;
                 found
@@ -145,23 +159,6 @@ pub(super) fn against_colliders(
             }
         }
     }
-}
-
-/// The farthest (m) the motion of a collider from pose `then` to `now` carries a point of the
-/// box `(lo, hi)` (m): its largest at one of the box's corners.
-fn longest_carry(now: &Pose, then: &Pose, (lo, hi): (DVec3, DVec3)) -> f64 {
-    (0..8)
-        .map(|corner| {
-            let pick = |bit: usize, l: f64, h: f64| if corner >> bit & 1 == 0 { l } else { h };
-            let x = DVec3::new(
-                pick(0, lo.x, hi.x),
-                pick(1, lo.y, hi.y),
-                pick(2, lo.z, hi.z),
-            );
-            let carried = now.transform_point(then.inverse_transform_point(x.as_vec3()));
-            (carried.as_dvec3() - x).length()
-        })
-        .fold(0.0, f64::max)
 }
 
 /// How deep (m) `x` lies inside `collider`, whose box is `(lo, hi)` (m), (zero or less
@@ -180,46 +177,64 @@ fn depth_in(collider: &Collider, (lo, hi): (DVec3, DVec3), x: DVec3) -> f64 {
     }
 }
 
-/// Whether the point that was at `from` (m) when `collider` (whose box is `aabb`, m) was at
-/// `then` went through it on its way to `to` (m), a path longer than `tolerance` (m).
+/// Whether the point that moved from `from` to `to` (m) while `collider` (whose box is `aabb`,
+/// m) made its `motion` went through it: the point's path in the collider's frame
+/// ([`ColliderMotion::path`]), longer than `tolerance` (m), entered a solid shape through one
+/// face and left it through one facing away from it, or went through a surface without
+/// interior (a triangle mesh or height field) to end beyond the tolerance from it.
 fn crossed(
     (collider, aabb): (&Collider, (DVec3, DVec3)),
-    then: &Pose,
+    motion: &ColliderMotion,
     (from, to): (DVec3, DVec3),
     tolerance: f64,
 ) -> bool {
     let pose = collider.position();
-    // Where the point started, carried along with the collider's motion over the frame.
-    let from = pose
-        .transform_point(then.inverse_transform_point(from.as_vec3()))
-        .as_dvec3();
-    let path = to - from;
-    if disjoint((from.min(to), from.max(to)), aabb) {
+    let path = motion.path(from, to);
+    let bounds = bounding_box(path.iter().copied());
+    if disjoint(bounds, aabb) {
         return false;
     }
     let shape = collider.shape();
+    let length: f64 = path.windows(2).map(|s| (s[1] - s[0]).length()).sum();
     // A point inside at the start was a penetration then, not a crossing now.
-    if path.length() <= tolerance || shape.project_point(pose, from.as_vec3(), false).is_inside {
+    if length <= tolerance
+        || shape
+            .project_point(pose, path[0].as_vec3(), false)
+            .is_inside
+    {
         return false;
     }
-    let forward = Ray::new(from.as_vec3(), path.as_vec3());
-    if shape.as_trimesh().is_some() || shape.as_heightfield().is_some() {
-        if shape.cast_ray(pose, &forward, 1.0, false).is_none() {
-            return false;
+    // The first time (m along the path from its start) the segments of `path`, in order, meet
+    // the shape's surface, with the surface's normal there.
+    let first_hit = |path: &mut dyn Iterator<Item = (DVec3, DVec3)>| {
+        let mut walked = 0.0;
+        for (a, b) in path {
+            let ray = Ray::new(a.as_vec3(), (b - a).as_vec3());
+            if let Some(hit) = shape.cast_ray_and_get_normal(pose, &ray, 1.0, false) {
+                return Some((
+                    walked + f64::from(hit.time_of_impact) * (b - a).length(),
+                    hit,
+                ));
+            }
+            walked += (b - a).length();
         }
+        None
+    };
+    let forward = || path.windows(2).map(|s| (s[0], s[1]));
+    let Some((entry, entry_hit)) = first_hit(&mut forward()) else {
+        return false;
+    };
+    if shape.as_trimesh().is_some() || shape.as_heightfield().is_some() {
         // A surface without interior: through it, and now beyond the tolerance from it.
         let projection = shape.project_point(pose, to.as_vec3(), false);
         return (projection.point.as_dvec3() - to).length() > tolerance;
     }
-    let backward = Ray::new(to.as_vec3(), (-path).as_vec3());
-    let (Some(entry), Some(exit)) = (
-        shape.cast_ray_and_get_normal(pose, &forward, 1.0, false),
-        shape.cast_ray_and_get_normal(pose, &backward, 1.0, false),
-    ) else {
+    let mut backward = path.windows(2).rev().map(|s| (s[1], s[0]));
+    let Some((exit, exit_hit)) = first_hit(&mut backward) else {
         return false;
     };
     // In through one face and out through one facing away from it: to the far side.
-    entry.time_of_impact + exit.time_of_impact < 1.0 && entry.normal.dot(exit.normal) < 0.0
+    entry + exit < length && entry_hit.normal.dot(exit_hit.normal) < 0.0
 }
 
 /// Records in `found` the points of `checked` that lie inside the tetrahedra of `other` deeper
