@@ -84,7 +84,8 @@ impl ColliderMotion {
             )
         });
         let corners: Vec<DVec3> = corners.collect();
-        (self.poses.iter())
+        // From the last instant, now, nothing is carried.
+        (self.poses[..self.poses.len() - 1].iter())
             .flat_map(|pose| {
                 corners.iter().map(move |x| {
                     let carried = now.transform_point(pose.inverse_transform_point(x.as_vec3()));
