@@ -59,6 +59,7 @@ use crate::body::{DeformableBodyHandle, DeformableBodySet};
 use crate::coupling::{SoftCoupling, SoftStepResults};
 use crate::integrate::AutomaticReport;
 use cluster::Cluster;
+use collider_path::ColliderMotion;
 use energy::{Member, MemberEnergy, RigidPose};
 use penetration::Checked;
 use rapier3d::dynamics::{RigidBodyHandle, RigidBodySet};
@@ -213,8 +214,9 @@ impl Audit {
             exchanging: clusters.iter().flat_map(|c| c.exchanging.clone()).collect(),
         });
         let mut handles: Vec<_> = input.soft_bodies.iter().map(|(handle, _)| handle).collect();
+        let motions = collider_motions(&input, previous);
         let audits = crate::parallel::map_chunks(&mut handles, 1, |_, handle| {
-            self.body_audit(&input, handle[0], previous, results)
+            self.body_audit(&input, handle[0], (previous, &motions), results)
         });
         let bodies = (handles.into_iter().zip(audits))
             .map(|(handle, mut audit)| {
@@ -230,12 +232,13 @@ impl Audit {
     }
 
     /// The contact, element and solver checks of the deformable body `handle` (its energy is
-    /// its cluster's, set by the caller).
+    /// its cluster's, set by the caller), against the `previous` frame in which the colliders
+    /// made their `motions`.
     fn body_audit(
         &self,
         input: &AuditInput<'_>,
         handle: DeformableBodyHandle,
-        previous: Option<&Snapshot>,
+        (previous, motions): (Option<&Snapshot>, &HashMap<ColliderHandle, ColliderMotion>),
         results: &SoftStepResults,
     ) -> BodyAudit {
         let body = &input.soft_bodies[handle];
@@ -250,7 +253,7 @@ impl Audit {
         let before = previous.and_then(|p| p.positions.get(&handle).map(Vec::as_slice));
         let checked = Checked::new(body, glued, before, tolerance);
         let mut penetrations = Penetrations::default();
-        let poses = previous.map_or(HashMap::new(), |p| p.collider_poses.clone());
+
         // A body standing in as a rigid body meets colliders through rapier's contacts, as
         // rigid bodies do: rapier answers for them.
         if input.coupling.rigid_stand_in_of(handle).is_none() {
@@ -258,7 +261,7 @@ impl Audit {
                 &checked,
                 input.colliders,
                 input.bodies,
-                &poses,
+                motions,
                 &mut penetrations,
             );
             penetration::colliders_inside(&checked, input.colliders, &mut penetrations);
@@ -288,6 +291,22 @@ impl Audit {
             step_error: result.and_then(|r| r.as_ref().err()).cloned(),
         }
     }
+}
+
+/// Each collider's motion since the `previous` frame, for those that were there then.
+fn collider_motions(
+    input: &AuditInput<'_>,
+    previous: Option<&Snapshot>,
+) -> HashMap<ColliderHandle, ColliderMotion> {
+    let Some(previous) = previous else {
+        return HashMap::new();
+    };
+    (input.colliders.iter())
+        .filter_map(|(handle, collider)| {
+            let then = previous.collider_poses.get(&handle)?;
+            Some((handle, ColliderMotion::new(then, collider)))
+        })
+        .collect()
 }
 
 /// What a frame is compared with: the world now.

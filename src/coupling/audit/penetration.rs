@@ -26,7 +26,6 @@ use crate::mesh::bounding_box;
 use rapier3d::dynamics::{RigidBodyHandle, RigidBodySet};
 use rapier3d::geometry::{Collider, ColliderHandle, ColliderSet};
 use rapier3d::glamx::DVec3;
-use rapier3d::math::Pose;
 use rapier3d::parry::query::Ray;
 use std::collections::HashMap;
 
@@ -87,7 +86,7 @@ pub(super) fn disjoint(a: (DVec3, DVec3), b: (DVec3, DVec3)) -> bool {
 }
 
 /// Records in `found` the body's points deeper than the tolerance in `colliders`, and those
-/// that crossed one since the previous frame, whose colliders were at `poses` then.
+/// that crossed one since the previous frame, in which the colliders made their `motions`.
 ///
 /// A collider is passed over whole when its box, widened by how far a point's path in its frame
 /// can lie from the point's end, misses the points' box: each place on the path is where the
@@ -98,11 +97,13 @@ pub(super) fn against_colliders(
     checked: &Checked<'_>,
     colliders: &ColliderSet,
     bodies: &RigidBodySet,
-    poses: &HashMap<ColliderHandle, Pose>,
+    motions: &HashMap<ColliderHandle, ColliderMotion>,
     found: &mut Penetrations,
 ) {
     let (now_bounds, before_bounds) = (checked.bounds_now, checked.bounds_before);
     let longest_move = checked.longest_move();
+    // The points' paths, one after another.
+    let mut path = Vec::new();
     for (handle, collider) in colliders.iter() {
         if collider.is_sensor()
             || !checked
@@ -114,12 +115,10 @@ pub(super) fn against_colliders(
         }
         let aabb = collider.compute_aabb();
         let aabb = (aabb.mins.as_dvec3(), aabb.maxs.as_dvec3());
-        let motion = poses
-            .get(&handle)
-            .map(|then| ColliderMotion::new(then, collider.position()));
+        let motion = motions.get(&handle);
         // The points' places at the instants the paths are taken at lie within the box of
         // their ends (on straight lines between them).
-        let carried = match (before_bounds, &motion) {
+        let carried = match (before_bounds, motion) {
             (Some(before), Some(motion)) => {
                 let ends = (before.0.min(now_bounds.0), before.1.max(now_bounds.1));
                 motion.longest_carry(ends)
@@ -143,12 +142,14 @@ pub(super) fn against_colliders(
             let depth = depth_in(collider, aabb, *x);
             if depth > checked.tolerance {
                 found.add_penetration(depth, PenetrationTarget::Collider(handle));
-            } else if let (Some(before), Some(motion)) = (&checked.before, &motion)
+            } else if let (Some(before), Some(motion)) = (&checked.before, motion)
                 && depth <= 0.0
+                && motion.may_meet((before[i].0, *x), checked.tolerance)
                 && crossed(
                     (collider, aabb),
                     motion,
                     (before[i].0, *x),
+                    &mut path,
                     checked.tolerance,
                 )
             {
@@ -179,17 +180,19 @@ fn depth_in(collider: &Collider, (lo, hi): (DVec3, DVec3), x: DVec3) -> f64 {
 
 /// Whether the point that moved from `from` to `to` (m) while `collider` (whose box is `aabb`,
 /// m) made its `motion` went through it: the point's path in the collider's frame
-/// ([`ColliderMotion::path`]), longer than `tolerance` (m), entered a solid shape through one
-/// face and left it through one facing away from it, or went through a surface without
-/// interior (a triangle mesh or height field) to end beyond the tolerance from it.
+/// ([`ColliderMotion::path_into`], written into `path`), longer than `tolerance` (m), entered a
+/// solid shape through one face and left it through one facing away from it, or went through a
+/// surface without interior (a triangle mesh or height field) to end beyond the tolerance from
+/// it.
 fn crossed(
     (collider, aabb): (&Collider, (DVec3, DVec3)),
     motion: &ColliderMotion,
     (from, to): (DVec3, DVec3),
+    path: &mut Vec<DVec3>,
     tolerance: f64,
 ) -> bool {
     let pose = collider.position();
-    let path = motion.path(from, to);
+    motion.path_into((from, to), path);
     let bounds = bounding_box(path.iter().copied());
     if disjoint(bounds, aabb) {
         return false;
