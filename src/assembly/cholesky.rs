@@ -61,9 +61,9 @@ struct Analysis {
 
 /// The lower triangle of the permuted matrix `P A Pᵀ` (column pointers and row indices, rows
 /// unsorted within a column) and, for each of its entries, the index of the value of `A` it
-/// holds. faer's own numeric factorization permutes `A` anew at every factorization (a
-/// count, a prefix sum and a scatter over its entries, a fifth of a small body's
-/// factorization); the permutation depends on the pattern alone, so it is found once, by
+/// holds. faer's own numeric factorization permutes `A` anew at every factorization (a count,
+/// a prefix sum and a scatter over its entries: a tenth of the factorizations' instructions in
+/// the game scene); the permutation depends on the pattern alone, so it is found once, by
 /// permuting the values' own indices, and each factorization gathers its values through it:
 /// the same matrix, entry for entry, so the same factor.
 #[derive(Debug)]

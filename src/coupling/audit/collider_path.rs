@@ -4,15 +4,19 @@
 //! Over a frame the point moves straight from where it was to where it is (world frame), and
 //! the collider from its pose then to its pose now, its origin straight and its rotation at a
 //! steady rate (spherical interpolation). In the collider's frame the point describes a curve:
-//! a straight chord there cuts across the arc the collider's turning gives it. A 3 cm box turning
-//! 2.2 rad about its centre in a frame carries a still point 28 mm from its axis along an arc
-//! that never comes nearer than 28 mm (outside the box, whose corners are 21 mm from the axis),
-//! whose chord passes 12.7 mm from the centre, through the box; boxes tumbling as they land in
-//! the game scene turn 1.4-1.8 rad in a 1/60 s frame. So the path is the polyline through the point's
-//! places in the collider's frame now at `n + 1` evenly spaced instants (both ends included),
-//! each segment turning the collider by at most [`MAX_TURN`]: a segment's chord lies within
-//! `r δ²/8` of its arc (`δ` the segment's turn, `r` the point's distance from the axis), under
-//! 0.32 mm at `r = 1 m`. A collider that turns less is followed by the one straight chord.
+//! a straight chord there cuts across the arc the collider's turning gives it. A 3 cm box
+//! turning 2.2 rad about its centre in a frame carries a still point 28 mm from its axis along
+//! an arc that never comes nearer than 28 mm (outside the box, whose corners are 21 mm from the
+//! axis), whose chord passes 12.7 mm from the centre, through the box; boxes tumbling as they
+//! land in the game scene turn 1.4-1.8 rad in a 1/60 s frame. So the path is the polyline
+//! through the point's places in the collider's frame now at `n + 1` evenly spaced instants
+//! (both ends included), each segment turning the collider by at most [`MAX_TURN`]: a segment's
+//! chord lies within `r δ²/8` of its arc (`δ` the segment's turn, `r` the point's distance from
+//! the axis), under 0.32 mm at `r = 1 m`. A collider that turns less is followed by the one
+//! straight chord, and a ball's turning, which moves no point of its shape, not at all. The
+//! turning keeps a point's distance from the collider's origin: a point whose distance from the
+//! moving origin stays beyond the shape's reach is passed over without its path
+//! ([`ColliderMotion::may_meet`]).
 
 use rapier3d::geometry::Collider;
 use rapier3d::glamx::DVec3;
@@ -28,6 +32,9 @@ const MAX_SEGMENTS: usize = 64;
 /// is taken at, the first its pose then, the last its pose now.
 pub(super) struct ColliderMotion {
     poses: Vec<Pose>,
+    /// The first and last of them.
+    then: Pose,
+    now: Pose,
     /// The radius (m) about the collider's origin of a ball holding its shape.
     reach: f64,
 }
@@ -58,7 +65,12 @@ impl ColliderMotion {
             .collect();
         let sphere = collider.shape().compute_local_bounding_sphere();
         let reach = f64::from(sphere.center.length() + sphere.radius);
-        Self { poses, reach }
+        Self {
+            poses,
+            then,
+            now: *now,
+            reach,
+        }
     }
 
     /// Whether the path in the collider's frame of a point that moved from `from` to `to` (m,
@@ -67,7 +79,7 @@ impl ColliderMotion {
     /// as the point is from the moving origin, the nearest of which is found in closed form (both
     /// move straight); the segments cut inside their arcs by at most `r δ²/8`.
     pub(super) fn may_meet(&self, (from, to): (DVec3, DVec3), tolerance: f64) -> bool {
-        let (then, now) = (self.poses[0], *self.now());
+        let (then, now) = (self.then, self.now);
         let start = from - then.translation.as_dvec3();
         let change = (to - now.translation.as_dvec3()) - start;
         let along = if change.length_squared() > 0.0 {
@@ -81,16 +93,11 @@ impl ColliderMotion {
         nearest <= self.reach + tolerance + sagitta
     }
 
-    /// The collider's pose now.
-    fn now(&self) -> &Pose {
-        self.poses.last().expect("a motion has at least two poses")
-    }
-
     /// Writes into `path` (emptied first) the path (m, in the world as the collider is now) of a
     /// point that moved straight from `from` to `to` (m, world frame): where it was relative to
     /// the collider at each instant, carried with the collider to its pose now; the last is `to`.
     pub(super) fn path_into(&self, (from, to): (DVec3, DVec3), path: &mut Vec<DVec3>) {
-        let (now, segments) = (self.now(), self.poses.len() - 1);
+        let (now, segments) = (self.now, self.poses.len() - 1);
         path.clear();
         path.extend(self.poses.iter().enumerate().map(|(k, pose)| {
             if k == segments {
@@ -106,7 +113,7 @@ impl ColliderMotion {
     /// the box `(lo, hi)` (m): at each instant, its largest at one of the box's corners (the
     /// carrying is affine, its length convex).
     pub(super) fn longest_carry(&self, (lo, hi): (DVec3, DVec3)) -> f64 {
-        let now = self.now();
+        let now = self.now;
         let corners = (0..8).map(|corner: usize| {
             let pick = |bit: usize, l: f64, h: f64| if corner >> bit & 1 == 0 { l } else { h };
             DVec3::new(
@@ -117,7 +124,7 @@ impl ColliderMotion {
         });
         let corners: Vec<DVec3> = corners.collect();
         // From the last instant, now, nothing is carried.
-        (self.poses[..self.poses.len() - 1].iter())
+        (self.poses.iter().take(self.poses.len() - 1))
             .flat_map(|pose| {
                 corners.iter().map(move |x| {
                     let carried = now.transform_point(pose.inverse_transform_point(x.as_vec3()));

@@ -253,7 +253,6 @@ impl Audit {
         let before = previous.and_then(|p| p.positions.get(&handle).map(Vec::as_slice));
         let checked = Checked::new(body, glued, before, tolerance);
         let mut penetrations = Penetrations::default();
-
         // A body standing in as a rigid body meets colliders through rapier's contacts, as
         // rigid bodies do: rapier answers for them.
         if input.coupling.rigid_stand_in_of(handle).is_none() {
