@@ -124,14 +124,16 @@ impl SymbolicFactor {
             },
         )
         .ok()?;
-        let identity: Vec<usize> = (0..pattern.nrows()).collect();
-        let perm = match cholesky.perm() {
-            Some(perm) => perm,
-            None => PermRef::new_checked(&identity, &identity, pattern.nrows()),
-        };
-        let permuted = match cholesky.raw() {
-            SymbolicCholeskyRaw::Supernodal(_) => Some(PermutedPattern::new(pattern, perm)?),
-            SymbolicCholeskyRaw::Simplicial(_) => None,
+        let permuted = match (cholesky.raw(), cholesky.perm()) {
+            (SymbolicCholeskyRaw::Simplicial(_), _) => None,
+            (SymbolicCholeskyRaw::Supernodal(_), Some(perm)) => {
+                Some(PermutedPattern::new(pattern, perm)?)
+            }
+            (SymbolicCholeskyRaw::Supernodal(_), None) => {
+                let identity: Vec<usize> = (0..pattern.nrows()).collect();
+                let perm = PermRef::new_checked(&identity, &identity, pattern.nrows());
+                Some(PermutedPattern::new(pattern, perm)?)
+            }
         };
         Some(Self(Arc::new(Analysis { cholesky, permuted })))
     }

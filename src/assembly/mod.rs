@@ -427,7 +427,7 @@ pub(crate) fn solve(factor: &Factor, rhs: &[DVec3]) -> Vec<DVec3> {
 }
 
 /// The nine unit changes of `F`, in the column-major order of a [`StressTangent`]'s columns.
-fn unit_changes() -> [DMat3; 9] {
+pub(crate) fn unit_changes() -> [DMat3; 9] {
     std::array::from_fn(|column| {
         let mut df = [0.0; 9];
         df[column] = 1.0;

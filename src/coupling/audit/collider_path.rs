@@ -114,7 +114,7 @@ impl ColliderMotion {
     /// carrying is affine, its length convex).
     pub(super) fn longest_carry(&self, (lo, hi): (DVec3, DVec3)) -> f64 {
         let now = self.now;
-        let corners = (0..8).map(|corner: usize| {
+        let corners: [DVec3; 8] = std::array::from_fn(|corner| {
             let pick = |bit: usize, l: f64, h: f64| if corner >> bit & 1 == 0 { l } else { h };
             DVec3::new(
                 pick(0, lo.x, hi.x),
@@ -122,7 +122,6 @@ impl ColliderMotion {
                 pick(2, lo.z, hi.z),
             )
         });
-        let corners: Vec<DVec3> = corners.collect();
         // From the last instant, now, nothing is carried.
         (self.poses.iter().take(self.poses.len() - 1))
             .flat_map(|pose| {
