@@ -55,7 +55,8 @@ impl ImplicitIntegrator {
         if let Some(factor) = factor.flatten()
             && self.reuse_factorization
         {
-            solver.chord.keep(factor, incremental.start.h);
+            let correction = incremental.kept_correction(body);
+            solver.chord.keep(factor, incremental.start.h, correction);
             #[cfg(feature = "serde-serialize")]
             solver.chord.remember(&solver.stiffness);
         }

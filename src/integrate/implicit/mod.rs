@@ -500,12 +500,13 @@ impl ImplicitIntegrator {
                 return finish(solver, outcome);
             }
             history.push(relative);
-            let (direction, search) = self.direction(
+            let (direction, search, kept) = self.direction(
                 body,
                 (solver, incremental),
                 (&inertia, &residual),
                 &mut outcome,
             )?;
+            let start = kept.then(|| body.positions.clone());
             let energy = |body: &DeformableBody| incremental.energy(body);
             let mut next = descend(
                 body,
@@ -518,6 +519,9 @@ impl ImplicitIntegrator {
             );
             if search == Search::Short {
                 outcome.reused_factorizations += 1;
+                let from = (&residual[..], potential, reference);
+                next =
+                    self.reuse_served(body, (solver, incremental), from, start, next, &mut outcome);
                 self.record_reuse(&mut solver.chord, &residual, next.as_ref(), reference);
                 if next.is_none() {
                     // The exact tangent may still descend where an earlier one does not; this
@@ -550,7 +554,7 @@ impl ImplicitIntegrator {
         (solver, incremental): (&mut Solver, &Potential),
         (inertia, residual): (&[f64], &[DVec3]),
         outcome: &mut Outcome,
-    ) -> Result<(Vec<DVec3>, Search), Error> {
+    ) -> Result<(Vec<DVec3>, Search, bool), Error> {
         let remaining = self.max_newton_iterations - outcome.iterations;
         let reusable = (self.reuse_factorization && solver.method == Method::Direct)
             .then(|| {
@@ -559,15 +563,45 @@ impl ImplicitIntegrator {
             })
             .flatten();
         Ok(match reusable {
-            Some(factor) => (
-                incremental.reused_direction(body, factor, residual),
-                Search::Short,
-            ),
+            Some(kept) => {
+                let (direction, kept) = incremental.reused_direction(body, kept, residual);
+                (direction, Search::Short, kept)
+            }
             None => (
                 self.exact_direction(body, solver, incremental, inertia, residual, outcome)?,
                 Search::Thorough,
+                false,
             ),
         })
+    }
+
+    /// What a reused iteration from `start` (the body's positions, where the out-of-balance
+    /// force and minimized energy were `from`'s residual (N) and potential (J), `reference` its
+    /// force scale) came to, `next`; if it took in the kept correction (`start` given) and did
+    /// not contract, the iteration taken again from `start` with the current coupling (see
+    /// [`reuse_with_current_coupling`]), counted in `outcome`.
+    fn reuse_served(
+        &self,
+        body: &mut DeformableBody,
+        (solver, incremental): (&mut Solver, &Potential),
+        (residual, potential, reference): (&[DVec3], f64, f64),
+        start: Option<Vec<DVec3>>,
+        next: Option<(Vec<DVec3>, f64)>,
+        outcome: &mut Outcome,
+    ) -> Option<(Vec<DVec3>, f64)> {
+        let after = self.reuse_after(next.as_ref(), reference);
+        let Some(start) = start.filter(|_| !chord::contracts(norm(residual), after)) else {
+            return next;
+        };
+        body.positions.clone_from(&start);
+        match reuse_with_current_coupling(body, solver, incremental, (residual, potential)) {
+            Some(again) => {
+                outcome.reused_factorizations += 1;
+                again
+            }
+            // Back at `start`: no step taken.
+            None => None,
+        }
     }
 
     /// Tells the chord how a reused iteration from `residual` went: to `next` (its residual), or
@@ -580,15 +614,20 @@ impl ImplicitIntegrator {
         next: Option<&(Vec<DVec3>, f64)>,
         reference: f64,
     ) {
-        let after = next.map_or(f64::INFINITY, |(next, _)| {
+        chord.record(norm(residual), self.reuse_after(next, reference));
+    }
+
+    /// The out-of-balance force (N) a reused iteration left, `next`'s, as the chord counts it:
+    /// zero within the tolerance of the force scale `reference` (N), infinite if it did not move.
+    fn reuse_after(&self, next: Option<&(Vec<DVec3>, f64)>, reference: f64) -> f64 {
+        next.map_or(f64::INFINITY, |(next, _)| {
             let after = norm(next);
             if after <= self.tolerance * reference {
                 0.0
             } else {
                 after
             }
-        });
-        chord.record(norm(residual), after);
+        })
     }
 
     /// Whether Newton stops at the relative residual `relative` after `iterations`, the earlier
@@ -620,6 +659,31 @@ impl ImplicitIntegrator {
             }
         })
     }
+}
+
+/// A reused iteration again from where `body` is, its out-of-balance force and minimized
+/// energy `(residual, potential)` (N, J), with the kept factorization of `solver`'s chord and
+/// the current coupling instead of the kept correction, which did not serve (the coupling's
+/// geometry changed: a heavy body swinging on a rope turns its arms); `None` (the body not
+/// moved) without a factorization to reuse. Returns what [`descend`] does.
+fn reuse_with_current_coupling(
+    body: &mut DeformableBody,
+    solver: &mut Solver,
+    incremental: &Potential,
+    (residual, potential): (&[DVec3], f64),
+) -> Option<Option<(Vec<DVec3>, f64)>> {
+    let (factor, _) = solver.chord.factor_for(incremental.start.h, true)?;
+    let (direction, _) = incremental.reused_direction(body, (factor, None), residual);
+    let energy = |body: &DeformableBody| incremental.energy(body);
+    Some(descend(
+        body,
+        residual,
+        potential,
+        &direction,
+        Search::Short,
+        energy,
+        |body| incremental.residual(body, &mut solver.forces),
+    ))
 }
 
 /// Ends an implicit substep of `h` (s) from `start` at the body's positions: the rigid bodies'

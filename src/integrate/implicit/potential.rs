@@ -12,6 +12,7 @@ use super::rigid_response::{Placement, RigidResponse};
 use crate::assembly::Factor;
 use crate::assembly::{Stiffness, solve};
 use crate::body::DeformableBody;
+use crate::chord::KeptCorrection;
 use crate::constraint::{self, BodyConstraints};
 use crate::contact;
 use crate::damping::RayleighDamping;
@@ -334,15 +335,38 @@ impl<'a> Potential<'a> {
     }
 
     /// The Newton direction (m per node) for `residual` (N) solved with `factor`, an earlier
-    /// iteration's, with the unassembled terms taken in.
+    /// iteration's, with the unassembled terms taken in: the `correction` that iteration took in
+    /// (kept where the body has no chamber, see [`crate::chord`]), else the current ones; and
+    /// whether it took in the kept correction.
     pub(super) fn reused_direction(
         &self,
         body: &DeformableBody,
-        factor: &Factor,
+        (factor, correction): (&Factor, Option<&KeptCorrection>),
         residual: &[DVec3],
-    ) -> Vec<DVec3> {
+    ) -> (Vec<DVec3>, bool) {
         let direction = solve(factor, residual);
-        self.take_in_unassembled(body, (factor, true), residual, direction)
+        let kept = correction.filter(|_| body.chamber_terms().is_empty());
+        if let Some(corrected) = kept.and_then(|c| c.apply(&direction)) {
+            let descent: f64 = residual
+                .iter()
+                .zip(&corrected)
+                .map(|(r, d)| r.dot(*d))
+                .sum();
+            if descent > 0.0 {
+                return (corrected, true);
+            }
+        }
+        let taken_in = self.take_in_unassembled(body, (factor, true), residual, direction);
+        (taken_in, false)
+    }
+
+    /// The correction the last direction's solve took in, to be kept with its factorization
+    /// (none for a body with chambers, whose solves take the chambers in too).
+    pub(super) fn kept_correction(&self, body: &DeformableBody) -> Option<KeptCorrection> {
+        body.chamber_terms()
+            .is_empty()
+            .then(|| self.rigid.borrow().kept_correction())
+            .flatten()
     }
 
     /// The Newton direction `direction` (m per node), solved with `factor` (the one of the last

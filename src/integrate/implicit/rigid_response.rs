@@ -23,6 +23,7 @@
 //! is what the bodies receive when the step's impulses are recorded.
 
 use crate::body::DeformableBody;
+use crate::chord::KeptCorrection;
 use crate::constraint::{self, BodyConstraints, ImplicitTerm};
 use crate::contact::ImplicitStep;
 use crate::load::ChamberSolve;
@@ -65,6 +66,9 @@ pub(super) struct RigidResponse {
     /// The last Newton direction's columns of `U` and `Z = K⁻¹ U` (see
     /// [`RigidResponse::take_in`]).
     solved_columns: Option<(Columns, Columns)>,
+    /// The last call's `S = (I − Q Uᵀ Z)⁻¹ Q` when the direction it returned took the response
+    /// in (see [`RigidResponse::kept_correction`]).
+    taken_correction: Option<DMatrix<f64>>,
     /// The effective step `ĥ`, the penalty step (see [`ImplicitStep`]) and the step's length
     /// `h` (s).
     effective: f64,
@@ -176,6 +180,7 @@ impl RigidResponse {
             solved_at: Vec::new(),
             kinetic: 0.0,
             solved_columns: None,
+            taken_correction: None,
             effective,
             penalty_step,
             length,
@@ -434,6 +439,7 @@ impl RigidResponse {
         residual: &[DVec3],
         direction: Vec<DVec3>,
     ) -> Vec<DVec3> {
+        self.taken_correction = None;
         if !self.coupled {
             return direction;
         }
@@ -461,7 +467,8 @@ impl RigidResponse {
         });
         let u_d = DVector::from_fn(m, |i, _| dot(&coupling.columns[i], &direction[own.clone()]));
         let system = DMatrix::identity(m, m) - &q * u_z;
-        let Some(weights) = system.lu().solve(&(&q * u_d)) else {
+        let lu = system.lu();
+        let Some(weights) = lu.solve(&(&q * u_d)) else {
             self.solved_columns = Some((coupling.columns, solved));
             return direction;
         };
@@ -474,10 +481,24 @@ impl RigidResponse {
         self.solved_columns = Some((coupling.columns, solved));
         let finite = taken.iter().all(|d| d.is_finite());
         if finite && dot(residual, &taken) > 0.0 {
+            self.taken_correction = lu.solve(&q);
             taken
         } else {
             direction
         }
+    }
+
+    /// The correction the last [`RigidResponse::take_in`] took into the direction it returned,
+    /// for a factorization kept with that direction ([`KeptCorrection`]); `None` if it returned
+    /// the direction as solved.
+    pub(super) fn kept_correction(&self) -> Option<KeptCorrection> {
+        let s = self.taken_correction.as_ref()?;
+        let (u, z) = self.solved_columns.as_ref()?;
+        Some(KeptCorrection {
+            u: u.clone(),
+            z: z.clone(),
+            s: s.as_slice().to_vec(),
+        })
     }
 
     /// The columns of `U = −Σ P_cᵀ T_c J_c` (N/m per node, six per body some term acts against)
