@@ -21,15 +21,18 @@
 //! strongly nonlinear motion wastes at most one solve every few substeps.
 //!
 //! A factorization is kept with the low-rank correction its direction took in beside it
-//! ([`KeptCorrection`]: the dynamic rigid bodies' response, `(K − U S Uᵀ)⁻¹` by the Woodbury
+//! ([`KeptCorrection`]: the dynamic rigid bodies' response, `(K − U Q Uᵀ)⁻¹` by the Woodbury
 //! identity), and a reused iteration takes that same correction in: the matrix it solves with is
 //! then the whole Newton matrix of the earlier iteration. Taking in the current `U` instead mixes
 //! an earlier `K` with a current `U`: a light rigid body pressed into a soft one by stiff
-//! penalties makes `K` and `U S Uᵀ` two large terms that nearly cancel (the body follows the
+//! penalties makes `K` and `U Q Uᵀ` two large terms that nearly cancel (the body follows the
 //! surface), so the slight change of the penalties' pieces between iterations is not cancelled
 //! and the iteration contracts poorly (a 27 g box resting on a 625-tetrahedron block: a median
 //! contraction of 0.26 per reused iteration, most failing the rule, so the block assembled and
-//! factored its tangent at nearly every substep).
+//! factored its tangent at nearly every substep). Where the coupling's geometry changes instead
+//! (a heavy body swinging on a rope turns its arms), the current `U` serves better: a reused
+//! iteration that does not contract with the kept correction is taken again from the same start
+//! with the current coupling before it counts as failing.
 
 use crate::assembly::Factor;
 #[cfg(feature = "serde-serialize")]
