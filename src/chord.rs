@@ -37,6 +37,7 @@
 use crate::assembly::Factor;
 #[cfg(feature = "serde-serialize")]
 use crate::assembly::Stiffness;
+use crate::newton::dot;
 use rapier3d::glamx::DVec3;
 use rapier3d::na::{DMatrix, DVector};
 
@@ -85,8 +86,6 @@ impl KeptCorrection {
         if !fits(&self.u) || !fits(&self.z) || self.z.len() != m || self.s.len() != m * m {
             return None;
         }
-        let dot =
-            |a: &[DVec3], b: &[DVec3]| -> f64 { a.iter().zip(b).map(|(x, y)| x.dot(*y)).sum() };
         let u_d = DVector::from_fn(m, |i, _| dot(&self.u[i], direction));
         let weights = DMatrix::from_column_slice(m, m, &self.s) * u_d;
         let mut corrected = direction.to_vec();

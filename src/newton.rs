@@ -181,6 +181,11 @@ pub(crate) fn accepted_within(
 }
 
 /// Euclidean norm of a field of per-node vectors.
+/// `Σ aᵢ·bᵢ` over the nodes of two per-node vectors.
+pub(crate) fn dot<V: NodeVector>(a: &[V], b: &[V]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x.dot(*y)).sum()
+}
+
 pub(crate) fn norm<V: NodeVector>(v: &[V]) -> f64 {
     v.iter().map(|x| x.length_squared()).sum::<f64>().sqrt()
 }
@@ -232,7 +237,7 @@ pub(crate) fn descend<C: Configuration>(
     // The out-of-balance force decides only where the energy cannot: where the decrease the
     // direction promises is lost in the energy's round-off. Elsewhere a step that raises the
     // energy is not taken, however it changes the force.
-    let promised: f64 = residual.iter().zip(direction).map(|(r, d)| r.dot(*d)).sum();
+    let promised = dot(residual, direction);
     let current = if promised <= ENERGY_RESOLUTION * energy_now.abs() {
         norm(residual)
     } else {

@@ -25,6 +25,7 @@ use crate::Error;
 use crate::assembly::{Factor, Stiffness};
 use crate::body::DeformableBody;
 use crate::linear_solver::{Method, solve_newton_system};
+use crate::newton::dot;
 use rapier3d::glamx::DVec3;
 
 /// A Newton system is solved again, with the pieces its direction lands on, at most this many
@@ -161,7 +162,7 @@ pub(super) fn engaging<T>(
             .map(|(r, f)| *r + *f)
             .collect();
         let (again, solved) = solve(&rhs, Some(&engaged))?;
-        let descent: f64 = residual.iter().zip(&again).map(|(r, d)| r.dot(*d)).sum();
+        let descent = dot(residual, &again);
         if descent <= 0.0 {
             taken = None;
             break;

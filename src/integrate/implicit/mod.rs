@@ -594,14 +594,8 @@ impl ImplicitIntegrator {
             return next;
         };
         body.positions.clone_from(&start);
-        match reuse_with_current_coupling(body, solver, incremental, (residual, potential)) {
-            Some(again) => {
-                outcome.reused_factorizations += 1;
-                again
-            }
-            // Back at `start`: no step taken.
-            None => None,
-        }
+        outcome.reused_factorizations += 1;
+        reuse_with_current_coupling(body, solver, incremental, (residual, potential))
     }
 
     /// Tells the chord how a reused iteration from `residual` went: to `next` (its residual), or
@@ -664,18 +658,18 @@ impl ImplicitIntegrator {
 /// A reused iteration again from where `body` is, its out-of-balance force and minimized
 /// energy `(residual, potential)` (N, J), with the kept factorization of `solver`'s chord and
 /// the current coupling instead of the kept correction, which did not serve (the coupling's
-/// geometry changed: a heavy body swinging on a rope turns its arms); `None` (the body not
-/// moved) without a factorization to reuse. Returns what [`descend`] does.
+/// geometry changed: a heavy body swinging on a rope turns its arms). Returns what [`descend`]
+/// does; `None`, the body not moved, also without a factorization to reuse.
 fn reuse_with_current_coupling(
     body: &mut DeformableBody,
     solver: &mut Solver,
     incremental: &Potential,
     (residual, potential): (&[DVec3], f64),
-) -> Option<Option<(Vec<DVec3>, f64)>> {
+) -> Option<(Vec<DVec3>, f64)> {
     let (factor, _) = solver.chord.factor_for(incremental.start.h, true)?;
     let (direction, _) = incremental.reused_direction(body, (factor, None), residual);
     let energy = |body: &DeformableBody| incremental.energy(body);
-    Some(descend(
+    descend(
         body,
         residual,
         potential,
@@ -683,7 +677,7 @@ fn reuse_with_current_coupling(
         Search::Short,
         energy,
         |body| incremental.residual(body, &mut solver.forces),
-    ))
+    )
 }
 
 /// Ends an implicit substep of `h` (s) from `start` at the body's positions: the rigid bodies'

@@ -20,7 +20,7 @@ use crate::element::deformation_gradient;
 use crate::integrate::PreviousStep;
 use crate::load::ChamberSolve;
 use crate::material::green_strain;
-use crate::newton::norm;
+use crate::newton::{dot, norm};
 use crate::stencil::Stencil;
 use rapier3d::glamx::{DMat3, DVec3};
 use std::cell::{Cell, RefCell};
@@ -345,16 +345,11 @@ impl<'a> Potential<'a> {
         residual: &[DVec3],
     ) -> (Vec<DVec3>, bool) {
         let direction = solve(factor, residual);
-        let kept = correction.filter(|_| body.chamber_terms().is_empty());
-        if let Some(corrected) = kept.and_then(|c| c.apply(&direction)) {
-            let descent: f64 = residual
-                .iter()
-                .zip(&corrected)
-                .map(|(r, d)| r.dot(*d))
-                .sum();
-            if descent > 0.0 {
-                return (corrected, true);
-            }
+        let kept = correction.filter(|_| !body.has_chambers());
+        if let Some(corrected) = kept.and_then(|c| c.apply(&direction))
+            && dot(residual, &corrected) > 0.0
+        {
+            return (corrected, true);
         }
         let taken_in = self.take_in_unassembled(body, (factor, true), residual, direction);
         (taken_in, false)
@@ -363,8 +358,7 @@ impl<'a> Potential<'a> {
     /// The correction the last direction's solve took in, to be kept with its factorization
     /// (none for a body with chambers, whose solves take the chambers in too).
     pub(super) fn kept_correction(&self, body: &DeformableBody) -> Option<KeptCorrection> {
-        body.chamber_terms()
-            .is_empty()
+        (!body.has_chambers())
             .then(|| self.rigid.borrow().kept_correction())
             .flatten()
     }

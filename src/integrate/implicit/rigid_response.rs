@@ -27,6 +27,7 @@ use crate::chord::KeptCorrection;
 use crate::constraint::{self, BodyConstraints, ImplicitTerm};
 use crate::contact::ImplicitStep;
 use crate::load::ChamberSolve;
+use crate::newton::dot;
 use crate::rigid::RigidProxy;
 use rapier3d::glamx::{DMat3, DVec3};
 use rapier3d::na::{DMatrix, DVector, Matrix3, Matrix6, Vector6};
@@ -447,8 +448,6 @@ impl RigidResponse {
         if coupling.columns.is_empty() {
             return direction;
         }
-        let dot =
-            |a: &[DVec3], b: &[DVec3]| -> f64 { a.iter().zip(b).map(|(x, y)| x.dot(*y)).sum() };
         // With chambers `Z` depends on their gradients, which move with the body.
         let solved = match self.solved_columns.take() {
             Some((columns, solved))
