@@ -14,7 +14,9 @@
 //! thread, where its arithmetic is the same whatever the number of threads.
 //! The matrix's lower triangle in the fill-reducing order, which faer's numeric factorization
 //! would permute anew each time, is laid out once per pattern and gathered into
-//! ([`PermutedPattern`]): the same matrix, so the same factor, to the bit.
+//! ([`PermutedPattern`]): the same matrix, so the same factor, to the bit. faer sets every
+//! value of `L` itself, so a factor dropped leaves its values' storage to the next
+//! factorization of its pattern ([`Analysis::spare`]) instead of a zeroed allocation each time.
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::perm::PermRef;
@@ -29,7 +31,7 @@ use faer::sparse::linalg::cholesky::{
 use faer::sparse::utils::permute_self_adjoint_to_unsorted;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side};
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 
 /// The unknowns from which a factor's numeric factorization and solves run on rayon's threads
 /// (with the `parallel` feature).
@@ -57,6 +59,22 @@ pub(crate) struct SymbolicFactor(Arc<Analysis>);
 struct Analysis {
     cholesky: SymbolicCholesky<usize>,
     permuted: Option<PermutedPattern>,
+    /// The values' storage of a dropped supernodal factor of this pattern, for the next one
+    /// (faer's numeric factorization zeroes and fills it): a Newton iteration's factor replaces
+    /// the last one, and the storage passes from one to the next. At most one is kept, so a
+    /// pattern holds at most one factor's values beyond the factors alive.
+    spare: Mutex<Option<Vec<f64>>>,
+}
+
+impl Analysis {
+    /// Storage for a factor's `len` values: the spare one if there is one of that length,
+    /// else a new one.
+    fn values(&self, len: usize) -> Vec<f64> {
+        let spare = self.spare.lock().ok().and_then(|mut spare| spare.take());
+        spare
+            .filter(|values| values.len() == len)
+            .unwrap_or_else(|| vec![0.0; len])
+    }
 }
 
 /// The lower triangle of the permuted matrix `P A Pᵀ` (column pointers and row indices, rows
@@ -135,7 +153,11 @@ impl SymbolicFactor {
                 Some(PermutedPattern::new(pattern, perm)?)
             }
         };
-        Some(Self(Arc::new(Analysis { cholesky, permuted })))
+        Some(Self(Arc::new(Analysis {
+            cholesky,
+            permuted,
+            spare: Mutex::new(None),
+        })))
     }
 }
 
@@ -153,13 +175,15 @@ impl Factor {
         symbolic: SymbolicFactor,
         matrix: SparseColMatRef<'_, usize, f64>,
     ) -> Option<Self> {
-        let Analysis { cholesky, permuted } = &*symbolic.0;
+        let Analysis {
+            cholesky, permuted, ..
+        } = &*symbolic.0;
         let n = cholesky.nrows();
         let par = parallelism(n);
-        let mut values = vec![0.0; cholesky.len_val()];
         let (SymbolicCholeskyRaw::Supernodal(supernodal), Some(permuted)) =
             (cholesky.raw(), permuted)
         else {
+            let mut values = vec![0.0; cholesky.len_val()];
             // faer keeps its simplicial factorization for the tiniest patterns (a single
             // unknown) even when told to force the supernodal one: its own path for them.
             let scratch = cholesky.factorize_numeric_llt_scratch::<f64>(par, Default::default());
@@ -194,6 +218,7 @@ impl Factor {
             Default::default(),
         );
         let mut buffer = MemBuffer::try_new(scratch).ok()?;
+        let mut values = symbolic.0.values(cholesky.len_val());
         factorize_supernodal_numeric_llt(
             &mut values,
             SparseColMatRef::new(pattern, &gathered),
@@ -221,6 +246,18 @@ impl Factor {
     }
 }
 
+impl Drop for Factor {
+    /// Leaves a supernodal factor's values' storage to the next factorization of its pattern.
+    fn drop(&mut self) {
+        let analysis = &self.symbolic.0;
+        if analysis.permuted.is_some()
+            && let Ok(mut spare) = analysis.spare.lock()
+        {
+            *spare = Some(std::mem::take(&mut self.values));
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -241,14 +278,9 @@ mod tests {
         SparseColMat::try_new_from_triplets(n, n, &entries).unwrap()
     }
 
-    #[test]
-    fn a_factor_through_the_kept_permutation_is_faers_own_to_the_bit() {
-        let matrix = banded(60);
-        let symbolic = SymbolicFactor::try_new(matrix.symbolic()).unwrap();
+    /// faer's own factor of `matrix` with the analysis `symbolic`, its values.
+    fn faers_own(symbolic: &SymbolicFactor, matrix: &SparseColMat<usize, f64>) -> Vec<f64> {
         let inner = &symbolic.0.cholesky;
-        assert!(matches!(inner.raw(), SymbolicCholeskyRaw::Supernodal(_)));
-        assert!(inner.perm().is_some());
-        let ours = Factor::try_new(symbolic.clone(), matrix.as_ref()).unwrap();
         let mut theirs = vec![0.0; inner.len_val()];
         let scratch = inner.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default());
         let mut buffer = MemBuffer::new(scratch);
@@ -262,7 +294,38 @@ mod tests {
             Default::default(),
         ))
         .unwrap();
-        assert_eq!(ours.values, theirs);
+        theirs
+    }
+
+    #[test]
+    fn a_factor_through_the_kept_permutation_is_faers_own_to_the_bit() {
+        let matrix = banded(60);
+        let symbolic = SymbolicFactor::try_new(matrix.symbolic()).unwrap();
+        let inner = &symbolic.0.cholesky;
+        assert!(matches!(inner.raw(), SymbolicCholeskyRaw::Supernodal(_)));
+        assert!(inner.perm().is_some());
+        let ours = Factor::try_new(symbolic.clone(), matrix.as_ref()).unwrap();
+        assert_eq!(ours.values, faers_own(&symbolic, &matrix));
+    }
+
+    #[test]
+    fn a_factor_made_in_a_dropped_factors_storage_is_faers_own_to_the_bit() {
+        // The second matrix has the first's pattern and other values: its factor, made in the
+        // storage the first factor left when dropped (holding the first's values), must hold
+        // none of them.
+        let first = banded(60);
+        let symbolic = SymbolicFactor::try_new(first.symbolic()).unwrap();
+        let dropped = Factor::try_new(symbolic.clone(), first.as_ref()).unwrap();
+        let storage = dropped.values.as_ptr();
+        drop(dropped);
+        let mut second = first.clone();
+        for (k, value) in second.val_mut().iter_mut().enumerate() {
+            *value *= 1.0 + 1e-3 * (k % 7) as f64;
+        }
+        let ours = Factor::try_new(symbolic.clone(), second.as_ref()).unwrap();
+        assert_eq!(ours.values.as_ptr(), storage, "the storage was not reused");
+        assert_eq!(ours.values, faers_own(&symbolic, &second));
+        assert_ne!(ours.values, faers_own(&symbolic, &first));
     }
 
     #[test]

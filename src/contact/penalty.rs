@@ -100,6 +100,19 @@ fn carried(contact: &NodeContact, step: &ImplicitStep) -> Carried {
     }
 }
 
+/// Whether the implicit `step` skips `contact`'s terms (see [`ImplicitStep::partners_only`]),
+/// known before the obstacle's travel is found: the rigid bodies' response evaluates the few
+/// terms against a dynamic body many times per step, and passes over the contacts with the
+/// ground and other still colliders.
+#[inline(always)]
+fn skipped(contact: &NodeContact, step: &ImplicitStep) -> bool {
+    step.partners_only
+        && !matches!(
+            contact.obstacle,
+            Obstacle::Collider { proxy: Some(p), .. } if step.rigid[p].is_dynamic()
+        )
+}
+
 /// The implicit force (N) on a contact's point at `x` (m, its position relative to the
 /// obstacle's travel), of effective mass `mass` (kg), in the implicit `step`: the penalty and
 /// the lagged friction.
@@ -246,10 +259,10 @@ pub(super) fn for_each_term_at(
 ) {
     // Every penalty, then every friction term.
     for contact in contacts {
-        let obstacle = carried(contact, &step);
-        if step.skips(&obstacle.partner) {
+        if skipped(contact, &step) {
             continue;
         }
+        let obstacle = carried(contact, &step);
         let point = contact_point(contact, embedding);
         let at = point.stencil();
         let mass = effective_mass(&at, nodes.masses, nodes.pinned);
@@ -265,10 +278,10 @@ pub(super) fn for_each_term_at(
         }
     }
     for contact in contacts {
-        let obstacle = carried(contact, &step);
-        if step.skips(&obstacle.partner) {
+        if skipped(contact, &step) {
             continue;
         }
+        let obstacle = carried(contact, &step);
         let point = contact_point(contact, embedding);
         let x = point.position(nodes.positions) - obstacle.travel;
         if let Some((energy, force, tangent)) = contact.friction_term(x, settings, step.effective) {
