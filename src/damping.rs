@@ -25,6 +25,18 @@ pub struct RayleighDamping {
     psi: f64,
 }
 
+/// The damping of an implicit step (see [`RayleighDamping::step_potential`]): its strain rate
+/// is the Green strain's change over the step of `h` (s) from `green`, one per integration point.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct StepDamping<'a> {
+    /// The body's damping.
+    pub(crate) damping: &'a RayleighDamping,
+    /// Per integration point, the Green strain the rate is measured from.
+    pub(crate) green: &'a [DMat3],
+    /// The step (s).
+    pub(crate) h: f64,
+}
+
 /// A [`RayleighDamping`] as written (feature `serde-serialize`); read back through
 /// [`RayleighDamping::new`].
 #[cfg(feature = "serde-serialize")]
@@ -133,6 +145,21 @@ impl RayleighDamping {
             .add_diagonal(strain_rate.trace() * f64x4::splat(self.phi))
     }
 
+    /// [`RayleighDamping::step_first_piola`]'s stress as a second Piola–Kirchhoff stress
+    /// `φ tr(Ġ) I + 2ψ Ġ` (Pa) in four lanes, `Ġ = (G(F) − G_prev)/h` for deformation gradients
+    /// `f`, the Green strains `green_previous` the rate is measured from and the step `h` (s).
+    #[inline(always)]
+    pub(crate) fn step_second_piola_lanes(
+        &self,
+        f: &Mat3x4,
+        green_previous: &Mat3x4,
+        h: f64,
+    ) -> Mat3x4 {
+        let green = f.transpose_mul(f).add_diagonal(f64x4::splat(-1.0)) * f64x4::splat(0.5);
+        let rate = (green - *green_previous) * f64x4::splat(1.0 / h);
+        (rate * f64x4::splat(2.0 * self.psi)).add_diagonal(rate.trace() * f64x4::splat(self.phi))
+    }
+
     /// `φ tr(E) I + 2ψ E` (Pa) for a symmetric strain rate `E` (1/s).
     #[inline(always)]
     fn stress_of_rate(&self, rate: &DMat3) -> DMat3 {
@@ -202,6 +229,51 @@ impl RayleighDamping {
 mod tests {
     use super::*;
     use crate::material::green_strain;
+
+    /// The step's stress in four lanes, `F S`, is the scalar [`RayleighDamping::step_first_piola`]
+    /// of each lane to round-off (1e-13 of its largest entry): the force kernel's implicit path
+    /// takes it so.
+    #[test]
+    fn the_step_stress_in_lanes_is_the_scalar_one() {
+        let damping = RayleighDamping::new(300.0, 200.0).unwrap();
+        let lane = |l: usize, scale: f64| {
+            let k = l as f64;
+            DMat3::from_cols_array(&[
+                1.0 + scale * k,
+                0.05 * k,
+                -0.02,
+                0.03,
+                0.95 + 0.5 * scale * k,
+                0.04 * k,
+                -0.01,
+                0.02,
+                1.05 - scale,
+            ])
+        };
+        let fs: [DMat3; 4] = std::array::from_fn(|l| lane(l, 0.03));
+        let previous: [DMat3; 4] = std::array::from_fn(|l| green_strain(&lane(l, 0.01)));
+        let h = 1e-3;
+        let lanes = damping.step_second_piola_lanes(
+            &Mat3x4::from_lanes(fs),
+            &Mat3x4::from_lanes(previous),
+            h,
+        );
+        for l in 0..4 {
+            let scalar = damping.step_first_piola(&fs[l], &previous[l], h);
+            let ours = fs[l] * lanes.lane(l);
+            let scale = scalar
+                .to_cols_array()
+                .iter()
+                .fold(0.0f64, |m, x| m.max(x.abs()));
+            assert!(scale > 0.0);
+            assert!(
+                (ours - scalar)
+                    .to_cols_array()
+                    .iter()
+                    .all(|d| d.abs() <= 1e-13 * scale)
+            );
+        }
+    }
 
     /// The step potential's stress is its derivative and the differential is the stress's
     /// derivative (central differences, 1e-6 relative): the implicit integrator's Newton

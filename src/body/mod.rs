@@ -19,7 +19,7 @@ pub use stand_in::RigidStandIn;
 pub use state::SPEED_OF_LIGHT;
 pub(crate) use surface::BodySurface;
 
-use crate::damping::RayleighDamping;
+use crate::damping::{RayleighDamping, StepDamping};
 use crate::element::{ElementOrder, ElementShape, Elements};
 use crate::embedding::Embedding;
 use crate::fvm::VolumetricTreatment;
@@ -297,6 +297,43 @@ impl DeformableBody {
         with_hyperelastic_model!(self.material, |model| self
             .elements
             .elastic_energy(&model, &self.positions))
+    }
+
+    /// The internal forces (N per node) at the current positions in an implicit step of `h`
+    /// (s) whose damping rate is measured from `green` (per integration point; unused when the
+    /// body is undamped), written into `forces` (resized to one per node): the elastic force
+    /// and the step's damping force, each element's deformation gradient found once.
+    pub(crate) fn step_forces_into(
+        &mut self,
+        (green, h): (&[DMat3], f64),
+        forces: &mut Vec<DVec3>,
+    ) {
+        forces.resize(self.node_count(), DVec3::ZERO);
+        let Self {
+            elements,
+            material,
+            damping,
+            positions,
+            ..
+        } = self;
+        let damping = damping
+            .as_ref()
+            .map(|damping| StepDamping { damping, green, h });
+        with_hyperelastic_model!(material, |model| {
+            elements.step_forces(&model, damping, positions, forces);
+        });
+    }
+
+    /// The elastic energy (J) at the current positions plus, when the body is damped, the
+    /// dissipation potential of an implicit step of `h` (s) whose rate is measured from `green`
+    /// (per integration point; see [`RayleighDamping::step_potential`]).
+    pub(crate) fn step_energy(&self, (green, h): (&[DMat3], f64)) -> f64 {
+        let damping = (self.damping.as_ref()).map(|damping| StepDamping { damping, green, h });
+        with_hyperelastic_model!(self.material, |model| self.elements.step_energy(
+            &model,
+            damping,
+            &self.positions
+        ))
     }
 
     /// Kinetic energy `Σ m v²/2` (J).

@@ -14,6 +14,7 @@
 
 mod mean_dilatation;
 mod quadratic;
+mod step;
 
 pub use crate::shape::{hex27, tet10};
 
@@ -236,6 +237,23 @@ impl Elements {
             }
             return;
         }
+        self.point_forces(model, x, out, |_, nodes, gradients, f| {
+            damping.map_or(DMat3::ZERO, |damping| {
+                damping.first_piola(f, &deformation_gradient(nodes, gradients, v))
+            })
+        });
+    }
+
+    /// Writes into `out` the forces (N) of the integration points' stresses at positions `x`
+    /// (m): the model's first Piola–Kirchhoff stress (with the averaged volumetric term's share
+    /// when the elements average it) plus `damping(point, nodes, gradients, F)` (Pa).
+    pub(super) fn point_forces<M: VolumetricTerm>(
+        &self,
+        model: &M,
+        x: &[DVec3],
+        out: &mut [DVec3],
+        damping: impl Fn(usize, &[u32], &[DVec3], &DMat3) -> DMat3 + Sync + Send,
+    ) {
         out.fill(DVec3::ZERO);
         let excesses = self.volumetric_excesses(model, x);
         let bulk = model.volumetric_modulus();
@@ -245,10 +263,7 @@ impl Elements {
             if let Some(excesses) = &excesses {
                 stress += model.volume_measure_gradient(&f) * (bulk * excesses[point]);
             }
-            if let Some(damping) = damping {
-                stress += damping.first_piola(&f, &deformation_gradient(nodes, gradients, v));
-            }
-            stress
+            stress + damping(point, nodes, gradients, &f)
         });
     }
 

@@ -15,7 +15,7 @@
 //! would need windows as large as the whole mesh for every chunk; it is summed serially instead.
 
 use super::TetRest;
-use crate::damping::RayleighDamping;
+use crate::damping::{RayleighDamping, StepDamping};
 use crate::lanes::{LANES, Mat3x4, Vec3x4, f64x4};
 use crate::material::HyperelasticModel;
 use crate::mesh::TetMesh;
@@ -241,20 +241,61 @@ impl FvmMesh {
         out: &mut [DVec3],
     ) {
         assert!(
-            x.len() == self.node_count
-                && v.len() == self.node_count
-                && out.len() == self.node_count,
+            v.len() == self.node_count,
+            "positions, velocities and forces need one entry per node"
+        );
+        let rate = damping.map_or(DampingRate::None, |damping| {
+            DampingRate::Velocities(damping, v)
+        });
+        self.forces_with(ForceLaw { model, rate }, x, out);
+    }
+
+    /// Writes into `out` the internal force (N) on every node at positions `x` (m) in an
+    /// implicit step: the elastic force and, with `damping`, the step's damping force (the
+    /// gradient of [`RayleighDamping::step_potential`], its rate measured from each
+    /// tetrahedron's Green strain), in one pass over the tetrahedra.
+    ///
+    /// # Panics
+    /// If `x` or `out` does not have one entry per node, or `damping` one Green strain per
+    /// tetrahedron.
+    pub(crate) fn step_forces<M: HyperelasticModel>(
+        &mut self,
+        model: &M,
+        damping: Option<StepDamping>,
+        x: &[DVec3],
+        out: &mut [DVec3],
+    ) {
+        let rate = damping.map_or(DampingRate::None, |step| {
+            assert!(
+                step.green.len() == self.tet_count,
+                "one Green strain per tetrahedron"
+            );
+            DampingRate::Step(step)
+        });
+        self.forces_with(ForceLaw { model, rate }, x, out);
+    }
+
+    /// Writes into `out` the forces (N) of `law` at positions `x` (m), chunk by chunk (see the
+    /// module's documentation).
+    fn forces_with<M: HyperelasticModel>(
+        &mut self,
+        law: ForceLaw<'_, M>,
+        x: &[DVec3],
+        out: &mut [DVec3],
+    ) {
+        assert!(
+            x.len() == self.node_count && out.len() == self.node_count,
             "positions, velocities and forces need one entry per node"
         );
         out.fill(DVec3::ZERO);
-        let law = ForceLaw { model, damping };
         if self.windows.is_empty() {
             let run = TetRun {
                 tets: &self.tets,
                 blocks: &self.blocks,
                 valid: self.tet_count,
+                first_tet: 0,
             };
-            add_run_forces(law, run, [x, v], out, 0);
+            add_run_forces(law, run, x, out, 0);
             return;
         }
         let (tets, blocks, tet_count) = (&self.tets, &self.blocks, self.tet_count);
@@ -267,8 +308,9 @@ impl FvmMesh {
                 tets: &tets[start..end],
                 blocks,
                 valid: tet_count - start,
+                first_tet: start,
             };
-            add_run_forces(law, run, [x, v], window, *first);
+            add_run_forces(law, run, x, window, *first);
         };
         #[cfg(feature = "parallel")]
         {
@@ -292,20 +334,59 @@ impl FvmMesh {
     /// Summed in the force loop's chunks of tetrahedra (on rayon's threads with the `parallel`
     /// feature), the chunks' sums in order: the same whatever the number of threads.
     pub fn elastic_energy<M: HyperelasticModel>(&self, model: &M, x: &[DVec3]) -> f64 {
+        self.step_energy(model, None, x)
+    }
+
+    /// The elastic energy (J) at positions `x` (m) and, with `damping`, the step's dissipation
+    /// potential ([`RayleighDamping::step_potential`]) weighted alike: `Σ w (Ψ(F) + D(F))`, each
+    /// tetrahedron's `F` found once; summed as [`FvmMesh::elastic_energy`] is.
+    ///
+    /// # Panics
+    /// If `damping` does not have one Green strain per tetrahedron.
+    pub(crate) fn step_energy<M: HyperelasticModel>(
+        &self,
+        model: &M,
+        damping: Option<StepDamping>,
+        x: &[DVec3],
+    ) -> f64 {
+        if let Some(step) = damping {
+            assert!(
+                step.green.len() == self.tet_count,
+                "one Green strain per tetrahedron"
+            );
+        }
         crate::parallel::sum_ranges(self.tet_count, CHUNK_TETS, |tets| {
             tets.map(|t| {
                 let gradient = self.tet_rest(t).gradient(&gather(&self.tets[t], x));
-                self.tet_weight(t) * model.energy_density(&gradient)
+                let mut density = model.energy_density(&gradient);
+                if let Some(step) = damping {
+                    density += step
+                        .damping
+                        .step_potential(&gradient, &step.green[t], step.h);
+                }
+                self.tet_weight(t) * density
             })
             .sum()
         })
     }
 }
 
-/// The constitutive side of the force loop: the elastic model and the optional damping.
+/// The constitutive side of the force loop: the elastic model and where the damping's rate
+/// comes from.
 struct ForceLaw<'a, M> {
     model: &'a M,
-    damping: Option<&'a RayleighDamping>,
+    rate: DampingRate<'a>,
+}
+
+/// Where the damping stress's strain rate comes from.
+#[derive(Clone, Copy)]
+enum DampingRate<'a> {
+    /// No damping.
+    None,
+    /// The nodes' velocities (m/s): `Ġ = sym(Fᵀ Ḟ)`.
+    Velocities(&'a RayleighDamping, &'a [DVec3]),
+    /// An implicit step's: the Green strain's change over the step.
+    Step(StepDamping<'a>),
 }
 
 impl<M> Clone for ForceLaw<'_, M> {
@@ -322,20 +403,22 @@ struct TetRun<'a> {
     tets: &'a [[u32; 4]],
     blocks: &'a [RestBlock],
     valid: usize,
+    /// The mesh's index of the run's first tetrahedron.
+    first_tet: usize,
 }
 
-/// Adds the forces (N) of `run`'s real tetrahedra at positions `x` (m) and velocities `v` (m/s)
-/// into `out`, whose entry 0 is node `first`.
+/// Adds the forces (N) of `law` on `run`'s real tetrahedra at positions `x` (m) into `out`,
+/// whose entry 0 is node `first`.
 #[inline(always)]
 fn add_run_forces<M: HyperelasticModel>(
     law: ForceLaw<'_, M>,
     run: TetRun<'_>,
-    [x, v]: [&[DVec3]; 2],
+    x: &[DVec3],
     out: &mut [DVec3],
     first: usize,
 ) {
     for (b, (block_tets, rest)) in run.tets.chunks_exact(LANES).zip(run.blocks).enumerate() {
-        let forces = block_forces(law.model, law.damping, rest, block_tets, x, v);
+        let forces = block_forces(law, rest, (block_tets, run.first_tet + b * LANES), x);
         let block_valid = run.valid.saturating_sub(b * LANES).min(LANES);
         for (tet, tet_forces) in block_tets.iter().zip(&forces).take(block_valid) {
             for (&n, f) in tet.iter().zip(tet_forces) {
@@ -345,24 +428,30 @@ fn add_run_forces<M: HyperelasticModel>(
     }
 }
 
-/// [`tet_forces`] for the [`LANES`] tetrahedra of one block.
+/// [`tet_forces`] for the [`LANES`] tetrahedra `tets` of one block, the first of them the
+/// mesh's tetrahedron `index`, with the damping's rate as `law` has it.
 #[inline(always)]
 fn block_forces<M: HyperelasticModel>(
-    model: &M,
-    damping: Option<&RayleighDamping>,
+    law: ForceLaw<'_, M>,
     rest: &RestBlock,
-    tets: &[[u32; 4]],
+    (tets, index): (&[[u32; 4]], usize),
     x: &[DVec3],
-    v: &[DVec3],
 ) -> [[DVec3; 4]; LANES] {
     let f = lane_edges(tets, x) * rest.inverse_rest_edges;
-    let extra = match damping {
-        Some(damping) => {
+    let extra = match law.rate {
+        DampingRate::None => Mat3x4::splat(DMat3::ZERO),
+        DampingRate::Velocities(damping, v) => {
             damping.second_piola_lanes(&f, &(lane_edges(tets, v) * rest.inverse_rest_edges))
         }
-        None => Mat3x4::splat(DMat3::ZERO),
+        DampingRate::Step(step) => {
+            // Padding lanes past the last tetrahedron take a zero strain; their forces are
+            // not added.
+            let green = |l: usize| step.green.get(index + l).copied().unwrap_or(DMat3::ZERO);
+            let green = Mat3x4::from_lanes(std::array::from_fn(green));
+            step.damping.step_second_piola_lanes(&f, &green, step.h)
+        }
     };
-    let stress = model.first_piola_plus_lanes(&f, &extra);
+    let stress = law.model.first_piola_plus_lanes(&f, &extra);
     // Forces on nodes 1..3 are the columns of P b = -V P Dm⁻ᵀ (V the stiffness weight).
     let forces = stress * rest.inverse_rest_edges.transpose() * -rest.weight;
     let [f1, f2, f3] = forces.cols.map(Vec3x4::to_lanes);
@@ -408,4 +497,70 @@ fn chunk_windows(tets: &[[u32; 4]], node_count: usize) -> Vec<(usize, Vec<DVec3>
 #[inline]
 pub(crate) fn gather(tet: &[u32; 4], values: &[DVec3]) -> [DVec3; 4] {
     tet.map(|n| values[n as usize])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::material::{LameParameters, StableNeoHookean, green_strain};
+
+    /// The implicit step's forces and energy in one pass are the separate passes' (the elastic
+    /// forces and energy, and per tetrahedron the scalar damping stress and dissipation
+    /// potential) to round-off, 1e-12 of the largest: on 15 tetrahedra (the last block padded),
+    /// deformed and measured from other Green strains tetrahedron by tetrahedron.
+    #[test]
+    fn a_steps_forces_and_energy_in_one_pass_are_the_separate_passes() {
+        let mesh = crate::mesh::cuboid(DVec3::new(0.15, 0.05, 0.05), [3, 1, 1]).unwrap();
+        let mut fvm = FvmMesh::new(&mesh);
+        assert_eq!(fvm.tet_count % LANES, 3);
+        let model = StableNeoHookean::new(LameParameters {
+            lambda: 4e5,
+            mu: 2e5,
+        });
+        let damping = RayleighDamping::new(300.0, 200.0).unwrap();
+        let moved = |scale: f64| -> Vec<DVec3> {
+            (mesh.positions().iter().enumerate())
+                .map(|(n, p)| {
+                    let k = n as f64;
+                    *p + DVec3::new((0.7 * k).sin(), (1.3 * k).cos(), (0.4 * k).sin()) * scale
+                })
+                .collect()
+        };
+        let (x, earlier) = (moved(4e-3), moved(2e-3));
+        let green: Vec<DMat3> = (0..fvm.tet_count)
+            .map(|t| green_strain(&fvm.tet_rest(t).gradient(&gather(&fvm.tets[t], &earlier))))
+            .collect();
+        let h = 1e-3;
+        let step = StepDamping {
+            damping: &damping,
+            green: &green,
+            h,
+        };
+        let mut fused = vec![DVec3::ZERO; x.len()];
+        fvm.step_forces(&model, Some(step), &x, &mut fused);
+        let mut separate = vec![DVec3::ZERO; x.len()];
+        let still = vec![DVec3::ZERO; x.len()];
+        fvm.internal_forces(&model, None, &x, &still, &mut separate);
+        let mut dissipation = 0.0;
+        for (t, green) in green.iter().enumerate() {
+            let rest = fvm.tet_rest(t);
+            let f = rest.gradient(&gather(&fvm.tets[t], &x));
+            let stress = damping.step_first_piola(&f, green, h);
+            for (&n, force) in fvm.tets[t].iter().zip(stress_forces(&rest, &stress)) {
+                separate[n as usize] += force;
+            }
+            dissipation += fvm.tet_weight(t) * damping.step_potential(&f, green, h);
+        }
+        let largest = separate.iter().map(|f| f.length()).fold(0.0, f64::max);
+        assert!(largest > 0.0);
+        for (a, b) in fused.iter().zip(&separate) {
+            assert!(a.distance(*b) <= 1e-12 * largest, "{a} against {b}");
+        }
+        let energy = fvm.step_energy(&model, Some(step), &x);
+        let expected = fvm.elastic_energy(&model, &x) + dissipation;
+        assert!(
+            (energy - expected).abs() <= 1e-12 * expected,
+            "{energy} against {expected}"
+        );
+    }
 }

@@ -15,8 +15,6 @@ use crate::body::DeformableBody;
 use crate::chord::KeptCorrection;
 use crate::constraint::{self, BodyConstraints};
 use crate::contact;
-use crate::damping::RayleighDamping;
-use crate::element::deformation_gradient;
 use crate::integrate::PreviousStep;
 use crate::load::ChamberSolve;
 use crate::material::green_strain;
@@ -206,9 +204,8 @@ impl<'a> Potential<'a> {
         body: &mut DeformableBody,
         forces: &mut Vec<DVec3>,
     ) -> Vec<DVec3> {
-        body.velocities.fill(DVec3::ZERO);
-        body.internal_forces_into(forces);
         let start = self.start;
+        body.step_forces_into((&start.green, start.h), forces);
         body.add_potential_forces(&start.cone_origins, forces);
         let mut residual: Vec<DVec3> = (0..body.positions.len())
             .map(|n| {
@@ -217,9 +214,6 @@ impl<'a> Potential<'a> {
                 forces[n] + start.load[n] + inertial
             })
             .collect();
-        if let Some(damping) = body.damping {
-            self.add_damping_forces(body, &damping, &mut residual);
-        }
         let mut rigid = self.rigid.borrow_mut();
         rigid.solve(body, self.constraints);
         constraint::add_implicit_forces(body, self.constraints, rigid.step(), &mut residual);
@@ -229,19 +223,6 @@ impl<'a> Potential<'a> {
             }
         }
         residual
-    }
-
-    pub(super) fn add_damping_forces(
-        &self,
-        body: &DeformableBody,
-        damping: &RayleighDamping,
-        out: &mut [DVec3],
-    ) {
-        body.elements
-            .add_stress_forces(out, |point, nodes, gradients| {
-                let f = deformation_gradient(nodes, gradients, &body.positions);
-                damping.step_first_piola(&f, &self.start.green[point], self.start.h)
-            });
     }
 
     /// The force scale the tolerance is relative to (N): the largest of gravity, the inertial
@@ -276,20 +257,12 @@ impl<'a> Potential<'a> {
             .zip(body.positions.iter().zip(&self.start.positions))
             .map(|(f, (x, x0))| f.dot(*x - *x0))
             .sum();
-        let dissipation = match body.damping {
-            Some(damping) => body
-                .elements
-                .sum_over_points(|point, nodes, gradients, weight| {
-                    let f = deformation_gradient(nodes, gradients, &body.positions);
-                    weight * damping.step_potential(&f, &self.start.green[point], self.start.h)
-                }),
-            None => 0.0,
-        };
         let mut rigid = self.rigid.borrow_mut();
         let response = rigid.solve(body, self.constraints);
         let penalty = constraint::implicit_energy(body, self.constraints, rigid.step());
         let follower = body.follower_potential(&self.start.cone_origins, &self.start.positions);
-        inertia + body.elastic_energy() + follower + dissipation + penalty + response - load
+        let elastic = body.step_energy((&self.start.green, self.start.h));
+        inertia + elastic + follower + penalty + response - load
     }
 
     /// `M/h² + K_elastic + K_damping + K_contact`, each element's stress tangent projected to be positive
