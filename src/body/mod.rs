@@ -309,18 +309,10 @@ impl DeformableBody {
         forces: &mut Vec<DVec3>,
     ) {
         forces.resize(self.node_count(), DVec3::ZERO);
-        let Self {
-            elements,
-            material,
-            damping,
-            positions,
-            ..
-        } = self;
-        let damping = damping
-            .as_ref()
-            .map(|damping| StepDamping { damping, green, h });
-        with_hyperelastic_model!(material, |model| {
-            elements.step_forces(&model, damping, positions, forces);
+        let damping = self.damping;
+        let damping = (damping.as_ref()).map(|damping| StepDamping { damping, green, h });
+        with_hyperelastic_model!(self.material, |model| {
+            (self.elements).step_forces(&model, damping, &self.positions, forces);
         });
     }
 
