@@ -261,8 +261,8 @@ impl<'a> Potential<'a> {
         let response = rigid.solve(body, self.constraints);
         let penalty = constraint::implicit_energy(body, self.constraints, rigid.step());
         let follower = body.follower_potential(&self.start.cone_origins, &self.start.positions);
-        let elastic = body.step_energy((&self.start.green, self.start.h));
-        inertia + elastic + follower + penalty + response - load
+        let elastic_and_dissipation = body.step_energy((&self.start.green, self.start.h));
+        inertia + elastic_and_dissipation + follower + penalty + response - load
     }
 
     /// `M/h² + K_elastic + K_damping + K_contact`, each element's stress tangent projected to be positive
